@@ -1,0 +1,14 @@
+"""dtcosim physics core: pure numpy/scipy, SI units inside, no FMI.
+
+Modules
+-------
+units, validation, errors   unit conversions from the paper, validators, exceptions
+contact                     CFS (eq. 2-4) and impact (eq. 1) contact laws
+stages, drivetrain, presets gear stages, shafts, topology, paper presets (Tables 3, 5, 6)
+assembly                    bodies, mesh/shaft matrices, forces and analytic Jacobian
+wind, generator             rotor-speed process (eq. 13-14), generator rotor and load events
+reference                   monolithic LSODA reference solver and energy audit
+cases                       the paper's reference cases (Tables 2, 4, 7; Fig. 10-11)
+"""
+
+__version__ = "0.1.0"

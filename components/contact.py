@@ -1,0 +1,354 @@
+"""Gear contact laws: CFS (eq. 2-4) and the MSC.Adams-style impact law (eq. 1).
+
+A mesh is described by :class:`MeshContact` (SI units). :class:`ContactLaw`
+evaluates the normal contact force of *all* meshes of an assembly at once,
+together with its derivatives with respect to deflection and deflection rate,
+so the drivetrain can assemble an analytic Jacobian.
+
+Sign change of the damping term
+-------------------------------
+The paper warns (Sec. 2.2) that the total CFS force must not change sign within
+one flank contact: while teeth separate quickly, ``c0 |d_BL| d_BL_dot`` can
+exceed the elastic term and the mesh would *pull* the flanks together, which
+teeth cannot do. dtcosim clips the force at zero on the loaded flank
+("flank-consistent clipping"): the force is ``max(0, F)`` while
+``d_BL > 0`` and ``min(0, F)`` while ``d_BL < 0``. The clipped force is
+continuous in the state (it passes through zero), so implicit integrators
+keep converging; its derivatives are those of the active branch (zero on the
+clipped branch). The impact law is treated the same way.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Sequence
+
+import numpy as np
+
+from . import units
+from .validation import finite, in_range, non_negative, one_of, positive, set_fields
+
+CONTACT_LAWS = ("cfs", "impact")
+
+
+@dataclass(frozen=True)
+class MeshContact:
+    """Contact parameters of one gear mesh, SI units.
+
+    Parameters
+    ----------
+    stiffness : float
+        Hertzian contact stiffness k0 [N/m^e] (eq. 1, 2).
+    exponent : float
+        Force exponent e [-], 3/2 for Hertzian contact.
+    damping : float
+        CFS contact damping c0 [N s/m^2]; damping coefficient is ``c0 |d_BL|`` (eq. 9).
+    regularisation : float
+        Backlash regularisation factor lambda [1/m] (eq. 4).
+    backlash_normal_m : float
+        Linear (normal) backlash j_n [m]; the circumferential backlash is
+        ``j_t = j_n / cos(alpha)``.
+    pressure_angle_rad : float
+        Pressure angle alpha [rad]; forces act on the base radius ``r cos(alpha)``.
+    law : {"cfs", "impact"}
+        Contact law: CFS (eq. 2 with the tanh backlash of eq. 3-4) or "impact"
+        (eq. 1: same stiffness term, damping ``STEP(p, 0, 0, d_max, c_max) p_dot`` with
+        the cubic STEP of MSC.Adams and a sharp backlash).
+    impact_depth_m : float
+        Penetration d_max [m] at which the impact damping reaches c_max (Table 3: 0.1 mm).
+    impact_damping : float or None
+        Maximum impact damping c_max [N s/m]. ``None`` means ``c0 * d_max``, so that
+        both laws have the same damping coefficient at full penetration.
+    contact_ratio : float
+        Transverse contact ratio epsilon [-] (Table 1: 1.62 sun-planet); used only by
+        the time-varying mesh stiffness option.
+    stiffness_variation : float
+        Relative amplitude of time-varying mesh stiffness [-]: 0 (default) keeps the
+        paper's constant stiffness. See :mod:`components.mesh_stiffness`.
+    """
+
+    stiffness: float
+    exponent: float = 1.5
+    damping: float = 0.0
+    regularisation: float = 1.0e4
+    backlash_normal_m: float = 0.0
+    pressure_angle_rad: float = math.radians(20.0)
+    law: str = "cfs"
+    impact_depth_m: float = 1.0e-4
+    impact_damping: float | None = None
+    contact_ratio: float = 1.62
+    stiffness_variation: float = 0.0
+
+    def __post_init__(self) -> None:
+        set_fields(
+            self,
+            stiffness=positive("stiffness", self.stiffness),
+            exponent=in_range("exponent", self.exponent, 1.0, 3.0),
+            damping=non_negative("damping", self.damping),
+            regularisation=positive("lambda", self.regularisation),
+            backlash_normal_m=non_negative("backlash", self.backlash_normal_m),
+            pressure_angle_rad=in_range("pressure_angle_rad", self.pressure_angle_rad, 0.0, 0.5 * math.pi - 1e-6),
+            law=one_of("law", self.law, CONTACT_LAWS),
+            impact_depth_m=positive("impact_depth_m", self.impact_depth_m),
+            contact_ratio=in_range("contact_ratio", self.contact_ratio, 1.0, 10.0),
+            stiffness_variation=in_range("stiffness_variation", self.stiffness_variation, 0.0, 0.9),
+        )
+        if self.impact_damping is not None:
+            set_fields(self, impact_damping=non_negative("impact_damping", self.impact_damping))
+
+    @classmethod
+    def from_paper(
+        cls,
+        k0_n_per_mm_e: float,
+        c0_ns_per_mm2: float,
+        lambda_per_mm: float,
+        backlash_mm: float,
+        pressure_angle_deg: float = 20.0,
+        exponent: float = 1.5,
+        **kwargs,
+    ) -> "MeshContact":
+        """Build from the paper's units (Tables 3, 5, 6).
+
+        Parameters
+        ----------
+        k0_n_per_mm_e : float
+            Contact stiffness [N/mm^e].
+        c0_ns_per_mm2 : float
+            Contact damping [N s/mm^2] (the tables print N s/mm; c = c0 |delta|).
+        lambda_per_mm : float
+            Regularisation factor [1/mm].
+        backlash_mm : float
+            Linear backlash j_n [mm].
+        pressure_angle_deg : float
+            Pressure angle [deg].
+        """
+        e = in_range("exponent", exponent, 1.0, 3.0)
+        return cls(
+            stiffness=units.contact_stiffness(positive("k0", k0_n_per_mm_e), e),
+            exponent=e,
+            damping=units.contact_damping(non_negative("c0", c0_ns_per_mm2)),
+            regularisation=units.regularisation(positive("lambda", lambda_per_mm)),
+            backlash_normal_m=units.mm(non_negative("backlash", backlash_mm)),
+            pressure_angle_rad=math.radians(finite("pressure_angle_deg", pressure_angle_deg)),
+            **kwargs,
+        )
+
+    @property
+    def backlash_circumferential_m(self) -> float:
+        """Circumferential backlash j_t = j_n / cos(alpha) [m] (eq. 4)."""
+        return self.backlash_normal_m / math.cos(self.pressure_angle_rad)
+
+    @property
+    def impact_damping_max(self) -> float:
+        """c_max [N s/m] used by the impact law."""
+        if self.impact_damping is None:
+            return self.damping * self.impact_depth_m
+        return self.impact_damping
+
+
+@dataclass(frozen=True)
+class ContactForces:
+    """Forces of all meshes and their partial derivatives, each shape ``(..., n_mesh)``.
+
+    Attributes
+    ----------
+    force : ndarray
+        Normal contact force F [N], positive on the flank loaded in normal power flow.
+    d_force_d_deflection : ndarray
+        dF/dd [N/m].
+    d_force_d_rate : ndarray
+        dF/d(d_dot) [N s/m].
+    elastic : ndarray
+        Elastic part of the force (before clipping) [N]; used by the energy audit.
+    """
+
+    force: np.ndarray
+    d_force_d_deflection: np.ndarray
+    d_force_d_rate: np.ndarray
+    elastic: np.ndarray
+
+
+@dataclass(frozen=True)
+class ContactLaw:
+    """Vectorised contact law over a fixed set of meshes.
+
+    Parameters
+    ----------
+    meshes : sequence of MeshContact
+        One entry per mesh, in assembly order.
+    """
+
+    meshes: Sequence[MeshContact]
+    _k: np.ndarray = field(init=False, repr=False)
+    _e: np.ndarray = field(init=False, repr=False)
+    _c: np.ndarray = field(init=False, repr=False)
+    _lam: np.ndarray = field(init=False, repr=False)
+    _half_jt: np.ndarray = field(init=False, repr=False)
+    _impact: np.ndarray = field(init=False, repr=False)
+    _dmax: np.ndarray = field(init=False, repr=False)
+    _cmax: np.ndarray = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        m = tuple(self.meshes)
+        set_fields(
+            self,
+            meshes=m,
+            _k=np.array([x.stiffness for x in m], dtype=float),
+            _e=np.array([x.exponent for x in m], dtype=float),
+            _c=np.array([x.damping for x in m], dtype=float),
+            _lam=np.array([x.regularisation for x in m], dtype=float),
+            _half_jt=np.array([0.5 * x.backlash_circumferential_m for x in m], dtype=float),
+            _impact=np.array([x.law == "impact" for x in m], dtype=bool),
+            _dmax=np.array([x.impact_depth_m for x in m], dtype=float),
+            _cmax=np.array([x.impact_damping_max for x in m], dtype=float),
+        )
+        set_fields(self, _any_impact=bool(self._impact.any()), _all_impact=bool(self._impact.all()))
+
+    @property
+    def size(self) -> int:
+        """Number of meshes."""
+        return len(self.meshes)
+
+    def backlash_deflection(self, deflection: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Regularised indentation d_BL of eq. 3-4 and its first two derivatives.
+
+        Parameters
+        ----------
+        deflection : ndarray, shape (..., n_mesh)
+            Linearised tooth distance delta [m] at the pitch radius.
+
+        Returns
+        -------
+        d_bl, d_bl_prime, d_bl_second : ndarray
+            d_BL [m], d d_BL / d delta [-], d^2 d_BL / d delta^2 [1/m].
+        """
+        h = self._half_jt
+        lam = self._lam
+        x1 = deflection - h
+        x2 = deflection + h
+        u1 = lam * x1
+        u2 = lam * x2
+        t1 = np.tanh(u1)
+        t2 = np.tanh(u2)
+        d_bl = deflection + 0.5 * (x1 * t1 - x2 * t2)  # eq. 3, 4
+        s1 = 1.0 - t1 * t1
+        s2 = 1.0 - t2 * t2
+        d_bl_prime = 1.0 + 0.5 * (t1 + u1 * s1 - t2 - u2 * s2)
+        d_bl_second = lam * (s1 * (1.0 - u1 * t1) - s2 * (1.0 - u2 * t2))
+        return d_bl, d_bl_prime, d_bl_second
+
+    def hard_backlash(self, deflection: np.ndarray) -> np.ndarray:
+        """Penetration with a sharp backlash: 0 inside ``|delta| < j_t/2`` [m]."""
+        h = self._half_jt
+        return np.where(deflection > h, deflection - h, np.where(deflection < -h, deflection + h, 0.0))
+
+    def evaluate(
+        self,
+        deflection: np.ndarray,
+        rate: np.ndarray,
+        stiffness_factor: np.ndarray | float = 1.0,
+    ) -> ContactForces:
+        """Contact forces of all meshes.
+
+        Parameters
+        ----------
+        deflection : ndarray, shape (..., n_mesh)
+            Deflection delta [m] (eq. 8, 10), positive when the flank loaded in
+            normal power flow is compressed.
+        rate : ndarray, shape (..., n_mesh)
+            Deflection rate [m/s].
+        stiffness_factor : ndarray or float
+            Multiplier on k0 (time-varying mesh stiffness); 1 for the paper's model.
+
+        Returns
+        -------
+        ContactForces
+        """
+        k = self._k * stiffness_factor
+        e = self._e
+        if self._all_impact:
+            return self._impact_law(deflection, rate, k)
+        d_bl, d_bl_p, d_bl_pp = self.backlash_deflection(deflection)
+        abs_bl = np.abs(d_bl)
+        sgn = np.sign(d_bl)
+        pow_em1 = abs_bl ** (e - 1.0)
+        elastic = k * sgn * pow_em1 * abs_bl  # k0 sgn(d_BL) |d_BL|^e (eq. 2)
+        d_elastic = k * e * pow_em1
+        rate_bl = d_bl_p * rate
+        c = self._c
+        damping = c * abs_bl * rate_bl  # c0 |d_BL| d_BL_dot (eq. 2, 9)
+        force = elastic + damping
+        dF_dd = (d_elastic + c * sgn * rate_bl) * d_bl_p + c * abs_bl * d_bl_pp * rate
+        dF_dv = c * abs_bl * d_bl_p
+        # flank-consistent clipping: a flank pushes, never pulls (see module docstring)
+        active = force * sgn > 0.0
+        force = np.where(active, force, 0.0)
+        dF_dd = np.where(active, dF_dd, 0.0)
+        dF_dv = np.where(active, dF_dv, 0.0)
+        if self._any_impact:
+            imp = self._impact_law(deflection, rate, k)
+            sel = self._impact
+            force = np.where(sel, imp.force, force)
+            dF_dd = np.where(sel, imp.d_force_d_deflection, dF_dd)
+            dF_dv = np.where(sel, imp.d_force_d_rate, dF_dv)
+            elastic = np.where(sel, imp.elastic, elastic)
+        return ContactForces(force, dF_dd, dF_dv, elastic)
+
+    def _impact_law(self, deflection: np.ndarray, rate: np.ndarray, k: np.ndarray) -> ContactForces:
+        """Eq. 1 with a sharp backlash and the cubic STEP damping of MSC.Adams."""
+        p = self.hard_backlash(deflection)
+        abs_p = np.abs(p)
+        sgn = np.sign(p)
+        e = self._e
+        pow_em1 = abs_p ** (e - 1.0)
+        elastic = k * sgn * pow_em1 * abs_p
+        s = np.clip(abs_p / self._dmax, 0.0, 1.0)
+        step = self._cmax * s * s * (3.0 - 2.0 * s)  # STEP(p, 0, 0, d_max, c_max)
+        d_step = self._cmax * 6.0 * s * (1.0 - s) / self._dmax
+        force = elastic + step * rate
+        dF_dd = k * e * pow_em1 + d_step * sgn * rate
+        dF_dv = step
+        active = force * sgn > 0.0
+        return ContactForces(
+            np.where(active, force, 0.0),
+            np.where(active, dF_dd, 0.0),
+            np.where(active, dF_dv, 0.0),
+            elastic,
+        )
+
+    def potential_energy(self, deflection: np.ndarray) -> np.ndarray:
+        """Elastic energy stored in each mesh, ``V = int_0^delta F_el d delta`` [J / (N m / N)].
+
+        Returned per unit of the mesh's moment-arm factor: multiply by
+        ``cos(alpha)`` to get joules, as the generalised forces carry that factor.
+
+        Parameters
+        ----------
+        deflection : ndarray, shape (n_mesh,)
+            Deflection [m].
+
+        Returns
+        -------
+        ndarray, shape (n_mesh,)
+            Integral of the elastic force over the deflection [N m].
+        """
+        from scipy.integrate import quad
+
+        deflection = np.asarray(deflection, dtype=float)
+        out = np.empty(self.size)
+        for i in range(self.size):
+            sub = ContactLaw([self.meshes[i]])
+
+            def elastic(x: float) -> float:
+                return float(sub.evaluate(np.array([x]), np.array([0.0])).elastic[0])
+
+            d = float(deflection[i])
+            h = float(self._half_jt[i])
+            # split at the backlash edges, where the integrand has its kinks
+            pts = sorted({0.0, d, *[p for p in (-h, h) if min(0.0, d) < p < max(0.0, d)]})
+            total = 0.0
+            for a, b in zip(pts[:-1], pts[1:]):
+                total += quad(elastic, a, b, epsabs=0.0, epsrel=1e-12, limit=200)[0]
+            out[i] = total if d >= 0.0 else -total
+        return out

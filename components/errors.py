@@ -1,0 +1,56 @@
+"""Exception classes raised by the physics core.
+
+Every error that a user can cause by a bad input is a :class:`ParameterError`
+that names the parameter, the offending value and what was expected, and it is
+raised on construction of the parameter set, before anything is integrated.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+
+class DtcosimError(Exception):
+    """Base class of every error raised by dtcosim."""
+
+
+class ParameterError(DtcosimError, ValueError):
+    """A parameter has a value outside its admissible range.
+
+    Parameters
+    ----------
+    name : str
+        Dotted name of the parameter, e.g. ``"stage1.planet_inertia_kgm2"``.
+    value : Any
+        The rejected value.
+    expected : str
+        Human-readable description of what is admissible, e.g. ``"> 0"``.
+    """
+
+    def __init__(self, name: str, value: Any, expected: str) -> None:
+        self.name = name
+        self.value = value
+        self.expected = expected
+        super().__init__(f"invalid parameter {name} = {value!r}: expected {expected}")
+
+    def __reduce__(self):  # keep the exception picklable (Dask ships it between processes)
+        return (type(self), (self.name, self.value, self.expected))
+
+
+class SolverError(DtcosimError, RuntimeError):
+    """The time integration failed.
+
+    Parameters
+    ----------
+    message : str
+        What went wrong.
+    time_s : float
+        Simulation time [s] at which the integrator stopped.
+    """
+
+    def __init__(self, message: str, time_s: float) -> None:
+        self.time_s = float(time_s)
+        super().__init__(f"{message} (at t = {self.time_s:.6g} s)")
+
+    def __reduce__(self):
+        return (type(self), (str(self).rsplit(" (at t =", 1)[0], self.time_s))

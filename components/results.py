@@ -1,0 +1,155 @@
+"""Time-series results of a drivetrain simulation and their statistics.
+
+Variable names follow the Gearbox FMU interface so that monolithic and
+co-simulated results can be compared name by name:
+
+* ``stage{k}.F_sp[{i}]``, ``stage{k}.F_rp[{i}]``, ``stage{k}.F_mesh`` - contact forces [N]
+* ``stage{k}.d_sp[{i}]`` ... - mesh deflections [m] (``F`` replaced by ``d``)
+* ``shaft{k}.torque`` - shaft torques [N m]
+* ``<body>.omega`` - absolute body speeds [rad/s], e.g. ``stage1.sun.omega``
+* ``omega_rotor`` [rad/s], ``torque_rotor`` [N m], ``omega_out`` [rad/s],
+  ``alpha_out`` [rad/s^2] (output-gear acceleration), ``omega_gen`` [rad/s],
+  ``load_torque`` [N m]
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+UNITS = {
+    "F": "N",
+    "d": "m",
+    "torque": "N.m",
+    "omega": "rad/s",
+    "alpha": "rad/s2",
+}
+
+
+def unit_of(name: str) -> str:
+    """SI unit string of a result variable (FMI/SSP unit names: ``N``, ``N.m``, ``rad/s``)."""
+    last = name.rsplit(".", 1)[-1]
+    if last.startswith("F_"):
+        return "N"
+    if last.startswith("d_"):
+        return "m"
+    if "torque" in last:
+        return "N.m"
+    if last.startswith("omega"):
+        return "rad/s"
+    if last.startswith("alpha"):
+        return "rad/s2"
+    if last.startswith("phi"):
+        return "rad"
+    if last.startswith("time"):
+        return "s"
+    return "1"
+
+
+def window_statistics(time_s: np.ndarray, values: np.ndarray, window: tuple[float, float] | None) -> dict[str, float]:
+    """Mean, std, min and max of samples with ``window[0] <= t <= window[1]``.
+
+    Parameters
+    ----------
+    time_s : ndarray, shape (N,)
+    values : ndarray, shape (N,)
+    window : (float, float) or None
+        Analysis window [s]; None means all samples.
+    """
+    if window is None:
+        sel = slice(None)
+    else:
+        sel = (time_s >= window[0] - 1e-12) & (time_s <= window[1] + 1e-12)
+    x = np.asarray(values)[sel]
+    if x.size == 0:
+        return {"mean": float("nan"), "std": float("nan"), "min": float("nan"), "max": float("nan")}
+    return {"mean": float(x.mean()), "std": float(x.std()), "min": float(x.min()), "max": float(x.max())}
+
+
+@dataclass
+class EnergyAudit:
+    """Energy balance of a run [J]: ``input = output + dissipated + delta_stored``.
+
+    Attributes
+    ----------
+    input_work_j : float
+        Work done by the rotor (kinematic driver) on the gearbox.
+    output_work_j : float
+        Work extracted by the counter torque at the output.
+    dissipated_j : float
+        Energy dissipated by mesh and shaft damping.
+    stored_change_j : float
+        Change of kinetic + elastic energy.
+    """
+
+    input_work_j: float
+    output_work_j: float
+    dissipated_j: float
+    stored_change_j: float
+
+    @property
+    def residual_j(self) -> float:
+        """``input - output - dissipated - delta_stored`` [J]."""
+        return self.input_work_j - self.output_work_j - self.dissipated_j - self.stored_change_j
+
+    @property
+    def relative_residual(self) -> float:
+        """Residual relative to the input work [-]."""
+        return abs(self.residual_j) / max(abs(self.input_work_j), 1e-300)
+
+    def as_dict(self) -> dict[str, float]:
+        """Plain dict (JSON-ready)."""
+        return {
+            "input_work_j": self.input_work_j,
+            "output_work_j": self.output_work_j,
+            "dissipated_j": self.dissipated_j,
+            "stored_change_j": self.stored_change_j,
+            "residual_j": self.residual_j,
+            "relative_residual": self.relative_residual,
+        }
+
+
+@dataclass
+class SimulationResult:
+    """Sampled results of a run.
+
+    Attributes
+    ----------
+    time_s : ndarray, shape (N,)
+        Sample times [s].
+    series : dict of str -> ndarray, shape (N,)
+        Every recorded variable by name (see module docstring for names and units).
+    complete : bool
+        False if the run stopped early; the samples hold what was computed.
+    message : str
+        Solver message (the failure reason when ``complete`` is False).
+    wall_time_s : float
+        Wall-clock time of the integration [s].
+    energy : EnergyAudit or None
+        Energy balance over the run.
+    """
+
+    time_s: np.ndarray
+    series: dict[str, np.ndarray]
+    complete: bool = True
+    message: str = ""
+    wall_time_s: float = 0.0
+    energy: EnergyAudit | None = None
+    info: dict = field(default_factory=dict)
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        try:
+            return self.series[name]
+        except KeyError:
+            raise KeyError(f"no variable {name!r}; have {sorted(self.series)}") from None
+
+    @property
+    def names(self) -> list[str]:
+        """Recorded variable names."""
+        return list(self.series)
+
+    def statistics(self, window: tuple[float, float] | None = None, names=None) -> dict[str, dict[str, float]]:
+        """Statistics of each variable over ``window`` [s]."""
+        names = self.names if names is None else names
+        return {n: window_statistics(self.time_s, self.series[n], window) for n in names}

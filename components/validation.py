@@ -1,0 +1,82 @@
+"""Small validators used by the frozen parameter dataclasses.
+
+Each validator raises :class:`~components.errors.ParameterError` naming the
+parameter, its value and what was expected. NaN and infinity are rejected by
+every numeric check.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from .errors import ParameterError
+
+
+def _as_real(name: str, value: Any) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) and not hasattr(value, "__float__"):
+        raise ParameterError(name, value, "a real number")
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise ParameterError(name, value, "a real number") from None
+    if not math.isfinite(x):
+        raise ParameterError(name, value, "a finite real number")
+    return x
+
+
+def finite(name: str, value: Any) -> float:
+    """Return ``value`` as float; reject non-numbers, NaN and infinity."""
+    return _as_real(name, value)
+
+
+def positive(name: str, value: Any) -> float:
+    """Return ``value`` as float; require ``value > 0``."""
+    x = _as_real(name, value)
+    if not x > 0.0:
+        raise ParameterError(name, value, "> 0")
+    return x
+
+
+def non_negative(name: str, value: Any) -> float:
+    """Return ``value`` as float; require ``value >= 0``."""
+    x = _as_real(name, value)
+    if not x >= 0.0:
+        raise ParameterError(name, value, ">= 0")
+    return x
+
+
+def in_range(name: str, value: Any, low: float, high: float) -> float:
+    """Return ``value`` as float; require ``low <= value <= high``."""
+    x = _as_real(name, value)
+    if not low <= x <= high:
+        raise ParameterError(name, value, f"within [{low:g}, {high:g}]")
+    return x
+
+
+def integer_at_least(name: str, value: Any, minimum: int) -> int:
+    """Return ``value`` as int; require an integer ``>= minimum``."""
+    if isinstance(value, bool):
+        raise ParameterError(name, value, f"an integer >= {minimum}")
+    if isinstance(value, float):
+        if not math.isfinite(value) or value != int(value):
+            raise ParameterError(name, value, f"an integer >= {minimum}")
+    elif not isinstance(value, int) and not hasattr(value, "__index__"):
+        raise ParameterError(name, value, f"an integer >= {minimum}")
+    n = int(value)
+    if n < minimum:
+        raise ParameterError(name, value, f"an integer >= {minimum}")
+    return n
+
+
+def one_of(name: str, value: Any, choices: tuple[str, ...]) -> str:
+    """Require ``value`` to be one of ``choices``."""
+    if value not in choices:
+        raise ParameterError(name, value, "one of " + ", ".join(repr(c) for c in choices))
+    return value
+
+
+def set_fields(obj: Any, **values: Any) -> None:
+    """Assign normalised values to a frozen dataclass inside ``__post_init__``."""
+    for key, val in values.items():
+        object.__setattr__(obj, key, val)

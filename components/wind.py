@@ -1,0 +1,236 @@
+"""Stochastic rotor-speed process ("wind"), eq. 13-14.
+
+    omega(t) = omega0 + sum_k W_k cos(f_k t + phi_k),   S(f) = a exp(-a f / sigma^2)
+
+``f`` is an angular frequency [rad/s] (the paper writes ``cos(f_k t)``), the
+phases ``phi_k`` are drawn uniformly on [0, 2 pi) from a seeded generator, and
+the frequencies are the midpoints of ``n_harmonics`` equal bins of
+``[f_min, f_max]``. Once the phases are drawn the signal is a closed-form
+function of t, so speed, angle and acceleration are exact at any time.
+
+Amplitude conventions
+---------------------
+``"variance"`` (default): ``W_k = sqrt(2 S(f_k) df)``, the standard spectral
+representation; the fluctuation has variance ``sum S df ~= sigma^2``.
+
+``"paper"``: ``W_k = S(f_k) df`` evaluated literally in the paper's rpm-based
+units and converted to rad/s afterwards. The formula is not dimensionally
+consistent; with the paper's parameters it makes the speed fluctuation about
+0.001 rpm and the contact-force std about 400 times smaller than Table 7.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import units
+from .errors import ParameterError
+from .validation import finite, integer_at_least, non_negative, one_of, positive, set_fields
+
+AMPLITUDE_CONVENTIONS = ("variance", "paper")
+
+
+@dataclass(frozen=True)
+class WindParameters:
+    """Parameters of the rotor-speed process, SI units.
+
+    Parameters
+    ----------
+    mean_speed_rad_s : float
+        omega0 [rad/s] (paper: 16 rpm).
+    spectrum_level : float
+        a [(rad/s)^2 / (rad/s)]: spectral density at f = 0 (paper: 0.02 in rpm units).
+    sigma_rad_s : float
+        Fluctuation intensity sigma [rad/s] (paper: 0.12 rpm).
+    n_harmonics : int
+        Number of harmonics N (>= 1).
+    f_min_rad_s, f_max_rad_s : float
+        Frequency range [rad/s] of the harmonics.
+    seed : int
+        Seed of the phase generator (numpy ``default_rng``).
+    amplitude : {"variance", "paper"}
+        Amplitude convention, see module docstring.
+    """
+
+    mean_speed_rad_s: float = units.rpm(16.0)
+    spectrum_level: float = 0.02 * units.RPM_TO_RAD_PER_S**2
+    sigma_rad_s: float = units.rpm(0.12)
+    n_harmonics: int = 256
+    f_min_rad_s: float = 0.0
+    f_max_rad_s: float = 2.0 * np.pi
+    seed: int = 1
+    amplitude: str = "variance"
+
+    def __post_init__(self) -> None:
+        set_fields(
+            self,
+            mean_speed_rad_s=finite("wind.omega0", self.mean_speed_rad_s),
+            spectrum_level=non_negative("wind.a", self.spectrum_level),
+            sigma_rad_s=positive("wind.sigma", self.sigma_rad_s),
+            n_harmonics=integer_at_least("wind.n_harmonics", self.n_harmonics, 1),
+            f_min_rad_s=non_negative("wind.f_min", self.f_min_rad_s),
+            f_max_rad_s=positive("wind.f_max", self.f_max_rad_s),
+            seed=integer_at_least("wind.seed", self.seed, 0),
+            amplitude=one_of("wind.amplitude", self.amplitude, AMPLITUDE_CONVENTIONS),
+        )
+        if not self.f_max_rad_s > self.f_min_rad_s:
+            raise ParameterError("wind.f_max", self.f_max_rad_s, f"> f_min = {self.f_min_rad_s:g} rad/s")
+
+    @classmethod
+    def from_paper(
+        cls,
+        omega0_rpm: float = 16.0,
+        a: float = 0.02,
+        sigma_rpm: float = 0.12,
+        **kwargs,
+    ) -> "WindParameters":
+        """Build from the paper's rpm-based values (Sec. 4.2: 16 rpm, 0.02, 0.12)."""
+        c = units.RPM_TO_RAD_PER_S
+        return cls(
+            mean_speed_rad_s=units.rpm(finite("wind.omega0", omega0_rpm)),
+            spectrum_level=non_negative("wind.a", a) * c * c,
+            sigma_rad_s=units.rpm(positive("wind.sigma", sigma_rpm)),
+            **kwargs,
+        )
+
+    @property
+    def decay_s_per_rad(self) -> float:
+        """Spectral slope a / sigma^2 [s/rad] (eq. 14); unit-invariant."""
+        return self.spectrum_level / self.sigma_rad_s**2
+
+
+class RotorSpeedProcess:
+    """Closed-form realisation of the rotor-speed process.
+
+    Parameters
+    ----------
+    params : WindParameters
+        Process parameters; the phases are drawn once, here.
+
+    Attributes
+    ----------
+    frequencies_rad_s : ndarray, shape (N,)
+    amplitudes_rad_s : ndarray, shape (N,)
+    phases_rad : ndarray, shape (N,)
+    """
+
+    def __init__(self, params: WindParameters) -> None:
+        if not isinstance(params, WindParameters):
+            raise ParameterError("wind", params, "a WindParameters")
+        self.params = params
+        n = params.n_harmonics
+        df = (params.f_max_rad_s - params.f_min_rad_s) / n
+        f = params.f_min_rad_s + (np.arange(n) + 0.5) * df
+        spectrum = params.spectrum_level * np.exp(-params.decay_s_per_rad * f)  # eq. 14
+        if params.amplitude == "variance":
+            w = np.sqrt(2.0 * spectrum * df)
+        else:  # paper-literal W_k = S(f_k) df in rpm units (eq. 13), then to rad/s
+            c = units.RPM_TO_RAD_PER_S
+            w = (spectrum / c**2) * df * c
+        rng = np.random.default_rng(params.seed)
+        self.frequencies_rad_s = f
+        self.amplitudes_rad_s = w
+        self.phases_rad = rng.uniform(0.0, 2.0 * np.pi, n)
+        self._w_over_f = w / f
+        self._w_times_f = w * f
+        self._angle_offset = float(np.sum(self._w_over_f * np.sin(self.phases_rad)))
+
+    @property
+    def mean_speed_rad_s(self) -> float:
+        """omega0 [rad/s]."""
+        return self.params.mean_speed_rad_s
+
+    def _phase(self, t: np.ndarray) -> np.ndarray:
+        return np.multiply.outer(t, self.frequencies_rad_s) + self.phases_rad
+
+    def speed(self, t: float | np.ndarray) -> float | np.ndarray:
+        """Rotor speed omega(t) [rad/s] (eq. 13); ``t`` scalar or array [s]."""
+        return self._evaluate(t, lambda ph: np.cos(ph) @ self.amplitudes_rad_s, self.params.mean_speed_rad_s)
+
+    def angle(self, t: float | np.ndarray) -> float | np.ndarray:
+        """Rotor angle phi(t) = integral of omega from 0 [rad]."""
+        base = self.params.mean_speed_rad_s * np.asarray(t, dtype=float)
+        return self._evaluate(t, lambda ph: np.sin(ph) @ self._w_over_f - self._angle_offset, base)
+
+    def acceleration(self, t: float | np.ndarray) -> float | np.ndarray:
+        """Rotor acceleration d omega / dt [rad/s^2]."""
+        return self._evaluate(t, lambda ph: -(np.sin(ph) @ self._w_times_f), 0.0)
+
+    def _evaluate(self, t, series, base):
+        ta = np.asarray(t, dtype=float)
+        if ta.ndim == 0:
+            return float(base + series(self._phase(ta)))
+        out = np.empty(ta.shape)
+        flat = ta.reshape(-1)
+        chunk = max(1, 2_000_000 // self.params.n_harmonics)
+        res = out.reshape(-1)
+        for i in range(0, flat.size, chunk):
+            res[i : i + chunk] = series(self._phase(flat[i : i + chunk]))
+        return base + out
+
+
+@dataclass(frozen=True)
+class ConstantSpeed:
+    """Constant kinematic speed driver.
+
+    Parameters
+    ----------
+    speed_rad_s : float
+        Speed [rad/s].
+    """
+
+    speed_rad_s: float
+
+    def __post_init__(self) -> None:
+        set_fields(self, speed_rad_s=finite("driver.speed_rad_s", self.speed_rad_s))
+
+    def speed(self, t):
+        """Speed [rad/s]."""
+        return self.speed_rad_s + 0.0 * np.asarray(t, dtype=float) if np.ndim(t) else self.speed_rad_s
+
+    def angle(self, t):
+        """Angle [rad], zero at t = 0."""
+        return self.speed_rad_s * (np.asarray(t, dtype=float) if np.ndim(t) else float(t))
+
+    def acceleration(self, t):
+        """Acceleration [rad/s^2] (zero)."""
+        return 0.0 * np.asarray(t, dtype=float) if np.ndim(t) else 0.0
+
+
+@dataclass(frozen=True)
+class SineSpeed:
+    """Sinusoidal kinematic speed driver ``omega = amplitude sin(frequency t)`` (Fig. 10-11).
+
+    Parameters
+    ----------
+    amplitude_rad_s : float
+        Speed amplitude [rad/s].
+    frequency_rad_s : float
+        Angular frequency [rad/s].
+    """
+
+    amplitude_rad_s: float
+    frequency_rad_s: float
+
+    def __post_init__(self) -> None:
+        set_fields(
+            self,
+            amplitude_rad_s=finite("driver.amplitude_rad_s", self.amplitude_rad_s),
+            frequency_rad_s=positive("driver.frequency_rad_s", self.frequency_rad_s),
+        )
+
+    def speed(self, t):
+        """Speed [rad/s]."""
+        return self.amplitude_rad_s * np.sin(self.frequency_rad_s * np.asarray(t, dtype=float))
+
+    def angle(self, t):
+        """Angle [rad], zero at t = 0."""
+        w = self.frequency_rad_s
+        return self.amplitude_rad_s / w * (1.0 - np.cos(w * np.asarray(t, dtype=float)))
+
+    def acceleration(self, t):
+        """Acceleration [rad/s^2]."""
+        w = self.frequency_rad_s
+        return self.amplitude_rad_s * w * np.cos(w * np.asarray(t, dtype=float))
