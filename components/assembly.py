@@ -282,6 +282,12 @@ class Assembly:
         self.output_dof = int(out_free[0]) if out_free.size else None  # None when the output is the port
         self.output_body = bodies[output_index].name
         self.time_varying_stiffness = any(m.contact.stiffness_variation > 0.0 for m in self.meshes)
+        # matrices for the single-state fast path (mesh forces + shafts folded into constant matrices)
+        self._A_T = np.ascontiguousarray(self.A.T)  # (n_dof, n_mesh)
+        self._neg_B = np.ascontiguousarray(-(self.cos_alpha[:, None] * self.A))  # (n_mesh, n_dof)
+        self._shaft_QY = np.ascontiguousarray(-np.vstack([self.STkS.T, self.STcS.T]))  # y = [q, v] -> shaft torques on dofs
+        self._port_Q = -np.stack([self.STkS_port, self.STcS_port])  # (2, n_dof, n_port)
+        self._port_meshes = bool(np.any(self.A_port))
         self._mesh_rate = np.array([m.teeth_per_driver_rad for m in self.meshes])
         self._mesh_offset = np.array([m.phase_offset_rad for m in self.meshes])
         self._mesh_variation = np.array([m.contact.stiffness_variation for m in self.meshes])
@@ -355,6 +361,41 @@ class Assembly:
         cf = self.law.evaluate(d, dd, stiffness_factor)
         torque = self.shaft_k * s + self.shaft_c * sd
         return InternalLoads(d, dd, cf.force, cf.d_force_d_deflection, cf.d_force_d_rate, cf.elastic, s, sd, torque)
+
+    def fast_generalised_forces(
+        self,
+        y: np.ndarray,
+        port: np.ndarray | None = None,
+        stiffness_factor: np.ndarray | float = 1.0,
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Generalised forces of one state, without derivatives (co-simulation hot path).
+
+        Parameters
+        ----------
+        y : ndarray, shape (2 n_dof,)
+            State ``[q, v]``: deviation angles [rad] and speeds [rad/s].
+        port : ndarray, shape (2, n_port), optional
+            Port deviation angle(s) [rad] (row 0) and speed(s) [rad/s] (row 1).
+        stiffness_factor : ndarray or float
+            Mesh stiffness multiplier.
+
+        Returns
+        -------
+        Q : ndarray, shape (n_dof,)
+            Generalised torques [N m] (meshes and shafts).
+        force : ndarray, shape (n_mesh,)
+            Contact forces [N].
+        deflection : ndarray, shape (2, n_mesh)
+            Deflections [m] (row 0) and their rates [m/s] (row 1).
+        """
+        D = y.reshape(2, self.n_dof) @ self._A_T
+        if port is not None and self._port_meshes:
+            D += port @ self.A_port.T
+        force = self.law.force(D[0], D[1], stiffness_factor)
+        Q = force @ self._neg_B + y @ self._shaft_QY
+        if port is not None:
+            Q += self._port_Q[0] @ port[0] + self._port_Q[1] @ port[1]
+        return Q, force, D
 
     def generalised_forces(self, loads: InternalLoads) -> np.ndarray:
         """Generalised torques on the free bodies from meshes and shafts [N m], shape (..., n_dof)."""

@@ -204,6 +204,13 @@ class ContactLaw:
             _cmax=np.array([x.impact_damping_max for x in m], dtype=float),
         )
         set_fields(self, _any_impact=bool(self._impact.any()), _all_impact=bool(self._impact.all()))
+        # stacked (2, n_mesh) constants for the derivative-free fast path
+        set_fields(
+            self,
+            _pm_half_jt=np.vstack([-self._half_jt, self._half_jt]),
+            _lam2=np.vstack([self._lam, self._lam]),
+            _sqrt_law=bool(np.all(self._e == 1.5)),
+        )
 
     @property
     def size(self) -> int:
@@ -294,6 +301,27 @@ class ContactLaw:
             dF_dv = np.where(sel, imp.d_force_d_rate, dF_dv)
             elastic = np.where(sel, imp.elastic, elastic)
         return ContactForces(force, dF_dd, dF_dv, elastic)
+
+    def force(self, deflection: np.ndarray, rate: np.ndarray, stiffness_factor: np.ndarray | float = 1.0) -> np.ndarray:
+        """Contact forces only (no derivatives) for one state, shape (n_mesh,) [N].
+
+        Same values as ``evaluate(...).force``; written with few numpy calls
+        because it sits on the co-simulation hot path.
+        """
+        if self._any_impact:
+            return self.evaluate(deflection, rate, stiffness_factor).force
+        X = deflection + self._pm_half_jt  # rows: delta - j_t/2, delta + j_t/2
+        U = X * self._lam2
+        T = np.tanh(U)
+        XT = X * T
+        UST = U * (1.0 - T * T) + T
+        d_bl = deflection + 0.5 * (XT[0] - XT[1])  # eq. 3, 4
+        abs_bl = np.abs(d_bl)
+        sgn = np.sign(d_bl)
+        root = np.sqrt(abs_bl) if self._sqrt_law else abs_bl ** (self._e - 1.0)
+        rate_bl = (1.0 + 0.5 * (UST[0] - UST[1])) * rate
+        signed = abs_bl * (self._k * stiffness_factor * root + self._c * sgn * rate_bl)  # sgn * eq. 2
+        return sgn * np.maximum(signed, 0.0)  # flank-consistent clipping
 
     def _impact_law(self, deflection: np.ndarray, rate: np.ndarray, k: np.ndarray) -> ContactForces:
         """Eq. 1 with a sharp backlash and the cubic STEP damping of MSC.Adams."""

@@ -1,0 +1,373 @@
+"""The gearbox side of the co-simulation cut, as a stepping component.
+
+Inputs at each communication point ``t_n``: rotor speed and angle (the
+kinematic driver of the stage-1 carrier) and generator speed and angle (the
+far end of shaft 3, which stays in the gearbox). Over a step the inputs are
+interpreted consistently: speeds are held and angles advance with them,
+``phi(t) = phi_n + omega_n (t - t_n)``. The internal state is integrated with
+:class:`~components.integrators.Rosenbrock23` (linearly implicit, analytic
+Jacobian, one-step: no cold start at communication points).
+
+The state is kept in deviation coordinates relative to the rotor angle; when a
+new rotor input arrives the deviation is re-referenced so the bodies' absolute
+angles and speeds stay continuous (only the kinematically driven carrier
+follows the input jump).
+
+Outputs after each step: the shaft-3 torque on the generator (end-of-step
+value and step average), every contact force, shaft torque and body speed,
+the output speed and the rotor torque.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .assembly import Assembly
+from .drivetrain import Drivetrain
+from .errors import ParameterError, SolverError
+from .integrators import Rosenbrock23, StepControl
+from .validation import finite, one_of
+
+SHAFT_TORQUE_MODES = ("average", "end")
+
+
+class _Hermite:
+    """Cubic ``x(tau)`` on [0, h] with given value and slope at both ends."""
+
+    __slots__ = ("c0", "c1", "c2", "c3")
+
+    def __init__(self) -> None:
+        self.c0 = self.c1 = self.c2 = self.c3 = 0.0
+
+    def fit(self, h: float, x0: float, dx0: float, x1: float, dx1: float) -> None:
+        delta = (x1 - x0) / h
+        self.c0 = x0
+        self.c1 = dx0
+        self.c2 = (3.0 * delta - 2.0 * dx0 - dx1) / h
+        self.c3 = (dx0 + dx1 - 2.0 * delta) / (h * h)
+
+    def value(self, tau: float) -> float:
+        return self.c0 + tau * (self.c1 + tau * (self.c2 + tau * self.c3))
+
+    def rate(self, tau: float) -> float:
+        return self.c1 + tau * (2.0 * self.c2 + 3.0 * tau * self.c3)
+
+    def accel(self, tau: float) -> float:
+        return 2.0 * self.c2 + 6.0 * tau * self.c3
+
+    def jerk(self) -> float:
+        return 6.0 * self.c3
+
+
+class _StepSystem:
+    """The gearbox ODE over one communication step (local time tau = t - t_n).
+
+    The driver angle relative to its value at tau = 0 and the generator-port
+    deviation angle are cubic Hermite curves over the step. The most recent
+    force evaluation is cached: after an accepted step it holds the loads at
+    the end state, which give the outputs and the next step's first stage.
+    """
+
+    def __init__(self, assembly: Assembly) -> None:
+        self.assembly = assembly
+        self.driver = _Hermite()  # theta_in(tau) - theta_in(0)
+        self.port = _Hermite()  # q_port(tau) = theta_gen - kappa_gen theta_in
+        self.angle0 = 0.0  # theta_in(0), absolute [rad]
+        n = assembly.n_dof
+        self._port_qv = np.zeros((2, 1))
+        self.port_jacobian = np.zeros((2, n))  # d a / d q_port, d a / d v_port (from the last Jacobian)
+        self.last_Q = np.zeros(n)
+        self.last_force = np.zeros(assembly.n_mesh)
+        self.last_deflection = np.zeros((2, assembly.n_mesh))
+
+    def stiffness_factor(self, tau: float):
+        a = self.assembly
+        if not a.time_varying_stiffness:
+            return 1.0
+        return a.stiffness_factor(self.angle0 + self.driver.value(tau))
+
+    def acceleration(self, tau: float, y: np.ndarray) -> np.ndarray:
+        a = self.assembly
+        port = self._port_qv
+        port[0, 0] = self.port.value(tau)
+        port[1, 0] = self.port.rate(tau)
+        Q, force, deflection = a.fast_generalised_forces(y, port, self.stiffness_factor(tau))
+        self.last_Q, self.last_force, self.last_deflection = Q, force, deflection
+        return a.inv_inertia * Q - a.kinematic_ratio * self.driver.accel(tau)
+
+    def jacobian(self, tau: float, y: np.ndarray):
+        a = self.assembly
+        n = a.n_dof
+        qx = np.array([self.port.value(tau)])
+        vx = np.array([self.port.rate(tau)])
+        loads = a.loads(y[:n], y[n:], qx, vx, self.stiffness_factor(tau))
+        dq, dv, dqx, dvx = a.acceleration_jacobian(loads)
+        self.port_jacobian = np.stack([dqx[:, 0], dvx[:, 0]])
+        return dq, dv
+
+    def time_derivative(self, tau: float, y: np.ndarray) -> np.ndarray:
+        a = self.assembly
+        if a.time_varying_stiffness:  # stiffness varies with time too: difference the whole a(t)
+            eps = 1e-7
+            saved = (self.last_Q, self.last_force, self.last_deflection)
+            da = (self.acceleration(tau + eps, y) - self.acceleration(tau, y)) / eps
+            self.last_Q, self.last_force, self.last_deflection = saved
+            return da
+        # prescribed motions: port angle/speed and driver jerk
+        pj = self.port_jacobian
+        return pj[0] * self.port.rate(tau) + pj[1] * self.port.accel(tau) - a.kinematic_ratio * self.driver.jerk()
+
+
+class GearboxModel:
+    """Gearbox with shaft 3, cut at the generator, stepped by a co-simulation master.
+
+    Input model
+    -----------
+    FMI inputs are the rotor and generator speed and angle at the communication
+    point ``t_n``. Over ``[t_n, t_n + h]`` the gearbox moves the driver (and the
+    generator end of shaft 3) along a cubic Hermite curve that starts at the
+    motion it had at the end of the previous step and ends at the target
+    extrapolated from the new inputs, ``phi_n + omega_n h + alpha h^2 / 2`` with
+    speed ``omega_n + alpha h`` (``alpha`` estimated from the last two speed
+    inputs; zero on the first step or with ``extrapolate=False``). The
+    prescribed motions are therefore C1 in time: a new input never makes the
+    kinematic carrier jump in speed, which would kick the stiff, heavily damped
+    meshes into a fast transient at every step. They track the inputs to second
+    order in ``h`` without drift, because each target is re-anchored on the
+    received angle.
+
+    Parameters
+    ----------
+    drivetrain : Drivetrain
+        Must have a generator (its rotor is the cut; only shaft 3 is used here).
+    control : StepControl, optional
+        Integrator tolerances.
+    shaft_torque_mode : {"average", "end"}
+        Which value :attr:`shaft_torque_nm` reports: the torque averaged over the
+        last step (conserves the exchanged impulse) or its end-of-step value.
+    extrapolate : bool
+        Estimate the input slopes from the last two inputs (True) or hold the
+        input speeds over the step (False).
+
+    Attributes
+    ----------
+    y : ndarray, shape (2 n_dof,)
+        State ``[q, v]`` relative to the driver motion.
+    """
+
+    _SCALARS = (
+        "time_s", "driver_angle_rad", "driver_speed_rad_s", "driver_accel_rad_s2", "port_angle_rad",
+        "port_speed_rad_s", "last_step_s", "last_omega_rotor", "last_omega_gen", "shaft_torque_average_nm",
+    )
+
+    def __init__(
+        self,
+        drivetrain: Drivetrain,
+        control: StepControl | None = None,
+        shaft_torque_mode: str = "average",
+        extrapolate: bool = True,
+    ) -> None:
+        self.assembly = a = Assembly(drivetrain, cut_at_generator=True)
+        self.shaft_torque_mode = one_of("shaft_torque_mode", shaft_torque_mode, SHAFT_TORQUE_MODES)
+        self.extrapolate = bool(extrapolate)
+        self.system = _StepSystem(a)
+        self.integrator = Rosenbrock23(self.system, a.n_dof, control)
+        self._kx = float(a.port_ratio[0])
+        self._out_member = a.dof_index(a.stage_members[drivetrain.stages[-1].name]["output"])
+        self.initialized = False
+        self.y = np.zeros(2 * a.n_dof)
+        self.time_s = 0.0
+        self.driver_angle_rad = 0.0  # driver (rotor) motion at the current time
+        self.driver_speed_rad_s = 0.0
+        self.driver_accel_rad_s2 = 0.0
+        self.port_angle_rad = 0.0  # generator-port deviation theta_gen - ratio * theta_rotor
+        self.port_speed_rad_s = 0.0
+        self.last_step_s = 0.0
+        self.last_omega_rotor = 0.0
+        self.last_omega_gen = 0.0
+        self.shaft_torque_average_nm = 0.0
+
+    # ------------------------------------------------------------ outputs
+    @property
+    def ratio(self) -> float:
+        """Kinematic speed ratio generator / rotor [-]."""
+        return self._kx
+
+    @property
+    def contact_force_n(self) -> np.ndarray:
+        """Contact forces at the current time [N], shape (n_mesh,)."""
+        return self.system.last_force
+
+    @property
+    def deflection_m(self) -> np.ndarray:
+        """Mesh deflections at the current time [m], shape (n_mesh,)."""
+        return self.system.last_deflection[0]
+
+    @property
+    def shaft_twist_rad(self) -> np.ndarray:
+        """Shaft twists [rad] and their rates [rad/s], shape (2, n_shaft)."""
+        a = self.assembly
+        n = a.n_dof
+        qv = self.y.reshape(2, n) @ a.S.T
+        qv[0] += a.S_port[:, 0] * self.port_angle_rad
+        qv[1] += a.S_port[:, 0] * self.port_speed_rad_s
+        return qv
+
+    @property
+    def shaft_torques_nm(self) -> np.ndarray:
+        """Shaft torques at the current time [N m], shape (n_shaft,)."""
+        tw = self.shaft_twist_rad
+        return self.assembly.shaft_k * tw[0] + self.assembly.shaft_c * tw[1]
+
+    @property
+    def shaft_torque_end_nm(self) -> float:
+        """Shaft-3 torque on the generator at the end of the last step [N m]."""
+        return float(self.shaft_torques_nm[-1])
+
+    @property
+    def shaft_torque_nm(self) -> float:
+        """Shaft-3 torque on the generator [N m], per :attr:`shaft_torque_mode`."""
+        return self.shaft_torque_average_nm if self.shaft_torque_mode == "average" else self.shaft_torque_end_nm
+
+    @property
+    def speeds_rad_s(self) -> np.ndarray:
+        """Absolute speeds of the free bodies [rad/s], shape (n_dof,)."""
+        return self.assembly.kinematic_ratio * self.driver_speed_rad_s + self.y[self.assembly.n_dof :]
+
+    @property
+    def output_speed_rad_s(self) -> float:
+        """Speed of the last stage's output member [rad/s]."""
+        return float(self.speeds_rad_s[self._out_member])
+
+    @property
+    def rotor_torque_nm(self) -> float:
+        """Torque the rotor applies to the gearbox [N m] (driven carrier inertia + mesh/shaft reactions)."""
+        a = self.assembly
+        return float(
+            a.driver_inertia_kgm2 * self.driver_accel_rad_s2
+            + self.contact_force_n @ a.BT_driver
+            + self.shaft_torques_nm @ a.s_driver
+        )
+
+    # ------------------------------------------------------------ stepping
+    def initialize(self, t0: float, omega_rotor: float, phi_rotor: float, omega_gen: float, phi_gen: float) -> None:
+        """Kinematically consistent start with zero deflection at time ``t0`` [s].
+
+        Parameters
+        ----------
+        omega_rotor, phi_rotor : float
+            Rotor speed [rad/s] and angle [rad] at ``t0``.
+        omega_gen, phi_gen : float
+            Generator speed [rad/s] and angle [rad] at ``t0``.
+        """
+        self.time_s = finite("start_time", t0)
+        for name, val in (("omega_rotor", omega_rotor), ("phi_rotor", phi_rotor), ("omega_gen", omega_gen), ("phi_gen", phi_gen)):
+            finite(name, val)
+        self.y = np.zeros(2 * self.assembly.n_dof)
+        self.driver_angle_rad = float(phi_rotor)
+        self.driver_speed_rad_s = float(omega_rotor)
+        self.driver_accel_rad_s2 = 0.0
+        self.port_angle_rad = float(phi_gen - self._kx * phi_rotor)
+        self.port_speed_rad_s = float(omega_gen - self._kx * omega_rotor)
+        self.last_omega_rotor = float(omega_rotor)
+        self.last_omega_gen = float(omega_gen)
+        self.last_step_s = 0.0
+        self.integrator.reset()
+        sysm = self.system
+        sysm.angle0 = self.driver_angle_rad
+        sysm.driver.fit(1.0, 0.0, self.driver_speed_rad_s, self.driver_speed_rad_s, self.driver_speed_rad_s)
+        sysm.port.fit(1.0, self.port_angle_rad, self.port_speed_rad_s, self.port_angle_rad + self.port_speed_rad_s, self.port_speed_rad_s)
+        sysm.acceleration(0.0, self.y)  # loads at the initial state
+        self.shaft_torque_average_nm = self.shaft_torque_end_nm
+        self.initialized = True
+
+    def step(self, t: float, h: float, omega_rotor: float, phi_rotor: float, omega_gen: float, phi_gen: float) -> None:
+        """Advance from ``t`` to ``t + h`` [s] with the inputs received at ``t``.
+
+        On failure the state is left as it was at ``t`` and :class:`SolverError` is raised.
+        """
+        if not self.initialized:
+            self.initialize(t, omega_rotor, phi_rotor, omega_gen, phi_gen)
+        if not h > 0.0:
+            raise ParameterError("step_size", h, "> 0")
+        if self.extrapolate and self.last_step_s > 0.0:
+            alpha_rotor = (omega_rotor - self.last_omega_rotor) / self.last_step_s
+            alpha_gen = (omega_gen - self.last_omega_gen) / self.last_step_s
+        else:
+            alpha_rotor = alpha_gen = 0.0
+        kx = self._kx
+        angle1 = phi_rotor + h * (omega_rotor + 0.5 * h * alpha_rotor)
+        speed1 = omega_rotor + h * alpha_rotor
+        port1 = phi_gen + h * (omega_gen + 0.5 * h * alpha_gen) - kx * angle1
+        port_speed1 = omega_gen + h * alpha_gen - kx * speed1
+        if not math.isfinite(port1 + port_speed1):
+            raise SolverError(f"non-finite input (omega_rotor={omega_rotor!r}, phi_rotor={phi_rotor!r}, "
+                              f"omega_gen={omega_gen!r}, phi_gen={phi_gen!r})", t)
+        a = self.assembly
+        sysm = self.system
+        sysm.angle0 = self.driver_angle_rad
+        sysm.driver.fit(h, 0.0, self.driver_speed_rad_s, angle1 - self.driver_angle_rad, speed1)
+        sysm.port.fit(h, self.port_angle_rad, self.port_speed_rad_s, port1, port_speed1)
+        twist_start = self._output_twist()
+        # first stage reuses the loads at the end of the previous step: the prescribed
+        # motions are C1, so only the driver-acceleration term changes
+        a0 = a.inv_inertia * sysm.last_Q - a.kinematic_ratio * sysm.driver.accel(0.0)
+        saved = (self.integrator.snapshot(), sysm.last_Q, sysm.last_force, sysm.last_deflection)
+        try:
+            self.y, _ = self.integrator.advance(0.0, self.y, h, a0=a0)
+        except SolverError as exc:
+            self.integrator.restore(saved[0])
+            sysm.last_Q, sysm.last_force, sysm.last_deflection = saved[1:]
+            raise SolverError(str(exc).rsplit(" (at t =", 1)[0], t + exc.time_s) from None
+        self.time_s = t + h
+        self.driver_angle_rad = angle1
+        self.driver_speed_rad_s = speed1
+        self.driver_accel_rad_s2 = sysm.driver.accel(h)
+        self.port_angle_rad = port1
+        self.port_speed_rad_s = port_speed1
+        self.last_omega_rotor = omega_rotor
+        self.last_omega_gen = omega_gen
+        self.last_step_s = h
+        # (1/h) int T dt = k mean(twist) + c (twist_end - twist_start) / h, trapezoid for the mean twist
+        twist_end = self._output_twist()
+        k = a.shaft_k[-1]
+        self.shaft_torque_average_nm = k * 0.5 * (twist_start + twist_end) + a.shaft_c[-1] * (twist_end - twist_start) / h
+
+    def _output_twist(self) -> float:
+        """Twist of the output shaft (shaft 3) [rad]."""
+        a = self.assembly
+        return float(a.S[-1] @ self.y[: a.n_dof] + a.S_port[-1, 0] * self.port_angle_rad)
+
+    # ---------------------------------------------------------------- state
+    def get_state(self) -> dict:
+        """Complete internal state, integrator included (JSON-serialisable, exact float round trip)."""
+        state = {name: float(getattr(self, name)) for name in self._SCALARS}
+        sysm = self.system
+        state.update(
+            y=self.y.tolist(),
+            initialized=self.initialized,
+            integrator=self.integrator.get_state(),
+            last_Q=sysm.last_Q.tolist(),
+            last_force=sysm.last_force.tolist(),
+            last_deflection=sysm.last_deflection.tolist(),
+            port_jacobian=sysm.port_jacobian.tolist(),
+        )
+        return state
+
+    def set_state(self, state: dict) -> None:
+        """Restore a state produced by :meth:`get_state`."""
+        y = np.array(state["y"], dtype=float)
+        if y.shape != self.y.shape:
+            raise ParameterError("state.y", y.shape, f"shape {self.y.shape}")
+        for name in self._SCALARS:
+            setattr(self, name, float(state[name]))
+        self.y = y
+        self.initialized = bool(state["initialized"])
+        self.integrator.set_state(state["integrator"])
+        sysm = self.system
+        sysm.last_Q = np.array(state["last_Q"], dtype=float)
+        sysm.last_force = np.array(state["last_force"], dtype=float)
+        sysm.last_deflection = np.array(state["last_deflection"], dtype=float)
+        sysm.port_jacobian = np.array(state["port_jacobian"], dtype=float)
