@@ -206,3 +206,16 @@ def with_stage(drivetrain: Drivetrain, index: int, **changes) -> Drivetrain:
     stages = list(drivetrain.stages)
     stages[index] = replace(stages[index], **changes)
     return replace(drivetrain, stages=tuple(stages))
+
+
+def cosim_preset(name: str) -> Drivetrain:
+    """A preset with an output shaft and a generator, ready to be cut for co-simulation.
+
+    ``table6`` is the paper's drivetrain. ``table3`` and ``table5`` (single stages)
+    get Table 6's shaft 3 and generator rotor so the same FMU interface applies;
+    every value is an FMU parameter afterwards.
+    """
+    dt = preset(name)
+    if dt.generator is not None:
+        return dt
+    return replace(dt, generator=GeneratorParameters(), output_shaft=_table6_shafts()[2], output_torque_nm=0.0)
