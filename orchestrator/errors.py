@@ -1,0 +1,115 @@
+"""Exceptions raised by the orchestrator.
+
+Every mistake a user can make in a scenario is a :class:`ScenarioError` naming the
+offending key (``"simulation.step"``, ``"connections[2].to"``,
+``"components.gearbox.parameters.stage1.k0"``), its value and what was expected.
+Scenario errors are raised while the scenario is loaded and checked against the
+FMUs' model descriptions, before any FMU is instantiated.
+
+Failures while the co-simulation runs are :class:`FmuStepError` (an FMU returned
+fmi2Discard, fmi2Error or fmi2Fatal) and name the component, the FMI function,
+the simulation time and the status, plus the FMU's last log messages.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from components.errors import DtcosimError
+
+FMI_STATUS_LABELS = ("ok", "warning", "discard", "error", "fatal", "pending")
+
+
+def status_label(status: int) -> str:
+    """Readable name of an FMI 2 status code (``3`` -> ``"error"``)."""
+    return FMI_STATUS_LABELS[status] if 0 <= status < len(FMI_STATUS_LABELS) else f"illegal status {status}"
+
+
+class ScenarioError(DtcosimError, ValueError):
+    """A scenario (TOML file, SSP or the objects built from them) is invalid.
+
+    Parameters
+    ----------
+    key : str
+        Dotted path of the offending entry, e.g. ``"connections[2].to"``.
+    value : Any
+        The rejected value.
+    expected : str
+        What would have been accepted.
+    source : str, optional
+        File the scenario was read from (prefixed to the message).
+    """
+
+    def __init__(self, key: str, value: Any, expected: str, source: str | None = None) -> None:
+        self.key = key
+        self.value = value
+        self.expected = expected
+        self.source = source
+        where = f"{source}: " if source else ""
+        super().__init__(f"{where}invalid scenario entry {key} = {value!r}: expected {expected}")
+
+    def __reduce__(self):
+        return (type(self), (self.key, self.value, self.expected, self.source))
+
+
+class AlgebraicLoopError(ScenarioError):
+    """The connections close a loop of direct-feedthrough dependencies.
+
+    A fixed-step master without iteration cannot solve such a loop; the message
+    lists the variables on the cycle.
+    """
+
+    def __init__(self, cycle: list[str], source: str | None = None) -> None:
+        self.cycle = list(cycle)
+        ScenarioError.__init__(
+            self,
+            "connections",
+            " -> ".join(self.cycle),
+            "no algebraic loop: every cycle of connections must pass through an output that does not "
+            "depend directly on the FMU's inputs (ModelStructure dependencies)",
+            source,
+        )
+
+    def __reduce__(self):
+        return (type(self), (self.cycle, self.source))
+
+
+class InitializationError(DtcosimError, RuntimeError):
+    """The initial values could not be propagated (FMI call failed or no fixed point)."""
+
+
+class FmuStepError(DtcosimError, RuntimeError):
+    """An FMU returned a status worse than fmi2Warning during the run.
+
+    Parameters
+    ----------
+    component : str
+        Instance name in the scenario (e.g. ``"gearbox"``).
+    function : str
+        FMI function that failed (``"fmi2DoStep"``, ``"fmi2GetReal"``, ...).
+    time_s : float
+        Communication point at which the call was made [s].
+    status : int
+        FMI status code (2 discard, 3 error, 4 fatal).
+    log : list of str
+        The FMU's last log messages (may be empty).
+    """
+
+    def __init__(self, component: str, function: str, time_s: float, status: int, log: list[str] | None = None) -> None:
+        self.component = component
+        self.function = function
+        self.time_s = float(time_s)
+        self.status = int(status)
+        self.log = list(log or [])
+        detail = ("; FMU log: " + " | ".join(self.log[-5:])) if self.log else ""
+        super().__init__(
+            f"FMU {component!r}: {function} returned {status_label(self.status)} (status {self.status}) "
+            f"at t = {self.time_s:.6g} s{detail}"
+        )
+
+    def __reduce__(self):
+        return (type(self), (self.component, self.function, self.time_s, self.status, self.log))
+
+
+class SspError(DtcosimError, ValueError):
+    """An SSP file cannot be read or written (names the file and the problem)."""

@@ -1,0 +1,198 @@
+"""Connection graphs: stepping order of the components and algebraic-loop detection.
+
+Stepping order
+--------------
+The component graph has an edge A -> B when an output of A drives an input of B.
+Its strongly connected components (Tarjan) are the feedback loops (e.g. gearbox
+<-> generator) and the single components outside loops. The default order steps
+*receivers before their sources* across loops (reverse topological order of the
+strongly connected components) and the members of a loop in declaration order.
+With the Gauss-Seidel master a component then receives, from outside its loop,
+its sources' values at ``t_k`` (what an input set before ``fmi2DoStep(t_k, H)``
+means in FMI 2), and, inside its loop, the newer values of the members stepped
+before it. For the paper's system the order is ``gearbox, generator, wind``:
+the gearbox gets rotor and generator motion at the same instant ``t_k``, the
+generator the shaft torque of the step just computed. Stepping the wind source
+first would hand the gearbox the rotor motion at ``t_{k+1}`` next to the
+generator motion at ``t_k``; that inconsistency is a first-order coupling error
+(docs/orchestrator.md, coupling study).
+
+Algebraic loops
+---------------
+A loop is algebraic when every connection on it enters an input that the
+receiving FMU's output on the loop depends on *directly* (ModelStructure/Outputs
+``dependencies``; an output without the attribute depends on all inputs). The
+variable graph has an edge for every connection (output -> input) and for every
+direct dependency inside an FMU (input -> output); any cycle in it is an
+algebraic loop that a non-iterative fixed-step master cannot resolve.
+"""
+
+from __future__ import annotations
+
+from typing import Iterable, Mapping, Sequence
+
+
+def strongly_connected(nodes: Sequence[str], edges: Mapping[str, Iterable[str]]) -> list[list[str]]:
+    """Strongly connected components (Tarjan), each as a list of nodes.
+
+    Parameters
+    ----------
+    nodes : sequence of str
+        All nodes (order only affects the order of discovery).
+    edges : mapping of str -> iterable of str
+        Successors of each node.
+    """
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    on_stack: set[str] = set()
+    stack: list[str] = []
+    out: list[list[str]] = []
+    counter = 0
+
+    for root in nodes:
+        if root in index:
+            continue
+        # iterative DFS: (node, iterator over successors)
+        work = [(root, iter(edges.get(root, ())))]
+        index[root] = low[root] = counter
+        counter += 1
+        stack.append(root)
+        on_stack.add(root)
+        while work:
+            node, it = work[-1]
+            advanced = False
+            for nxt in it:
+                if nxt not in index:
+                    index[nxt] = low[nxt] = counter
+                    counter += 1
+                    stack.append(nxt)
+                    on_stack.add(nxt)
+                    work.append((nxt, iter(edges.get(nxt, ()))))
+                    advanced = True
+                    break
+                if nxt in on_stack:
+                    low[node] = min(low[node], index[nxt])
+            if advanced:
+                continue
+            work.pop()
+            if work:
+                parent = work[-1][0]
+                low[parent] = min(low[parent], low[node])
+            if low[node] == index[node]:
+                comp = []
+                while True:
+                    w = stack.pop()
+                    on_stack.discard(w)
+                    comp.append(w)
+                    if w == node:
+                        break
+                out.append(comp)
+    return out
+
+
+def stepping_order(components: Sequence[str], edges: Iterable[tuple[str, str]]) -> list[str]:
+    """Default order in which the Gauss-Seidel master steps the components.
+
+    Parameters
+    ----------
+    components : sequence of str
+        Component names in declaration order (order inside a loop, tie-break).
+    edges : iterable of (str, str)
+        ``(source component, target component)`` for every connection.
+
+    Returns
+    -------
+    list of str
+        Receivers before their sources across feedback loops (reverse topological
+        order of the strongly connected components); loop members in declaration
+        order; independent parts in declaration order.
+    """
+    rank = {c: i for i, c in enumerate(components)}
+    succ: dict[str, set[str]] = {c: set() for c in components}
+    for a, b in edges:
+        if a != b:
+            succ[a].add(b)
+    sccs = strongly_connected(list(components), {c: sorted(s, key=rank.get) for c, s in succ.items()})
+    comp_of = {c: i for i, scc in enumerate(sccs) for c in scc}
+    n = len(sccs)
+    # reversed condensation: an SCC is ready once every SCC it feeds has been placed
+    pending = [0] * n
+    feeders: list[set[int]] = [set() for _ in range(n)]
+    for a, targets in succ.items():
+        for b in targets:
+            ia, ib = comp_of[a], comp_of[b]
+            if ia != ib and ia not in feeders[ib]:
+                feeders[ib].add(ia)
+                pending[ia] += 1
+    first = [min(rank[c] for c in scc) for scc in sccs]
+    ready = sorted((i for i in range(n) if pending[i] == 0), key=lambda i: first[i])
+    order: list[str] = []
+    while ready:
+        i = ready.pop(0)
+        order.extend(sorted(sccs[i], key=rank.get))
+        for j in feeders[i]:
+            pending[j] -= 1
+            if pending[j] == 0:
+                ready.append(j)
+        ready.sort(key=lambda k: first[k])
+    return order
+
+
+def initialization_order(components: Sequence[str], edges: Iterable[tuple[str, str]]) -> list[str]:
+    """Order of the initialisation sweeps: sources before receivers (topological), loops in declaration order.
+
+    Parameters
+    ----------
+    components : sequence of str
+        Component names (declaration order is the tie-break).
+    edges : iterable of (str, str)
+        ``(source, target)`` of every connection and initial binding.
+    """
+    edges = list(edges)
+    reverse = stepping_order(list(components), [(b, a) for a, b in edges])
+    return reverse
+
+
+def find_algebraic_loop(
+    connections: Iterable[tuple[str, str]],
+    feedthrough: Mapping[str, Iterable[str]],
+) -> list[str] | None:
+    """A cycle of direct-feedthrough dependencies, or None.
+
+    Parameters
+    ----------
+    connections : iterable of (str, str)
+        ``("comp.output", "comp.input")`` pairs.
+    feedthrough : mapping of str -> iterable of str
+        For each ``"comp.input"``, the ``"comp.output"`` variables of the same FMU
+        that depend on it directly.
+
+    Returns
+    -------
+    list of str or None
+        The variables on one cycle, first repeated at the end
+        (``["a.y", "b.u", "b.y", "a.u", "a.y"]``), or None if there is none.
+    """
+    edges: dict[str, list[str]] = {}
+    for out, inp in connections:
+        edges.setdefault(out, []).append(inp)
+    for inp, outs in feedthrough.items():
+        edges.setdefault(inp, []).extend(outs)
+    nodes = sorted(set(edges) | {v for vs in edges.values() for v in vs})
+    for scc in strongly_connected(nodes, edges):
+        members = set(scc)
+        if len(scc) == 1 and scc[0] not in edges.get(scc[0], ()):
+            continue
+        # walk inside the SCC until a node repeats: that is a cycle
+        start = min(scc)
+        path = [start]
+        seen = {start: 0}
+        node = start
+        while True:
+            node = next(v for v in edges[node] if v in members)
+            if node in seen:
+                cycle = path[seen[node]:] + [node]
+                return cycle
+            seen[node] = len(path)
+            path.append(node)
+    return None
