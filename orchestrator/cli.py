@@ -15,6 +15,8 @@ from components.errors import DtcosimError
 
 #: modules providing subcommands, in help order
 COMMAND_MODULES = (
+    "orchestrator.commands.run",
+    "orchestrator.commands.export_ssp",
     "orchestrator.commands.reference",
 )
 

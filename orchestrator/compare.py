@@ -149,17 +149,22 @@ def monolithic_setup(system: ResolvedSystem) -> MonolithicSetup:
         )
     keys = set(flatten(template)) - set(gen_keys)
     g = system.parameter_values(by_role[GENERATOR])
-    events = []
-    i = 1
-    while f"event{i}.kind" in g:
-        code = int(g[f"event{i}.kind"])
-        if code:
-            events.append(LoadEvent(kind=EVENT_KINDS[code - 1], start_s=float(g[f"event{i}.start"]),
-                                    duration_s=float(g[f"event{i}.duration"]), factor=float(g[f"event{i}.factor"])))
-        i += 1
-    values = {k: gear_values[k] for k in keys}
-    values["generator.inertia"] = float(g["inertia"])
-    values["generator.counter_torque"] = float(g["counter_torque"])
+    try:
+        events = []
+        i = 1
+        while f"event{i}.kind" in g:
+            code = int(g[f"event{i}.kind"])
+            if code:
+                events.append(LoadEvent(kind=EVENT_KINDS[code - 1], start_s=float(g[f"event{i}.start"]),
+                                        duration_s=float(g[f"event{i}.duration"]), factor=float(g[f"event{i}.factor"])))
+            i += 1
+        values = {k: gear_values[k] for k in keys}
+        values["generator.inertia"] = float(g["inertia"])
+        values["generator.counter_torque"] = float(g["counter_torque"])
+    except KeyError as exc:
+        raise ReferenceError(f"GeneratorRotor FMU has no parameter {exc.args[0]!r}") from None
+    except (ParameterError, IndexError) as exc:
+        raise ReferenceError(f"generator load events not representable in the reference model: {exc}") from None
     try:
         drivetrain = unflatten(template, values)
     except ParameterError as exc:

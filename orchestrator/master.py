@@ -259,6 +259,20 @@ class CoSimulation:
             fmu_log={name: list(inst.log) for name, inst in self.instances.items()},
         )
 
+    def initial_values(self) -> dict[str, float]:
+        """Instantiate and initialise the FMUs, return what the initial bindings set, free the FMUs.
+
+        Returns
+        -------
+        dict of str -> float
+            ``{"component.parameter": value}`` for every ``[[initial]]`` binding.
+        """
+        try:
+            self._instantiate()
+            return self._initialize()
+        finally:
+            self._close()
+
     # ----------------------------------------------------------- lifecycle
     def _instantiate(self) -> None:
         sim = self.settings

@@ -1,0 +1,151 @@
+"""``dtcosim run``: run a co-simulation scenario and write its results.
+
+Exit status: 0 complete, 1 error (bad scenario, FMU failure: partial results
+written), 130 interrupted by Ctrl-C (partial results written).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from ..errors import ScenarioError
+from ..scenario import ALGORITHMS, EXTRAPOLATIONS, find_scenario
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add the ``run`` subcommand."""
+    p = sub.add_parser(
+        "run",
+        help="run a co-simulation scenario (default: the paper's 60 s scenario) and write results and plots",
+        description=(
+            "Run a co-simulation scenario through its FMUs with the fixed-step master and write "
+            "timeseries.csv, summary.json and PNG plots. SCENARIO is a TOML file, an .ssp/.ssd file, or the "
+            "name of a packaged scenario (default: paper-60s). Missing project FMUs are built first."
+        ),
+    )
+    p.add_argument("scenario", nargs="?", default=None, metavar="SCENARIO",
+                   help="scenario TOML/SSP file or packaged scenario name (default: paper-60s)")
+    p.add_argument("--out", type=Path, default=None, help="output directory (default: results/<scenario name>)")
+    p.add_argument("--fmu-dir", type=Path, default=None,
+                   help="directory searched for FMUs after the scenario's own (default: $DTCOSIM_FMU_DIR or the project's fmus/)")
+    p.add_argument("--compare-reference", action="store_true",
+                   help="also run the monolithic reference solver on the same scenario and report every statistic of both")
+    p.add_argument("--step", type=float, default=None, metavar="H", help="override the communication step [s]")
+    p.add_argument("--stop", type=float, default=None, metavar="T", help="override the stop time [s] (clips the window)")
+    p.add_argument("--output-interval", type=float, default=None, metavar="DT", help="override the sampling interval [s]")
+    p.add_argument("--algorithm", choices=ALGORITHMS, default=None, help="override the master algorithm")
+    p.add_argument("--extrapolation", choices=EXTRAPOLATIONS, default=None, help="override the input extrapolation")
+    p.add_argument("--set", action="append", default=[], metavar="COMPONENT.PARAMETER=VALUE",
+                   help="override a parameter value, e.g. --set wind.seed=7 (repeatable)")
+    p.add_argument("--no-build", action="store_true", help="do not build missing FMUs (fail instead)")
+    p.add_argument("--no-plots", action="store_true", help="do not write the PNG plots")
+    p.add_argument("--quiet", "-q", action="store_true", help="no progress bar and no statistics table")
+    p.set_defaults(func=run)
+
+
+def _parse_value(text: str):
+    low = text.strip().lower()
+    if low in ("true", "false"):
+        return low == "true"
+    try:
+        return int(text)
+    except ValueError:
+        pass
+    try:
+        return float(text)
+    except ValueError:
+        return text
+
+
+def apply_overrides(scenario, args: argparse.Namespace):
+    """The scenario with the command-line overrides applied (validated again)."""
+    sim = scenario.simulation
+    changes = {}
+    if args.step is not None:
+        changes["step_s"] = args.step
+        if args.output_interval is None and sim.output_interval_s < args.step:
+            changes["output_interval_s"] = args.step
+    if args.output_interval is not None:
+        changes["output_interval_s"] = args.output_interval
+    if args.stop is not None:
+        changes["stop_s"] = args.stop
+        w0, w1 = sim.window_s
+        end = min(w1, args.stop)
+        changes["window_s"] = (w0 if w0 < end else sim.start_s, end)  # clip the window to the new stop
+    if args.algorithm is not None:
+        changes["algorithm"] = args.algorithm
+    if args.extrapolation is not None:
+        changes["extrapolation"] = args.extrapolation
+    if changes:
+        scenario = scenario.with_simulation(**changes)
+    for item in args.set:
+        target, eq, value = item.partition("=")
+        comp, dot, param = target.partition(".")
+        if not eq or not dot or not comp or not param:
+            raise ScenarioError("--set", item, "COMPONENT.PARAMETER=VALUE")
+        scenario = scenario.with_parameters(comp, **{param: _parse_value(value)})
+    return scenario
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run the scenario; write results; print a summary."""
+    from ..fmu_store import ensure_fmus
+    from ..runner import load_any, run_scenario
+    from ..system import resolve_system
+
+    quiet = args.quiet
+    say = (lambda msg: None) if quiet else (lambda msg: print(msg, file=sys.stderr))
+    scenario = apply_overrides(load_any(find_scenario(args.scenario)), args)
+    paths = ensure_fmus(scenario, args.fmu_dir, build=not args.no_build, report=say)
+    system = resolve_system(scenario, fmu_paths=paths)
+    out_dir = args.out if args.out is not None else Path("results") / scenario.name
+    sim = scenario.simulation
+    say(f"{scenario.name}: {len(scenario.components)} FMUs, {sim.algorithm}/{sim.extrapolation}, "
+        f"H = {sim.step_s:g} s, {sim.start_s:g}-{sim.stop_s:g} s ({sim.n_steps} steps), order {', '.join(system.order)}")
+
+    bar = None
+    progress = None
+    if not quiet and sys.stderr.isatty():
+        from tqdm import tqdm
+
+        bar = tqdm(total=round(sim.stop_s - sim.start_s, 9), unit="s", unit_scale=False, desc="co-simulation",
+                   file=sys.stderr, bar_format="{l_bar}{bar}| {n:.2f}/{total:.2f} s simulated [{elapsed}<{remaining}]")
+        state = {"done": 0}
+
+        def progress(done: int, total: int) -> None:
+            bar.update((done - state["done"]) * sim.step_s)
+            state["done"] = done
+
+    try:
+        report = run_scenario(system, out_dir, compare_reference=args.compare_reference, plots=not args.no_plots,
+                              progress=progress)
+    finally:
+        if bar is not None:
+            bar.close()
+    outcome = report.outcome
+    s = report.summary
+    if not quiet:
+        print(f"{scenario.name}: {'complete' if outcome.complete else 'INCOMPLETE'}, {outcome.steps} steps, "
+              f"wall time {s['wall_time_s']:.2f} s (stepping {outcome.loop_time_s:.2f} s, "
+              f"{1e6 * outcome.loop_time_s / max(outcome.steps, 1):.1f} us/step)")
+        w0, w1 = sim.window_s
+        print(f"statistics over [{w0:g}, {w1:g}] s:")
+        print(f"  {'variable':<32}{'mean':>14}{'std':>14}{'min':>14}{'max':>14}")
+        for name, st in s["statistics"].items():
+            vals = [st[k] for k in ("mean", "std", "min", "max")]
+            print(f"  {name:<32}" + "".join(f"{v:14.6g}" if v is not None else f"{'-':>14}" for v in vals))
+        fig16 = s.get("generator_vs_ideal")
+        if fig16:
+            dev = fig16["relative_deviation"]
+            if dev.get("max_abs") is not None:
+                print(f"generator vs {fig16['ratio']:.6g} x rotor speed: mean {dev['mean']:+.2e}, "
+                      f"max |deviation| {dev['max_abs']:.2e} (relative)")
+        if report.comparison_text:
+            print(report.comparison_text)
+        print(f"results in {Path(out_dir)}/: " + ", ".join(p.name for p in report.files.values()))
+    if not outcome.complete:
+        print(f"dtcosim run: {outcome.error}; partial results written to {out_dir}", file=sys.stderr)
+        return 130 if outcome.interrupted else 1
+    return 0

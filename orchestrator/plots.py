@@ -1,0 +1,148 @@
+"""PNG plots of a drivetrain run (matplotlib, Agg canvas; no pyplot global state).
+
+* ``rotor_speed.png`` - rotor speed over time, the wind description (paper Fig. 15);
+* ``generator_speed.png`` - generator speed against the ideal gearbox, ratio x rotor
+  speed, with their relative difference below (Fig. 16);
+* ``contact_forces.png`` - every contact force, one panel per stage (Fig. 17).
+
+A plot is skipped when its variables were not recorded. The analysis window is
+shaded.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+
+from .derived import GEARBOX, GENERATOR, WIND, generator_vs_ideal, roles
+from .master import RunOutcome
+from .system import ResolvedSystem
+
+RPM_PER_RAD_S = 60.0 / (2.0 * math.pi)
+_FORCE_RE = re.compile(r"^(stage\d+)\.F_(sp|rp|mesh)(?:\[(\d+)\])?$")
+
+
+def _figure(rows: int = 1, height: float = 4.0, sharex: bool = True):
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(10.0, height), dpi=110, layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(rows, 1, sharex=sharex, squeeze=False)[:, 0]
+    return fig, axes
+
+
+def _shade_window(ax, window) -> None:
+    ax.axvspan(window[0], window[1], color="0.93", zorder=0, label=f"analysis window {window[0]:g}-{window[1]:g} s")
+
+
+def _finish(fig, path: Path) -> Path:
+    fig.savefig(path)
+    return path
+
+
+def plot_rotor_speed(outcome: RunOutcome, column: str, window, path: Path, title_suffix: str = "") -> Path:
+    """Rotor speed [rpm] over time (Fig. 15)."""
+    t = outcome.time_s
+    w = outcome.column(column) * RPM_PER_RAD_S
+    fig, (ax,) = _figure()
+    _shade_window(ax, window)
+    ax.plot(t, w, lw=0.8, color="C0", label=f"rotor speed {column}")
+    sel = (t >= window[0]) & (t <= window[1])
+    if sel.any():
+        ax.axhline(w[sel].mean(), color="C3", lw=1.0, ls="--", label=f"mean over window: {w[sel].mean():.4g} rpm")
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("rotor speed [rpm]")
+    ax.set_title("Rotor speed: stochastic wind description, eq. 13-14 (paper Fig. 15)" + title_suffix)
+    ax.grid(True, lw=0.3)
+    ax.legend(loc="best", fontsize=8)
+    ax.set_xlim(t[0], t[-1])
+    return _finish(fig, path)
+
+
+def plot_generator_speed(outcome: RunOutcome, rotor_column: str, gen_column: str, ratio: float, window,
+                         path: Path, title_suffix: str = "") -> Path:
+    """Generator speed against ratio x rotor speed, and their relative difference (Fig. 16)."""
+    t = outcome.time_s
+    gen = outcome.column(gen_column) * RPM_PER_RAD_S
+    ideal = ratio * outcome.column(rotor_column) * RPM_PER_RAD_S
+    fig, (ax, ax2) = _figure(2, height=6.0)
+    _shade_window(ax, window)
+    ax.plot(t, ideal, lw=1.6, color="C1", label=f"ideal gearbox: {ratio:.6g} x rotor speed")
+    ax.plot(t, gen, lw=0.8, color="C0", label=f"simulated generator speed {gen_column}")
+    ax.set_ylabel("speed [rpm]")
+    ax.set_title("Generator speed vs ideal gearbox (paper Fig. 16)" + title_suffix)
+    ax.grid(True, lw=0.3)
+    ax.legend(loc="best", fontsize=8)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        dev = 100.0 * (gen / ideal - 1.0)
+    _shade_window(ax2, window)
+    ax2.plot(t, dev, lw=0.7, color="C2", label="generator / ideal - 1")
+    ax2.axhline(0.0, color="0.3", lw=0.6)
+    ax2.set_xlabel("time [s]")
+    ax2.set_ylabel("difference [%]")
+    ax2.grid(True, lw=0.3)
+    ax2.legend(loc="best", fontsize=8)
+    ax2.set_xlim(t[0], t[-1])
+    return _finish(fig, path)
+
+
+def plot_contact_forces(outcome: RunOutcome, gearbox: str, window, path: Path, title_suffix: str = "") -> Path | None:
+    """Every recorded contact force of the gearbox [kN], one panel per stage (Fig. 17)."""
+    prefix = f"{gearbox}."
+    stages: dict[str, list[tuple[str, str, int]]] = {}
+    for i, c in enumerate(outcome.columns):
+        if c.component != gearbox:
+            continue
+        m = _FORCE_RE.match(c.variable)
+        if m:
+            stages.setdefault(m.group(1), []).append((c.variable, m.group(2), i))
+    if not stages:
+        return None
+    names = sorted(stages, key=lambda s: int(s[5:]))
+    fig, axes = _figure(len(names), height=2.6 * len(names) + 0.8)
+    t = outcome.time_s
+    styles = {"sp": "-", "rp": "--", "mesh": "-"}
+    labels = {"sp": "sun-planet", "rp": "ring-planet", "mesh": "mesh"}
+    for ax, stage in zip(axes, names):
+        _shade_window(ax, window)
+        for k, (var, kind, i) in enumerate(stages[stage]):
+            ax.plot(t, outcome.values[:, i] / 1e3, lw=0.7, ls=styles[kind], color=f"C{k % 10}",
+                    label=f"{var} ({labels[kind]})")
+        ax.set_ylabel("force [kN]")
+        ax.set_title(f"{prefix}{stage}", fontsize=10, loc="left")
+        ax.grid(True, lw=0.3)
+        ax.legend(loc="upper right", fontsize=7, ncol=3)
+    axes[-1].set_xlabel("time [s]")
+    axes[-1].set_xlim(t[0], t[-1])
+    fig.suptitle("Gear contact forces of all stages (paper Fig. 17)" + title_suffix)
+    return _finish(fig, path)
+
+
+def plot_run(system: ResolvedSystem, outcome: RunOutcome, out_dir: str | Path) -> list[Path]:
+    """Write the plots that the recorded variables allow; returns the files written."""
+    out_dir = Path(out_dir)
+    r = roles(system)
+    window = system.scenario.simulation.window_s
+    suffix = "" if outcome.complete else f" - INCOMPLETE, stopped at {outcome.stopped_at_s:g} s"
+    written: list[Path] = []
+    if outcome.time_s.size < 2:
+        return written
+    names = set(outcome.names)
+    rotor = f"{r[WIND]}.omega" if WIND in r else None
+    if rotor in names:
+        written.append(plot_rotor_speed(outcome, rotor, window, out_dir / "rotor_speed.png", suffix))
+    gen = f"{r[GENERATOR]}.omega" if GENERATOR in r else None
+    if rotor in names and gen in names:
+        fig16 = generator_vs_ideal(system, outcome)
+        if fig16 is not None:
+            written.append(plot_generator_speed(outcome, rotor, gen, fig16["ratio"], window,
+                                                out_dir / "generator_speed.png", suffix))
+    if GEARBOX in r:
+        p = plot_contact_forces(outcome, r[GEARBOX], window, out_dir / "contact_forces.png", suffix)
+        if p is not None:
+            written.append(p)
+    return written
