@@ -16,6 +16,8 @@ from components.errors import DtcosimError
 #: modules providing subcommands, in help order
 COMMAND_MODULES = (
     "orchestrator.commands.reference",
+    "orchestrator.commands.build",
+    "orchestrator.commands.validate",
 )
 
 

@@ -1,0 +1,1 @@
+"""pythonfmu slaves for the dtcosim components and the code that builds them into FMUs."""
