@@ -18,6 +18,8 @@ COMMAND_MODULES = (
     "orchestrator.commands.run",
     "orchestrator.commands.export_ssp",
     "orchestrator.commands.reference",
+    "orchestrator.commands.build",
+    "orchestrator.commands.validate",
 )
 
 

@@ -1,0 +1,301 @@
+"""Build the dtcosim FMUs (WindSource, Gearbox, GeneratorRotor) with pythonfmu.
+
+Each FMU is self-contained and collision-free:
+
+* its ``resources/`` hold a package ``_dtcosim_<fmu>_<hash>`` with a copy of
+  ``components/`` and of the slave modules it needs (``slaves/``), where
+  ``<hash>`` is a hash of that code, the FMU name, the preset and the
+  pythonfmu version. The slave modules' ``from components...`` imports are
+  rewritten to package-relative imports, so the FMU never imports an installed
+  ``components`` (or another FMU's copy);
+* the pythonfmu entry script is ``_dtcosim_<fmu>_<hash>_slave.py`` (pythonfmu
+  imports it by file stem, and module names are shared by every FMU in a
+  host process): it only subclasses the slave with the build's preset.
+
+Two FMUs built from different code therefore run their own code in one
+process, and an FMU runs where numpy and scipy exist but dtcosim does not.
+After pythonfmu has written the archive, ``modelDescription.xml`` gets units,
+InitialUnknowns and output dependencies (:mod:`fmus.model_description`) and is
+checked with ``fmpy.validation``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import importlib
+import json
+import re
+import shutil
+import sys
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Sequence
+
+import pythonfmu
+from pythonfmu import FmuBuilder
+
+import components
+from components.errors import DtcosimError
+from components.presets import PRESETS
+
+from . import model_description
+from .slaves import base as slave_base
+
+#: Bump when the layout of the generated FMUs changes.
+BUILD_FORMAT = 1
+
+#: FMU model name -> (slave module, extra slave modules it imports)
+FMU_SLAVES: dict[str, tuple[str, tuple[str, ...]]] = {
+    "WindSource": ("wind_source", ()),
+    "Gearbox": ("gearbox", ("gearbox_parameters",)),
+    "GeneratorRotor": ("generator_rotor", ()),
+}
+FMU_NAMES = tuple(FMU_SLAVES)
+#: slave modules every FMU carries
+COMMON_SLAVE_MODULES = ("__init__", "interface", "base")
+
+_COMPONENTS_IMPORT = re.compile(r"^(\s*)from components((?:\.\w+)*) import ", re.MULTILINE)
+_FORBIDDEN_IMPORT = re.compile(r"^\s*(?:from|import)\s+(?:components|fmus|orchestrator)\b", re.MULTILINE)
+_MIN_PYTHONFMU = (0, 7, 0)
+
+
+class BuildError(DtcosimError):
+    """An FMU could not be built or the built FMU is not valid."""
+
+
+@dataclass(frozen=True)
+class SourceTree:
+    """Where the code copied into the FMUs comes from.
+
+    Attributes
+    ----------
+    components_dir : Path
+        The ``components`` package.
+    slaves_dir : Path
+        The ``fmus/slaves`` package.
+    """
+
+    components_dir: Path
+    slaves_dir: Path
+
+    @classmethod
+    def installed(cls) -> "SourceTree":
+        """The packages this module was imported with."""
+        return cls(Path(components.__file__).parent, Path(slave_base.__file__).parent)
+
+    @classmethod
+    def at(cls, root: Path) -> "SourceTree":
+        """A checkout (or copy) with ``components/`` and ``fmus/slaves/`` under ``root``."""
+        root = Path(root)
+        return cls(root / "components", root / "fmus" / "slaves")
+
+
+@dataclass(frozen=True)
+class BuiltFmu:
+    """Result of one build.
+
+    Attributes
+    ----------
+    name : str
+        Model name (``WindSource``, ``Gearbox`` or ``GeneratorRotor``).
+    path : Path
+        The ``.fmu`` file.
+    build_id : str
+        Hash of the embedded code and configuration.
+    package : str
+        Name of the embedded package (``_dtcosim_<fmu>_<hash>``).
+    slave_module : str
+        Name of the pythonfmu entry module.
+    """
+
+    name: str
+    path: Path
+    build_id: str
+    package: str
+    slave_module: str
+
+
+def _check_pythonfmu() -> None:
+    version = tuple(int(p) for p in re.findall(r"\d+", pythonfmu.__version__)[:3])
+    if version < _MIN_PYTHONFMU:
+        raise BuildError(
+            f"pythonfmu {pythonfmu.__version__} is too old: >= {'.'.join(map(str, _MIN_PYTHONFMU))} is needed "
+            "(its C wrapper finds the slave class through the class hierarchy)"
+        )
+
+
+def _python_files(directory: Path) -> list[Path]:
+    return sorted(p for p in directory.rglob("*.py") if "__pycache__" not in p.parts)
+
+
+def _slave_files(name: str, source: SourceTree) -> list[Path]:
+    module, extra = FMU_SLAVES[name]
+    return [source.slaves_dir / f"{m}.py" for m in (*COMMON_SLAVE_MODULES, *extra, module)]
+
+
+def build_config(name: str, preset: str) -> dict:
+    """Configuration that, together with the code, determines an FMU."""
+    return {"format": BUILD_FORMAT, "fmu": name, "preset": preset, "pythonfmu": pythonfmu.__version__,
+            "dtcosim": components.__version__}
+
+
+def code_hash(name: str, preset: str, source: SourceTree | None = None) -> str:
+    """12-hex-digit hash of the code embedded in FMU ``name`` and of its build configuration."""
+    source = source or SourceTree.installed()
+    digest = hashlib.sha256(json.dumps(build_config(name, preset), sort_keys=True).encode())
+    files = [(f"components/{p.relative_to(source.components_dir).as_posix()}", p) for p in _python_files(source.components_dir)]
+    files += [(f"slaves/{p.name}", p) for p in _slave_files(name, source)]
+    for rel, path in files:
+        digest.update(rel.encode() + b"\0" + path.read_bytes() + b"\0")
+    return digest.hexdigest()[:12]
+
+
+def rewrite_slave_imports(code: str, module: str) -> str:
+    """Make a slave module's ``from components...`` imports relative to the embedding package."""
+    code = _COMPONENTS_IMPORT.sub(r"\1from ..components\2 import ", code)
+    leftover = _FORBIDDEN_IMPORT.search(code)
+    if leftover:
+        raise BuildError(f"slave module {module}: import {leftover.group(0).strip()!r} would not resolve inside an FMU")
+    return code
+
+
+def _entry_script(name: str, package: str, module: str, preset: str, build_id: str) -> str:
+    return (
+        f'"""pythonfmu entry module of the dtcosim {name} FMU (generated by fmus.build; do not edit).\n\n'
+        f"Preset {preset}, build {build_id}: the slave and physics code are in the package\n"
+        f'{package} next to this file.\n"""\n\n'
+        f"from {package}.slaves.{module} import {name} as _{name}\n\n"
+        "# pythonfmu's C wrapper (0.7) executes this file again for every new instance, in this\n"
+        "# module's namespace, and then releases a reference to that namespace it never took.\n"
+        "# Without a reference added by each execution the namespace is freed while the module\n"
+        "# still uses it and the host crashes later (reproduced). Costs one list entry per instance.\n"
+        '_namespace_refs = globals().setdefault("_namespace_refs", [])\n'
+        "_namespace_refs.append(globals())\n\n\n"
+        f"class {name}(_{name}):\n"
+        f'    """dtcosim {name} (preset {preset}, build {build_id})."""\n\n'
+        f'    preset = "{preset}"\n'
+        f'    build_id = "{build_id}"\n'
+    )
+
+
+def stage(name: str, preset: str, staging_dir: Path, source: SourceTree | None = None) -> tuple[Path, Path, str]:
+    """Write the entry script and the embedded package of FMU ``name`` into ``staging_dir``.
+
+    Returns
+    -------
+    script, package_dir : Path
+    build_id : str
+    """
+    if name not in FMU_SLAVES:
+        raise BuildError(f"unknown FMU {name!r}: expected one of {', '.join(FMU_NAMES)}")
+    if preset not in PRESETS:
+        raise BuildError(f"unknown preset {preset!r}: expected one of {', '.join(PRESETS)}")
+    source = source or SourceTree.installed()
+    build_id = code_hash(name, preset, source)
+    package = f"_dtcosim_{name.lower()}_{build_id}"
+    package_dir = Path(staging_dir) / package
+    shutil.copytree(source.components_dir, package_dir / "components", ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+    (package_dir / "slaves").mkdir()
+    for path in _slave_files(name, source):
+        code = rewrite_slave_imports(path.read_text(encoding="utf-8"), path.name)
+        (package_dir / "slaves" / path.name).write_text(code, encoding="utf-8")
+    info = build_config(name, preset) | {"build_id": build_id}
+    (package_dir / "__init__.py").write_text(
+        f'"""Code embedded in the dtcosim {name} FMU (generated by fmus.build)."""\n\nBUILD_INFO = {info!r}\n',
+        encoding="utf-8",
+    )
+    module, _ = FMU_SLAVES[name]
+    script = Path(staging_dir) / f"{package}_slave.py"
+    script.write_text(_entry_script(name, package, module, preset, build_id), encoding="utf-8")
+    return script, package_dir, build_id
+
+
+def _forget_modules(prefixes: Sequence[str], path_entries: Sequence[str]) -> None:
+    """Drop the staged modules from this process (the FMU must import its own copy)."""
+    for key in [k for k in sys.modules if any(k == p or k.startswith(p + ".") for p in prefixes)]:
+        del sys.modules[key]
+    for entry in path_entries:
+        while entry in sys.path:
+            sys.path.remove(entry)
+    importlib.invalidate_caches()
+
+
+def build_fmu(name: str, out_dir: Path | str, preset: str = "table6", source: SourceTree | None = None,
+              validate: bool = True) -> BuiltFmu:
+    """Build one FMU into ``out_dir`` (``<out_dir>/<name>.fmu``).
+
+    Parameters
+    ----------
+    name : {"WindSource", "Gearbox", "GeneratorRotor"}
+    out_dir : path
+        Output directory (created if missing).
+    preset : {"table6", "table5", "table3"}
+        Drivetrain preset: structure and parameter defaults.
+    source : SourceTree, optional
+        Code to embed (default: the installed ``components`` and ``fmus.slaves``).
+    validate : bool
+        Check the result with ``fmpy.validation`` and raise :class:`BuildError` on problems.
+    """
+    _check_pythonfmu()
+    source = source or SourceTree.installed()
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(prefix="dtcosim_fmu_") as tmp:
+        script, package_dir, build_id = stage(name, preset, Path(tmp), source)
+        package = package_dir.name
+        importlib.invalidate_caches()
+        try:
+            fmu_path = Path(FmuBuilder.build_FMU(script, dest=out_dir / f"{name}.fmu", project_files=[package_dir],
+                                                 canGetAndSetFMUstate=True, canSerializeFMUstate=True))
+            slave_class = getattr(sys.modules[script.stem], name)
+            variables = slave_class.interface()
+        finally:
+            _forget_modules([package, script.stem], [str(script.parent)])
+    xml = model_description.finalize(
+        model_description.read_member(fmu_path), variables, build_id,
+        f"dtcosim {components.__version__} with PythonFMU {pythonfmu.__version__}",
+    )
+    model_description.rewrite_archive(fmu_path, {model_description.MODEL_DESCRIPTION: xml})
+    if validate:
+        from .validation import check_fmu
+
+        problems = check_fmu(fmu_path)
+        if problems:
+            raise BuildError(f"{fmu_path} is not valid:\n  " + "\n  ".join(problems))
+    return BuiltFmu(name, fmu_path, build_id, package, script.stem)
+
+
+def build_all(out_dir: Path | str, preset: str = "table6", source: SourceTree | None = None,
+              names: Sequence[str] = FMU_NAMES, validate: bool = True) -> list[BuiltFmu]:
+    """Build the FMUs ``names`` (default: all three) into ``out_dir``."""
+    return [build_fmu(name, out_dir, preset, source, validate) for name in names]
+
+
+def add_arguments(parser: argparse.ArgumentParser, default_out: Path | str) -> None:
+    """Options shared by ``build_fmus.py`` and ``dtcosim build``."""
+    parser.add_argument("--out", type=Path, default=Path(default_out), help=f"output directory (default: {default_out})")
+    parser.add_argument("--preset", choices=PRESETS, default="table6",
+                        help="drivetrain preset giving the structure and parameter defaults (default: table6)")
+    parser.add_argument("--fmu", choices=FMU_NAMES, action="append",
+                        help="build only this FMU (repeatable; default: all three)")
+
+
+def run(args: argparse.Namespace) -> int:
+    """Build per parsed arguments and print what was written."""
+    for built in build_all(args.out, args.preset, names=args.fmu or FMU_NAMES):
+        print(f"{built.path}  ({built.name}, preset {args.preset}, build {built.build_id})")
+    return 0
+
+
+def main(argv: Sequence[str] | None = None, default_out: Path | str = "fmus") -> int:
+    """Command-line entry point (``python build_fmus.py``)."""
+    parser = argparse.ArgumentParser(description="Build the dtcosim FMUs WindSource, Gearbox and GeneratorRotor.")
+    add_arguments(parser, default_out)
+    args = parser.parse_args(argv)
+    try:
+        return run(args)
+    except DtcosimError as exc:
+        print(f"build_fmus: error: {exc}", file=sys.stderr)
+        return 1

@@ -1,0 +1,135 @@
+"""Post-processing of the ``modelDescription.xml`` that pythonfmu writes.
+
+pythonfmu emits neither units nor ``InitialUnknowns``; this module adds
+
+* ``UnitDefinitions`` (FMI 2 ``Unit`` with ``BaseUnit`` exponents where the unit
+  has an integer SI expression, plus display units such as rpm and deg) and the
+  ``unit`` attribute of every Real variable;
+* ``ModelStructure/InitialUnknowns`` listing the outputs (they are
+  ``initial="calculated"``: computed from parameters and inputs in
+  initialisation mode) and ``dependencies=""`` on every output (no direct
+  feedthrough: outputs change only in ``doStep``);
+* a deterministic GUID derived from the build hash and the generation tool.
+"""
+
+from __future__ import annotations
+
+import io
+import uuid
+import zipfile
+from pathlib import Path
+from typing import Iterable
+from xml.etree import ElementTree as ET
+
+from .slaves.interface import OUTPUT, REAL, UNITS, Variable
+
+MODEL_DESCRIPTION = "modelDescription.xml"
+_GUID_NAMESPACE = uuid.UUID("7b0f4c3e-52a1-4d6e-9f43-1d2f0c6a9e11")
+
+
+class ModelDescriptionError(RuntimeError):
+    """The generated model description does not match the slave's declared interface."""
+
+
+def _format_factor(x: float) -> str:
+    return repr(float(x))
+
+
+def _format_real(x: float) -> str:
+    """xs:double text that reads back as exactly ``x``."""
+    x = float(x)
+    if x != x:
+        return "NaN"
+    if x in (float("inf"), float("-inf")):
+        return "INF" if x > 0 else "-INF"
+    return repr(x)
+
+
+def unit_definitions(unit_names: Iterable[str]) -> ET.Element:
+    """``UnitDefinitions`` element for the given units (sorted by name)."""
+    root = ET.Element("UnitDefinitions")
+    for name in sorted(set(unit_names)):
+        unit = UNITS[name]
+        node = ET.SubElement(root, "Unit", name=unit.name)
+        if unit.base_exponents is not None:
+            ET.SubElement(node, "BaseUnit", {k: str(v) for k, v in unit.base_exponents.items()})
+        for display, factor in unit.display_units.items():
+            ET.SubElement(node, "DisplayUnit", name=display, factor=_format_factor(factor))
+    return root
+
+
+def finalize(xml: bytes, variables: tuple[Variable, ...], build_id: str, generation_tool: str) -> bytes:
+    """Add units, InitialUnknowns, output dependencies and a deterministic GUID.
+
+    Parameters
+    ----------
+    xml : bytes
+        modelDescription.xml as written by pythonfmu.
+    variables : tuple of Variable
+        The slave's interface, in value-reference order.
+    build_id : str
+        Hash of the code and configuration the FMU was built from.
+    generation_tool : str
+        Value of the ``generationTool`` attribute.
+
+    Returns
+    -------
+    bytes
+        The new modelDescription.xml (UTF-8).
+    """
+    root = ET.fromstring(xml)
+    model_variables = root.find("ModelVariables")
+    scalars = model_variables.findall("ScalarVariable")
+    if [s.get("name") for s in scalars] != [v.name for v in variables]:
+        raise ModelDescriptionError("modelDescription.xml variables differ from the slave's interface")
+    for index, (node, var) in enumerate(zip(scalars, variables)):
+        if int(node.get("valueReference")) != index:
+            raise ModelDescriptionError(f"{var.name}: value reference {node.get('valueReference')} != {index}")
+        if var.type == REAL:
+            real = node.find(REAL)
+            real.set("unit", var.unit)
+            if var.start is not None:  # exact round trip (pythonfmu writes 16 significant digits)
+                real.set("start", _format_real(var.start))
+
+    root.set("guid", "{" + str(uuid.uuid5(_GUID_NAMESPACE, f"{root.get('modelName')}:{build_id}:{generation_tool}")) + "}")
+    root.set("generationTool", generation_tool)
+
+    co_simulation = root.find("CoSimulation")
+    position = list(root).index(co_simulation) + 1
+    root.insert(position, unit_definitions(v.unit for v in variables if v.type == REAL))
+
+    structure = root.find("ModelStructure")
+    for child in list(structure):
+        structure.remove(child)
+    output_indices = [i + 1 for i, v in enumerate(variables) if v.causality == OUTPUT]
+    if output_indices:
+        outputs = ET.SubElement(structure, "Outputs")
+        for index in output_indices:
+            ET.SubElement(outputs, "Unknown", index=str(index), dependencies="")
+        initial = ET.SubElement(structure, "InitialUnknowns")
+        for index in output_indices:
+            ET.SubElement(initial, "Unknown", index=str(index))
+
+    ET.indent(root, space="  ")
+    buffer = io.BytesIO()
+    ET.ElementTree(root).write(buffer, encoding="UTF-8", xml_declaration=True)
+    return buffer.getvalue() + b"\n"
+
+
+def read_member(fmu_path: Path, name: str = MODEL_DESCRIPTION) -> bytes:
+    """One file of an FMU archive."""
+    with zipfile.ZipFile(fmu_path) as archive:
+        return archive.read(name)
+
+
+def rewrite_archive(fmu_path: Path, replacements: dict[str, bytes]) -> None:
+    """Rewrite an FMU archive (deflate-compressed) with some members replaced."""
+    fmu_path = Path(fmu_path)
+    with zipfile.ZipFile(fmu_path) as archive:
+        members = [(info, archive.read(info)) for info in archive.infolist()]
+    tmp = fmu_path.with_suffix(".fmu.tmp")
+    with zipfile.ZipFile(tmp, "w") as archive:
+        for info, data in members:
+            info.compress_type = zipfile.ZIP_DEFLATED
+            archive.writestr(info, replacements.get(info.filename, data))
+    tmp.replace(fmu_path)

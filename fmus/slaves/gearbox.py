@@ -1,0 +1,153 @@
+"""Gearbox FMU: the gearbox side of the co-simulation cut (:class:`components.gearbox_model.GearboxModel`).
+
+Inputs ``omega_rotor``, ``phi_rotor`` (kinematic driver of the stage-1 carrier)
+and ``omega_gen``, ``phi_gen`` (far end of shaft 3). Outputs: ``shaft_torque``
+(shaft 3 on the generator; step average or end value per the parameter
+``shaft_torque_mode``), ``shaft_torque_end``, ``shaft_torque_avg``,
+``omega_out``, ``torque_rotor``, every contact force (``stage1.F_sp[1]``,
+``stage1.F_rp[1]``, ..., ``stage3.F_mesh``), every shaft torque
+(``shaft1.torque``, ...) and every body speed (``stage1.sun.omega``, ...).
+
+The structure (stages, planets, shafts) is fixed at build time by the preset;
+every number is a parameter (see :mod:`fmus.slaves.gearbox_parameters`).
+Before the first step (initialisation mode) the outputs describe the
+kinematically consistent, undeflected initial state at the current inputs,
+e.g. ``omega_out = ratio * omega_rotor``.
+"""
+
+from __future__ import annotations
+
+from typing import Hashable, Iterable
+
+from components.assembly import Assembly
+from components.errors import ParameterError
+from components.gearbox_model import SHAFT_TORQUE_MODES, GearboxModel
+from components.integrators import StepControl
+from components.presets import cosim_preset
+from components.wind import WindParameters
+
+from .base import DtcosimSlave
+from .gearbox_parameters import control_from_values, drivetrain_from_values, drivetrain_variables, solver_variables
+from .interface import Variable, boolean_parameter, enumeration_text, integer_parameter, real_input, real_output
+
+_MESH_KINDS = {"sun_planet": "sun-planet mesh", "ring_planet": "ring-planet mesh", "parallel": "parallel-stage mesh"}
+
+# output groups, each refreshed from the model at most once per step and only when read
+_TORQUE, _SHAFTS, _SPEEDS, _ROTOR, _FORCES = "torque", "shafts", "speeds", "rotor", "forces"
+_MAIN_GROUPS = {"shaft_torque": _TORQUE, "shaft_torque_avg": _TORQUE, "shaft_torque_end": _SHAFTS,
+                "omega_out": _SPEEDS, "torque_rotor": _ROTOR}
+
+
+def _assembly(preset: str) -> Assembly:
+    return Assembly(cosim_preset(preset), cut_at_generator=True)
+
+
+class Gearbox(DtcosimSlave):
+    """Multi-stage gearbox with CFS gear contact and shaft 3, cut at the generator, as an FMU."""
+
+    description = ("dtcosim Gearbox: multi-stage planetary/parallel gearbox with CFS (or impact) gear contact "
+                   "and shaft 3, driven by the rotor motion and cut at the generator (SI units)")
+
+    @classmethod
+    def build_interface(cls) -> Iterable[Variable]:
+        template = cosim_preset(cls.preset)
+        assembly = _assembly(cls.preset)
+        omega0 = WindParameters().mean_speed_rad_s
+        ratio = float(assembly.port_ratio[0])
+        variables = drivetrain_variables(template)
+        variables += solver_variables(StepControl())
+        variables += [
+            integer_parameter("shaft_torque_mode", 0,
+                              f"value reported as shaft_torque: {enumeration_text(SHAFT_TORQUE_MODES)} "
+                              "(average over the last step conserves the exchanged impulse)"),
+            boolean_parameter("extrapolate_inputs", True,
+                              "extrapolate the input speeds over a step with the slope of the last two inputs "
+                              "(false: hold them)"),
+            real_input("omega_rotor", omega0, "rad/s", "rotor speed driving the stage-1 carrier"),
+            real_input("phi_rotor", 0.0, "rad", "rotor angle"),
+            real_input("omega_gen", ratio * omega0, "rad/s", "generator speed (far end of shaft 3)"),
+            real_input("phi_gen", 0.0, "rad", "generator angle (far end of shaft 3)"),
+            real_output("shaft_torque", "N.m",
+                        "torque of shaft 3 on the generator, per shaft_torque_mode (default: step average)"),
+            real_output("shaft_torque_end", "N.m", "torque of shaft 3 on the generator at the end of the last step"),
+            real_output("shaft_torque_avg", "N.m", "torque of shaft 3 on the generator averaged over the last step"),
+            real_output("omega_out", "rad/s", f"speed of the output member {assembly.stage_members[template.stages[-1].name]['output']}"),
+            real_output("torque_rotor", "N.m", "torque the rotor applies to the gearbox (for the power balance)"),
+        ]
+        for mesh in assembly.meshes:
+            variables.append(real_output(mesh.name, "N", f"contact force of the {mesh.stage} {_MESH_KINDS[mesh.kind]} {mesh.name}"))
+        for shaft in assembly.shafts:
+            variables.append(real_output(f"{shaft.name}.torque", "N.m",
+                                         f"torque of {shaft.name} ({shaft.upstream} -> {shaft.downstream})"))
+        for body in assembly.dof_names:
+            variables.append(real_output(f"{body}.omega", "rad/s", f"absolute speed of {body}"))
+        return variables
+
+    def __init__(self, **kwargs) -> None:
+        super().__init__(**kwargs)
+        assembly = _assembly(self.preset)
+        self._template = cosim_preset(self.preset)
+        vr = self.vr
+        self._vr_inputs = tuple(vr[n] for n in ("omega_rotor", "phi_rotor", "omega_gen", "phi_gen"))
+        self._vr_torque = (vr["shaft_torque"], vr["shaft_torque_avg"])
+        self._vr_shafts = (vr["shaft_torque_end"],) + tuple(vr[f"{s.name}.torque"] for s in assembly.shafts)
+        self._vr_speeds = (vr["omega_out"],) + tuple(vr[f"{b}.omega"] for b in assembly.dof_names)
+        self._vr_rotor = vr["torque_rotor"]
+        self._vr_forces = tuple(vr[m.name] for m in assembly.meshes)
+        self._out_index = assembly.dof_index(assembly.stage_members[self._template.stages[-1].name]["output"])
+        self.model: GearboxModel | None = None
+
+    def output_group(self, name: str) -> Hashable:
+        if name in _MAIN_GROUPS:
+            return _MAIN_GROUPS[name]
+        if name.endswith(".torque"):
+            return _SHAFTS
+        if name.endswith(".omega"):
+            return _SPEEDS
+        return _FORCES
+
+    # ------------------------------------------------------------------ hooks
+    def _configure(self) -> None:
+        mode = self.value("shaft_torque_mode")
+        if not 0 <= mode < len(SHAFT_TORQUE_MODES):
+            raise ParameterError("shaft_torque_mode", mode, enumeration_text(SHAFT_TORQUE_MODES))
+        drivetrain = drivetrain_from_values(self._template, self.value)
+        control = control_from_values(self.value)
+        self.model = GearboxModel(drivetrain, control, SHAFT_TORQUE_MODES[mode], bool(self.value("extrapolate_inputs")))
+
+    def _initialize(self, start_time: float) -> None:
+        values = self._values
+        self.model.initialize(start_time, *(values[i] for i in self._vr_inputs))
+
+    def _step(self, time: float, step_size: float) -> None:
+        values = self._values
+        i = self._vr_inputs
+        self.model.step(time, step_size, values[i[0]], values[i[1]], values[i[2]], values[i[3]])
+
+    def _refresh(self, group: Hashable) -> None:
+        model = self.model
+        values = self._values
+        if group == _TORQUE:
+            i_torque, i_avg = self._vr_torque
+            values[i_torque] = float(model.shaft_torque_nm)
+            values[i_avg] = float(model.shaft_torque_average_nm)
+        elif group == _SHAFTS:
+            torques = model.shaft_torques_nm.tolist()
+            for vr, value in zip(self._vr_shafts, [torques[-1]] + torques):
+                values[vr] = value
+        elif group == _SPEEDS:
+            speeds = model.speeds_rad_s
+            out = [float(speeds[self._out_index])] + speeds.tolist()
+            for vr, value in zip(self._vr_speeds, out):
+                values[vr] = value
+        elif group == _ROTOR:
+            values[self._vr_rotor] = float(model.rotor_torque_nm)
+        else:
+            for vr, value in zip(self._vr_forces, model.contact_force_n.tolist()):
+                values[vr] = value
+
+    def _component_state(self) -> dict:
+        return self.model.get_state()
+
+    def _restore_component_state(self, state: dict) -> None:
+        self.model.set_state(state)

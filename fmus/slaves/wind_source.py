@@ -1,0 +1,87 @@
+"""WindSource FMU: the rotor-speed process of eq. 13-14 (:mod:`components.wind`).
+
+Parameters (SI, paper defaults): ``omega0``, ``a``, ``sigma``, ``n_harmonics``,
+``f_min``, ``f_max``, ``seed``, ``amplitude`` (0 = variance-preserving
+``W_k = sqrt(2 S df)``, 1 = the paper's literal ``W_k = S df``).
+Outputs: rotor speed ``omega`` [rad/s] and angle ``phi`` [rad] (``phi(0) = 0``)
+at the current communication point. The signal is a closed-form function of
+time, so the only state is the time itself.
+"""
+
+from __future__ import annotations
+
+from typing import Hashable, Iterable
+
+from components.errors import ParameterError
+from components.wind import AMPLITUDE_CONVENTIONS, RotorSpeedProcess, WindParameters
+
+from .base import DtcosimSlave, fmu_parameter_names
+from .interface import Variable, enumeration_text, integer_parameter, real_output, real_parameter
+
+#: component parameter name -> FMU variable name
+_NAMES = {f"wind.{n}": n for n in ("omega0", "a", "sigma", "n_harmonics", "f_min", "f_max", "seed", "amplitude")}
+
+
+class WindSource(DtcosimSlave):
+    """Stochastic rotor speed (eq. 13-14) as an FMU with outputs ``omega`` and ``phi``."""
+
+    description = "dtcosim WindSource: stochastic rotor speed omega(t) and angle phi(t) of eq. 13-14 (SI units)"
+
+    @classmethod
+    def build_interface(cls) -> Iterable[Variable]:
+        d = WindParameters()
+        amplitude = enumeration_text(AMPLITUDE_CONVENTIONS)
+        return (
+            real_parameter("omega0", d.mean_speed_rad_s, "rad/s", "mean rotor speed omega0 (eq. 13; paper: 16 rpm)"),
+            real_parameter("a", d.spectrum_level, "rad/s",
+                           "spectral level a of S(f) = a exp(-a f / sigma^2) (eq. 14; paper: 0.02 in rpm units)"),
+            real_parameter("sigma", d.sigma_rad_s, "rad/s", "fluctuation intensity sigma (eq. 14; paper: 0.12 rpm)"),
+            integer_parameter("n_harmonics", d.n_harmonics, "number of harmonics N (>= 1)"),
+            real_parameter("f_min", d.f_min_rad_s, "rad/s", "lowest angular frequency of the harmonics"),
+            real_parameter("f_max", d.f_max_rad_s, "rad/s", "highest angular frequency of the harmonics"),
+            integer_parameter("seed", d.seed, "seed of the random phases (numpy default_rng, >= 0)"),
+            integer_parameter("amplitude", AMPLITUDE_CONVENTIONS.index(d.amplitude),
+                              f"amplitude convention: {amplitude} (W_k = sqrt(2 S df) or the paper's S df)"),
+            real_output("omega", "rad/s", "rotor speed omega(t) (eq. 13)"),
+            real_output("phi", "rad", "rotor angle phi(t), the integral of omega from t = 0"),
+        )
+
+    def output_group(self, name: str) -> Hashable:
+        return "motion"
+
+    def _configure(self) -> None:
+        code = self.value("amplitude")
+        if not 0 <= code < len(AMPLITUDE_CONVENTIONS):
+            raise ParameterError("amplitude", code, enumeration_text(AMPLITUDE_CONVENTIONS))
+        with fmu_parameter_names(_NAMES):
+            params = WindParameters(
+                mean_speed_rad_s=self.value("omega0"),
+                spectrum_level=self.value("a"),
+                sigma_rad_s=self.value("sigma"),
+                n_harmonics=self.value("n_harmonics"),
+                f_min_rad_s=self.value("f_min"),
+                f_max_rad_s=self.value("f_max"),
+                seed=self.value("seed"),
+                amplitude=AMPLITUDE_CONVENTIONS[code],
+            )
+            self.process = RotorSpeedProcess(params)
+        self._vr_omega = self.vr["omega"]
+        self._vr_phi = self.vr["phi"]
+
+    def _initialize(self, start_time: float) -> None:
+        pass  # closed form in time: nothing to initialise
+
+    def _step(self, time: float, step_size: float) -> None:
+        if not step_size > 0.0:
+            raise ParameterError("step_size", step_size, "> 0")
+
+    def _refresh(self, group: Hashable) -> None:
+        t = self._time
+        self._values[self._vr_omega] = self.process.speed(t)
+        self._values[self._vr_phi] = self.process.angle(t)
+
+    def _component_state(self) -> dict:
+        return {}
+
+    def _restore_component_state(self, state: dict) -> None:
+        pass

@@ -1,0 +1,42 @@
+"""Validation of built FMUs: ``fmpy.validation`` plus dtcosim's own conventions."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Iterable
+
+from fmpy import read_model_description
+from fmpy.validation import validate_fmu
+
+
+def convention_problems(fmu_path: Path | str) -> list[str]:
+    """dtcosim conventions: described variables, a unit on every Real, state handling enabled."""
+    md = read_model_description(str(fmu_path), validate=False)
+    problems = []
+    for v in md.modelVariables:
+        if not v.description:
+            problems.append(f'Variable "{v.name}" has no description.')
+        if v.type == "Real" and not v.unit:
+            problems.append(f'Real variable "{v.name}" declares no unit.')
+    cs = md.coSimulation
+    if cs is None:
+        problems.append("The FMU does not support co-simulation.")
+    elif not (cs.canGetAndSetFMUstate and cs.canSerializeFMUstate):
+        problems.append("canGetAndSetFMUstate and canSerializeFMUstate must be true.")
+    return problems
+
+
+def check_fmu(fmu_path: Path | str) -> list[str]:
+    """All problems of one FMU (empty if it is valid)."""
+    problems = validate_fmu(str(fmu_path))
+    if problems:
+        return list(problems)
+    return convention_problems(fmu_path)
+
+
+def fmu_files(paths: Iterable[Path | str]) -> list[Path]:
+    """``.fmu`` files named directly or contained in the given directories (sorted)."""
+    found: list[Path] = []
+    for p in map(Path, paths):
+        found += sorted(p.glob("*.fmu")) if p.is_dir() else [p]
+    return found

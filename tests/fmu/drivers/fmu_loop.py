@@ -1,0 +1,135 @@
+"""Plain fmpy co-simulation loop over the three dtcosim FMUs (imports nothing from dtcosim).
+
+Used by the tests in-process and in a fresh virtual environment that has
+numpy, scipy and fmpy but not dtcosim; also a template for other hosts.
+
+Initialisation (the order the orchestrator uses): WindSource -> omega, phi at
+t0; Gearbox inputs from the wind, ``omega_gen = omega_out``, ``phi_gen =
+ratio * phi_rotor`` (zero twist); GeneratorRotor ``initial_speed/angle`` from
+those; then every FMU exits initialisation mode. Stepping (Gauss-Seidel, step
+``H``): the Gearbox steps with the wind and generator motion at ``t``, the
+generator steps with the Gearbox's ``shaft_torque``, the wind steps.
+
+Usage: ``python fmu_loop.py FMU_DIR T_END H OUT.npz``
+"""
+
+from __future__ import annotations
+
+import sys
+from ctypes import c_double, c_uint32
+from pathlib import Path
+
+import numpy as np
+from fmpy import extract, read_model_description
+from fmpy.fmi2 import FMU2Slave
+
+#: recorded signals: (FMU, variable)
+RECORDED = (
+    ("WindSource", "omega"),
+    ("Gearbox", "shaft_torque"),
+    ("Gearbox", "omega_out"),
+    ("Gearbox", "stage1.F_sp[1]"),
+    ("Gearbox", "torque_rotor"),
+    ("GeneratorRotor", "omega"),
+)
+
+
+class Instance:
+    """One FMU instance with value references by name and fast get/set through the C API."""
+
+    def __init__(self, fmu_path: Path, name: str) -> None:
+        md = read_model_description(str(fmu_path))
+        self.vr = {v.name: v.valueReference for v in md.modelVariables}
+        self.unzip_dir = extract(str(fmu_path))
+        self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=self.unzip_dir,
+                             modelIdentifier=md.coSimulation.modelIdentifier, instanceName=name)
+        self.fmu.instantiate(loggingOn=True)
+        self.fmu.setupExperiment(startTime=0.0)
+        self.fmu.enterInitializationMode()
+
+    def get(self, *names: str) -> list[float]:
+        return self.fmu.getReal([self.vr[n] for n in names])
+
+    def set(self, **values: float) -> None:
+        self.fmu.setReal([self.vr[n] for n in values], list(values.values()))
+
+    def setter(self, *names: str):
+        """Fast setter for fixed value references (pre-built arrays)."""
+        vrs = (c_uint32 * len(names))(*[self.vr[n] for n in names])
+        buf = (c_double * len(names))()
+        fmi2SetReal, component = self.fmu.fmi2SetReal, self.fmu.component
+
+        def set_values(*values: float) -> None:
+            buf[:] = values
+            fmi2SetReal(component, vrs, len(names), buf)
+
+        return set_values
+
+    def getter(self, *names: str):
+        """Fast getter for fixed value references (pre-built arrays)."""
+        vrs = (c_uint32 * len(names))(*[self.vr[n] for n in names])
+        buf = (c_double * len(names))()
+        fmi2GetReal, component = self.fmu.fmi2GetReal, self.fmu.component
+
+        def get_values() -> list[float]:
+            fmi2GetReal(component, vrs, len(names), buf)
+            return buf[:]
+
+        return get_values
+
+
+def run(fmu_dir: str | Path, t_end: float, step: float) -> dict[str, np.ndarray]:
+    """Run the loop; returns ``{"time": ..., "<FMU>.<variable>": ...}`` sampled after each step."""
+    fmu_dir = Path(fmu_dir)
+    wind = Instance(fmu_dir / "WindSource.fmu", "wind")
+    gearbox = Instance(fmu_dir / "Gearbox.fmu", "gearbox")
+    generator = Instance(fmu_dir / "GeneratorRotor.fmu", "generator")
+    instances = {"WindSource": wind, "Gearbox": gearbox, "GeneratorRotor": generator}
+
+    omega_rotor, phi_rotor = wind.get("omega", "phi")
+    gearbox.set(omega_rotor=omega_rotor, phi_rotor=phi_rotor)
+    (omega_out,) = gearbox.get("omega_out")
+    ratio = omega_out / omega_rotor
+    gearbox.set(omega_gen=omega_out, phi_gen=ratio * phi_rotor)
+    generator.set(initial_speed=omega_out, initial_angle=ratio * phi_rotor)
+    for inst in instances.values():
+        inst.fmu.exitInitializationMode()
+
+    set_gearbox = gearbox.setter("omega_rotor", "phi_rotor", "omega_gen", "phi_gen")
+    get_torque = gearbox.getter("shaft_torque")
+    set_torque = generator.setter("shaft_torque")
+    get_wind = wind.getter("omega", "phi")
+    get_generator = generator.getter("omega", "phi")
+    recorders = [instances[f].getter(v) for f, v in RECORDED]
+
+    n_steps = int(round(t_end / step))
+    record = np.empty((n_steps + 1, len(RECORDED) + 1))
+    record[0] = [0.0] + [r()[0] for r in recorders]
+    for n in range(n_steps):
+        t = n * step
+        set_gearbox(*get_wind(), *get_generator())
+        gearbox.fmu.doStep(t, step)
+        set_torque(*get_torque())
+        generator.fmu.doStep(t, step)
+        wind.fmu.doStep(t, step)
+        record[n + 1] = [t + step] + [r()[0] for r in recorders]
+    for inst in instances.values():
+        inst.fmu.terminate()
+        inst.fmu.freeInstance()
+    out = {"time": record[:, 0]}
+    for k, (f, v) in enumerate(RECORDED):
+        out[f"{f}.{v}"] = record[:, k + 1]
+    out["initial_generator_speed"] = np.array(omega_out)
+    return out
+
+
+def loaded_dtcosim_modules() -> list[str]:
+    """Top-level modules of this process that come from dtcosim (the FMUs' private packages included)."""
+    tops = {name.split(".")[0] for name in sys.modules}
+    return sorted(t for t in tops if t.startswith("_dtcosim_") or t in ("components", "fmus", "orchestrator"))
+
+
+if __name__ == "__main__":
+    fmu_dir, t_end, step, out_path = sys.argv[1], float(sys.argv[2]), float(sys.argv[3]), sys.argv[4]
+    result = run(fmu_dir, t_end, step)
+    np.savez(out_path, modules=np.array(loaded_dtcosim_modules()), **result)
