@@ -219,6 +219,8 @@ class ContactLaw:
             _pm_half_jt=np.vstack([-self._half_jt, self._half_jt]),
             _lam2=np.vstack([self._lam, self._lam]),
             _sqrt_law=bool(np.all(self._e == 1.5)),
+            # |delta| beyond which tanh(lambda (|delta| -+ j_t/2)) == 1 in double precision
+            _deep=self._half_jt + 20.0 / self._lam,
         )
 
     @property
@@ -319,6 +321,13 @@ class ContactLaw:
         """
         if self._any_impact:
             return self.evaluate(deflection, rate, stiffness_factor).force
+        abs_d = np.abs(deflection)
+        if self._sqrt_law and not (abs_d < self._deep).any():
+            # every mesh deep in flank contact: d_BL = delta - sgn(delta) j_t/2 and d d_BL/d delta = 1 exactly
+            flank = np.sign(deflection)
+            pen = abs_d - self._half_jt
+            signed = pen * (self._k * stiffness_factor * np.sqrt(pen) + self._c * flank * rate)
+            return flank * np.maximum(signed, 0.0)
         X = deflection + self._pm_half_jt  # rows: delta - j_t/2, delta + j_t/2
         U = X * self._lam2
         T = np.tanh(U)
