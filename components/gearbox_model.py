@@ -327,12 +327,13 @@ class GearboxModel:
         # first stage reuses the loads at the end of the previous step: the prescribed
         # motions are C1, so only the driver-acceleration term changes
         a0 = sysm.last_acceleration + a.kinematic_ratio * (sysm.last_alpha - sysm.driver.accel(0.0))
-        saved = (self.integrator.snapshot(), sysm.cache())
+        saved = (self.integrator.snapshot(), sysm.cache(), sysm.port_jacobian)
         try:
             self.y, _ = self.integrator.advance(0.0, self.y, h, a0=a0)
         except SolverError as exc:
             self.integrator.restore(saved[0])
             sysm.restore(saved[1])
+            sysm.port_jacobian = saved[2]
             raise SolverError(str(exc).rsplit(" (at t =", 1)[0], t + exc.time_s) from None
         self.time_s = t + h
         self.driver_angle_rad = angle1
