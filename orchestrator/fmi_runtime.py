@@ -30,6 +30,8 @@ from .fmu_interface import FmuInterface
 FMI_OK, FMI_WARNING, FMI_DISCARD, FMI_ERROR, FMI_FATAL = 0, 1, 2, 3, 4
 
 _EXTRACTED: dict[str, Path] = {}
+#: log message lists of the live instances by instance name (see FmuInstance)
+_LOG_SINKS: dict[str, deque] = {}
 _EXTRACT_ROOT: Path | None = None
 
 
@@ -98,7 +100,11 @@ class FmuInstance:
         def logger(env, instance, status, category, message):
             text = message.decode("utf-8", "replace") if message else ""
             cat = category.decode("utf-8", "replace") if category else ""
-            self.log.append(f"[{status_label(status)}] {cat + ': ' if cat else ''}{text}")
+            name = instance.decode("utf-8", "replace") if instance else ""
+            # pythonfmu 0.7 may deliver a message through another instance's callbacks:
+            # route it by the instance name it carries
+            sink = _LOG_SINKS.get(name, self.log)
+            sink.append(f"[{status_label(status)}] {cat + ': ' if cat else ''}{text}")
 
         cb = fmi2CallbackFunctions()
         cb.logger = fmi2CallbackLoggerTYPE(logger)
@@ -147,9 +153,11 @@ class FmuInstance:
     # -------------------------------------------------------------- lifecycle
     def instantiate(self, start_s: float, stop_s: float | None) -> None:
         """fmi2Instantiate (logging on) and fmi2SetupExperiment."""
+        _LOG_SINKS[self.name] = self.log
         self._call("fmi2Instantiate", start_s, self.slave.instantiate, False, self._callbacks, True)
         self.component = self.slave.component
         self.state = "instantiated"
+        _LOG_SINKS[self.name] = self.log
         self._call("fmi2SetupExperiment", start_s, self.slave.setupExperiment, None, start_s, stop_s)
 
     def enter_initialization(self, start_s: float) -> None:
@@ -220,6 +228,8 @@ class FmuInstance:
                 pass
         self.state = "freed"
         self.component = None
+        if _LOG_SINKS.get(self.name) is self.log:
+            del _LOG_SINKS[self.name]
 
 
 def value_references(iface: FmuInterface, names: Iterable[str]):

@@ -1,0 +1,207 @@
+"""The master with small real FMUs: time grid, Gauss-Seidel/Jacobi data flow, extrapolation,
+initialisation, sampling, failures, convergence with the step size."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.linalg import expm
+
+from orchestrator.master import CoSimulation
+from orchestrator.scenario import load_scenario
+from orchestrator.system import resolve_system
+
+CHAIN = """
+name = "chain"
+[simulation]
+start = 0.3
+stop = {stop}
+step = 0.1
+algorithm = "{algorithm}"
+extrapolation = "{extrapolation}"
+{order}
+[components.src]
+fmu = "ToySine.fmu"
+[components.src.parameters]
+frequency = 0.37
+[components.int]
+fmu = "ToyIntegrator.fmu"
+[[connections]]
+from = "src.y"
+to = "int.u"
+[record]
+variables = ["src.y", "src.t_seen", "int.u_seen", "int.t_seen", "int.x"]
+"""
+
+
+def run_chain(toy_scenario, algorithm="gauss-seidel", extrapolation="hold", order="", stop=100.3):
+    text = CHAIN.format(algorithm=algorithm, extrapolation=extrapolation, order=order, stop=stop)
+    out = CoSimulation(resolve_system(load_scenario(toy_scenario(text)))).run(handle_sigint=False)
+    assert out.complete
+    return out
+
+
+def test_time_is_kept_by_integer_step_count(toy_scenario):
+    out = run_chain(toy_scenario)  # 1000 steps of 0.1 s from 0.3 s
+    k = np.arange(1, out.steps + 1)
+    # the communication point of step k-1 is t0 + (k-1) H exactly, not a running sum
+    assert np.array_equal(out.column("int.t_seen")[1:], 0.3 + (k - 1) * 0.1)
+    assert np.array_equal(out.time_s, 0.3 + np.arange(out.steps + 1) * 0.1)
+    running = 0.3
+    for _ in range(out.steps):
+        running += 0.1
+    assert running != out.time_s[-1]  # accumulating would have drifted
+
+
+def test_gauss_seidel_default_order_feeds_values_at_the_communication_point(toy_scenario):
+    out = run_chain(toy_scenario)
+    # the integrator is stepped before its source: it receives y(t_k) for the step from t_k
+    y = out.column("src.y")
+    assert np.array_equal(out.column("int.u_seen")[1:], y[:-1])
+
+
+def test_gauss_seidel_with_source_first_feeds_the_new_values(toy_scenario):
+    out = run_chain(toy_scenario, order='order = ["src", "int"]')
+    assert np.array_equal(out.column("int.u_seen")[1:], out.column("src.y")[1:])
+
+
+def test_jacobi_feeds_values_at_the_communication_point(toy_scenario):
+    out = run_chain(toy_scenario, algorithm="jacobi", order='order = ["src", "int"]')
+    assert np.array_equal(out.column("int.u_seen")[1:], out.column("src.y")[:-1])
+
+
+def test_linear_extrapolation_to_the_step_midpoint(toy_scenario):
+    y_out = run_chain(toy_scenario, extrapolation="linear")
+    y = y_out.column("src.y")
+    u = y_out.column("int.u_seen")
+    # samples at t_k, t_{k-1}: 1.5 y_k - 0.5 y_{k-1}; first step holds
+    assert u[1] == y[0]
+    np.testing.assert_allclose(u[2:], 1.5 * y[1:-1] - 0.5 * y[:-2], rtol=0, atol=1e-15)
+    gs = run_chain(toy_scenario, extrapolation="linear", order='order = ["src", "int"]')
+    y, u = gs.column("src.y"), gs.column("int.u_seen")
+    # source already stepped: mean of the samples at t_{k+1} and t_k
+    np.testing.assert_allclose(u[1:], 0.5 * (y[1:] + y[:-1]), rtol=0, atol=1e-15)
+
+
+def test_sampling_every_n_steps_matches_every_step(toy_scenario):
+    every = run_chain(toy_scenario, stop=10.3)
+    text = CHAIN.format(algorithm="gauss-seidel", extrapolation="hold", order="", stop=10.3).replace(
+        "step = 0.1", "step = 0.1\noutput_interval = 0.5")
+    sparse = CoSimulation(resolve_system(load_scenario(toy_scenario(text)))).run(handle_sigint=False)
+    assert sparse.values.shape == (21, 5)
+    np.testing.assert_array_equal(sparse.time_s, every.time_s[::5])
+    np.testing.assert_array_equal(sparse.values, every.values[::5])
+
+
+INIT = """
+name = "init"
+[simulation]
+stop = 0.05
+step = 0.01
+[components.gain]
+fmu = "ToyGain.fmu"
+[components.gain.parameters]
+u = 3.0
+[components.int]
+fmu = "ToyIntegrator.fmu"
+[components.follower]
+fmu = "ToyInit.fmu"
+[components.follower.parameters]
+p0 = 0.5
+[[connections]]
+from = "int.x"
+to = "follower.u"
+[[initial]]
+from = "gain.y"
+to = "int.x0"
+[[initial]]
+from = "follower.y"
+to = "gain.gain"
+"""
+
+
+def test_initialisation_propagates_outputs_into_parameters(toy_scenario):
+    system = resolve_system(load_scenario(toy_scenario(INIT)))
+    out = CoSimulation(system).run(handle_sigint=False)
+    # sweep 1: int.x0 = gain.y = 2 (default gain) * 3 = 6; follower.y = p0 = 0.5 -> gain.gain = 0.5
+    # sweep 2: int.x0 = 0.5 * 3 = 1.5; nothing else changes; sweep 3 confirms the fixed point
+    assert out.complete
+    assert out.initial_values == {"int.x0": 1.5, "gain.gain": 0.5}
+    assert out.column("int.x")[0] == 1.5
+
+
+def test_initial_binding_sets_a_parameter_before_exit(toy_scenario):
+    text = INIT.split("[[initial]]\nfrom = \"follower.y\"")[0].replace("u = 3.0", "u = 3.0\ngain = 2.0")
+    out = CoSimulation(resolve_system(load_scenario(toy_scenario(text)))).run(handle_sigint=False)
+    assert out.initial_values == {"int.x0": 6.0}
+    assert out.column("int.x")[0] == 6.0
+
+
+FAIL = """
+name = "fail"
+[simulation]
+stop = 1.0
+step = 0.01
+[components.src]
+fmu = "ToySine.fmu"
+[components.fail]
+fmu = "ToyFailer.fmu"
+[components.fail.parameters]
+fail_at = 0.5
+mode = 0
+[[connections]]
+from = "src.y"
+to = "fail.u"
+[record]
+variables = ["src.y", "fail.y"]
+"""
+
+
+def test_fmu_failure_stops_the_run_with_partial_results(toy_scenario):
+    out = CoSimulation(resolve_system(load_scenario(toy_scenario(FAIL)))).run(handle_sigint=False)
+    assert not out.complete
+    assert out.steps == 50 and out.stopped_at_s == pytest.approx(0.5)
+    assert out.time_s.size == 51 and np.all(np.isfinite(out.values))
+    assert "FMU 'fail'" in out.error and "fmi2DoStep" in out.error and "discard" in out.error
+    assert "t = 0.5 s" in out.error and "solver failed to converge" in out.error
+
+
+MASSES = """
+name = "masses"
+[simulation]
+stop = 2.0
+step = {step}
+output_interval = 0.02
+algorithm = "{algorithm}"
+[components.a]
+fmu = "ToyMassA.fmu"
+[components.b]
+fmu = "ToyMassB.fmu"
+[[connections]]
+from = "a.x"
+to = "b.xa"
+[[connections]]
+from = "a.v"
+to = "b.va"
+[[connections]]
+from = "b.F"
+to = "a.F"
+[record]
+variables = ["a.x"]
+"""
+
+
+@pytest.mark.parametrize("algorithm", ["gauss-seidel", "jacobi"])
+def test_coupling_error_of_a_split_oscillator_shrinks_with_the_step(toy_scenario, algorithm):
+    ma, ka, ca, mb, kb, cb = 1.0, 100.0, 0.5, 0.5, 50.0, 0.2
+    A = np.array([[0, 1, 0, 0], [-(ka + kb) / ma, -(ca + cb) / ma, kb / ma, cb / ma],
+                  [0, 0, 0, 1], [kb / mb, cb / mb, -kb / mb, -cb / mb]])
+    errors = []
+    for h in (4e-3, 2e-3, 1e-3):
+        text = MASSES.format(step=h, algorithm=algorithm)
+        out = CoSimulation(resolve_system(load_scenario(toy_scenario(text, f"m{h}.toml")))).run(handle_sigint=False)
+        exact = np.array([(expm(A * t) @ [0.1, 0, 0, 0])[0] for t in out.time_s])
+        errors.append(np.sqrt(np.mean((out.column("a.x") - exact) ** 2)))
+    assert errors[0] > errors[1] > errors[2]
+    assert errors[0] / errors[2] > 3.0  # first order at least
+    assert errors[2] < 1e-3
