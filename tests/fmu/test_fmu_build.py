@@ -177,3 +177,14 @@ def test_single_stage_presets_build_and_run(tmp_path, preset):
     assert result["Gearbox.omega_out"][0] == pytest.approx(ratio * result["WindSource.omega"][0], rel=1e-12)
     assert result["initial_generator_speed"] == pytest.approx(ratio * omega0, rel=0.05)
     assert all(math.isfinite(x) for x in result["Gearbox.shaft_torque"])
+
+
+def test_documented_variable_tables_match_the_code():
+    from fmus.docs import update
+
+    doc = fmu_build.SourceTree.installed().components_dir.parent / "docs" / "fmus.md"
+    if not doc.is_file():
+        pytest.skip("docs/fmus.md is not next to the installed package")
+    text = doc.read_text(encoding="utf-8")
+    assert "<!-- BEGIN GENERATED Gearbox -->" in text
+    assert update(text) == text, "run: python -m fmus.docs --update docs/fmus.md"

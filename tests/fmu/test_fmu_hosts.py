@@ -3,11 +3,15 @@ libcosim through libcosimpy, and two differently built FMUs in one process."""
 
 from __future__ import annotations
 
+import os
 import shutil
+import subprocess
 import sys
+import zipfile
 
 import numpy as np
 import pytest
+from fmpy import read_model_description
 from fmu_helpers import Instance, load_driver, run_python
 
 from components.gearbox_model import GearboxModel
@@ -130,3 +134,39 @@ def test_two_differently_built_fmus_each_run_their_own_code(built_fmus, tmp_path
     assert sys.modules[f"{patched.package}.components.gearbox_model"].__file__ != \
         sys.modules[f"{original.package}.components.gearbox_model"].__file__
     assert not isinstance(GearboxModel.rotor_torque_nm, float)
+
+
+@pytest.mark.slow
+def test_c_host_runs_the_gearbox_with_libpython_preloaded(fmu_path, libpython, tmp_path, bare_python):
+    """A plain C host (dlopen + FMI calls, drivers/c_host.c) needs libpython preloaded; results equal fmpy's."""
+    compiler = shutil.which("cc") or shutil.which("gcc")
+    if compiler is None:
+        pytest.skip("no C compiler")
+    host = tmp_path / "c_host"
+    source = load_driver("fmu_loop").__file__.replace("fmu_loop.py", "c_host.c")
+    subprocess.run([compiler, "-O1", "-o", str(host), source, "-ldl"], check=True, capture_output=True)
+    unzipped = tmp_path / "Gearbox"
+    with zipfile.ZipFile(fmu_path("Gearbox")) as archive:
+        archive.extractall(unzipped)
+    md = read_model_description(str(fmu_path("Gearbox")))
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    args = [str(host), str(unzipped / "binaries" / "linux64" / "Gearbox.so"), (unzipped / "resources").as_uri(),
+            md.guid, "200"] + [str(vr[n]) for n in ("omega_rotor", "phi_rotor", "omega_gen", "phi_gen", "shaft_torque")]
+    site = next((bare_python.parent.parent / "lib").glob("python3*/site-packages"))
+    without = subprocess.run(args, capture_output=True, text=True, timeout=120)
+    assert without.returncode != 0 and "undefined symbol" in without.stderr  # the FMU needs libpython's symbols
+    env = {**os.environ, "LD_PRELOAD": str(libpython), "PYTHONPATH": str(site)}
+    result = subprocess.run(args, capture_output=True, text=True, timeout=300, env=env)
+    assert result.returncode == 0, result.stderr[-3000:]
+    torque_c = float(result.stdout.split()[-1])
+    # the same run through fmpy in this process
+    inst = Instance(fmu_path("Gearbox"), "same-as-c")
+    omega_rotor = 1.6755160819145563
+    omega_gen = 0.99 * 100.0 * omega_rotor
+    inst.initialize(omega_rotor=omega_rotor, phi_rotor=0.0, omega_gen=omega_gen, phi_gen=0.0)
+    for n in range(200):
+        t = n * H
+        inst.set(omega_rotor=omega_rotor, phi_rotor=omega_rotor * t, omega_gen=omega_gen, phi_gen=omega_gen * t)
+        inst.step(t, H)
+    assert torque_c == inst.get("shaft_torque")[0]
+    inst.free()
