@@ -288,6 +288,16 @@ class Assembly:
         self._shaft_QY = np.ascontiguousarray(-np.vstack([self.STkS.T, self.STcS.T]))  # y = [q, v] -> shaft torques on dofs
         self._port_Q = -np.stack([self.STkS_port, self.STcS_port])  # (2, n_dof, n_port)
         self._port_meshes = bool(np.any(self.A_port))
+        if self.ports.size > 1:
+            raise ParameterError("ports", self.ports.size, "at most one prescribed port")
+        port_q = self._port_Q[0][:, 0] if self.ports.size else np.zeros(self.n_dof)
+        port_v = self._port_Q[1][:, 0] if self.ports.size else np.zeros(self.n_dof)
+        # acceleration = [force, q, v, port_angle, port_speed, alpha_in] @ _fast_matrix
+        self._fast_matrix = np.ascontiguousarray(
+            np.vstack([self._neg_B, self._shaft_QY, port_q[None, :], port_v[None, :], -self.kinematic_ratio[None, :]])
+            * np.append(self.inv_inertia[None, :].repeat(self._neg_B.shape[0] + 2 * self.n_dof + 2, 0), [np.ones(self.n_dof)], 0)
+        )
+        self._fast_extra = np.zeros(3)
         self._mesh_rate = np.array([m.teeth_per_driver_rad for m in self.meshes])
         self._mesh_offset = np.array([m.phase_offset_rad for m in self.meshes])
         self._mesh_variation = np.array([m.contact.stiffness_variation for m in self.meshes])
@@ -362,40 +372,50 @@ class Assembly:
         torque = self.shaft_k * s + self.shaft_c * sd
         return InternalLoads(d, dd, cf.force, cf.d_force_d_deflection, cf.d_force_d_rate, cf.elastic, s, sd, torque)
 
-    def fast_generalised_forces(
+    def fast_acceleration(
         self,
         y: np.ndarray,
-        port: np.ndarray | None = None,
+        port_angle_rad: float = 0.0,
+        port_speed_rad_s: float = 0.0,
+        driver_acceleration: float = 0.0,
         stiffness_factor: np.ndarray | float = 1.0,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Generalised forces of one state, without derivatives (co-simulation hot path).
+        """Deviation accelerations of one state without derivatives (co-simulation hot path).
+
+        Everything linear (inverse inertia, shafts, the port, the driver
+        acceleration) is folded into one constant matrix, so one evaluation is
+        a deflection product, the contact law and one more product.
 
         Parameters
         ----------
         y : ndarray, shape (2 n_dof,)
             State ``[q, v]``: deviation angles [rad] and speeds [rad/s].
-        port : ndarray, shape (2, n_port), optional
-            Port deviation angle(s) [rad] (row 0) and speed(s) [rad/s] (row 1).
+        port_angle_rad, port_speed_rad_s : float
+            Deviation angle [rad] and speed [rad/s] of the (single) prescribed port; 0 without one.
+        driver_acceleration : float
+            Driver acceleration alpha_in [rad/s^2].
         stiffness_factor : ndarray or float
             Mesh stiffness multiplier.
 
         Returns
         -------
-        Q : ndarray, shape (n_dof,)
-            Generalised torques [N m] (meshes and shafts).
+        acceleration : ndarray, shape (n_dof,)
+            q_ddot [rad/s^2].
         force : ndarray, shape (n_mesh,)
             Contact forces [N].
         deflection : ndarray, shape (2, n_mesh)
             Deflections [m] (row 0) and their rates [m/s] (row 1).
         """
         D = y.reshape(2, self.n_dof) @ self._A_T
-        if port is not None and self._port_meshes:
-            D += port @ self.A_port.T
+        if self._port_meshes:
+            D[0] += self.A_port[:, 0] * port_angle_rad
+            D[1] += self.A_port[:, 0] * port_speed_rad_s
         force = self.law.force(D[0], D[1], stiffness_factor)
-        Q = force @ self._neg_B + y @ self._shaft_QY
-        if port is not None:
-            Q += self._port_Q[0] @ port[0] + self._port_Q[1] @ port[1]
-        return Q, force, D
+        extra = self._fast_extra
+        extra[0] = port_angle_rad
+        extra[1] = port_speed_rad_s
+        extra[2] = driver_acceleration
+        return np.concatenate((force, y, extra)) @ self._fast_matrix, force, D
 
     def generalised_forces(self, loads: InternalLoads) -> np.ndarray:
         """Generalised torques on the free bodies from meshes and shafts [N m], shape (..., n_dof)."""

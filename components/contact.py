@@ -16,9 +16,10 @@ places, which dtcosim handles by clipping ("flank-consistent clipping"):
    exceed the elastic term and the total force would change sign within one
    flank contact; the paper warns about exactly this (Sec. 2.2).
 2. The regularisation itself: ``x tanh(lambda x)`` under-estimates ``|x|`` near
-   ``x = 0``, so ``d_BL`` of eq. 3 dips to ``-1/(8 lambda)`` just *inside* each
-   backlash edge (e.g. -0.0125 mm for lambda = 10/mm, a 70 N pull with the
-   Table 3 stiffness) and the flank would pull the teeth back across the gap.
+   ``x = 0``, so ``d_BL`` of eq. 3 dips to ``-0.139/lambda`` just *inside* each
+   backlash edge (at ``0.64/lambda`` from it; -0.014 mm for lambda = 10/mm, an
+   82 N pull with the Table 3 stiffness) and the flank would pull the teeth
+   back across the gap.
    Left alone, this glues lightly loaded teeth to the flank and suppresses the
    backlash traversal of Fig. 10-11.
 
@@ -219,6 +220,8 @@ class ContactLaw:
             _pm_half_jt=np.vstack([-self._half_jt, self._half_jt]),
             _lam2=np.vstack([self._lam, self._lam]),
             _sqrt_law=bool(np.all(self._e == 1.5)),
+            # |delta| beyond which tanh(lambda (|delta| -+ j_t/2)) == 1 in double precision
+            _deep=self._half_jt + 20.0 / self._lam,
         )
 
     @property
@@ -240,6 +243,10 @@ class ContactLaw:
             d_BL [m], d d_BL / d delta [-], d^2 d_BL / d delta^2 [1/m].
         """
         h = self._half_jt
+        abs_d = np.abs(deflection)
+        if not (abs_d < self._deep).any():  # all deep in flank contact: tanh saturated exactly
+            flank = np.sign(deflection)
+            return deflection - flank * h, np.ones_like(abs_d), np.zeros_like(abs_d)
         lam = self._lam
         x1 = deflection - h
         x2 = deflection + h
@@ -319,6 +326,13 @@ class ContactLaw:
         """
         if self._any_impact:
             return self.evaluate(deflection, rate, stiffness_factor).force
+        abs_d = np.abs(deflection)
+        if self._sqrt_law and not (abs_d < self._deep).any():
+            # every mesh deep in flank contact: d_BL = delta - sgn(delta) j_t/2 and d d_BL/d delta = 1 exactly
+            flank = np.sign(deflection)
+            pen = abs_d - self._half_jt
+            signed = pen * (self._k * stiffness_factor * np.sqrt(pen) + self._c * flank * rate)
+            return flank * np.maximum(signed, 0.0)
         X = deflection + self._pm_half_jt  # rows: delta - j_t/2, delta + j_t/2
         U = X * self._lam2
         T = np.tanh(U)
@@ -355,38 +369,35 @@ class ContactLaw:
             elastic,
         )
 
-    def potential_energy(self, deflection: np.ndarray) -> np.ndarray:
-        """Elastic energy stored in each mesh, ``V = int_0^delta F_el d delta`` [J / (N m / N)].
+    def potential_energy(self, deflection: np.ndarray, nodes: int = 64) -> np.ndarray:
+        """Elastic energy stored in each mesh, ``V = int_0^delta F_el d delta`` [N m].
 
-        Returned per unit of the mesh's moment-arm factor: multiply by
-        ``cos(alpha)`` to get joules, as the generalised forces carry that factor.
+        Multiply by ``cos(alpha)`` to get the energy of the generalised forces
+        (the moment arm is the base radius). Integrated by Gauss-Legendre
+        quadrature on the pieces between 0, the backlash edges and ``delta``,
+        vectorised over all meshes.
 
         Parameters
         ----------
         deflection : ndarray, shape (n_mesh,)
             Deflection [m].
+        nodes : int
+            Gauss-Legendre nodes per piece.
 
         Returns
         -------
         ndarray, shape (n_mesh,)
-            Integral of the elastic force over the deflection [N m].
         """
-        from scipy.integrate import quad
-
-        deflection = np.asarray(deflection, dtype=float)
-        out = np.empty(self.size)
-        for i in range(self.size):
-            sub = ContactLaw([self.meshes[i]])
-
-            def elastic(x: float) -> float:
-                return float(sub.evaluate(np.array([x]), np.array([0.0])).elastic[0])
-
-            d = float(deflection[i])
-            h = float(self._half_jt[i])
-            # split at the backlash edges, where the integrand has its kinks
-            pts = sorted({0.0, d, *[p for p in (-h, h) if min(0.0, d) < p < max(0.0, d)]})
-            total = 0.0
-            for a, b in zip(pts[:-1], pts[1:]):
-                total += quad(elastic, a, b, epsabs=0.0, epsrel=1e-12, limit=200)[0]
-            out[i] = total if d >= 0.0 else -total
-        return out
+        d = np.asarray(deflection, dtype=float)
+        x, w = np.polynomial.legendre.leggauss(nodes)
+        h = self._half_jt
+        # pieces [0, min(|d|, h)] and [min(|d|, h), |d|] on the side of d (an edge is a kink)
+        s = np.where(d < 0.0, -1.0, 1.0)
+        edge = s * np.minimum(np.abs(d), h)
+        total = np.zeros(self.size)
+        for a, b in ((np.zeros_like(d), edge), (edge, d)):
+            mid, half = 0.5 * (a + b), 0.5 * (b - a)
+            pts = mid + np.outer(x, half)  # (nodes, n_mesh)
+            f = self.evaluate(pts, np.zeros_like(pts)).elastic
+            total += half * (w @ f)
+        return total

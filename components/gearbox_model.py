@@ -76,9 +76,9 @@ class _StepSystem:
         self.port = _Hermite()  # q_port(tau) = theta_gen - kappa_gen theta_in
         self.angle0 = 0.0  # theta_in(0), absolute [rad]
         n = assembly.n_dof
-        self._port_qv = np.zeros((2, 1))
         self.port_jacobian = np.zeros((2, n))  # d a / d q_port, d a / d v_port (from the last Jacobian)
-        self.last_Q = np.zeros(n)
+        self.last_acceleration = np.zeros(n)
+        self.last_alpha = 0.0  # driver acceleration used in the last evaluation [rad/s^2]
         self.last_force = np.zeros(assembly.n_mesh)
         self.last_deflection = np.zeros((2, assembly.n_mesh))
 
@@ -89,13 +89,20 @@ class _StepSystem:
         return a.stiffness_factor(self.angle0 + self.driver.value(tau))
 
     def acceleration(self, tau: float, y: np.ndarray) -> np.ndarray:
-        a = self.assembly
-        port = self._port_qv
-        port[0, 0] = self.port.value(tau)
-        port[1, 0] = self.port.rate(tau)
-        Q, force, deflection = a.fast_generalised_forces(y, port, self.stiffness_factor(tau))
-        self.last_Q, self.last_force, self.last_deflection = Q, force, deflection
-        return a.inv_inertia * Q - a.kinematic_ratio * self.driver.accel(tau)
+        alpha = self.driver.accel(tau)
+        acc, force, deflection = self.assembly.fast_acceleration(
+            y, self.port.value(tau), self.port.rate(tau), alpha, self.stiffness_factor(tau)
+        )
+        self.last_acceleration, self.last_alpha, self.last_force, self.last_deflection = acc, alpha, force, deflection
+        return acc
+
+    def cache(self) -> tuple:
+        """The cached last evaluation (for undo)."""
+        return (self.last_acceleration, self.last_alpha, self.last_force, self.last_deflection)
+
+    def restore(self, cached: tuple) -> None:
+        """Undo to :meth:`cache`."""
+        self.last_acceleration, self.last_alpha, self.last_force, self.last_deflection = cached
 
     def jacobian(self, tau: float, y: np.ndarray):
         a = self.assembly
@@ -111,9 +118,9 @@ class _StepSystem:
         a = self.assembly
         if a.time_varying_stiffness:  # stiffness varies with time too: difference the whole a(t)
             eps = 1e-7
-            saved = (self.last_Q, self.last_force, self.last_deflection)
+            saved = self.cache()
             da = (self.acceleration(tau + eps, y) - self.acceleration(tau, y)) / eps
-            self.last_Q, self.last_force, self.last_deflection = saved
+            self.restore(saved)
             return da
         # prescribed motions: port angle/speed and driver jerk
         pj = self.port_jacobian
@@ -160,6 +167,7 @@ class GearboxModel:
     _SCALARS = (
         "time_s", "driver_angle_rad", "driver_speed_rad_s", "driver_accel_rad_s2", "port_angle_rad",
         "port_speed_rad_s", "last_step_s", "last_omega_rotor", "last_omega_gen", "shaft_torque_average_nm",
+        "output_twist_rad",
     )
 
     def __init__(
@@ -188,6 +196,10 @@ class GearboxModel:
         self.last_omega_rotor = 0.0
         self.last_omega_gen = 0.0
         self.shaft_torque_average_nm = 0.0
+        self.output_twist_rad = 0.0  # twist of the output shaft (shaft 3) [rad]
+        # output twist = _twist_q . q + _twist_port * port angle
+        self._twist_q = np.concatenate((a.S[-1], np.zeros(a.n_dof)))
+        self._twist_port = float(a.S_port[-1, 0])
 
     # ------------------------------------------------------------ outputs
     @property
@@ -280,6 +292,7 @@ class GearboxModel:
         sysm.driver.fit(1.0, 0.0, self.driver_speed_rad_s, self.driver_speed_rad_s, self.driver_speed_rad_s)
         sysm.port.fit(1.0, self.port_angle_rad, self.port_speed_rad_s, self.port_angle_rad + self.port_speed_rad_s, self.port_speed_rad_s)
         sysm.acceleration(0.0, self.y)  # loads at the initial state
+        self.output_twist_rad = self._output_twist()
         self.shaft_torque_average_nm = self.shaft_torque_end_nm
         self.initialized = True
 
@@ -310,16 +323,17 @@ class GearboxModel:
         sysm.angle0 = self.driver_angle_rad
         sysm.driver.fit(h, 0.0, self.driver_speed_rad_s, angle1 - self.driver_angle_rad, speed1)
         sysm.port.fit(h, self.port_angle_rad, self.port_speed_rad_s, port1, port_speed1)
-        twist_start = self._output_twist()
+        twist_start = self.output_twist_rad
         # first stage reuses the loads at the end of the previous step: the prescribed
         # motions are C1, so only the driver-acceleration term changes
-        a0 = a.inv_inertia * sysm.last_Q - a.kinematic_ratio * sysm.driver.accel(0.0)
-        saved = (self.integrator.snapshot(), sysm.last_Q, sysm.last_force, sysm.last_deflection)
+        a0 = sysm.last_acceleration + a.kinematic_ratio * (sysm.last_alpha - sysm.driver.accel(0.0))
+        saved = (self.integrator.snapshot(), sysm.cache(), sysm.port_jacobian)
         try:
             self.y, _ = self.integrator.advance(0.0, self.y, h, a0=a0)
         except SolverError as exc:
             self.integrator.restore(saved[0])
-            sysm.last_Q, sysm.last_force, sysm.last_deflection = saved[1:]
+            sysm.restore(saved[1])
+            sysm.port_jacobian = saved[2]
             raise SolverError(str(exc).rsplit(" (at t =", 1)[0], t + exc.time_s) from None
         self.time_s = t + h
         self.driver_angle_rad = angle1
@@ -331,14 +345,13 @@ class GearboxModel:
         self.last_omega_gen = omega_gen
         self.last_step_s = h
         # (1/h) int T dt = k mean(twist) + c (twist_end - twist_start) / h, trapezoid for the mean twist
-        twist_end = self._output_twist()
+        twist_end = self.output_twist_rad = self._output_twist()
         k = a.shaft_k[-1]
         self.shaft_torque_average_nm = k * 0.5 * (twist_start + twist_end) + a.shaft_c[-1] * (twist_end - twist_start) / h
 
     def _output_twist(self) -> float:
         """Twist of the output shaft (shaft 3) [rad]."""
-        a = self.assembly
-        return float(a.S[-1] @ self.y[: a.n_dof] + a.S_port[-1, 0] * self.port_angle_rad)
+        return float(self._twist_q @ self.y) + self._twist_port * self.port_angle_rad
 
     # ---------------------------------------------------------------- state
     def get_state(self) -> dict:
@@ -349,7 +362,8 @@ class GearboxModel:
             y=self.y.tolist(),
             initialized=self.initialized,
             integrator=self.integrator.get_state(),
-            last_Q=sysm.last_Q.tolist(),
+            last_acceleration=sysm.last_acceleration.tolist(),
+            last_alpha=sysm.last_alpha,
             last_force=sysm.last_force.tolist(),
             last_deflection=sysm.last_deflection.tolist(),
             port_jacobian=sysm.port_jacobian.tolist(),
@@ -367,7 +381,8 @@ class GearboxModel:
         self.initialized = bool(state["initialized"])
         self.integrator.set_state(state["integrator"])
         sysm = self.system
-        sysm.last_Q = np.array(state["last_Q"], dtype=float)
+        sysm.last_acceleration = np.array(state["last_acceleration"], dtype=float)
+        sysm.last_alpha = float(state["last_alpha"])
         sysm.last_force = np.array(state["last_force"], dtype=float)
         sysm.last_deflection = np.array(state["last_deflection"], dtype=float)
         sysm.port_jacobian = np.array(state["port_jacobian"], dtype=float)

@@ -123,6 +123,7 @@ class Rosenbrock23:
         self._age = -1  # < 0: no Jacobian yet
         self._hd = -1.0  # step*d the inverse was formed for
         self._winv = np.zeros((2 * n, 2 * n))
+        self._winv_v = np.zeros((2 * n, n))
         c = self.control
         self._atol = np.concatenate((np.full(n, c.atol_q), np.full(n, c.atol_v)))
 
@@ -147,6 +148,7 @@ class Rosenbrock23:
         winv[n:, :n] = hd * ginv_dq
         winv[n:, n:] = ginv
         self._winv = winv
+        self._winv_v = np.ascontiguousarray(winv[:, n:])
         self._hd = hd
 
     # -------------------------------------------------------------------- step
@@ -157,17 +159,16 @@ class Rosenbrock23:
         if hd != self._hd:
             self._factor(hd)
         winv = self._winv
-        hdT = np.zeros(2 * n)
-        hdT[n:] = hd * self.system.time_derivative(t, y)
-        k1 = winv @ (f0 + hdT)
+        w_hdT = self._winv_v @ (hd * self.system.time_derivative(t, y))  # W^-1 [0, h d a_t]
+        k1 = winv @ f0 + w_hdT
         y1 = y + (0.5 * h) * k1
         f1 = np.concatenate((y1[n:], self.system.acceleration(t + 0.5 * h, y1)))
         k2 = winv @ (f1 - k1) + k1
         yn = y + h * k2
         fn = np.concatenate((yn[n:], self.system.acceleration(t + h, yn)))
-        k3 = winv @ (fn - _E32 * (k2 - f1) - 2.0 * (k1 - f0) + hdT)
+        k3 = winv @ (fn - _E32 * (k2 - f1) - 2.0 * (k1 - f0)) + w_hdT
         scale = self._atol + self.control.rtol * np.maximum(np.abs(y), np.abs(yn))
-        err = (h / 6.0) * float(np.max(np.abs(k1 - 2.0 * k2 + k3) / scale))
+        err = (h / 6.0) * float((np.abs(k1 + k3 - 2.0 * k2) / scale).max())
         if not math.isfinite(err):
             err = math.inf
         return yn, fn, err
@@ -238,11 +239,13 @@ class Rosenbrock23:
 
     def snapshot(self) -> tuple:
         """Cheap in-memory copy of the state (arrays are replaced, never mutated, so references suffice)."""
-        return (self.h_next, self.accepted, self.rejected, self.jacobians, self._age, self._hd, self._dq, self._dv, self._winv)
+        return (self.h_next, self.accepted, self.rejected, self.jacobians, self._age, self._hd, self._dq, self._dv,
+                self._winv, self._winv_v)
 
     def restore(self, snap: tuple) -> None:
         """Undo to a :meth:`snapshot`."""
-        (self.h_next, self.accepted, self.rejected, self.jacobians, self._age, self._hd, self._dq, self._dv, self._winv) = snap
+        (self.h_next, self.accepted, self.rejected, self.jacobians, self._age, self._hd, self._dq, self._dv,
+         self._winv, self._winv_v) = snap
 
     # ------------------------------------------------------------------- state
     def get_state(self) -> dict:
@@ -271,6 +274,7 @@ class Rosenbrock23:
         self._dq = np.array(state["dq"], dtype=float).reshape(n, n)
         self._dv = np.array(state["dv"], dtype=float).reshape(n, n)
         self._winv = np.array(state["winv"], dtype=float).reshape(2 * n, 2 * n)
+        self._winv_v = np.ascontiguousarray(self._winv[:, n:])
 
     def reset(self) -> None:
         """Forget the step size and the Jacobian (e.g. after re-initialisation)."""

@@ -254,9 +254,12 @@ def _collect(system: MonolithicSystem, t: np.ndarray, Y: np.ndarray) -> Simulati
     q = Y[:, :n]
     v = Y[:, n : 2 * n]
     drv = system.driver
-    omega_in = np.asarray(drv.speed(t), dtype=float) * np.ones_like(t)
-    alpha_in = np.asarray(drv.acceleration(t), dtype=float) * np.ones_like(t)
-    angle_in = np.asarray(drv.angle(t), dtype=float) * np.ones_like(t)
+    if hasattr(drv, "kinematics"):
+        angle_in, omega_in, alpha_in = drv.kinematics(t)
+    else:
+        omega_in = np.asarray(drv.speed(t), dtype=float) * np.ones_like(t)
+        alpha_in = np.asarray(drv.acceleration(t), dtype=float) * np.ones_like(t)
+        angle_in = np.asarray(drv.angle(t), dtype=float) * np.ones_like(t)
     kfac = a.stiffness_factor(angle_in) if a.time_varying_stiffness else 1.0
     loads = a.loads(q, v, stiffness_factor=kfac)
     load_torque = np.asarray(system.schedule(t), dtype=float) * np.ones_like(t)

@@ -1,0 +1,197 @@
+"""Flat, named SI parameters <-> a structured :class:`Drivetrain`.
+
+FMUs and scenario files address parameters by flat names such as
+``stage1.planet_inertia`` or ``shaft3.stiffness``. This module is the single
+mapping between those names and the frozen parameter dataclasses, used by the
+Gearbox FMU (its parameters) and by the orchestrator (monolithic reference of
+a scenario), so both always describe the same drivetrain.
+
+The structure (number and kind of stages, planets per stage) comes from a
+template drivetrain; every value can be overridden by name. Validation happens
+when the dataclasses are rebuilt, so a bad value raises
+:class:`~components.errors.ParameterError` naming the parameter.
+
+Names, units and meaning
+------------------------
+Per planetary stage ``stageK``: ``sun_radius``, ``ring_radius``, ``module``,
+``width`` [m]; ``sun_mass``, ``planet_mass`` [kg]; ``sun_inertia``,
+``planet_inertia``, ``carrier_inertia`` [kg m^2] (carrier: extra inertia on top of
+the planets' orbital inertia). Per parallel stage: ``drive_radius``,
+``driven_radius``, ``module``, ``width`` [m]; ``drive_mass``, ``driven_mass``
+[kg]; ``drive_inertia``, ``driven_inertia`` [kg m^2]. Mesh contact of every stage
+(sun-planet and ring-planet share them): ``k0`` [N/m^e], ``exponent`` [-], ``c0``
+[N s/m^2], ``lambda`` [1/m], ``backlash`` [m] (normal), ``pressure_angle`` [rad],
+``contact_law`` (0 = CFS, 1 = impact), ``impact_depth`` [m], ``impact_damping``
+[N s/m] (negative: ``c0 * impact_depth``), ``contact_ratio`` [-],
+``stiffness_variation`` [-]. Per shaft ``shaftK``: ``stiffness`` [N m/rad],
+``damping`` [N m s/rad]. Generator: ``generator.inertia`` [kg m^2],
+``generator.counter_torque`` [N m]. Without a generator: ``output_torque`` [N m].
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from typing import Mapping
+
+from .contact import CONTACT_LAWS, MeshContact
+from .drivetrain import Drivetrain
+from .errors import ParameterError
+from .stages import ParallelStage, PlanetaryStage, Shaft
+
+UNITS: dict[str, str] = {
+    "sun_radius": "m", "ring_radius": "m", "drive_radius": "m", "driven_radius": "m", "module": "m", "width": "m",
+    "sun_mass": "kg", "planet_mass": "kg", "drive_mass": "kg", "driven_mass": "kg",
+    "sun_inertia": "kg.m2", "planet_inertia": "kg.m2", "carrier_inertia": "kg.m2",
+    "drive_inertia": "kg.m2", "driven_inertia": "kg.m2",
+    "k0": "N/m^e", "exponent": "1", "c0": "N.s/m2", "lambda": "1/m", "backlash": "m", "pressure_angle": "rad",
+    "contact_law": "1", "impact_depth": "m", "impact_damping": "N.s/m", "contact_ratio": "1",
+    "stiffness_variation": "1", "stiffness": "N.m/rad", "damping": "N.m.s/rad", "inertia": "kg.m2",
+    "counter_torque": "N.m", "output_torque": "N.m",
+}
+
+DESCRIPTIONS: dict[str, str] = {
+    "sun_radius": "sun pitch radius", "ring_radius": "ring pitch radius", "drive_radius": "drive-gear pitch radius",
+    "driven_radius": "driven-gear pitch radius", "module": "gear module", "width": "face width",
+    "sun_mass": "sun mass", "planet_mass": "mass of one planet", "drive_mass": "drive-gear mass",
+    "driven_mass": "driven-gear mass", "sun_inertia": "sun polar inertia", "planet_inertia": "planet spin inertia",
+    "carrier_inertia": "carrier inertia in addition to the planets' orbital inertia",
+    "drive_inertia": "drive-gear inertia", "driven_inertia": "driven-gear inertia",
+    "k0": "Hertzian contact stiffness k0 (eq. 2)", "exponent": "contact force exponent e",
+    "c0": "contact damping c0, damping = c0 |delta_BL| (eq. 2, 9)", "lambda": "backlash regularisation factor (eq. 4)",
+    "backlash": "normal backlash j_n", "pressure_angle": "pressure angle", "contact_law": "0 = CFS (eq. 2-4), 1 = impact (eq. 1)",
+    "impact_depth": "penetration d_max of full impact damping", "impact_damping": "impact damping c_max (< 0: c0 * d_max)",
+    "contact_ratio": "contact ratio (time-varying stiffness)", "stiffness_variation": "relative mesh-stiffness variation (0: off)",
+    "stiffness": "torsional stiffness", "damping": "torsional damping", "inertia": "rotor inertia",
+    "counter_torque": "generator counter torque", "output_torque": "counter torque on the output gear",
+}
+
+_MESH_FIELDS = {
+    "k0": "stiffness", "exponent": "exponent", "c0": "damping", "lambda": "regularisation",
+    "backlash": "backlash_normal_m", "pressure_angle": "pressure_angle_rad", "impact_depth": "impact_depth_m",
+    "contact_ratio": "contact_ratio", "stiffness_variation": "stiffness_variation",
+}
+_PLANETARY_FIELDS = {
+    "sun_radius": "sun_radius_m", "ring_radius": "ring_radius_m", "module": "module_m", "width": "width_m",
+    "sun_mass": "sun_mass_kg", "planet_mass": "planet_mass_kg", "sun_inertia": "sun_inertia_kgm2",
+    "planet_inertia": "planet_inertia_kgm2", "carrier_inertia": "carrier_inertia_kgm2",
+}
+_PARALLEL_FIELDS = {
+    "drive_radius": "drive_radius_m", "driven_radius": "driven_radius_m", "module": "module_m", "width": "width_m",
+    "drive_mass": "drive_mass_kg", "driven_mass": "driven_mass_kg", "drive_inertia": "drive_inertia_kgm2",
+    "driven_inertia": "driven_inertia_kgm2",
+}
+
+
+def unit_of_parameter(name: str) -> str:
+    """Unit string of a flat parameter name (``"N/m^e"`` has the exponent e)."""
+    return UNITS.get(name.rsplit(".", 1)[-1], "1")
+
+
+def description_of_parameter(name: str) -> str:
+    """Short description of a flat parameter name."""
+    return DESCRIPTIONS.get(name.rsplit(".", 1)[-1], name)
+
+
+def _mesh_values(prefix: str, mesh: MeshContact) -> dict[str, float]:
+    out = {f"{prefix}.{k}": float(getattr(mesh, f)) for k, f in _MESH_FIELDS.items()}
+    out[f"{prefix}.contact_law"] = float(CONTACT_LAWS.index(mesh.law))
+    out[f"{prefix}.impact_damping"] = -1.0 if mesh.impact_damping is None else float(mesh.impact_damping)
+    return out
+
+
+def flatten(drivetrain: Drivetrain) -> dict[str, float]:
+    """All parameter values of a drivetrain by flat name (SI units)."""
+    out: dict[str, float] = {}
+    for st in drivetrain.stages:
+        fields = _PLANETARY_FIELDS if isinstance(st, PlanetaryStage) else _PARALLEL_FIELDS
+        out.update({f"{st.name}.{k}": float(getattr(st, f)) for k, f in fields.items()})
+        out.update(_mesh_values(st.name, st.sun_mesh if isinstance(st, PlanetaryStage) else st.mesh))
+    for sh in drivetrain.all_shafts:
+        out[f"{sh.name}.stiffness"] = sh.stiffness_nm_per_rad
+        out[f"{sh.name}.damping"] = sh.damping_nms_per_rad
+    if drivetrain.generator is not None:
+        out["generator.inertia"] = drivetrain.generator.inertia_kgm2
+        out["generator.counter_torque"] = drivetrain.generator.counter_torque_nm
+    else:
+        out["output_torque"] = drivetrain.output_torque_nm
+    return out
+
+
+def _mesh_from(prefix: str, mesh: MeshContact, values: Mapping[str, float]) -> MeshContact:
+    changes = {f: values[f"{prefix}.{k}"] for k, f in _MESH_FIELDS.items() if f"{prefix}.{k}" in values}
+    key = f"{prefix}.contact_law"
+    if key in values:
+        code = values[key]
+        if not (isinstance(code, (int, float)) and not isinstance(code, bool) and float(code).is_integer()
+                and 0 <= int(code) < len(CONTACT_LAWS)):
+            raise ParameterError(key, code, "0 (CFS) or 1 (impact)")
+        changes["law"] = CONTACT_LAWS[int(code)]
+    key = f"{prefix}.impact_damping"
+    if key in values:
+        v = values[key]
+        changes["impact_damping"] = None if (isinstance(v, (int, float)) and not math.isnan(v) and v < 0) else v
+    try:
+        return replace(mesh, **changes)
+    except ParameterError as exc:  # re-raise under the flat name
+        flat = next((f"{prefix}.{k}" for k, f in _MESH_FIELDS.items() if exc.name in (f, k)), f"{prefix}.{exc.name}")
+        raise ParameterError(flat, exc.value, exc.expected) from None
+
+
+def unflatten(template: Drivetrain, values: Mapping[str, float]) -> Drivetrain:
+    """A drivetrain with the structure of ``template`` and the given values.
+
+    Parameters
+    ----------
+    template : Drivetrain
+        Supplies the structure and every value not given.
+    values : mapping of str -> float
+        Flat names (see module docstring); unknown names raise ParameterError.
+
+    Returns
+    -------
+    Drivetrain
+        Validated; a bad value raises ParameterError naming the flat parameter.
+    """
+    known = flatten(template)
+    for name in values:
+        if name not in known:
+            raise ParameterError(name, values[name], "a parameter of this drivetrain (see components.parameter_map)")
+    stages = []
+    for st in template.stages:
+        fields = _PLANETARY_FIELDS if isinstance(st, PlanetaryStage) else _PARALLEL_FIELDS
+        changes = {f: values[f"{st.name}.{k}"] for k, f in fields.items() if f"{st.name}.{k}" in values}
+        if isinstance(st, PlanetaryStage):
+            mesh = _mesh_from(st.name, st.sun_mesh, values)
+            changes.update(sun_mesh=mesh, ring_mesh=mesh)
+        else:
+            changes["mesh"] = _mesh_from(st.name, st.mesh, values)
+        try:
+            stages.append(replace(st, **changes))
+        except ParameterError as exc:
+            local = exc.name.split(".", 1)[-1]
+            flat = next((f"{st.name}.{k}" for k, f in fields.items() if f == local), exc.name)
+            raise ParameterError(flat, exc.value, exc.expected) from None
+
+    def shaft(sh: Shaft) -> Shaft:
+        try:
+            return Shaft(
+                sh.name,
+                values.get(f"{sh.name}.stiffness", sh.stiffness_nm_per_rad),
+                values.get(f"{sh.name}.damping", sh.damping_nms_per_rad),
+            )
+        except ParameterError as exc:
+            raise ParameterError(exc.name.replace("_nm_per_rad", "").replace("_nms_per_rad", ""), exc.value, exc.expected) from None
+
+    shafts = tuple(shaft(sh) for sh in template.shafts)
+    if template.generator is not None:
+        from .generator import GeneratorParameters
+
+        gen = template.generator
+        generator = GeneratorParameters(
+            inertia_kgm2=values.get("generator.inertia", gen.inertia_kgm2),
+            counter_torque_nm=values.get("generator.counter_torque", gen.counter_torque_nm),
+            events=gen.events,
+        )
+        return replace(template, stages=tuple(stages), shafts=shafts, generator=generator, output_shaft=shaft(template.output_shaft))
+    return replace(template, stages=tuple(stages), shafts=shafts, output_torque_nm=values.get("output_torque", template.output_torque_nm))

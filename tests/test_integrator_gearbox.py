@@ -1,0 +1,141 @@
+"""Rosenbrock23 W-method and the co-simulation gearbox component."""
+
+import json
+
+import numpy as np
+import pytest
+
+from components.errors import SolverError
+from components.gearbox_model import GearboxModel
+from components.generator import GeneratorParameters, GeneratorRotor
+from components.integrators import Rosenbrock23, StepControl
+from components.presets import table6_gearbox
+from components.reference import simulate_monolithic
+from components.wind import RotorSpeedProcess, WindParameters
+
+
+class Oscillator:
+    """Damped oscillator q'' = -k q - c q' + sin(t) (k = 400, c = 2: 20 rad/s, lightly damped)."""
+
+    k, c = 400.0, 2.0
+    n = 1
+
+    def acceleration(self, t, y):
+        return np.array([-self.k * y[0] - self.c * y[1] + np.sin(t)])
+
+    def jacobian(self, t, y):
+        return np.array([[-self.k]]), np.array([[-self.c]])
+
+    def time_derivative(self, t, y):
+        return np.array([np.cos(t)])
+
+
+def _integrate(h, max_age):
+    osc = Oscillator()
+    integ = Rosenbrock23(osc, 1, StepControl(rtol=1e3, atol_q=1e3, atol_v=1e3, jacobian_max_age=max_age))  # fixed h
+    integ.h_next = h
+    y = np.array([1.0, 0.0])
+    t = 0.0
+    while t < 1.0 - 1e-12:
+        y, _ = integ.advance(t, y, t + h)
+        t += h
+    return y[0]
+
+
+def test_second_order_convergence_on_a_stiff_problem():
+    ref = _integrate(1e-5, 1)
+    errors = [abs(_integrate(h, 1) - ref) for h in (1e-2, 5e-3, 2.5e-3)]
+    orders = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
+    assert np.all(orders > 1.7), orders
+
+
+def test_stale_jacobian_keeps_the_order():
+    ref = _integrate(1e-5, 1)
+    e1 = abs(_integrate(1e-2, 50) - ref)
+    e2 = abs(_integrate(5e-3, 50) - ref)
+    assert e1 / e2 > 3.0  # still second order with a Jacobian reused for 50 steps
+
+
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")
+def test_step_size_floor_raises_solver_error():
+    class Blowup(Oscillator):
+        def acceleration(self, t, y):
+            return np.array([np.inf])
+
+    integ = Rosenbrock23(Blowup(), 1, StepControl(h_min=1e-6))
+    with pytest.raises(SolverError, match="below h_min"):
+        integ.advance(0.0, np.array([0.0, 0.0]), 1e-3)
+
+
+def _paper_setup():
+    dt = table6_gearbox()
+    wind = RotorSpeedProcess(WindParameters())
+    return dt, wind
+
+
+def _cosim(dt, wind, t_end, h, model=None, gen=None, start=0):
+    model = model or GearboxModel(dt)
+    gen = gen or GeneratorRotor(dt.generator, initial_speed_rad_s=dt.ratio * wind.speed(0.0))
+    if start == 0:
+        model.initialize(0.0, wind.speed(0.0), wind.angle(0.0), gen.speed_rad_s, gen.angle_rad)
+    n = int(round(t_end / h))
+    out = []
+    for k in range(start, start + n):
+        t = k * h
+        model.step(t, h, wind.speed(t), wind.angle(t), gen.speed_rad_s, gen.angle_rad)
+        gen.step(t, h, model.shaft_torque_nm)
+        out.append((model.contact_force_n[0], model.contact_force_n[-1], gen.speed_rad_s, model.shaft_torque_nm))
+    return np.array(out), model, gen
+
+
+def test_cosimulated_gearbox_tracks_the_monolithic_reference():
+    dt, wind = _paper_setup()
+    h = 1e-3
+    out, model, gen = _cosim(dt, wind, 3.5, h)
+    ref = simulate_monolithic(dt, wind, 3.5, output_interval_s=h)
+    sel = slice(1000, None)  # after the first second
+    for col, name in ((0, "stage1.F_sp[1]"), (1, "stage3.F_mesh"), (2, "omega_gen")):
+        err = np.abs(out[sel, col] - ref[name][1:][sel]).max()
+        assert err < 1e-3 * np.abs(ref[name]).max(), name
+    # past the start-up transient: one internal step per communication step, Jacobian rarely refreshed
+    before = (model.integrator.accepted, model.integrator.jacobians)
+    _cosim(dt, wind, 0.5, h, model, gen, start=3500)
+    assert model.integrator.accepted - before[0] == 500
+    assert model.integrator.jacobians - before[1] <= 500 // 20 + 1
+
+
+def test_state_round_trip_replays_bit_identically():
+    dt, wind = _paper_setup()
+    h = 1e-3
+    _, model, gen = _cosim(dt, wind, 0.5, h)
+    state = json.loads(json.dumps(model.get_state()))  # through JSON, as an FMU would serialise it
+    gen_state = (gen.speed_rad_s, gen.angle_rad)
+    first, _, _ = _cosim(dt, wind, 0.2, h, model, gen, start=500)
+    fresh = GearboxModel(dt)
+    fresh.set_state(state)
+    gen.speed_rad_s, gen.angle_rad = gen_state
+    second, _, _ = _cosim(dt, wind, 0.2, h, fresh, gen, start=500)
+    np.testing.assert_array_equal(first, second)
+
+
+def test_failed_step_leaves_state_untouched():
+    dt, wind = _paper_setup()
+    model = GearboxModel(dt, control=StepControl(max_steps=2))
+    gen = GeneratorRotor(dt.generator, initial_speed_rad_s=dt.ratio * wind.speed(0.0))
+    model.initialize(0.0, wind.speed(0.0), wind.angle(0.0), gen.speed_rad_s, gen.angle_rad)
+    before = json.dumps(model.get_state())
+    with pytest.raises(SolverError, match=r"more than 2 steps.*at t ="):
+        model.step(0.0, 0.5, wind.speed(0.0), wind.angle(0.0), gen.speed_rad_s + 50.0, gen.angle_rad)
+    assert json.dumps(model.get_state()) == before
+
+
+def test_averaged_torque_conserves_the_exchanged_impulse():
+    dt, wind = _paper_setup()
+    h = 2e-3
+    out, _, _ = _cosim(dt, wind, 1.0, h)
+    ref = simulate_monolithic(dt, wind, 1.0, output_interval_s=1e-4)
+    t = ref.time_s
+    torque = ref["shaft3.torque"]
+    impulse_ref = np.trapezoid(torque, t)
+    impulse_cosim = out[:, 3].sum() * h
+    assert impulse_cosim == pytest.approx(impulse_ref, rel=2e-3)

@@ -1,0 +1,86 @@
+"""The paper's cases with the monolithic reference solver (Tables 2, 4, 7; Fig. 10-11, 16)."""
+
+import json
+
+import numpy as np
+import pytest
+
+from components.cases import CASES, TABLE7_PAPER, run_case
+from orchestrator.cli import main
+
+
+@pytest.fixture(scope="module")
+def table7():
+    return run_case("table7")
+
+
+def test_table2_parallel_stage_mean_force():
+    _, stats = run_case("table2")
+    assert stats["stage1.F_mesh"]["mean"] == pytest.approx(9.67e3, rel=0.01)
+
+
+def test_table4_planetary_stage_force_sums():
+    _, stats = run_case("table4")
+    assert stats["stage1.sum_F_sp"]["mean"] == pytest.approx(9.66e3, rel=0.01)
+    assert stats["stage1.sum_F_rp"]["mean"] == pytest.approx(9.66e3, rel=0.01)
+
+
+def test_fig10_sine_drive_crosses_the_backlash():
+    result, stats = run_case("sine")
+    assert result.complete
+    f = result["stage1.F_sp[1]"]
+    assert f.max() > 10.0 and f.min() < -10.0  # both flanks carry load
+    inside = np.abs(f) < 1.0
+    assert 0.1 < inside.mean() < 0.99  # zero-force intervals inside the backlash
+    edges = np.flatnonzero(np.diff(inside.astype(int)))
+    assert edges.size >= 6  # repeated contact loss and re-contact
+    assert stats["stage1.F_sp[1]"]["backlash_fraction"] == pytest.approx(inside.mean(), abs=1e-3)
+
+
+def test_table7_means(table7, capsys):
+    result, stats = table7
+    assert result.complete
+    for name, (mean, std) in TABLE7_PAPER.items():
+        assert stats[name]["mean"] == pytest.approx(mean, rel=0.01), name
+        with capsys.disabled():
+            print(f"\n{name}: mean {stats[name]['mean']:.5g} (paper {mean:.5g}), std {stats[name]['std']:.5g} (paper {std:.5g})")
+
+
+def test_fig16_generator_follows_ideal_gearbox(table7):
+    result, stats = table7
+    dev = stats["omega_gen_deviation"]
+    assert max(abs(dev["min"]), abs(dev["max"])) < 0.01
+
+
+def test_energy_audit_closes(table7):
+    result, _ = table7
+    e = result.energy
+    assert e.input_work_j > 2e8  # ~4.3 MW for 60 s
+    assert e.relative_residual < 0.005
+    assert e.dissipated_j > 0
+
+
+def test_monolithic_run_is_fast(table7):
+    result, _ = table7
+    assert result.info["rhs_calls"] < 50_000  # the benchmark tracks wall time; this guards against stiffness blow-ups
+
+
+def test_reference_cli_json(capsys):
+    assert main(["reference", "--case", "table2", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["case"] == "table2"
+    assert set(out["statistics"]["stage1.F_mesh"]) == {"mean", "std", "min", "max"}
+    assert out["wall_time_s"] > 0
+
+
+def test_reference_cli_table7_names(capsys):
+    assert main(["reference", "--case", "table7", "--json", "--t-end", "6"]) == 0
+    stats = json.loads(capsys.readouterr().out)["statistics"]
+    for k in (1, 2):
+        for i in (1, 2, 3):
+            assert f"stage{k}.F_sp[{i}]" in stats and f"stage{k}.F_rp[{i}]" in stats
+    assert "stage3.F_mesh" in stats and "omega_gen" in stats
+
+
+def test_all_cases_are_listed():
+    assert set(CASES) == {"table2", "table4", "sine", "table7"}
