@@ -1,1 +1,1 @@
-"""pythonfmu slaves for the dtcosim components and the code that builds them into FMUs."""
+"""Thin pythonfmu slaves over the physics in components/ (``fmus.slaves``), and the FMU build (``fmus.build``, build_fmus.py)."""

@@ -58,7 +58,7 @@ UNITS: dict[str, UnitDefinition] = {
         _unit("N.m", {"kg": 1, "m": 2, "s": -2}, **{"kN.m": 1.0e-3}),
         _unit("N.m/rad", {"kg": 1, "m": 2, "s": -2, "rad": -1}),
         _unit("N.m.s/rad", {"kg": 1, "m": 2, "s": -1, "rad": -1}),
-        _unit("N/m^1.5", None),
+        _unit("N/m^e", None),  # contact stiffness k0 for a force exponent e (N/m^1.5 by default)
         _unit("N.s/m2", {"kg": 1, "m": -1, "s": -1}),
         _unit("N.s/m", {"kg": 1, "s": -1}),
         _unit("1/m", {"m": -1}),

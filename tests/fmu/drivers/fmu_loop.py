@@ -100,10 +100,11 @@ def run(fmu_dir: str | Path, t_end: float, step: float) -> dict[str, np.ndarray]
     set_torque = generator.setter("shaft_torque")
     get_wind = wind.getter("omega", "phi")
     get_generator = generator.getter("omega", "phi")
-    recorders = [instances[f].getter(v) for f, v in RECORDED]
+    recorded = [(f, v) for f, v in RECORDED if v in instances[f].vr]  # e.g. no F_sp in a parallel-only preset
+    recorders = [instances[f].getter(v) for f, v in recorded]
 
     n_steps = int(round(t_end / step))
-    record = np.empty((n_steps + 1, len(RECORDED) + 1))
+    record = np.empty((n_steps + 1, len(recorded) + 1))
     record[0] = [0.0] + [r()[0] for r in recorders]
     for n in range(n_steps):
         t = n * step
@@ -117,7 +118,7 @@ def run(fmu_dir: str | Path, t_end: float, step: float) -> dict[str, np.ndarray]
         inst.fmu.terminate()
         inst.fmu.freeInstance()
     out = {"time": record[:, 0]}
-    for k, (f, v) in enumerate(RECORDED):
+    for k, (f, v) in enumerate(recorded):
         out[f"{f}.{v}"] = record[:, k + 1]
     out["initial_generator_speed"] = np.array(omega_out)
     return out

@@ -1,0 +1,204 @@
+#!/usr/bin/env python3
+"""Cost of one communication step of the Gearbox FMU through fmpy, next to a trivial FMU.
+
+One step is ``fmi2SetReal`` (4 inputs) + ``fmi2DoStep`` + ``fmi2GetReal``
+(``shaft_torque``) at H = 1 ms, called through fmpy's low-level ``FMU2Slave``
+with pre-built value-reference and value arrays. The Gearbox is driven at the
+Table 7 operating point: its inputs are the rotor and generator motion of a
+coupled wind -> gearbox -> generator run (computed beforehand with the
+components, which the FMU reproduces bit for bit), and timing starts after
+the start-up transient (``--warmup``). The trivial FMU (4 inputs, 1 output,
+``do_step`` copies one input) is built in the same run and measures the FMI
+plumbing alone. Each figure is the median over ``--repeat`` blocks of
+``--steps`` steps of the mean cost per step.
+
+Usage::
+
+    python benchmarks/bench_gearbox_fmu.py [--steps 1000] [--repeat 5] [--warmup 3.0] [--preset table6]
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import sys
+import tempfile
+import textwrap
+import time
+from ctypes import c_double, c_uint32
+from pathlib import Path
+
+import numpy as np
+from fmpy import extract, read_model_description
+from fmpy.fmi2 import FMU2Slave
+from pythonfmu import FmuBuilder
+
+from components.gearbox_model import GearboxModel
+from components.generator import GeneratorRotor
+from components.presets import cosim_preset
+from components.wind import RotorSpeedProcess, WindParameters
+from fmus.build import build_fmu
+
+STEP_S = 1.0e-3
+INPUTS = ("omega_rotor", "phi_rotor", "omega_gen", "phi_gen")
+
+TRIVIAL_SLAVE = textwrap.dedent('''
+    from pythonfmu import Fmi2Causality, Fmi2Slave, Real
+
+
+    class DtcosimBenchTrivial(Fmi2Slave):
+        """Four inputs, one output; do_step copies the first input."""
+
+        def __init__(self, **kwargs):
+            super().__init__(**kwargs)
+            self.u1 = self.u2 = self.u3 = self.u4 = 0.0
+            self.y = 0.0
+            for name in ("u1", "u2", "u3", "u4"):
+                self.register_variable(Real(name, causality=Fmi2Causality.input))
+            self.register_variable(Real("y", causality=Fmi2Causality.output))
+
+        def do_step(self, current_time, step_size):
+            self.y = self.u1
+            return True
+''')
+
+
+def reference_inputs(preset: str, n_steps: int) -> tuple[np.ndarray, GearboxModel]:
+    """Gearbox inputs of a coupled run with the components, shape (n_steps, 4), as the FMU loop computes them."""
+    drivetrain = cosim_preset(preset)
+    gearbox = GearboxModel(drivetrain)
+    wind = RotorSpeedProcess(WindParameters())
+    w0, p0 = wind.speed(0.0), wind.angle(0.0)
+    gearbox.initialize(0.0, w0, p0, gearbox.ratio * w0, gearbox.ratio * p0)
+    w_out = gearbox.output_speed_rad_s
+    ratio = w_out / w0
+    gearbox.initialize(0.0, w0, p0, w_out, ratio * p0)
+    generator = GeneratorRotor(drivetrain.generator, w_out, ratio * p0)
+    inputs = np.empty((n_steps, 4))
+    t_wind = 0.0
+    for n in range(n_steps):
+        t = n * STEP_S
+        inputs[n] = wind.speed(t_wind), wind.angle(t_wind), generator.speed_rad_s, generator.angle_rad
+        gearbox.step(t, STEP_S, *inputs[n])
+        generator.step(t, STEP_S, gearbox.shaft_torque_nm)
+        t_wind = t + STEP_S
+    return inputs, (w0, p0, w_out, ratio * p0)
+
+
+class LowLevelFmu:
+    """An instantiated FMU with pre-built arrays for one setReal/doStep/getReal round trip."""
+
+    def __init__(self, path: Path, inputs: tuple[str, ...], output: str, initial: dict[str, float]) -> None:
+        md = read_model_description(str(path))
+        vr = {v.name: v.valueReference for v in md.modelVariables}
+        self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=extract(str(path)),
+                             modelIdentifier=md.coSimulation.modelIdentifier, instanceName="bench")
+        self.fmu.instantiate()
+        self.fmu.setupExperiment(startTime=0.0)
+        self.fmu.enterInitializationMode()
+        if initial:
+            self.fmu.setReal([vr[k] for k in initial], list(initial.values()))
+        self.fmu.exitInitializationMode()
+        self.in_vr = (c_uint32 * len(inputs))(*[vr[n] for n in inputs])
+        self.in_val = (c_double * len(inputs))()
+        self.out_vr = (c_uint32 * 1)(vr[output])
+        self.out_val = (c_double * 1)()
+        self.n_in = len(inputs)
+
+    def run(self, inputs: np.ndarray, first_step: int) -> float:
+        """Step through ``inputs`` (one row per step); returns the wall time [s] of the FMI calls."""
+        fmu, component = self.fmu, self.fmu.component
+        set_real, do_step, get_real = fmu.fmi2SetReal, fmu.fmi2DoStep, fmu.fmi2GetReal
+        in_vr, in_val, out_vr, out_val, n_in = self.in_vr, self.in_val, self.out_vr, self.out_val, self.n_in
+        rows = inputs.tolist()
+        elapsed = 0.0
+        clock = time.perf_counter
+        for k, row in enumerate(rows):
+            in_val[:] = row
+            start = clock()
+            set_real(component, in_vr, n_in, in_val)
+            status = do_step(component, (first_step + k) * STEP_S, STEP_S, 1)
+            get_real(component, out_vr, 1, out_val)
+            elapsed += clock() - start
+            if status != 0:
+                raise RuntimeError(f"fmi2DoStep returned status {status} at step {first_step + k}")
+        return elapsed
+
+    def close(self) -> None:
+        self.fmu.terminate()
+        self.fmu.freeInstance()
+
+
+def build_trivial(out_dir: Path) -> Path:
+    """Build the trivial pythonfmu FMU into ``out_dir``."""
+    src = out_dir / "src"
+    src.mkdir()
+    script = src / "dtcosim_bench_trivial.py"
+    script.write_text(TRIVIAL_SLAVE)
+    return Path(FmuBuilder.build_FMU(script, dest=out_dir))
+
+
+def blocks(fmu: LowLevelFmu, inputs: np.ndarray, first_step: int, steps: int, repeat: int) -> list[float]:
+    """Mean cost per step [us] of ``repeat`` consecutive blocks of ``steps`` steps."""
+    out = []
+    for r in range(repeat):
+        lo = r * steps
+        out.append(fmu.run(inputs[lo: lo + steps], first_step + lo) / steps * 1e6)
+    return out
+
+
+def model_only(preset: str, inputs: np.ndarray, initial: tuple, warmup: int, steps: int, repeat: int) -> list[float]:
+    """The same blocks with GearboxModel.step called directly (no FMI) [us/step]."""
+    gearbox = GearboxModel(cosim_preset(preset))
+    gearbox.initialize(0.0, *initial)
+    for n in range(warmup):
+        gearbox.step(n * STEP_S, STEP_S, *inputs[n])
+    out = []
+    clock = time.perf_counter
+    for r in range(repeat):
+        start = clock()
+        for n in range(warmup + r * steps, warmup + (r + 1) * steps):
+            gearbox.step(n * STEP_S, STEP_S, *inputs[n])
+            gearbox.shaft_torque_nm
+        out.append((clock() - start) / steps * 1e6)
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--steps", type=int, default=1000, help="steps per timed block (default 1000)")
+    parser.add_argument("--repeat", type=int, default=5, help="timed blocks (default 5)")
+    parser.add_argument("--warmup", type=float, default=3.0, help="simulated start-up time not timed [s] (default 3)")
+    parser.add_argument("--preset", default="table6", help="drivetrain preset (default table6)")
+    args = parser.parse_args(argv)
+
+    warmup = int(round(args.warmup / STEP_S))
+    n_total = warmup + args.steps * args.repeat
+    inputs, initial = reference_inputs(args.preset, n_total)
+    with tempfile.TemporaryDirectory(prefix="dtcosim_bench_") as tmp:
+        tmp = Path(tmp)
+        gearbox_path = build_fmu("Gearbox", tmp, args.preset).path
+        trivial_path = build_trivial(tmp)
+        gearbox = LowLevelFmu(gearbox_path, INPUTS, "shaft_torque", dict(zip(INPUTS, initial)))
+        gearbox.run(inputs[:warmup], 0)
+        gearbox_us = blocks(gearbox, inputs[warmup:], warmup, args.steps, args.repeat)
+        gearbox.close()
+        trivial = LowLevelFmu(trivial_path, ("u1", "u2", "u3", "u4"), "y", {})
+        trivial.run(inputs[:warmup], 0)
+        trivial_us = blocks(trivial, inputs[warmup:], warmup, args.steps, args.repeat)
+        trivial.close()
+    model_us = model_only(args.preset, inputs, initial, warmup, args.steps, args.repeat)
+
+    g, t, m = statistics.median(gearbox_us), statistics.median(trivial_us), statistics.median(model_us)
+    print(f"setReal(4) + doStep + getReal(1) at H = {STEP_S * 1e3:g} ms, preset {args.preset}, "
+          f"after {args.warmup:g} s start-up; median of {args.repeat} blocks of {args.steps} steps")
+    print(f"  Gearbox FMU          {g:8.1f} us/step   blocks: {', '.join(f'{x:.1f}' for x in gearbox_us)}")
+    print(f"  trivial FMU          {t:8.1f} us/step   blocks: {', '.join(f'{x:.1f}' for x in trivial_us)}")
+    print(f"  ratio Gearbox/trivial {g / t:7.2f}")
+    print(f"  GearboxModel.step alone (no FMI) {m:.1f} us/step; FMU layer + FMI = {g - m:.1f} us/step")
+    print(f"  target: Gearbox <= 100 us/step -> {'met' if g <= 100.0 else 'NOT met'}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
