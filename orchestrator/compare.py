@@ -74,33 +74,6 @@ def component_roles(system: ResolvedSystem) -> dict[str, str]:
     return roles
 
 
-def _gearbox_flat_values(values: Mapping[str, Any]) -> dict[str, float]:
-    """Gearbox FMU parameter values under :mod:`components.parameter_map` names.
-
-    Accepts the map's own names (``stage1.k0``) and per-mesh names
-    (``stage1.sun_mesh.k0``, ``stage1.ring_mesh.k0``, ``stage3.mesh.k0``, with
-    ``law`` for ``contact_law``); sun and ring mesh of a stage must agree, since
-    the reference model gives both one contact law.
-    """
-    out: dict[str, float] = {}
-    seen_from: dict[str, str] = {}
-    for name, value in values.items():
-        parts = name.split(".")
-        if len(parts) == 3 and parts[1] in ("sun_mesh", "ring_mesh", "mesh"):
-            field = "contact_law" if parts[2] == "law" else parts[2]
-            flat = f"{parts[0]}.{field}"
-            if flat in out and float(out[flat]) != float(value):
-                raise ReferenceError(
-                    f"gearbox parameters {seen_from[flat]} = {out[flat]!r} and {name} = {value!r} differ; the "
-                    "monolithic reference uses one contact law per stage"
-                )
-            out[flat] = value
-            seen_from[flat] = name
-        else:
-            out[name] = value
-    return out
-
-
 def monolithic_setup(system: ResolvedSystem) -> MonolithicSetup:
     """Rebuild drivetrain and rotor-speed process from the scenario's effective FMU parameters.
 
@@ -131,11 +104,11 @@ def monolithic_setup(system: ResolvedSystem) -> MonolithicSetup:
     except KeyError as exc:
         raise ReferenceError(f"WindSource FMU has no parameter {exc.args[0]!r}") from None
 
-    gear_values = _gearbox_flat_values(system.parameter_values(by_role[GEARBOX]))
+    gear_values = system.parameter_values(by_role[GEARBOX])
     gen_keys = ("generator.inertia", "generator.counter_torque")
     template = None
     preset_name = ""
-    # the FMU's drivetrain parameters: stageN.* and shaftN.* (not solver.*, shaft_torque_mode, ...)
+    # the FMU's drivetrain parameters (stageN.*, shaftN.*), not its solver options (solver.*, shaft_torque_mode, ...)
     structural = {k for k in gear_values if "." in k and k.split(".")[0].startswith(("stage", "shaft"))}
     for name in PRESETS:
         candidate = cosim_preset(name)

@@ -9,8 +9,10 @@ missing FMU is a scenario error naming the component.
 
 from __future__ import annotations
 
+import re
+import zipfile
 from pathlib import Path
-from typing import Callable
+from typing import Callable, Mapping
 
 from .scenario import Scenario
 from .system import default_fmu_dir, resolve_fmu_paths
@@ -71,3 +73,38 @@ def ensure_fmus(scenario: Scenario, fmu_dir: str | Path | None = None, build: bo
             build_all(fmu_dir, names=names)
     return resolve_fmu_paths(scenario, fmu_dir)
 
+
+
+_BUILD_ID = re.compile(r"^_dtcosim_[a-z]+_([0-9a-f]{12})_slave$")
+
+
+def stale_project_fmus(paths: Mapping[str, Path]) -> list[str]:
+    """Warnings for project FMUs built from other code than the installed ``components``/``fmus``.
+
+    A project FMU carries the hash of the code it embeds in its pythonfmu entry
+    module name (``resources/slavemodule.txt``); it is stale when that hash matches
+    the current sources for no preset. Other FMUs are not checked.
+    """
+    try:
+        from components.presets import PRESETS
+        from fmus.build import FMU_NAMES, code_hash
+    except ImportError:
+        return []
+    current: dict[str, set[str]] = {}
+    out = []
+    for comp, path in paths.items():
+        try:
+            with zipfile.ZipFile(path) as zf:
+                module = zf.read("resources/slavemodule.txt").decode().strip()
+        except (KeyError, OSError, zipfile.BadZipFile):
+            continue
+        m = _BUILD_ID.match(module)
+        name = path.stem
+        if not m or name not in FMU_NAMES:
+            continue
+        if name not in current:
+            current[name] = {code_hash(name, preset) for preset in PRESETS}
+        if m.group(1) not in current[name]:
+            out.append(f"{path} ({comp}) was built from other code than the installed dtcosim (build {m.group(1)}); "
+                       f"rebuild it with `dtcosim build --out {path.parent}`")
+    return out

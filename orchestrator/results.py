@@ -144,6 +144,8 @@ def build_summary(system: ResolvedSystem, outcome: RunOutcome, *, wall_time_s: f
         }
         for name, iface in system.interfaces.items()
     }
+    if outcome.profile is not None:
+        summary["profile"] = {"seconds_per_fmi_function": outcome.profile, "loop_time_s": outcome.loop_time_s}
     if files:
         summary["files"] = dict(files)
     if comparison is not None:

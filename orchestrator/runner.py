@@ -52,7 +52,8 @@ class RunReport:
 
 
 def run_scenario(system: ResolvedSystem, out_dir: str | Path, *, compare_reference: bool = False, plots: bool = True,
-                 progress: Callable[[int, int], None] | None = None, handle_sigint: bool = True) -> RunReport:
+                 progress: Callable[[int, int], None] | None = None, handle_sigint: bool = True,
+                 profile: bool = False) -> RunReport:
     """Run a checked scenario and write ``timeseries.csv``, ``summary.json`` and the plots.
 
     Parameters
@@ -69,6 +70,8 @@ def run_scenario(system: ResolvedSystem, out_dir: str | Path, *, compare_referen
         Progress callback (communication steps).
     handle_sigint : bool
         Stop cleanly on Ctrl-C (partial results, ``complete: false``).
+    profile : bool
+        Time every FMI call per FMU (``summary.json`` key ``profile``).
 
     Returns
     -------
@@ -78,7 +81,7 @@ def run_scenario(system: ResolvedSystem, out_dir: str | Path, *, compare_referen
     wall0 = time.perf_counter()
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    outcome = CoSimulation(system).run(progress=progress, handle_sigint=handle_sigint)
+    outcome = CoSimulation(system, profile=profile).run(progress=progress, handle_sigint=handle_sigint)
     files: dict[str, Path] = {"timeseries": write_timeseries(out / TIMESERIES_FILE, outcome)}
     derived: dict[str, Any] = {}
     fig16 = generator_vs_ideal(system, outcome)

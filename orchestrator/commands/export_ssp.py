@@ -32,7 +32,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Export the scenario."""
-    from ..fmu_store import ensure_fmus
+    from ..fmu_store import ensure_fmus, stale_project_fmus
     from ..master import CoSimulation
     from ..runner import load_any
     from ..ssp import export_ssp
@@ -41,6 +41,8 @@ def run(args: argparse.Namespace) -> int:
     scenario = load_any(find_scenario(args.scenario))
     paths = ensure_fmus(scenario, args.fmu_dir, build=not args.no_build,
                         report=lambda m: print(m, file=sys.stderr))
+    for warning in stale_project_fmus(paths):
+        print(f"dtcosim export-ssp: warning: {warning}", file=sys.stderr)
     system = resolve_system(scenario, fmu_paths=paths)
     initial = CoSimulation(system).initial_values() if scenario.initial else {}
     out = export_ssp(system, args.out, initial)

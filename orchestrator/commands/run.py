@@ -41,6 +41,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="override a parameter value, e.g. --set wind.seed=7 (repeatable)")
     p.add_argument("--no-build", action="store_true", help="do not build missing FMUs (fail instead)")
     p.add_argument("--no-plots", action="store_true", help="do not write the PNG plots")
+    p.add_argument("--profile", action="store_true",
+                   help="time every FMI call per FMU and report where the stepping time goes (adds ~1 us per call)")
     p.add_argument("--quiet", "-q", action="store_true", help="no progress bar and no statistics table")
     p.set_defaults(func=run)
 
@@ -91,7 +93,7 @@ def apply_overrides(scenario, args: argparse.Namespace):
 
 def run(args: argparse.Namespace) -> int:
     """Run the scenario; write results; print a summary."""
-    from ..fmu_store import ensure_fmus
+    from ..fmu_store import ensure_fmus, stale_project_fmus
     from ..runner import load_any, run_scenario
     from ..system import resolve_system
 
@@ -99,6 +101,8 @@ def run(args: argparse.Namespace) -> int:
     say = (lambda msg: None) if quiet else (lambda msg: print(msg, file=sys.stderr))
     scenario = apply_overrides(load_any(find_scenario(args.scenario)), args)
     paths = ensure_fmus(scenario, args.fmu_dir, build=not args.no_build, report=say)
+    for warning in stale_project_fmus(paths):
+        print(f"dtcosim run: warning: {warning}", file=sys.stderr)
     system = resolve_system(scenario, fmu_paths=paths)
     out_dir = args.out if args.out is not None else Path("results") / scenario.name
     sim = scenario.simulation
@@ -120,7 +124,7 @@ def run(args: argparse.Namespace) -> int:
 
     try:
         report = run_scenario(system, out_dir, compare_reference=args.compare_reference, plots=not args.no_plots,
-                              progress=progress)
+                              progress=progress, profile=args.profile)
     finally:
         if bar is not None:
             bar.close()
@@ -142,6 +146,15 @@ def run(args: argparse.Namespace) -> int:
             if dev.get("max_abs") is not None:
                 print(f"generator vs {fig16['ratio']:.6g} x rotor speed: mean {dev['mean']:+.2e}, "
                       f"max |deviation| {dev['max_abs']:.2e} (relative)")
+        if outcome.profile:
+            steps = max(outcome.steps, 1)
+            print("time per communication step in FMI calls [us]:")
+            print(f"  {'component':<16}{'fmi2SetReal':>13}{'fmi2DoStep':>13}{'fmi2GetReal':>13}")
+            fmi_total = 0.0
+            for comp, times in outcome.profile.items():
+                fmi_total += sum(times.values())
+                print(f"  {comp:<16}" + "".join(f"{1e6 * times[f] / steps:13.1f}" for f in ("fmi2SetReal", "fmi2DoStep", "fmi2GetReal")))
+            print(f"  master (loop minus FMI calls): {1e6 * (outcome.loop_time_s - fmi_total) / steps:.1f} us/step")
         if report.comparison_text:
             print(report.comparison_text)
         print(f"results in {Path(out_dir)}/: " + ", ".join(p.name for p in report.files.values()))
