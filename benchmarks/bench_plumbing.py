@@ -93,7 +93,11 @@ def build(out: Path) -> dict[str, Path]:
     paths = {}
     for name, body in SLAVES.items():
         script = out / f"{name.lower()}_bench.py"
-        script.write_text("from pythonfmu import Fmi2Slave, Fmi2Causality, Real\n" + textwrap.dedent(body))
+        script.write_text(
+            "from pythonfmu import Fmi2Slave, Fmi2Causality, Real\n"
+            # balance pythonfmu 0.7's extra release of the module namespace per instance (see fmus/build.py)
+            "_namespace_refs = globals().setdefault('_namespace_refs', [])\n_namespace_refs.append(globals())\n"
+            + textwrap.dedent(body))
         fmu = Path(FmuBuilder.build_FMU(script, dest=out))
         tmp = fmu.with_suffix(".tmp")
         with zipfile.ZipFile(fmu) as zin, zipfile.ZipFile(tmp, "w") as zout:

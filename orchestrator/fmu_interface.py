@@ -68,6 +68,11 @@ class FmuInterface:
     can_handle_variable_step, can_get_and_set_state : bool
     sha256 : str
         Hex digest of the FMU file.
+    default_step_s : float or None
+        DefaultExperiment stepSize.
+    unit_definitions : mapping of str -> mapping of str -> float
+        FMI 2 UnitDefinitions: unit name -> SI base-unit exponents (``kg``, ``m``, ``s``,
+        ``A``, ``K``, ``mol``, ``cd``, ``rad``) and ``factor``, ``offset`` (non-default entries only).
     """
 
     path: Path
@@ -82,6 +87,7 @@ class FmuInterface:
     can_get_and_set_state: bool
     sha256: str
     default_step_s: float | None = None
+    unit_definitions: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
     _inputs: tuple[str, ...] = field(default=(), repr=False)
 
     def variable(self, name: str) -> FmuVariable:
@@ -190,6 +196,17 @@ def read_fmu_interface(path: str | Path, key: str = "fmu") -> FmuInterface:
     default_step = None
     if md.defaultExperiment is not None and md.defaultExperiment.stepSize:
         default_step = float(md.defaultExperiment.stepSize)
+    units: dict[str, dict[str, float]] = {}
+    for u in md.unitDefinitions or ():
+        b = u.baseUnit
+        if b is None:
+            continue
+        entry = {k: getattr(b, k) for k in ("kg", "m", "s", "A", "K", "mol", "cd", "rad") if getattr(b, k)}
+        if b.factor != 1.0:
+            entry["factor"] = float(b.factor)
+        if b.offset != 0.0:
+            entry["offset"] = float(b.offset)
+        units[u.name] = entry
     iface = FmuInterface(
         path=p,
         model_name=md.modelName or "",
@@ -203,6 +220,7 @@ def read_fmu_interface(path: str | Path, key: str = "fmu") -> FmuInterface:
         can_get_and_set_state=bool(cs.canGetAndSetFMUstate),
         sha256=file_sha256(p),
         default_step_s=default_step,
+        unit_definitions=MappingProxyType(units),
         _inputs=inputs,
     )
     _CACHE[cache_key] = iface

@@ -5,7 +5,8 @@ Export
 ``SystemStructure.ssd`` holds one ``ssd:Component`` per FMU (``source =
 "resources/<file>.fmu"``) with an ``ssd:Connector`` (kind and ``ssc:Real`` /
 ``ssc:Integer`` / ``ssc:Boolean`` / ``ssc:String`` type, unit) for every variable
-the scenario connects, binds or sets, its parameter values as an inline
+the scenario connects, binds, sets or records (the units are defined in
+``ssd:Units`` from the FMUs' UnitDefinitions), its parameter values as an inline
 ``ssv:ParameterSet``, the ``ssd:Connections``, and an ``ssd:DefaultExperiment``
 (start, stop) whose annotations carry
 
@@ -128,6 +129,7 @@ def system_structure(system: ResolvedSystem, initial_values: Mapping[str, float]
     if sc.description:
         sysel.set("description", sc.description)
     elements = ET.SubElement(sysel, _q("ssd:Elements"))
+    units: dict[str, Mapping[str, float]] = {}  # unit definitions of the connectors (SSP 1.0 ssd:Units)
     for comp in sc.components:
         iface = system.interfaces[comp.name]
         el = ET.SubElement(elements, _q("ssd:Component"), name=comp.name, source=resources[comp.name],
@@ -157,7 +159,10 @@ def system_structure(system: ResolvedSystem, initial_values: Mapping[str, float]
         for var_name in names:
             var = iface.variables[var_name]
             kind = var.causality if var.causality in ("input", "output", "parameter", "calculatedParameter") else "unspecified"
-            _connector(connectors, var_name, kind, var.type, var.unit)
+            unit = var.unit if var.unit in iface.unit_definitions else ""
+            if unit:
+                units.setdefault(unit, iface.unit_definitions[unit])
+            _connector(connectors, var_name, kind, var.type, unit)
         values = dict(comp.parameters)
         for key, value in initial_values.items():
             ref = VariableRef.parse(key, "initial")
@@ -177,12 +182,19 @@ def system_structure(system: ResolvedSystem, initial_values: Mapping[str, float]
             ET.SubElement(conns, _q("ssd:Connection"), startElement=con.source.component,
                           startConnector=con.source.variable, endElement=con.target.component,
                           endConnector=con.target.variable)
+    if units:
+        units_el = ET.SubElement(root, _q("ssd:Units"))
+        for name, base in sorted(units.items()):
+            unit_el = ET.SubElement(units_el, _q("ssc:Unit"), name=name)
+            ET.SubElement(unit_el, _q("ssc:BaseUnit"), {k: (str(int(v)) if k not in ("factor", "offset") else _num(v))
+                                                           for k, v in base.items()})
     exp = ET.SubElement(root, _q("ssd:DefaultExperiment"), startTime=_num(sim.start_s), stopTime=_num(sim.stop_s))
     annotations = ET.SubElement(exp, _q("ssd:Annotations"))
     osp = ET.SubElement(annotations, _q("ssc:Annotation"), type=OSP_ANNOTATION)
     alg = ET.SubElement(osp, _q("osp:Algorithm"))
     ET.SubElement(alg, _q("osp:FixedStepAlgorithm"), baseStepSize=_num(sim.step_s))
-    dtc = ET.SubElement(annotations, _q("ssc:Annotation"), type=DTCOSIM_ANNOTATION)
+    dtc_annotation = ET.SubElement(annotations, _q("ssc:Annotation"), type=DTCOSIM_ANNOTATION)
+    dtc = ET.SubElement(dtc_annotation, _q("dtc:Scenario"))  # an ssc:Annotation holds exactly one element
     settings = ET.SubElement(
         dtc, _q("dtc:Simulation"), step=_num(sim.step_s), outputInterval=_num(sim.output_interval_s),
         windowStart=_num(sim.window_s[0]), windowEnd=_num(sim.window_s[1]), algorithm=sim.algorithm,
@@ -326,7 +338,7 @@ def import_ssp(path: str | Path) -> Scenario:
                 if fsa is not None:
                     step = _float_attr(fsa, "baseStepSize", "osp:FixedStepAlgorithm")
             elif ann.get("type") == DTCOSIM_ANNOTATION:
-                dtc = ann
+                dtc = ann.find("dtc:Scenario", NS)
     if stop is None:
         raise ScenarioError("simulation.stop", None, "a stopTime in ssd:DefaultExperiment", source)
     sim_kwargs: dict[str, Any] = {"start_s": start, "stop_s": stop}

@@ -69,6 +69,12 @@ def test_export_import_round_trip_and_identical_run(toy_scenario, tmp_path):
     x0 = root.find(".//ssd:Component[@name='int']//ssv:Parameter[@name='x0']/ssv:Real", NS)
     assert float(x0.get("value")) == 6.0
 
+    # valid against the SSP 1.0 schema (fmpy validates while reading)
+    from fmpy.ssp.ssd import read_ssd
+
+    ssd = read_ssd(str(ssp))
+    assert [c.name for c in ssd.system.elements] == ["gain", "src", "int", "fail"]
+
     back = import_ssp(ssp)
     assert back.name == original.name and back.description == original.description
     assert back.simulation == original.simulation

@@ -1,7 +1,8 @@
 """Small real pythonfmu FMUs for testing the master (built by the tests themselves).
 
 Each slave lives in its own module name (pythonfmu shares modules by name inside
-one process). After building, the modelDescription is patched the way the
+one process) and balances pythonfmu 0.7's extra release of the module namespace
+(see HEADER). After building, the modelDescription is patched the way the
 project's FMUs are: state outputs declare ``dependencies=""`` (no direct
 feedthrough) unless the toy is meant to have feedthrough, and units are added.
 
@@ -27,6 +28,12 @@ from pathlib import Path
 HEADER = """
 import math
 from pythonfmu import Fmi2Slave, Fmi2Causality, Fmi2Variability, Real, Integer, Boolean, String
+
+# pythonfmu 0.7's C wrapper executes this module again for each new instance and then releases
+# a reference to its namespace that it never took; keep one per execution, or the namespace is
+# freed while still in use and the process crashes at exit (same fix as fmus.build's entry script)
+_namespace_refs = globals().setdefault("_namespace_refs", [])
+_namespace_refs.append(globals())
 """
 
 SOURCES = {
