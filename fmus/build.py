@@ -177,6 +177,8 @@ def _entry_script(name: str, package: str, module: str, preset: str, build_id: s
         f'    """dtcosim {name} (preset {preset}, build {build_id})."""\n\n'
         f'    preset = "{preset}"\n'
         f'    build_id = "{build_id}"\n'
+        f'    version = "{components.__version__}+{build_id}"\n'
+        f'    description = _{name}.description + " (preset {preset}, build {build_id})"\n'
     )
 
 

@@ -47,6 +47,7 @@ class Gearbox(DtcosimSlave):
 
     description = ("dtcosim Gearbox: multi-stage planetary/parallel gearbox with CFS (or impact) gear contact "
                    "and shaft 3, driven by the rotor motion and cut at the generator (SI units)")
+    eager_output_groups = frozenset({_TORQUE})  # shaft_torque is read every step
 
     @classmethod
     def build_interface(cls) -> Iterable[Variable]:

@@ -37,6 +37,7 @@ class GeneratorRotor(DtcosimSlave):
 
     description = ("dtcosim GeneratorRotor: generator inertia driven by the shaft-3 torque against a counter "
                    "torque with load events (SI units)")
+    eager_output_groups = frozenset({"motion"})
 
     @classmethod
     def build_interface(cls) -> Iterable[Variable]:

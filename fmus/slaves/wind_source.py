@@ -26,6 +26,7 @@ class WindSource(DtcosimSlave):
     """Stochastic rotor speed (eq. 13-14) as an FMU with outputs ``omega`` and ``phi``."""
 
     description = "dtcosim WindSource: stochastic rotor speed omega(t) and angle phi(t) of eq. 13-14 (SI units)"
+    eager_output_groups = frozenset({"motion"})
 
     @classmethod
     def build_interface(cls) -> Iterable[Variable]:

@@ -91,3 +91,16 @@ def test_gearbox_state_holds_the_integrator(fmu_path):
     assert len(integrator["winv"]) == (2 * 11) ** 2  # W^-1 of the 11-DOF Table 6 gearbox
     inst.fmu.freeFMUstate(state)
     inst.free()
+
+
+def test_reset_starts_the_instance_afresh(fmu_path):
+    inst = Instance(fmu_path("Gearbox"), "g")
+    runs = []
+    for _ in range(2):
+        inst.initialize(**gearbox_motion(0.0, RATIO))
+        for n in range(10):
+            drive(inst, "Gearbox", n)
+        runs.append(inst.real_outputs())
+        inst.fmu.reset()
+    assert runs[0] == runs[1]
+    inst.free()
