@@ -7,6 +7,7 @@ written), 130 interrupted by Ctrl-C (partial results written).
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 
@@ -114,8 +115,14 @@ def run(args: argparse.Namespace) -> int:
     if not quiet and sys.stderr.isatty():
         from tqdm import tqdm
 
+        try:
+            size = os.get_terminal_size(sys.stderr.fileno())
+        except OSError:
+            size = os.terminal_size((0, 0))
+        # a terminal of unknown size reports 0 x 0, which would make tqdm hide the bar
         bar = tqdm(total=round(sim.stop_s - sim.start_s, 9), unit="s", unit_scale=False, desc="co-simulation",
-                   file=sys.stderr, bar_format="{l_bar}{bar}| {n:.2f}/{total:.2f} s simulated [{elapsed}<{remaining}]")
+                   file=sys.stderr, ncols=size.columns or 80, nrows=size.lines or 24,
+                   bar_format="{l_bar}{bar}| {n:.2f}/{total:.2f} s simulated [{elapsed}<{remaining}]")
         state = {"done": 0}
 
         def progress(done: int, total: int) -> None:

@@ -48,3 +48,39 @@ def test_bad_override_is_a_scenario_error(paper_fmu_dir, tmp_path):
                    "--out", str(tmp_path / "x"), cwd=tmp_path)
     assert proc.returncode == 1
     assert "components.gearbox.parameters.no_such" in proc.stderr
+
+
+def _run_on_terminal(args, cwd):
+    """Run dtcosim with stderr on a pseudo-terminal (size unknown, as some CI terminals); return its output."""
+    import os
+    import pty
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    master, slave = pty.openpty()
+    proc = subprocess.Popen([str(Path(sys.executable).parent / "dtcosim"), *args], cwd=cwd,
+                            stdout=subprocess.DEVNULL, stderr=slave, stdin=subprocess.DEVNULL)
+    os.close(slave)
+    out = b""
+    while True:
+        try:
+            chunk = os.read(master, 65536)
+        except OSError:
+            break
+        if not chunk:
+            break
+        out += chunk
+    assert proc.wait(timeout=120) == 0
+    os.close(master)
+    return out.decode("utf-8", "replace")
+
+
+def test_progress_bar_on_a_terminal_and_quiet(toy_scenario, tmp_path):
+    from conftest import TOY_SCENARIO
+
+    path = toy_scenario(TOY_SCENARIO.replace("stop = 0.1", "stop = 5.0"))
+    shown = _run_on_terminal(["run", str(path), "--out", str(tmp_path / "a"), "--no-plots"], tmp_path)
+    assert "co-simulation: 100%" in shown and "5.00/5.00 s simulated" in shown
+    quiet = _run_on_terminal(["run", str(path), "--out", str(tmp_path / "b"), "--no-plots", "--quiet"], tmp_path)
+    assert quiet.strip() == ""
