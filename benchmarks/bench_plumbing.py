@@ -66,6 +66,7 @@ stop = {stop}
 step = 1e-3
 algorithm = "{algorithm}"
 extrapolation = "{extrapolation}"
+order = ["source", "relay", "sink"]  # the hand-written loop's order
 [components.source]
 fmu = "BenchSource.fmu"
 [components.relay]
@@ -196,20 +197,27 @@ def master_loop(folder: Path, steps: int, algorithm: str, extrapolation: str) ->
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--steps", type=int, default=20000, help="communication steps per loop (default 20000)")
+    parser.add_argument("--repeat", type=int, default=3, help="interleaved repetitions; the median is shown (default 3)")
     args = parser.parse_args()
+    import statistics
+
+    labels = ["fmpy high-level loop (8 calls/step)", "raw FMI calls, plain addresses (floor)"]
+    variants = [(alg, ex) for alg in ("gauss-seidel", "jacobi") for ex in ("hold", "linear")]
+    labels += [f"dtcosim master {alg}/{ex}" for alg, ex in variants]
+    times: dict[str, list[float]] = {label: [] for label in labels}
     with tempfile.TemporaryDirectory(prefix="dtcosim-bench-") as tmp:
         folder = Path(tmp)
         paths = build(folder)
-        rows = [
-            ("fmpy high-level loop (8 calls/step)", high_level_loop(paths, args.steps)),
-            ("raw FMI calls, plain addresses (floor)", raw_loop(paths, args.steps)),
-        ]
-        for alg in ("gauss-seidel", "jacobi"):
-            for ex in ("hold", "linear"):
-                rows.append((f"dtcosim master {alg}/{ex}", master_loop(folder, args.steps, alg, ex)))
-    floor = rows[1][1]
-    print(f"three trivial pythonfmu FMUs, {args.steps} steps")
-    for label, dt in rows:
+        for _ in range(args.repeat):  # interleaved, so machine noise hits every variant alike
+            times[labels[0]].append(high_level_loop(paths, args.steps))
+            times[labels[1]].append(raw_loop(paths, args.steps))
+            for label, (alg, ex) in zip(labels[2:], variants):
+                times[label].append(master_loop(folder, args.steps, alg, ex))
+    median = {label: statistics.median(v) for label, v in times.items()}
+    floor = median[labels[1]]
+    print(f"three trivial pythonfmu FMUs, {args.steps} steps, median of {args.repeat} interleaved runs")
+    for label in labels:
+        dt = median[label]
         print(f"  {label:<42} {dt * 1e6:7.1f} us/step   ({(dt - floor) * 1e6:+6.1f} us vs floor)")
 
 
