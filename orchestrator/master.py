@@ -97,7 +97,7 @@ class RunOutcome:
     complete : bool
         True if the run reached the stop time.
     steps : int
-        Communication steps completed.
+        Communication steps completed (the samples cover the sampled ones among them).
     stopped_at_s : float
         Time of the last completed communication point [s].
     error : str or None
@@ -188,6 +188,8 @@ class CoSimulation:
     ----------
     system : ResolvedSystem
         Checked scenario (settings: algorithm, extrapolation, step, times, recording).
+    profile : bool
+        Time every FMI call of the stepping loop per FMU (:attr:`RunOutcome.profile`).
     """
 
     def __init__(self, system: ResolvedSystem, profile: bool = False) -> None:
@@ -374,7 +376,10 @@ class CoSimulation:
 
     # ----------------------------------------------------------------- loop
     def _loop(self, advance, slots, data, n_steps, stride, progress, handle_sigint) -> tuple[int, str | None, bool]:
-        """Step until the stop time, an FMU failure or Ctrl-C; returns (steps done, error, interrupted)."""
+        """Step until the stop time, an FMU failure or Ctrl-C.
+
+        Returns (communication steps completed, error message or None, interrupted).
+        """
         t0, H = self.settings.start_s, self.settings.step_s
         stop_flag = {"stop": False}
         previous_handler = None
@@ -410,9 +415,7 @@ class CoSimulation:
         finally:
             if previous_handler is not None:
                 signal.signal(signal.SIGINT, previous_handler)
-        if error is None:
-            return k, None, False
-        return (k // stride) * stride, error, interrupted  # only complete sampled rows
+        return k, error, error is not None and interrupted
 
 
 def compile_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str, stride: int,
@@ -479,7 +482,7 @@ def compile_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str, st
         inst = s.inst
         ns.update({
             f"c{i}": inst.component, f"do{i}": inst.do_step, f"set{i}": _raw(inst.set_real), f"get{i}": _raw(inst.get_real),
-            f"ib{i}": s.in_buf, f"IB{i}": ctypes.addressof(s.in_buf),
+            f"ib{i}": s.in_buf, f"IB{i}": ctypes.addressof(s.in_buf), f"keep{i}": (s.in_vr, s.out_vr),
             f"VRI{i}": ctypes.addressof(s.in_vr), f"VRO{i}": ctypes.addressof(s.out_vr),
         })
         body.append(f"# {s.name}")

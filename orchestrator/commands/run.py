@@ -92,6 +92,27 @@ def apply_overrides(scenario, args: argparse.Namespace):
     return scenario
 
 
+def _progress_bar(sim):
+    """A tqdm bar on stderr counting simulated seconds, and the master's progress callback for it."""
+    from tqdm import tqdm
+
+    try:
+        size = os.get_terminal_size(sys.stderr.fileno())
+    except OSError:
+        size = os.terminal_size((0, 0))
+    # a terminal of unknown size reports 0 x 0, which would make tqdm hide the bar
+    bar = tqdm(total=round(sim.stop_s - sim.start_s, 9), unit="s", unit_scale=False, desc="co-simulation",
+               file=sys.stderr, ncols=size.columns or 80, nrows=size.lines or 24,
+               bar_format="{l_bar}{bar}| {n:.2f}/{total:.2f} s simulated [{elapsed}<{remaining}]")
+    done_steps = [0]
+
+    def progress(done: int, total: int) -> None:
+        bar.update((done - done_steps[0]) * sim.step_s)
+        done_steps[0] = done
+
+    return bar, progress
+
+
 def run(args: argparse.Namespace) -> int:
     """Run the scenario; write results; print a summary."""
     from ..fmu_store import ensure_fmus, stale_project_fmus
@@ -110,25 +131,7 @@ def run(args: argparse.Namespace) -> int:
     say(f"{scenario.name}: {len(scenario.components)} FMUs, {sim.algorithm}/{sim.extrapolation}, "
         f"H = {sim.step_s:g} s, {sim.start_s:g}-{sim.stop_s:g} s ({sim.n_steps} steps), order {', '.join(system.order)}")
 
-    bar = None
-    progress = None
-    if not quiet and sys.stderr.isatty():
-        from tqdm import tqdm
-
-        try:
-            size = os.get_terminal_size(sys.stderr.fileno())
-        except OSError:
-            size = os.terminal_size((0, 0))
-        # a terminal of unknown size reports 0 x 0, which would make tqdm hide the bar
-        bar = tqdm(total=round(sim.stop_s - sim.start_s, 9), unit="s", unit_scale=False, desc="co-simulation",
-                   file=sys.stderr, ncols=size.columns or 80, nrows=size.lines or 24,
-                   bar_format="{l_bar}{bar}| {n:.2f}/{total:.2f} s simulated [{elapsed}<{remaining}]")
-        state = {"done": 0}
-
-        def progress(done: int, total: int) -> None:
-            bar.update((done - state["done"]) * sim.step_s)
-            state["done"] = done
-
+    bar, progress = _progress_bar(sim) if not quiet and sys.stderr.isatty() else (None, None)
     try:
         report = run_scenario(system, out_dir, compare_reference=args.compare_reference, plots=not args.no_plots,
                               progress=progress, profile=args.profile)

@@ -205,3 +205,12 @@ def test_coupling_error_of_a_split_oscillator_shrinks_with_the_step(toy_scenario
     assert errors[0] > errors[1] > errors[2]
     assert errors[0] / errors[2] > 3.0  # first order at least
     assert errors[2] < 1e-3
+
+
+def test_failure_between_samples_keeps_the_sampled_rows(toy_scenario):
+    text = FAIL.replace("step = 0.01", "step = 0.01\noutput_interval = 0.03")
+    out = CoSimulation(resolve_system(load_scenario(toy_scenario(text)))).run(handle_sigint=False)
+    assert not out.complete and out.steps == 50 and out.stopped_at_s == pytest.approx(0.5)
+    assert out.time_s.size == 17 and out.time_s[-1] == pytest.approx(0.48)
+    every = CoSimulation(resolve_system(load_scenario(toy_scenario(FAIL, "every.toml")))).run(handle_sigint=False)
+    np.testing.assert_array_equal(out.values, every.values[::3][:17])
