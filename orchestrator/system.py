@@ -30,11 +30,21 @@ READABLE_CAUSALITIES = ("output", "calculatedParameter")
 
 
 def default_fmu_dir() -> Path:
-    """Directory of the built FMUs: ``$DTCOSIM_FMU_DIR`` or the project's ``fmus/`` folder."""
+    """Directory of the built FMUs.
+
+    ``$DTCOSIM_FMU_DIR`` if set; else the project's ``fmus/`` folder (where
+    ``build_fmus.py`` writes) when running from a source checkout; else
+    ``$XDG_CACHE_HOME/dtcosim/fmus`` (default ``~/.cache/dtcosim/fmus``) for an
+    installed package, whose folder may not be writable.
+    """
     env = os.environ.get("DTCOSIM_FMU_DIR")
     if env:
         return Path(env)
-    return Path(__file__).resolve().parent.parent / "fmus"
+    root = Path(__file__).resolve().parent.parent
+    if (root / "build_fmus.py").is_file():
+        return root / "fmus"
+    cache = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(cache) / "dtcosim" / "fmus"
 
 
 @dataclass(frozen=True)

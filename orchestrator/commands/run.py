@@ -41,6 +41,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--set", action="append", default=[], metavar="COMPONENT.PARAMETER=VALUE",
                    help="override a parameter value, e.g. --set wind.seed=7 (repeatable)")
     p.add_argument("--no-build", action="store_true", help="do not build missing FMUs (fail instead)")
+    p.add_argument("--check", action="store_true",
+                   help="only check the scenario against the FMUs' model descriptions (nothing is instantiated) and exit")
     p.add_argument("--no-plots", action="store_true", help="do not write the PNG plots")
     p.add_argument("--profile", action="store_true",
                    help="time every FMI call per FMU and report where the stepping time goes (adds ~1 us per call)")
@@ -126,6 +128,11 @@ def run(args: argparse.Namespace) -> int:
     for warning in stale_project_fmus(paths):
         print(f"dtcosim run: warning: {warning}", file=sys.stderr)
     system = resolve_system(scenario, fmu_paths=paths)
+    if args.check:
+        print(f"{scenario.name}: valid ({len(scenario.components)} FMUs, {len(scenario.connections)} connections, "
+              f"{len(system.recorded)} recorded variables; stepping order {', '.join(system.order)}; "
+              f"initialisation order {', '.join(system.init_order)})")
+        return 0
     out_dir = args.out if args.out is not None else Path("results") / scenario.name
     sim = scenario.simulation
     say(f"{scenario.name}: {len(scenario.components)} FMUs, {sim.algorithm}/{sim.extrapolation}, "

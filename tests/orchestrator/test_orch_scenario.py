@@ -157,3 +157,11 @@ def test_graph_orders():
     assert initialization_order(["a", "b", "c"], chain) == ["a", "b", "c"]
     assert find_algebraic_loop([("a.y", "b.u")], {"b.u": ["b.y"]}) is None
     assert find_algebraic_loop([("a.y", "b.u"), ("b.y", "a.u")], {"b.u": ["b.y"], "a.u": ["a.y"]}) is not None
+
+
+def test_cli_check_validates_without_instantiating(toy_scenario, monkeypatch, capsys, tmp_path):
+    instantiated = []
+    monkeypatch.setattr(FmuInstance, "instantiate", lambda self, *a: instantiated.append(self.name))
+    assert cli.main(["run", str(toy_scenario()), "--check", "--out", str(tmp_path / "o")]) == 0
+    assert "toy: valid (3 FMUs, 1 connections, 4 recorded variables" in capsys.readouterr().out
+    assert instantiated == [] and not (tmp_path / "o").exists()
