@@ -13,6 +13,7 @@ the rotor torque and the output acceleration at the requested output times.
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass
 from typing import Protocol
@@ -141,11 +142,14 @@ def simulate_monolithic(
     settings: SolverSettings | None = None,
     t_start_s: float = 0.0,
     raise_on_failure: bool = False,
+    initial_state: np.ndarray | None = None,
 ) -> SimulationResult:
     """Integrate the monolithic drivetrain model.
 
-    Initial state: kinematically consistent speeds at the initial driver speed and
-    zero deflection (teeth centred in the backlash); loads act as steps at t = 0.
+    Initial state: by default kinematically consistent speeds at the initial driver
+    speed and zero deflection (teeth centred in the backlash); loads act as steps at
+    t = 0. ``initial_state`` starts from another state instead, e.g. the static
+    equilibrium of :func:`components.modes.static_equilibrium` (no load step).
 
     Parameters
     ----------
@@ -163,6 +167,10 @@ def simulate_monolithic(
         Start time [s].
     raise_on_failure : bool
         Raise :class:`SolverError` instead of returning an incomplete result.
+    initial_state : ndarray, shape (2 n_dof,), optional
+        ``[q, v]`` at ``t_start_s``: deviation angles [rad] and deviation speeds
+        [rad/s] of the free bodies (order of ``Assembly.dof_names``), relative to
+        the kinematic motion ``kappa * theta_in``. Default: zeros.
 
     Returns
     -------
@@ -178,7 +186,8 @@ def simulate_monolithic(
     dt = positive("output_interval_s", output_interval_s)
     system = MonolithicSystem(drivetrain, driver)
     n = system.n
-    n_out = int(round((t1 - t0) / dt))
+    # whole output intervals that fit (never past t_end), then t_end itself if it is not one of them
+    n_out = int(math.floor((t1 - t0) / dt + 1e-9))
     t_out = t0 + dt * np.arange(n_out + 1)
     t_out[-1] = min(t_out[-1], t1) if abs(t_out[-1] - t1) < 1e-9 * max(1.0, abs(t1)) else t_out[-1]
     if t_out[-1] < t1 - 1e-12:
@@ -188,6 +197,11 @@ def simulate_monolithic(
         [np.full(n, settings.atol_angle_rad), np.full(n, settings.atol_speed_rad_s), np.full(3, 1e-3)]
     )
     y = np.zeros(2 * n + 3)
+    if initial_state is not None:
+        y0 = np.asarray(initial_state, dtype=float)
+        if y0.shape != (2 * n,) or not np.all(np.isfinite(y0)):
+            raise ParameterError("initial_state", y0.shape, f"finite [q, v] of shape ({2 * n},)")
+        y[: 2 * n] = y0
     Y = np.full((t_out.size, y.size), np.nan)
     Y[0] = y
     breaks = [t for t in system.schedule.event_times if t0 < t < t1]
