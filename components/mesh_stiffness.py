@@ -162,3 +162,40 @@ def mesh_frequency_hz(teeth_per_driver_revolution: float | np.ndarray, rotor_spe
         Rotor speed [rad/s].
     """
     return np.abs(np.multiply.outer(rotor_speed_rad_s, teeth_per_driver_revolution)) / (2.0 * math.pi)
+
+
+def max_step_s(
+    teeth_per_driver_revolution: np.ndarray,
+    variation: np.ndarray,
+    max_rotor_speed_rad_s: float,
+    transition: float = TRANSITION_FRACTION,
+) -> float:
+    """Largest integration step that cannot jump over a stiffness transition [s].
+
+    An adaptive integrator only sees the stiffness where it evaluates the right-hand
+    side: a step longer than a pair-count zone can skip the zone entirely while its
+    error estimate stays small. Capping the step at half a transition width (of the
+    fastest mesh whose stiffness varies) makes every transition visible.
+
+    Parameters
+    ----------
+    teeth_per_driver_revolution : ndarray, shape (n_mesh,)
+        ``Mesh.teeth_per_driver_rad`` of every mesh [-].
+    variation : ndarray, shape (n_mesh,)
+        Stiffness variation of every mesh [-]; meshes with 0 are ignored.
+    max_rotor_speed_rad_s : float
+        Largest rotor speed magnitude over the run [rad/s].
+    transition : float
+        Transition width [mesh cycles].
+
+    Returns
+    -------
+    float
+        ``transition * T_mesh,min / 2`` [s]; ``inf`` if no mesh varies or the rotor stands still.
+    """
+    rate = np.abs(np.asarray(teeth_per_driver_revolution, dtype=float))[np.asarray(variation) > 0.0]
+    omega = abs(float(max_rotor_speed_rad_s))
+    if rate.size == 0 or omega == 0.0:
+        return math.inf
+    period = 2.0 * math.pi / (rate.max() * omega)
+    return 0.5 * transition * period
