@@ -635,7 +635,8 @@ class DrivetrainMode:
         Deviation angles referred to the rotor, ``q_i / kappa_i`` (a rigid rotation of the
         whole train is uniform), normalised to a largest component of +1.
     dominant_bodies : str
-        Bodies holding most of the modal kinetic energy, e.g. ``"generator 100%"``.
+        Bodies holding most of the modal kinetic energy, e.g. ``"generator 100%"`` (the
+        planets of a stage counted together as ``"stage1.planets"``).
     strain_energy_fraction : dict of str -> float
         Share of the modal strain energy per mesh group (``stage1.sun_planet``, ...) and shaft.
     dominant_elements : str
@@ -775,6 +776,9 @@ def drivetrain_modes(drivetrain: Drivetrain, operating_point: OperatingPoint, st
     stages = [a.bodies[j].stage for j in a.free]
     kappa = a.kinematic_ratio
     group_names, membership = _element_groups(a)
+    body_groups = [f"{stages[i]}.planets" if roles[i] == "planet" else names[i] for i in range(len(names))]
+    body_group_names = list(dict.fromkeys(body_groups))
+    body_membership = np.array([[g == h for h in body_groups] for g in body_group_names], dtype=float)
     k_mesh = a.cos_alpha * model.equilibrium.mesh_stiffness_n_per_m
     k_elem = np.concatenate([k_mesh, a.shaft_k])
     rows = np.vstack([a.A, a.S])
@@ -799,7 +803,7 @@ def drivetrain_modes(drivetrain: Drivetrain, operating_point: OperatingPoint, st
                 kind=kind,
                 stage=stage,
                 shape_referred=referred,
-                dominant_bodies=_share_text(names, m.energy_fraction),
+                dominant_bodies=_share_text(body_group_names, body_membership @ m.energy_fraction),
                 strain_energy_fraction=dict(zip(group_names, map(float, strain_share))),
                 dominant_elements=_share_text(group_names, strain_share),
             )

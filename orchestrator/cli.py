@@ -16,6 +16,7 @@ from components.errors import DtcosimError
 #: modules providing subcommands, in help order
 COMMAND_MODULES = (
     "orchestrator.commands.reference",
+    "orchestrator.commands.modes",
 )
 
 
