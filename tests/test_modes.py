@@ -236,6 +236,8 @@ def test_table6_only_the_generator_mode_is_underdamped(table6_modes):
     assert gen.dominant_bodies.startswith("generator")
     assert gen.mode.damping_ratio == pytest.approx(0.2965, abs=5e-4)
     assert gen.mode.damped_frequency_hz == pytest.approx(0.9102, abs=5e-4)
+    for dm in table6_modes.modes[1:]:  # every gear mode: overdamped, zeta far above 1
+        assert dm.mode.overdamped and dm.mode.damping_ratio > 30.0
 
 
 def test_table6_generator_mode_matches_the_series_stiffness_closed_form(table6_modes):
