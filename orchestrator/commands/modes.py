@@ -60,8 +60,8 @@ def run(args: argparse.Namespace) -> int:
     an = report["analysis"]
     eq = an.model.equilibrium
     print(f"dtcosim modes: preset {args.preset} at {op.rotor_speed_rpm:g} rpm, output torque {op.output_torque_nm:g} N m")
-    print(f"static equilibrium: {eq.iterations} Newton iterations, residual {eq.residual_nm:.2g} N m, "
-          f"rotor torque {eq.rotor_torque_nm:.6g} N m")
+    print(f"static equilibrium: residual {eq.residual_nm:.2g} N m after {eq.iterations} Newton iteration(s) "
+          f"from the secant-stiffness start; rotor torque {eq.rotor_torque_nm:.6g} N m")
     print(format_mode_table(an))
     n_under = len(an.underdamped)
     print(f"{n_under} underdamped mode(s), {len(an.modes) - n_under} overdamped; "
