@@ -1,0 +1,1 @@
+"""Thin pythonfmu slaves over the physics in components/, and the FMU build (see build_fmus.py)."""
