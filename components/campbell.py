@@ -246,7 +246,7 @@ class CampbellDiagram:
             "mesh_frequency": self.mesh_formula,
             "mode_kind": list(self.mode_kind),
             "mode_label": list(self.mode_label),
-            "rows": self.rows(),
+            "rows": [{k: (None if isinstance(v, float) and math.isnan(v) else v) for k, v in r.items()} for r in self.rows()],
             "crossings": self.crossings(),
         }
 

@@ -529,7 +529,13 @@ def load_duration_distribution(
 
 # --------------------------------------------------------------------------- run level
 def _default_load_names(series: Mapping[str, np.ndarray]) -> list[str]:
-    return [n for n in series if n.rsplit(".", 1)[-1].startswith("F_") or n.endswith(".torque") and n.startswith("shaft")]
+    """Contact forces ``*.F_*`` and shaft torques ``*shaft<k>.torque`` (with or without a ``gearbox.`` prefix)."""
+    out = []
+    for n in series:
+        parts = n.split(".")
+        if parts[-1].startswith("F_") or (len(parts) >= 2 and parts[-1] == "torque" and parts[-2].startswith("shaft")):
+            out.append(n)
+    return out
 
 
 @dataclass

@@ -32,7 +32,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .drivetrain import Drivetrain
-from .errors import ParameterError
+from .errors import SolverError
 from .modes import DrivetrainModalAnalysis, OperatingPoint, drivetrain_modes
 from .reference import SolverSettings, simulate_monolithic
 from .results import SimulationResult
@@ -184,7 +184,7 @@ def free_response_check(
         x0 = eq.state + (amp / ratio) * delta
         result = simulate_monolithic(loaded, driver, record, output_interval_s=h, settings=settings, initial_state=x0)
         if not result.complete:
-            raise ParameterError("impulse", result.message, "a free response the monolithic solver can integrate")
+            raise SolverError(f"free response of mode {dm.mode.index}: {result.message}", float(result.time_s[-1]))
         eta = (deviation_state(result, analysis) - eq.state) @ ss.left[:, j].conj()
         peak = spectral_peak_hz(eta, h)
         checks.append(

@@ -63,7 +63,7 @@ def test_campbell_rows_and_json(campbell):
     assert len(rows) == 17
     assert rows[0]["rotor_speed_rpm"] == pytest.approx(4.0)
     assert rows[-1]["stage3_mesh_hz"] == pytest.approx(20 * 80 * 20 / 60)
-    d = json.loads(json.dumps(campbell.as_dict(), allow_nan=True))
+    d = json.loads(json.dumps(campbell.as_dict(), allow_nan=False))  # strict JSON: NaN -> null
     assert d["load_law"]["kind"] == "quadratic"
     with pytest.raises(ParameterError, match="increasing positive"):
         campbell_diagram(table6_gearbox(), [1.0, 0.5])

@@ -197,3 +197,17 @@ def test_fatigue_report_of_a_run_is_json_and_csv_ready(wind_run, tmp_path):
     ldd_rows = list(csv.DictReader(write_ldd_csv(tmp_path / "ldd.csv", report).open()))
     assert len(ldd_rows) == 3 * 64
     assert sum(float(r["time_s"]) for r in ldd_rows if r["variable"] == "shaft1.torque") == pytest.approx(5.0)
+
+
+def test_fatigue_report_of_fmu_style_columns(wind_run):
+    """Result columns of a co-simulation carry the component prefix (``gearbox.shaft1.torque``)."""
+    series = {f"gearbox.{k}": v for k, v in wind_run.series.items() if ".F_" in k or k.startswith("shaft")}
+    series["wind.omega"] = wind_run["omega_rotor"]
+    report = fatigue_report(series, time_s=wind_run.time_s, window=(1.0, 6.0))
+    assert len(report.loads) == 16 and "wind.omega" not in report.loads
+    assert sorted(report.ldd) == ["gearbox.shaft1.torque", "gearbox.shaft2.torque", "gearbox.shaft3.torque"]
+    assert report.loads["gearbox.shaft1.torque"].unit == "N.m"
+    direct = fatigue_report(wind_run, window=(1.0, 6.0))
+    assert report.loads["gearbox.stage3.F_mesh"].del_by_exponent == direct.loads["stage3.F_mesh"].del_by_exponent
+    with pytest.raises(ParameterError, match="time_s"):
+        fatigue_report(series)
