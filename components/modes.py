@@ -50,7 +50,7 @@ from .assembly import Assembly
 from .drivetrain import Drivetrain
 from .errors import DtcosimError, ParameterError
 from .units import rad_per_s_to_rpm, rpm
-from .validation import finite
+from .validation import finite, set_fields
 
 #: |Im lambda| / |lambda| below which an eigenvalue counts as real (overdamped root).
 REAL_EIGENVALUE_TOLERANCE = 1e-7
@@ -82,10 +82,10 @@ class OperatingPoint:
     output_torque_nm: float
 
     def __post_init__(self) -> None:
-        finite("rotor_speed_rad_s", self.rotor_speed_rad_s)
         t = finite("output_torque_nm", self.output_torque_nm)
         if t == 0.0:
             raise ParameterError("output_torque_nm", t, "non-zero (unloaded teeth float in the backlash)")
+        set_fields(self, rotor_speed_rad_s=finite("rotor_speed_rad_s", self.rotor_speed_rad_s), output_torque_nm=t)
 
     @classmethod
     def from_rpm(cls, rotor_speed_rpm: float, output_torque_nm: float) -> "OperatingPoint":
