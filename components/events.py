@@ -28,7 +28,7 @@ import numpy as np
 
 from .cases import CONTACT_LOSS_THRESHOLD_N
 from .errors import ParameterError
-from .results import SimulationResult
+from .results import SimulationResult, select_window
 from .validation import positive
 
 
@@ -70,26 +70,6 @@ class ContactLossStatistics:
         return asdict(self)
 
 
-def _select(time_s: np.ndarray, values: np.ndarray, window: tuple[float, float] | None) -> tuple[np.ndarray, np.ndarray]:
-    t = np.asarray(time_s, dtype=float)
-    x = np.asarray(values, dtype=float)
-    if t.ndim != 1 or x.shape != t.shape:
-        raise ParameterError("values", x.shape, f"a 1-D series of the time vector's shape {t.shape}")
-    if t.size < 2 or np.any(np.diff(t) <= 0.0):
-        raise ParameterError("time_s", t.size, "at least 2 strictly increasing sample times")
-    if not np.all(np.isfinite(x)):
-        raise ParameterError("values", "non-finite samples", "finite values (an incomplete run?)")
-    if window is not None:
-        lo, hi = window
-        if not hi > lo:
-            raise ParameterError("window", window, "(start, end) with end > start")
-        sel = (t >= lo - 1e-12) & (t <= hi + 1e-12)
-        if sel.sum() < 2:
-            raise ParameterError("window", window, f"at least 2 samples inside [{t[0]:g}, {t[-1]:g}] s")
-        t, x = t[sel], x[sel]
-    return t, x
-
-
 def _inside_fraction(f0: np.ndarray, f1: np.ndarray, threshold: float) -> np.ndarray:
     """Fraction of each linear segment F0 -> F1 with ``|F| < threshold``."""
     df = f1 - f0
@@ -129,7 +109,7 @@ def contact_loss_events(
     ContactLossStatistics
     """
     thr = positive("threshold_n", threshold_n)
-    t, f = _select(time_s, force_n, window)
+    t, f = select_window(time_s, force_n, window)
     dt = np.diff(t)
     frac = _inside_fraction(f[:-1], f[1:], thr)
     inside_time = frac * dt

@@ -51,7 +51,7 @@ import fatpack
 import numpy as np
 
 from .errors import ParameterError
-from .results import SimulationResult, unit_of
+from .results import SimulationResult, select_window, unit_of
 from .validation import non_negative, one_of, positive
 
 #: Default Woehler exponents (welded steel 3, shafts 5, gear teeth 8 and 10).
@@ -339,26 +339,6 @@ class FatigueLoads:
         }
 
 
-def _window_select(time_s, values, window):
-    t = np.asarray(time_s, dtype=float)
-    y = np.asarray(values, dtype=float)
-    if t.ndim != 1 or y.shape != t.shape:
-        raise ParameterError("values", y.shape, f"a 1-D series of the time vector's shape {t.shape}")
-    if t.size < 2 or np.any(np.diff(t) <= 0.0):
-        raise ParameterError("time_s", t.size, "at least 2 strictly increasing sample times")
-    if window is not None:
-        lo, hi = window
-        if not hi > lo:
-            raise ParameterError("window", window, "(start, end) with end > start")
-        sel = (t >= lo - 1e-12) & (t <= hi + 1e-12)
-        if sel.sum() < 2:
-            raise ParameterError("window", window, "at least 2 samples inside the window")
-        t, y = t[sel], y[sel]
-    if not np.all(np.isfinite(y)):
-        raise ParameterError("values", "non-finite samples", "finite values (an incomplete run?)")
-    return t, y
-
-
 def fatigue_loads(
     time_s: np.ndarray,
     values: np.ndarray,
@@ -388,7 +368,7 @@ def fatigue_loads(
     FatigueLoads
     """
     s = settings or FatigueSettings()
-    t, y = _window_select(time_s, values, window)
+    t, y = select_window(time_s, values, window)
     span_t = float(t[-1] - t[0])
     cyc = rainflow(y, s.gate_fraction * float(y.max() - y.min()), s.residue)
     n_ref = s.reference_cycles_for(span_t)
@@ -497,7 +477,7 @@ def load_duration_distribution(
     LoadDurationDistribution
     """
     t_all = np.asarray(time_s, dtype=float)
-    t, y = _window_select(t_all, values, window)
+    t, y = select_window(t_all, values, window)
     w = sample_durations(t)
     if isinstance(bins, (int, np.integer)) and not isinstance(bins, bool):
         if bins < 1:
@@ -513,7 +493,7 @@ def load_duration_distribution(
     time_in, _ = np.histogram(y, bins=edges, weights=w)
     revs = None
     if speed_rad_s is not None:
-        _, sp = _window_select(t_all, speed_rad_s, window)
+        _, sp = select_window(t_all, speed_rad_s, window)
         revs, _ = np.histogram(y, bins=edges, weights=w * np.abs(sp) / (2.0 * math.pi))
     outside = float(w.sum() - time_in.sum())
     return LoadDurationDistribution(
