@@ -84,9 +84,14 @@ class Mesh:
     contact : MeshContact
         Contact parameters.
     teeth_per_driver_rad : float
-        Tooth pairs passing per radian of driver (rotor) rotation (mesh frequency / rotor speed).
+        Mesh-cycle phase advance per radian of driver (rotor) rotation [rad/rad], i.e.
+        tooth pairs passing per rotor *revolution*: mesh frequency [Hz] = this x rotor
+        speed [rad/s] / (2 pi). ``Z_ring kappa_carrier`` (planetary, ring fixed),
+        ``Z_drive kappa_drive`` (parallel).
     phase_offset_rad : float
-        Mesh-cycle phase of this mesh at theta_in = 0 [rad] (sequential planet phasing).
+        Mesh-cycle phase of this mesh at theta_in = 0 [rad] (sequential planet phasing:
+        ``-Z_sun psi_i`` sun-planet, ``+Z_ring psi_i`` ring-planet, planet i at carrier
+        angle ``psi_i``; see :mod:`components.mesh_stiffness`).
     """
 
     name: str

@@ -13,6 +13,7 @@ the rotor torque and the output acceleration at the requested output times.
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass
 from typing import Protocol
@@ -50,7 +51,9 @@ class SolverSettings:
     atol_speed_rad_s : float
         Absolute tolerance on deviation speeds [rad/s].
     max_step_s : float
-        Largest internal step [s] (0: unlimited).
+        Largest internal step [s] (0: unlimited). With time-varying mesh stiffness the
+        solver caps the step at half a stiffness transition anyway
+        (:func:`components.mesh_stiffness.max_step_s`).
     max_steps : int
         Maximum internal steps between two output times.
     """
@@ -141,11 +144,14 @@ def simulate_monolithic(
     settings: SolverSettings | None = None,
     t_start_s: float = 0.0,
     raise_on_failure: bool = False,
+    initial_state: np.ndarray | None = None,
 ) -> SimulationResult:
     """Integrate the monolithic drivetrain model.
 
-    Initial state: kinematically consistent speeds at the initial driver speed and
-    zero deflection (teeth centred in the backlash); loads act as steps at t = 0.
+    Initial state: by default kinematically consistent speeds at the initial driver
+    speed and zero deflection (teeth centred in the backlash); loads act as steps at
+    t = 0. ``initial_state`` starts from another state instead, e.g. the static
+    equilibrium of :func:`components.modes.static_equilibrium` (no load step).
 
     Parameters
     ----------
@@ -163,6 +169,10 @@ def simulate_monolithic(
         Start time [s].
     raise_on_failure : bool
         Raise :class:`SolverError` instead of returning an incomplete result.
+    initial_state : ndarray, shape (2 n_dof,), optional
+        ``[q, v]`` at ``t_start_s``: deviation angles [rad] and deviation speeds
+        [rad/s] of the free bodies (order of ``Assembly.dof_names``), relative to
+        the kinematic motion ``kappa * theta_in``. Default: zeros.
 
     Returns
     -------
@@ -178,7 +188,8 @@ def simulate_monolithic(
     dt = positive("output_interval_s", output_interval_s)
     system = MonolithicSystem(drivetrain, driver)
     n = system.n
-    n_out = int(round((t1 - t0) / dt))
+    # whole output intervals that fit (never past t_end), then t_end itself if it is not one of them
+    n_out = int(math.floor((t1 - t0) / dt + 1e-9))
     t_out = t0 + dt * np.arange(n_out + 1)
     t_out[-1] = min(t_out[-1], t1) if abs(t_out[-1] - t1) < 1e-9 * max(1.0, abs(t1)) else t_out[-1]
     if t_out[-1] < t1 - 1e-12:
@@ -188,8 +199,22 @@ def simulate_monolithic(
         [np.full(n, settings.atol_angle_rad), np.full(n, settings.atol_speed_rad_s), np.full(3, 1e-3)]
     )
     y = np.zeros(2 * n + 3)
+    if initial_state is not None:
+        y0 = np.asarray(initial_state, dtype=float)
+        if y0.shape != (2 * n,) or not np.all(np.isfinite(y0)):
+            raise ParameterError("initial_state", y0.shape, f"finite [q, v] of shape ({2 * n},)")
+        y[: 2 * n] = y0
     Y = np.full((t_out.size, y.size), np.nan)
     Y[0] = y
+    hmax = settings.max_step_s
+    a = system.assembly
+    if a.time_varying_stiffness:
+        # a step longer than a pair-count zone could skip it unseen: cap at half a transition
+        from .mesh_stiffness import max_step_s
+
+        omega_max = float(np.max(np.abs(np.asarray(driver.speed(np.linspace(t0, t1, 2001)), dtype=float))))
+        cap = max_step_s(a._mesh_rate, a._mesh_variation, 1.05 * omega_max)
+        hmax = cap if hmax <= 0.0 else min(hmax, cap)
     breaks = [t for t in system.schedule.event_times if t0 < t < t1]
     edges = [t0, *breaks, t1]
     complete = True
@@ -208,7 +233,7 @@ def simulate_monolithic(
             tfirst=True,
             rtol=settings.rtol,
             atol=atol,
-            hmax=settings.max_step_s,
+            hmax=hmax,
             mxstep=settings.max_steps,
             full_output=True,
         )

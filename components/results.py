@@ -47,6 +47,59 @@ def unit_of(name: str) -> str:
     return "1"
 
 
+def window_mask(time_s: np.ndarray, window: tuple[float, float] | None) -> np.ndarray | slice:
+    """Samples with ``window[0] <= t <= window[1]`` (all samples for None)."""
+    if window is None:
+        return slice(None)
+    return (time_s >= window[0] - 1e-12) & (time_s <= window[1] + 1e-12)
+
+
+def select_window(
+    time_s: np.ndarray, values: np.ndarray, window: tuple[float, float] | None
+) -> tuple[np.ndarray, np.ndarray]:
+    """Validated samples of one series inside an analysis window.
+
+    Parameters
+    ----------
+    time_s : ndarray, shape (N,)
+        Strictly increasing sample times [s].
+    values : ndarray, shape (N,)
+        Finite samples.
+    window : (float, float) or None
+        ``(start, end)`` [s]; None keeps every sample.
+
+    Returns
+    -------
+    t, x : ndarray
+        The samples inside the window (at least 2).
+
+    Raises
+    ------
+    ParameterError
+        Shapes differ, times not increasing, non-finite samples, or fewer than
+        2 samples in the window.
+    """
+    from .errors import ParameterError
+
+    t = np.asarray(time_s, dtype=float)
+    x = np.asarray(values, dtype=float)
+    if t.ndim != 1 or x.shape != t.shape:
+        raise ParameterError("values", x.shape, f"a 1-D series of the time vector's shape {t.shape}")
+    if t.size < 2 or np.any(np.diff(t) <= 0.0):
+        raise ParameterError("time_s", t.size, "at least 2 strictly increasing sample times")
+    if window is not None:
+        lo, hi = window
+        if not hi > lo:
+            raise ParameterError("window", window, "(start, end) with end > start")
+        sel = window_mask(t, window)
+        if sel.sum() < 2:
+            raise ParameterError("window", window, f"at least 2 samples inside [{t[0]:g}, {t[-1]:g}] s")
+        t, x = t[sel], x[sel]
+    if not np.all(np.isfinite(x)):
+        raise ParameterError("values", "non-finite samples", "finite values (an incomplete run?)")
+    return t, x
+
+
 def window_statistics(time_s: np.ndarray, values: np.ndarray, window: tuple[float, float] | None) -> dict[str, float]:
     """Mean, std, min and max of samples with ``window[0] <= t <= window[1]``.
 
@@ -57,11 +110,7 @@ def window_statistics(time_s: np.ndarray, values: np.ndarray, window: tuple[floa
     window : (float, float) or None
         Analysis window [s]; None means all samples.
     """
-    if window is None:
-        sel = slice(None)
-    else:
-        sel = (time_s >= window[0] - 1e-12) & (time_s <= window[1] + 1e-12)
-    x = np.asarray(values)[sel]
+    x = np.asarray(values)[window_mask(time_s, window)]
     if x.size == 0:
         return {"mean": float("nan"), "std": float("nan"), "min": float("nan"), "max": float("nan")}
     return {"mean": float(x.mean()), "std": float(x.std()), "min": float(x.min()), "max": float(x.max())}

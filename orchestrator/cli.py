@@ -20,6 +20,7 @@ COMMAND_MODULES = (
     "orchestrator.commands.reference",
     "orchestrator.commands.build",
     "orchestrator.commands.validate",
+    "orchestrator.commands.modes",
 )
 
 
