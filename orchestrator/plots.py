@@ -120,6 +120,19 @@ def plot_generator_speed(outcome: RunOutcome, rotor_column: str, gen_column: str
     ax2.grid(True, lw=0.3)
     ax2.legend(loc="best", fontsize=8)
     ax2.set_xlim(t[0], t[-1])
+    # scale both panels to the analysis window; a larger start-up transient is clipped
+    sel = (t >= window[0]) & (t <= window[1]) & np.isfinite(dev)
+    if sel.any():
+        for axis, curves in ((ax, (gen, ideal)), (ax2, (dev,))):
+            lo = min(float(np.min(c[sel])) for c in curves)
+            hi = max(float(np.max(c[sel])) for c in curves)
+            pad = 0.15 * (hi - lo) if hi > lo else max(abs(hi), 1e-9) * 0.01
+            full_lo = min(float(np.nanmin(c)) for c in curves)
+            full_hi = max(float(np.nanmax(c)) for c in curves)
+            if full_lo < lo - pad or full_hi > hi + pad:
+                axis.set_ylim(lo - pad, hi + pad)
+                axis.text(0.005, 0.02, "scaled to the analysis window (start-up transient clipped)",
+                          transform=axis.transAxes, fontsize=7, color="0.35")
     return _finish(fig, path)
 
 
