@@ -2,4 +2,21 @@
 
 The master talks to the FMUs only through FMI (fmpy). It imports
 :mod:`components` only for the monolithic reference and for analyses.
+
+Co-simulation modules
+---------------------
+scenario        system description (frozen dataclasses) and its TOML format
+fmu_interface   what an FMU offers, read from modelDescription.xml
+system          a scenario checked against its FMUs (ResolvedSystem)
+graph           stepping/initialisation order, algebraic-loop detection
+fmi_runtime     FMU instances through fmpy's FMU2Slave, log capture
+master          fixed-step Gauss-Seidel/Jacobi master (generated stepping loop)
+results         timeseries.csv and summary.json
+derived         component roles, ideal gearbox ratio, Fig. 16 check
+plots           Fig. 15-17 as PNG
+compare         monolithic reference of a scenario and the comparison report
+ssp             SSP 1.0 export and import
+libcosim_host   running an SSP in libcosim (child process with libpython preloaded)
+fmu_store       locating/building the project's FMUs
+runner          one run from scenario to files (used by ``dtcosim run``)
 """
