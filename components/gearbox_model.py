@@ -200,6 +200,7 @@ class GearboxModel:
         # output twist = _twist_q . q + _twist_port * port angle
         self._twist_q = np.concatenate((a.S[-1], np.zeros(a.n_dof)))
         self._twist_port = float(a.S_port[-1, 0])
+        self._output_matrix = self._build_output_matrix()
 
     # ------------------------------------------------------------ outputs
     @property
@@ -256,12 +257,66 @@ class GearboxModel:
     @property
     def rotor_torque_nm(self) -> float:
         """Torque the rotor applies to the gearbox [N m] (driven carrier inertia + mesh/shaft reactions)."""
+        return self.rotor_torque_from(self.shaft_torques_nm)
+
+    def rotor_torque_from(self, shaft_torques_nm: np.ndarray) -> float:
+        """Rotor torque [N m] given the current shaft torques [N m], shape (n_shaft,)."""
         a = self.assembly
         return float(
             a.driver_inertia_kgm2 * self.driver_accel_rad_s2
             + self.contact_force_n @ a.BT_driver
-            + self.shaft_torques_nm @ a.s_driver
+            + shaft_torques_nm @ a.s_driver
         )
+
+    @property
+    def output_names(self) -> list[str]:
+        """Names of the entries of :meth:`output_vector`, in order (FMU variable names)."""
+        a = self.assembly
+        return (
+            ["shaft_torque", "shaft_torque_avg", "shaft_torque_end", "omega_out", "torque_rotor"]
+            + a.mesh_names
+            + [f"{s}.torque" for s in a.shaft_names]
+            + [f"{b}.omega" for b in a.dof_names]
+        )
+
+    def _build_output_matrix(self) -> np.ndarray:
+        """Linear map ``z -> [shaft_torque_end, omega_out, torque_rotor, forces, shaft torques, speeds]``.
+
+        ``z = [contact forces (n_mesh), q, v (n_dof each), port angle, port speed,
+        driver speed, driver acceleration]``: every output except the step-averaged
+        shaft torque is linear in ``z``.
+        """
+        a = self.assembly
+        n, m, ns = a.n_dof, a.n_mesh, a.n_shaft
+        rows = m + 2 * n + 4
+        shafts = np.zeros((rows, ns))
+        shafts[m : m + n] = (a.shaft_k[:, None] * a.S).T
+        shafts[m + n : m + 2 * n] = (a.shaft_c[:, None] * a.S).T
+        shafts[m + 2 * n] = a.shaft_k * a.S_port[:, 0]
+        shafts[m + 2 * n + 1] = a.shaft_c * a.S_port[:, 0]
+        speeds = np.zeros((rows, n))
+        speeds[m + n : m + 2 * n] = np.eye(n)
+        speeds[m + 2 * n + 2] = a.kinematic_ratio
+        forces = np.zeros((rows, m))
+        forces[:m] = np.eye(m)
+        rotor = shafts @ a.s_driver  # shaft reactions on the driven carrier
+        rotor[:m] += a.BT_driver  # mesh reactions
+        rotor[m + 2 * n + 3] += a.driver_inertia_kgm2  # carrier (and orbital planet) inertia
+        return np.column_stack((shafts[:, -1], speeds[:, self._out_member], rotor, forces, shafts, speeds))
+
+    def output_vector(self) -> np.ndarray:
+        """Every output at the current time in one pass, ordered as :attr:`output_names`.
+
+        Units: torques [N m], speeds [rad/s], contact forces [N].
+        """
+        z = np.concatenate((self.system.last_force, self.y, self._output_extra()))
+        linear = z @ self._output_matrix
+        avg = self.shaft_torque_average_nm
+        head = (avg if self.shaft_torque_mode == "average" else linear[0], avg)
+        return np.concatenate((head, linear))
+
+    def _output_extra(self) -> tuple[float, float, float, float]:
+        return (self.port_angle_rad, self.port_speed_rad_s, self.driver_speed_rad_s, self.driver_accel_rad_s2)
 
     # ------------------------------------------------------------ stepping
     def initialize(self, t0: float, omega_rotor: float, phi_rotor: float, omega_gen: float, phi_gen: float) -> None:

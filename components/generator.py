@@ -11,6 +11,7 @@ torque drives the rotor; a positive counter torque brakes it.
 
 from __future__ import annotations
 
+import bisect
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -123,6 +124,8 @@ class TorqueSchedule:
     def __init__(self, breaks, values) -> None:
         self.breaks = np.asarray(breaks, dtype=float)
         self.values = np.asarray(values, dtype=float)
+        self._break_list = self.breaks.tolist()
+        self._value_list = self.values.tolist()
 
     @classmethod
     def from_events(cls, base_torque_nm: float, events: tuple[LoadEvent, ...] = ()) -> "TorqueSchedule":
@@ -147,6 +150,9 @@ class TorqueSchedule:
 
     def __call__(self, t: float | np.ndarray) -> float | np.ndarray:
         """Torque [N m] at time(s) ``t`` [s] (right-continuous)."""
+        if isinstance(t, float):  # scalar fast path (called every communication step)
+            i = bisect.bisect_right(self._break_list, t) - 1
+            return self._value_list[min(max(i, 0), len(self._value_list) - 1)]
         idx = np.searchsorted(self.breaks, t, side="right") - 1
         out = self.values[np.clip(idx, 0, self.values.size - 1)]
         return float(out) if np.ndim(out) == 0 else out

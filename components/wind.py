@@ -145,6 +145,15 @@ class RotorSpeedProcess:
     def _phase(self, t: np.ndarray) -> np.ndarray:
         return np.multiply.outer(t, self.frequencies_rad_s) + self.phases_rad
 
+    def speed_and_angle(self, t: float) -> tuple[float, float]:
+        """Speed [rad/s] and angle [rad] at one time ``t`` [s], in one pass over the harmonics."""
+        ph = self.frequencies_rad_s * t + self.phases_rad
+        w0 = self.params.mean_speed_rad_s
+        return (
+            float(w0 + np.cos(ph) @ self.amplitudes_rad_s),
+            float(w0 * t + (np.sin(ph) @ self._w_over_f - self._angle_offset)),  # same association as angle()
+        )
+
     def speed(self, t: float | np.ndarray) -> float | np.ndarray:
         """Rotor speed omega(t) [rad/s] (eq. 13); ``t`` scalar or array [s]."""
         return self._evaluate(t, lambda ph: np.cos(ph) @ self.amplitudes_rad_s, self.params.mean_speed_rad_s)

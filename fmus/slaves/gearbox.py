@@ -32,10 +32,9 @@ from .interface import Variable, boolean_parameter, enumeration_text, integer_pa
 
 _MESH_KINDS = {"sun_planet": "sun-planet mesh", "ring_planet": "ring-planet mesh", "parallel": "parallel-stage mesh"}
 
-# output groups, each refreshed from the model at most once per step and only when read
-_TORQUE, _SHAFTS, _SPEEDS, _ROTOR, _FORCES = "torque", "shafts", "speeds", "rotor", "forces"
-_MAIN_GROUPS = {"shaft_torque": _TORQUE, "shaft_torque_avg": _TORQUE, "shaft_torque_end": _SHAFTS,
-                "omega_out": _SPEEDS, "torque_rotor": _ROTOR}
+# all outputs form one group: computed in one vectorised pass (GearboxModel.output_vector)
+# at most once per step, when the first output is read
+_OUTPUTS = "outputs"
 
 
 def _assembly(preset: str) -> Assembly:
@@ -47,7 +46,7 @@ class Gearbox(DtcosimSlave):
 
     description = ("dtcosim Gearbox: multi-stage planetary/parallel gearbox with CFS (or impact) gear contact "
                    "and shaft 3, driven by the rotor motion and cut at the generator (SI units)")
-    eager_output_groups = frozenset({_TORQUE})  # shaft_torque is read every step
+    eager_output_groups = frozenset({_OUTPUTS})  # shaft_torque is read every step
 
     @classmethod
     def build_interface(cls) -> Iterable[Variable]:
@@ -90,22 +89,15 @@ class Gearbox(DtcosimSlave):
         self._template = cosim_preset(self.preset)
         vr = self.vr
         self._vr_inputs = tuple(vr[n] for n in ("omega_rotor", "phi_rotor", "omega_gen", "phi_gen"))
-        self._vr_torque = (vr["shaft_torque"], vr["shaft_torque_avg"])
-        self._vr_shafts = (vr["shaft_torque_end"],) + tuple(vr[f"{s.name}.torque"] for s in assembly.shafts)
-        self._vr_speeds = (vr["omega_out"],) + tuple(vr[f"{b}.omega"] for b in assembly.dof_names)
-        self._vr_rotor = vr["torque_rotor"]
-        self._vr_forces = tuple(vr[m.name] for m in assembly.meshes)
-        self._out_index = assembly.dof_index(assembly.stage_members[self._template.stages[-1].name]["output"])
+        names = GearboxModel(self._template).output_names
+        self._vr_outputs = [vr[n] for n in names]
+        first = self._vr_outputs[0]
+        contiguous = self._vr_outputs == list(range(first, first + len(names)))
+        self._output_slice = slice(first, first + len(names)) if contiguous else None
         self.model: GearboxModel | None = None
 
     def output_group(self, name: str) -> Hashable:
-        if name in _MAIN_GROUPS:
-            return _MAIN_GROUPS[name]
-        if name.endswith(".torque"):
-            return _SHAFTS
-        if name.endswith(".omega"):
-            return _SPEEDS
-        return _FORCES
+        return _OUTPUTS
 
     # ------------------------------------------------------------------ hooks
     def _configure(self) -> None:
@@ -126,25 +118,12 @@ class Gearbox(DtcosimSlave):
         self.model.step(time, step_size, values[i[0]], values[i[1]], values[i[2]], values[i[3]])
 
     def _refresh(self, group: Hashable) -> None:
-        model = self.model
-        values = self._values
-        if group == _TORQUE:
-            i_torque, i_avg = self._vr_torque
-            values[i_torque] = float(model.shaft_torque_nm)
-            values[i_avg] = float(model.shaft_torque_average_nm)
-        elif group == _SHAFTS:
-            torques = model.shaft_torques_nm.tolist()
-            for vr, value in zip(self._vr_shafts, [torques[-1]] + torques):
-                values[vr] = value
-        elif group == _SPEEDS:
-            speeds = model.speeds_rad_s
-            out = [float(speeds[self._out_index])] + speeds.tolist()
-            for vr, value in zip(self._vr_speeds, out):
-                values[vr] = value
-        elif group == _ROTOR:
-            values[self._vr_rotor] = float(model.rotor_torque_nm)
+        out = self.model.output_vector().tolist()
+        if self._output_slice is not None:
+            self._values[self._output_slice] = out
         else:
-            for vr, value in zip(self._vr_forces, model.contact_force_n.tolist()):
+            values = self._values
+            for vr, value in zip(self._vr_outputs, out):
                 values[vr] = value
 
     def _component_state(self) -> dict:

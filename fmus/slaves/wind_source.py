@@ -77,9 +77,7 @@ class WindSource(DtcosimSlave):
             raise ParameterError("step_size", step_size, "> 0")
 
     def _refresh(self, group: Hashable) -> None:
-        t = self._time
-        self._values[self._vr_omega] = self.process.speed(t)
-        self._values[self._vr_phi] = self.process.angle(t)
+        self._values[self._vr_omega], self._values[self._vr_phi] = self.process.speed_and_angle(self._time)
 
     def _component_state(self) -> dict:
         return {}

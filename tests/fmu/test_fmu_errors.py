@@ -175,7 +175,7 @@ def test_host_survives_many_failed_instances_and_sees_the_message_without_loggin
     script = tmp_path / "failing_host.py"
     script.write_text(FAILING_HOST)
     result = run_python(this_python, str(script), str(fmu_path("Gearbox")), "12")
-    assert result.returncode == 0, result.stderr[-2000:]
+    assert result.returncode == 0, f"exit code {result.returncode}; stdout {result.stdout[-500:]!r}; stderr {result.stderr[-1500:]}"
     assert "failures 12" in result.stdout and "good instance stepped" in result.stdout
     # loggingOn = false: pythonfmu drops logger messages, the slave echoes errors to stderr
     assert result.stderr.count("invalid parameter stage1.sun_mass = -1.0: expected > 0") == 12

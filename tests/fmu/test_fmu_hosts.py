@@ -99,7 +99,7 @@ MARKER = 12345.0
 PATCH = f'''
 
 # --- test patch: this copy of the code reports a marker rotor torque ---
-GearboxModel.rotor_torque_nm = property(lambda self: {MARKER!r})
+GearboxModel.output_vector = lambda self: __import__('numpy').full(len(self.output_names), {MARKER!r})
 '''
 
 
