@@ -331,7 +331,8 @@ class ContactLaw:
             # every mesh deep in flank contact: d_BL = delta - sgn(delta) j_t/2 and d d_BL/d delta = 1 exactly
             flank = np.sign(deflection)
             pen = abs_d - self._half_jt
-            signed = pen * (self._k * stiffness_factor * np.sqrt(pen) + self._c * flank * rate)
+            k = self._k if type(stiffness_factor) is float and stiffness_factor == 1.0 else self._k * stiffness_factor
+            signed = pen * (k * np.sqrt(pen) + self._c * flank * rate)
             return flank * np.maximum(signed, 0.0)
         X = deflection + self._pm_half_jt  # rows: delta - j_t/2, delta + j_t/2
         U = X * self._lam2

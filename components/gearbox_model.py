@@ -114,6 +114,19 @@ class _StepSystem:
         self.port_jacobian = np.stack([dqx[:, 0], dvx[:, 0]])
         return dq, dv
 
+    def time_derivative_basis(self) -> np.ndarray | None:
+        """Rows ``[da/dq_port, da/dv_port, -kappa]``: ``da/dt = [port speed, port accel, driver jerk] @ rows``.
+
+        None with time-varying mesh stiffness (then ``da/dt`` is not of this form).
+        """
+        if self.assembly.time_varying_stiffness:
+            return None
+        return np.vstack((self.port_jacobian, -self.assembly.kinematic_ratio))
+
+    def time_derivative_coefficients(self, tau: float) -> tuple[float, float, float]:
+        """Coefficients of :meth:`time_derivative_basis` at local time ``tau`` [s]."""
+        return (self.port.rate(tau), self.port.accel(tau), self.driver.jerk())
+
     def time_derivative(self, tau: float, y: np.ndarray) -> np.ndarray:
         a = self.assembly
         if a.time_varying_stiffness:  # stiffness varies with time too: difference the whole a(t)

@@ -53,6 +53,11 @@ class SecondOrderSystem(Protocol):
     def time_derivative(self, t: float, y: np.ndarray) -> np.ndarray:
         """Partial da/dt (may be approximate: the method is a W-method)."""
 
+    # Optional: when ``time_derivative_basis`` returns a matrix ``B`` (k, n) that only
+    # changes when the Jacobian is re-evaluated, and ``time_derivative_coefficients(t)``
+    # the k numbers with ``da/dt = c(t) @ B``, the integrator applies ``W^-1`` to ``B``
+    # once per factorisation instead of to ``da/dt`` at every step.
+
 
 @dataclass(frozen=True)
 class StepControl:
@@ -124,6 +129,9 @@ class Rosenbrock23:
         self._hd = -1.0  # step*d the inverse was formed for
         self._winv = np.zeros((2 * n, 2 * n))
         self._winv_v = np.zeros((2 * n, n))
+        self._w_basis = None
+        basis = getattr(system, "time_derivative_basis", None)
+        self._basis_form = basis is not None and basis() is not None
         c = self.control
         self._atol = np.concatenate((np.full(n, c.atol_q), np.full(n, c.atol_v)))
 
@@ -149,6 +157,7 @@ class Rosenbrock23:
         winv[n:, n:] = ginv
         self._winv = winv
         self._winv_v = np.ascontiguousarray(winv[:, n:])
+        self._w_basis = None  # W^-1 applied to the time-derivative basis, formed on first use
         self._hd = hd
 
     # -------------------------------------------------------------------- step
@@ -159,7 +168,12 @@ class Rosenbrock23:
         if hd != self._hd:
             self._factor(hd)
         winv = self._winv
-        w_hdT = self._winv_v @ (hd * self.system.time_derivative(t, y))  # W^-1 [0, h d a_t]
+        if self._basis_form:  # W^-1 [0, h d a_t] with a_t = c(t) @ B
+            if self._w_basis is None:
+                self._w_basis = self._winv_v @ self.system.time_derivative_basis().T
+            w_hdT = self._w_basis @ (hd * np.asarray(self.system.time_derivative_coefficients(t)))
+        else:
+            w_hdT = self._winv_v @ (hd * self.system.time_derivative(t, y))
         k1 = winv @ f0 + w_hdT
         y1 = y + (0.5 * h) * k1
         f1 = np.concatenate((y1[n:], self.system.acceleration(t + 0.5 * h, y1)))
@@ -240,12 +254,12 @@ class Rosenbrock23:
     def snapshot(self) -> tuple:
         """Cheap in-memory copy of the state (arrays are replaced, never mutated, so references suffice)."""
         return (self.h_next, self.accepted, self.rejected, self.jacobians, self._age, self._hd, self._dq, self._dv,
-                self._winv, self._winv_v)
+                self._winv, self._winv_v, self._w_basis)
 
     def restore(self, snap: tuple) -> None:
         """Undo to a :meth:`snapshot`."""
         (self.h_next, self.accepted, self.rejected, self.jacobians, self._age, self._hd, self._dq, self._dv,
-         self._winv, self._winv_v) = snap
+         self._winv, self._winv_v, self._w_basis) = snap
 
     # ------------------------------------------------------------------- state
     def get_state(self) -> dict:
@@ -275,6 +289,7 @@ class Rosenbrock23:
         self._dv = np.array(state["dv"], dtype=float).reshape(n, n)
         self._winv = np.array(state["winv"], dtype=float).reshape(2 * n, 2 * n)
         self._winv_v = np.ascontiguousarray(self._winv[:, n:])
+        self._w_basis = None  # re-formed from the restored factorisation and basis on first use
 
     def reset(self) -> None:
         """Forget the step size and the Jacobian (e.g. after re-initialisation)."""
