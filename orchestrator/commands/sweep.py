@@ -1,0 +1,134 @@
+"""``dtcosim sweep``: run a parameter study on Dask workers.
+
+Exit status: 0 every point has a result (``ok`` or ``failed``: failed points
+are results, listed in the table); 1 invalid study, or points that hit an
+infrastructure error (re-tried by the next run); 130 interrupted by Ctrl-C
+(finished points are kept; run the same command again to continue).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add the ``sweep`` subcommand."""
+    p = sub.add_parser(
+        "sweep",
+        help="run a parameter study (grid, explicit points, seeds) on Dask workers and write a table and plots",
+        description=(
+            "Run every point of a study on Dask workers (a LocalCluster by default, or an existing cluster) "
+            "with the co-simulation or the monolithic engine, and write journal.jsonl (one line per finished "
+            "point), results.csv, study.json and PNG plots. STUDY is a study TOML file or the name of a packaged "
+            "study (paper-sensitivity). Points already in the output directory's journal are not run again."
+        ),
+    )
+    p.add_argument("study", metavar="STUDY", help="study TOML file or packaged study name (e.g. paper-sensitivity)")
+    p.add_argument("--workers", type=int, default=None, metavar="N",
+                   help="workers of the LocalCluster: processes with one thread each (default: CPU count)")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="use an existing Dask cluster through its scheduler, e.g. tcp://10.0.0.5:8786 (left running)")
+    p.add_argument("--out", type=Path, default=None, help="output directory (default: results/<study name>)")
+    p.add_argument("--fmu-dir", type=Path, default=None,
+                   help="directory searched for the base scenario's FMUs (default: $DTCOSIM_FMU_DIR or the project's fmus/)")
+    p.add_argument("--no-build", action="store_true", help="do not build missing project FMUs (fail instead)")
+    p.add_argument("--retry-failed", action="store_true",
+                   help="run points whose journal record says 'failed' again (default: failures are final)")
+    p.add_argument("--check", action="store_true", help="only validate the study against its base and print the plan")
+    p.add_argument("--report", action="store_true",
+                   help="only regenerate results.csv, study.json and the plots from the journal (nothing runs)")
+    p.add_argument("--no-plots", action="store_true", help="do not write the PNG plots")
+    p.add_argument("--quiet", "-q", action="store_true", help="no progress bar and no summary")
+    p.set_defaults(func=run)
+
+
+def _progress_bar(total: int, initial_desc: str):
+    """A tqdm bar on stderr counting finished points, and the per-record callback for it."""
+    from tqdm import tqdm
+
+    try:
+        size = os.get_terminal_size(sys.stderr.fileno())
+    except OSError:
+        size = os.terminal_size((0, 0))
+    bar = tqdm(total=total, unit="pt", desc=initial_desc, file=sys.stderr, ncols=size.columns or 80,
+               nrows=size.lines or 24, dynamic_ncols=False)
+    counts = {"failed": 0, "error": 0}
+
+    def progress(record: dict) -> None:
+        if record["status"] in counts:
+            counts[record["status"]] += 1
+            bar.set_postfix(failed=counts["failed"], error=counts["error"], refresh=False)
+        bar.update(1)
+
+    return bar, progress
+
+
+def run(args: argparse.Namespace) -> int:
+    """Validate the study, run its pending points, write the results."""
+    from ..study import StudyError, find_study, load_study
+    from ..study_report import status_counts, point_records, write_outputs
+    from ..sweep import pending_points, prepare_study, run_sweep
+    from ..journal import JOURNAL_FILE, read_journal
+
+    quiet = args.quiet
+    if args.workers is not None and args.workers < 1:
+        raise StudyError("--workers", args.workers, "an integer >= 1")
+    study = load_study(find_study(args.study))
+    prepared = prepare_study(study, fmu_dir=args.fmu_dir, build=not args.no_build)
+    out_dir = args.out if args.out is not None else Path("results") / study.name
+    say = (lambda msg: None) if quiet else (lambda msg: print(msg, file=sys.stderr))
+    if args.check:
+        todo = pending_points(prepared, read_journal(out_dir / JOURNAL_FILE), args.retry_failed)
+        print(f"{study.name}: valid; engine {study.engine}, base {study.base.kind} {study.base.name}; "
+              f"{len(prepared.points)} points ({' x '.join(str(n) for n in study.shape)}), {len(todo)} to run "
+              f"into {out_dir}; measures {', '.join(m.name for m in study.measures)}")
+        return 0
+    if args.report:
+        files = write_outputs(prepared, out_dir, plots=not args.no_plots)
+        counts = status_counts(point_records(prepared, out_dir=out_dir))
+        if not quiet:
+            print(f"{study.name}: {counts}; written " + ", ".join(p.name for p in files.values()))
+        return 0
+
+    where = f"scheduler {args.scheduler}" if args.scheduler else f"a LocalCluster of {args.workers or os.cpu_count()} workers"
+    bar = None
+    progress = None
+
+    def on_start(pending: int, skipped: int) -> None:
+        nonlocal bar, progress
+        say(f"{study.name}: {len(prepared.points)} points, {skipped} already in {out_dir / JOURNAL_FILE}, "
+            f"{pending} to run with the {study.engine} engine on {where}")
+        if pending and not quiet and sys.stderr.isatty():
+            bar, progress_cb = _progress_bar(pending, study.name)
+            progress = progress_cb
+
+    def forward(record: dict) -> None:
+        if progress is not None:
+            progress(record)
+
+    try:
+        report = run_sweep(prepared, out_dir, workers=args.workers, scheduler=args.scheduler,
+                           retry_failed=args.retry_failed, progress=forward, on_start=on_start,
+                           plots=not args.no_plots)
+    finally:
+        if bar is not None:
+            bar.close()
+    counts = status_counts(point_records(prepared, out_dir=out_dir))
+    if not quiet:
+        print(f"{study.name}: ran {report.submitted} points ({report.ok} ok, {report.failed} failed, "
+              f"{report.errors} errors) on {report.workers} workers in {report.compute_time_s:.2f} s "
+              f"(whole command {report.wall_time_s:.2f} s); skipped {report.skipped} already done")
+        print(f"table: {counts['ok']} ok, {counts['failed']} failed, {counts['error']} error, "
+              f"{counts['pending']} pending")
+        print(f"results in {out_dir}/: " + ", ".join(p.name for p in report.files.values()))
+    if counts["failed"]:
+        print(f"dtcosim sweep: warning: {counts['failed']} points failed (see the error column of "
+              f"{out_dir / 'results.csv'})", file=sys.stderr)
+    if report.interrupted:
+        print(f"dtcosim sweep: interrupted; {report.ok + report.failed + report.errors} finished points kept in "
+              f"{out_dir / JOURNAL_FILE}; run the same command again to continue", file=sys.stderr)
+        return 130
+    return 1 if counts["error"] or counts["pending"] else 0

@@ -1,0 +1,165 @@
+"""What a study computes per run: built-in measures and summary statistics.
+
+Measures are written as text in a study file:
+
+``I_max_acc`` [rad/s^2]
+    Eq. 11: ``max_t |d omega_out / dt|`` over the whole run (not only the
+    analysis window), the output gear being the last stage's output member.
+    Monolithic engine: evaluated from the ODE right-hand side at every accepted
+    LSODA step and refined with the solver's interpolant around the maximum
+    (:func:`components.acceleration.peak_output_acceleration`), a second
+    integration whose cost is not part of ``cpu_time``. Co-simulation engine:
+    the largest finite difference of the recorded ``omega_out`` samples, which
+    cannot resolve pulses shorter than the sampling interval (a lower bound).
+``cpu_time`` [s]
+    Eq. 12: process CPU time of the integration, measured in the worker with
+    ``time.process_time``. Monolithic: the LSODA integration alone (not the
+    evaluation of the recorded variables). Co-simulation: the master's run from
+    instantiation to freeing the FMUs (pythonfmu FMUs run inside the worker's
+    process, so their work counts).
+``wall_time`` [s]
+    Wall-clock time of the same span.
+``steps``, ``rhs_calls`` [-]
+    Internal LSODA steps and right-hand-side evaluations of the timed
+    integration (monolithic engine only).
+``<component>.<variable>:<statistic>``
+    A statistic of a recorded variable over the analysis window, e.g.
+    ``gearbox.stage1.F_sp[1]:std``; statistics ``mean``, ``std``, ``min``,
+    ``max``, ``absmax`` (largest magnitude), ``rms``. Units as in
+    ``timeseries.csv`` (SI).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from components.errors import DtcosimError
+from components.results import unit_of
+
+#: built-in measures: name -> (unit, description, engines)
+BUILTIN: dict[str, tuple[str, str, tuple[str, ...]]] = {
+    "I_max_acc": ("rad/s2", "peak output-gear acceleration max |d omega_out/dt| (eq. 11)", ("cosim", "monolithic")),
+    "cpu_time": ("s", "CPU time of the integration (eq. 12)", ("cosim", "monolithic")),
+    "wall_time": ("s", "wall-clock time of the integration", ("cosim", "monolithic")),
+    "steps": ("1", "internal solver steps", ("monolithic",)),
+    "rhs_calls": ("1", "right-hand-side evaluations", ("monolithic",)),
+}
+STATISTICS = ("mean", "std", "min", "max", "absmax", "rms")
+
+
+class MeasureError(DtcosimError, ValueError):
+    """A measure name cannot be parsed (``expected`` says what would be)."""
+
+    def __init__(self, text: object, expected: str) -> None:
+        self.text = text
+        self.expected = expected
+        super().__init__(f"invalid measure {text!r}: expected {expected}")
+
+    def __reduce__(self):
+        return (type(self), (self.text, self.expected))
+
+
+@dataclass(frozen=True)
+class Measure:
+    """One measure of a study.
+
+    Attributes
+    ----------
+    name : str
+        As written, e.g. ``"I_max_acc"`` or ``"gearbox.stage3.F_mesh:max"``.
+    variable : str or None
+        ``"component.variable"`` of a statistic (None for a built-in measure).
+    statistic : str or None
+        One of :data:`STATISTICS` (None for a built-in measure).
+    unit : str
+        SI unit of the value (``"1"``: dimensionless).
+    description : str
+    """
+
+    name: str
+    variable: str | None
+    statistic: str | None
+    unit: str
+    description: str
+
+    @property
+    def builtin(self) -> bool:
+        """True for ``I_max_acc``, ``cpu_time``, ``wall_time``, ``steps``, ``rhs_calls``."""
+        return self.variable is None
+
+    @property
+    def column(self) -> str:
+        """CSV column header ``name [unit]``."""
+        return f"{self.name} [{self.unit}]"
+
+    @property
+    def engines(self) -> tuple[str, ...]:
+        """Engines that can compute it."""
+        return BUILTIN[self.name][2] if self.builtin else ("cosim", "monolithic")
+
+
+def parse_measure(text: object) -> Measure:
+    """A :class:`Measure` from its name.
+
+    Raises
+    ------
+    MeasureError
+        Neither a built-in name nor ``component.variable:statistic``.
+    """
+    expected = ("a built-in measure (" + ", ".join(BUILTIN) + ") or 'component.variable:statistic' with statistic "
+                + " | ".join(STATISTICS))
+    if not isinstance(text, str) or not text:
+        raise MeasureError(text, expected)
+    if text in BUILTIN:
+        unit, description, _ = BUILTIN[text]
+        return Measure(text, None, None, unit, description)
+    variable, colon, stat = text.rpartition(":")
+    comp, dot, var = variable.partition(".")
+    if not colon or not dot or not comp or not var or stat not in STATISTICS:
+        raise MeasureError(text, expected)
+    return Measure(text, variable, stat, unit_of(var), f"{stat} of {variable}")
+
+
+def statistic(values: np.ndarray, name: str) -> float:
+    """One of :data:`STATISTICS` of a sample vector (NaN for no samples)."""
+    x = np.asarray(values, dtype=float)
+    if x.size == 0:
+        return float("nan")
+    if name == "mean":
+        return float(x.mean())
+    if name == "std":
+        return float(x.std())
+    if name == "min":
+        return float(x.min())
+    if name == "max":
+        return float(x.max())
+    if name == "absmax":
+        return float(np.abs(x).max())
+    if name == "rms":
+        return float(np.sqrt(np.mean(x * x)))
+    raise MeasureError(name, "one of " + ", ".join(STATISTICS))
+
+
+def window_values(time_s: np.ndarray, values: np.ndarray, window: tuple[float, float]) -> np.ndarray:
+    """Samples with ``window[0] <= t <= window[1]`` (1e-12 s slack)."""
+    t = np.asarray(time_s, dtype=float)
+    sel = (t >= window[0] - 1e-12) & (t <= window[1] + 1e-12)
+    return np.asarray(values, dtype=float)[sel]
+
+
+def max_abs_rate(time_s: np.ndarray, values: np.ndarray) -> float:
+    """Largest ``|dx/dt|`` between consecutive samples [unit of x per s].
+
+    Parameters
+    ----------
+    time_s : ndarray, shape (N,)
+        Strictly increasing times [s], N >= 2.
+    values : ndarray, shape (N,)
+    """
+    t = np.asarray(time_s, dtype=float)
+    x = np.asarray(values, dtype=float)
+    if t.size < 2:
+        return float("nan")
+    return float(np.max(np.abs(np.diff(x) / np.diff(t))))
