@@ -86,6 +86,15 @@ def grid(prepared, recs, measure: str, x: int, y: int | None):
     return mean, count, failed
 
 
+def _title(text: str, per_cell: int, width_in: float) -> str:
+    """A plot title wrapped to the figure width, noting the runs averaged per cell."""
+    import textwrap
+
+    if per_cell > 1:
+        text += f" (mean of {per_cell} runs per cell)"
+    return "\n".join(textwrap.wrap(text, width=max(30, int(width_in * 11))))
+
+
 def _per_cell(study, x: int, y: int | None) -> int:
     """Points that share one cell of the plot."""
     n = study.n_points // len(study.axes[x].values)
@@ -99,24 +108,26 @@ def heatmap(prepared, recs, spec: PlotSpec, path: Path) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     from matplotlib.colors import LogNorm, Normalize
+    from matplotlib.ticker import ScalarFormatter
 
     study = prepared.study
     m = study.measure(spec.measure)
     ax_x, ax_y = study.axes[spec.x], study.axes[spec.y]
     mean, count, failed = grid(prepared, recs, m.name, spec.x, spec.y)
     ny, nx = mean.shape
-    fig, ax = plt.subplots(figsize=(max(5.5, 0.95 * nx + 2.6), max(3.6, 0.5 * ny + 1.9)), constrained_layout=True)
+    width = max(5.5, 0.95 * nx + 2.6)
+    fig, ax = plt.subplots(figsize=(width, max(3.6, 0.5 * ny + 1.9)), constrained_layout=True)
     finite = mean[np.isfinite(mean)]
     lo = spec.vmin if spec.vmin is not None else (float(finite.min()) if finite.size else 0.0)
     hi = spec.vmax if spec.vmax is not None else (float(finite.max()) if finite.size else 1.0)
-    if not hi > lo:
-        hi = lo + (abs(lo) or 1.0) * 1e-9
+    if not hi > lo:  # one value (or none): a band around it
+        span = 0.05 * abs(lo) or 1.0
+        lo, hi = (lo - span if spec.vmin is None else lo), (hi + span if spec.vmax is None else hi)
     if spec.log and lo > 0:
         norm = LogNorm(vmin=lo, vmax=hi)
     else:
         norm = Normalize(vmin=lo, vmax=hi)
-    cmap = plt.get_cmap("viridis").copy()
-    cmap.set_bad("#f2f2f2")
+    cmap = plt.get_cmap("viridis").with_extremes(bad="#f2f2f2")
     im = ax.imshow(np.ma.masked_invalid(mean), origin="lower", aspect="auto", cmap=cmap, norm=norm,
                    interpolation="nearest")
     for j in range(ny):
@@ -129,17 +140,20 @@ def heatmap(prepared, recs, spec: PlotSpec, path: Path) -> Path:
                 ax.add_patch(plt.Rectangle((i - 0.5, j - 0.5), 1, 1, facecolor="#bdbdbd", hatch="//",
                                            edgecolor="#7f7f7f", linewidth=0))
                 ax.text(i, j, "failed", ha="center", va="center", fontsize=8, color="#b00020")
+            else:
+                ax.text(i, j, "not run", ha="center", va="center", fontsize=7.5, color="#9e9e9e")
     ax.set_xticks(range(nx), [_tick(ax_x.display(v)) for v in ax_x.values])
     ax.set_yticks(range(ny), [_tick(ax_y.display(v)) for v in ax_y.values])
     ax.set_xlabel(ax_x.axis_label)
     ax.set_ylabel(ax_y.axis_label)
     bar = fig.colorbar(im, ax=ax, pad=0.02)
     bar.set_label(f"{m.name} [{unit_text(m.unit)}]")
-    title = spec.title or f"{study.name}: {m.description}"
-    n_cell = _per_cell(study, spec.x, spec.y)
-    if n_cell > 1:
-        title += f"\n(mean of {n_cell} runs per cell)"
-    ax.set_title(title, fontsize=10.5)
+    if not spec.log:
+        bar.formatter = ScalarFormatter(useOffset=False)
+        bar.formatter.set_powerlimits((-3, 4))
+        bar.update_ticks()
+    ax.set_title(_title(spec.title or f"{study.name}: {m.description}", _per_cell(study, spec.x, spec.y), width),
+                 fontsize=10)
     fig.savefig(path, dpi=130)
     plt.close(fig)
     return path
@@ -184,7 +198,8 @@ def line_plot(prepared, recs, spec: PlotSpec, path: Path) -> Path:
         ax.set_ylim(spec.vmin, spec.vmax)
     ax.set_xlabel(axis.axis_label)
     ax.set_ylabel(f"{m.name} [{unit_text(m.unit)}]")
-    ax.set_title(spec.title or f"{study.name}: {m.description}", fontsize=10.5)
+    ax.set_title(_title(spec.title or f"{study.name}: {m.description}", _per_cell(study, spec.x, None), 6.4),
+                 fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     fig.savefig(path, dpi=130)

@@ -514,8 +514,17 @@ def _open_client(workers: int | None, scheduler: str | None):
         except OSError as exc:
             raise StudyError("--scheduler", scheduler, f"the address of a running Dask scheduler ({exc})") from None
     n = workers if workers else (os.cpu_count() or 1)
-    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                           silence_logs=logging.ERROR)
+    # Ctrl-C on a terminal signals the whole process group: the worker processes start with SIGINT ignored
+    # (an ignored signal stays ignored across exec), so only this process acts on it and closes the cluster
+    previous = None
+    if threading.current_thread() is threading.main_thread():
+        previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                               silence_logs=logging.ERROR)
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGINT, previous)
     return Client(cluster), cluster
 
 
@@ -593,6 +602,7 @@ def _execute(prepared: PreparedStudy, todo: list[int], journal: Journal, report:
     study = prepared.study
     code = prepared.identity["code"]
     futures: dict = {}
+    t0 = None
     with _Interrupts() as interrupts:
         client = cluster = None
         try:
@@ -634,12 +644,13 @@ def _execute(prepared: PreparedStudy, todo: list[int], journal: Journal, report:
                     report.errors += 1
                 if progress is not None:
                     progress(record)
-            report.compute_time_s = time.perf_counter() - t0
         except KeyboardInterrupt:
             report.interrupted = True
             if client is not None:
                 with contextlib.suppress(Exception):
                     client.cancel(list(futures))
         finally:
+            if t0 is not None:
+                report.compute_time_s = time.perf_counter() - t0
             if client is not None:
                 _close(client, cluster)

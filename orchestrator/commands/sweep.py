@@ -118,9 +118,11 @@ def run(args: argparse.Namespace) -> int:
             bar.close()
     counts = status_counts(point_records(prepared, out_dir=out_dir))
     if not quiet:
-        print(f"{study.name}: ran {report.submitted} points ({report.ok} ok, {report.failed} failed, "
-              f"{report.errors} errors) on {report.workers} workers in {report.compute_time_s:.2f} s "
-              f"(whole command {report.wall_time_s:.2f} s); skipped {report.skipped} already done")
+        finished = report.ok + report.failed + report.errors
+        print(f"{study.name}: {finished} of {report.submitted} submitted points finished ({report.ok} ok, "
+              f"{report.failed} failed, {report.errors} errors) on {report.workers} workers in "
+              f"{report.compute_time_s:.2f} s (whole command {report.wall_time_s:.2f} s); "
+              f"{report.skipped} skipped (already in the journal)")
         print(f"table: {counts['ok']} ok, {counts['failed']} failed, {counts['error']} error, "
               f"{counts['pending']} pending")
         print(f"results in {out_dir}/: " + ", ".join(p.name for p in report.files.values()))
