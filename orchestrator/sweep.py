@@ -50,6 +50,8 @@ from .study import Point, Study, StudyError, split_parameter
 from .study_engine import FAILED, OK, PointTask, StudyPayload, run_point
 
 ERROR = "error"
+#: how long a sweep waits for the first worker of an existing cluster [s]
+WAIT_FOR_WORKERS_S = 60.0
 #: modules left out of the code version: they present results, they do not change a point's numbers
 _PRESENTATION_MODULES = ("plots.py", "analysis_plots.py", "study_plots.py", "study_report.py", "modal_report.py",
                          "journal.py")
@@ -528,6 +530,15 @@ def _open_client(workers: int | None, scheduler: str | None):
     return Client(cluster), cluster
 
 
+def _worker_count(client) -> int:
+    """Workers connected to the scheduler now."""
+    try:
+        info = client.scheduler_info(n_workers=-1)  # newer distributed lists only a few workers by default
+    except TypeError:
+        info = client.scheduler_info()
+    return len(info.get("workers", {}))
+
+
 def _close(client, cluster) -> None:
     """Close the client, then the cluster we started (never an external one)."""
     with contextlib.suppress(Exception):
@@ -607,7 +618,14 @@ def _execute(prepared: PreparedStudy, todo: list[int], journal: Journal, report:
         client = cluster = None
         try:
             client, cluster = _open_client(workers, scheduler)
-            report.workers = len(client.scheduler_info(n_workers=-1).get("workers", {}))
+            report.workers = _worker_count(client)
+            if report.workers == 0:  # an existing cluster whose workers have not connected (yet)
+                try:
+                    client.wait_for_workers(1, timeout=WAIT_FOR_WORKERS_S)
+                except TimeoutError:
+                    raise StudyError("--scheduler", scheduler, f"a cluster with at least one worker (none connected "
+                                     f"within {WAIT_FOR_WORKERS_S:g} s)") from None
+                report.workers = _worker_count(client)
             payload = client.scatter([prepared.payload], hash=False)[0]
             t0 = time.perf_counter()
             run_id = uuid.uuid4().hex[:8]

@@ -83,3 +83,38 @@ def test_ctrl_c_keeps_every_finished_point_and_the_next_run_completes_the_rest(w
     assert report.submitted == 12 - len(kept) and report.ok == report.submitted
     records = read_journal(journal)
     assert len(records) == 12 and len({r["key"] for r in records}) == 12  # every point exactly once
+
+
+def _on_terminal(args: list[str], cwd: Path) -> str:
+    """Run dtcosim with stdout and stderr on a pseudo-terminal; return everything it printed."""
+    import pty
+
+    master, slave = pty.openpty()
+    proc = subprocess.Popen([str(Path(sys.executable).parent / "dtcosim"), *args], cwd=cwd, stdout=slave,
+                            stderr=slave, stdin=subprocess.DEVNULL)
+    os.close(slave)
+    shown = b""
+    while True:
+        try:
+            chunk = os.read(master, 65536)
+        except OSError:
+            break
+        if not chunk:
+            break
+        shown += chunk
+    assert proc.wait(timeout=120) == 0, shown.decode("utf-8", "replace")
+    os.close(master)
+    return shown.decode("utf-8", "replace")
+
+
+def test_progress_bar_on_a_terminal_quiet_and_check(write_study, tmp_path):
+    path = write_study(SMALL_STUDY)
+    out = str(tmp_path / "out")
+    shown = _on_terminal(["sweep", str(path), "--workers", "2", "--out", out, "--no-plots"], tmp_path)
+    assert "small: 100%" in shown and "4/4" in shown and "failed=1" in shown
+    assert "4 of 4 submitted points finished (3 ok, 1 failed, 0 errors)" in shown
+    assert "warning: 1 points failed" in shown
+    quiet = _on_terminal(["sweep", str(path), "--out", out, "--quiet"], tmp_path).strip().splitlines()
+    assert len(quiet) == 1 and quiet[0].startswith("dtcosim sweep: warning: 1 points failed")  # warnings only
+    check = _on_terminal(["sweep", str(path), "--out", out, "--check", "--retry-failed"], tmp_path)
+    assert "small: valid" in check and "4 points" in check and "1 to run" in check
