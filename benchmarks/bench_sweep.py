@@ -7,7 +7,10 @@ run: ``sweep`` is the whole :func:`orchestrator.sweep.run_sweep` call (cluster
 start-up, scatter, 49 points, journal, table and heat maps, cluster shutdown),
 ``compute`` the first submission to the last result. Target: at least 1.6 x on
 the 2-core machine. With ``--repeat N`` the pair is run N times, alternating, and
-the medians are reported (the machine is shared: expect +-10 %).
+the medians are reported (the machine is shared: expect +-10 %). Before and
+after, it measures how many cores are actually free: a CPU-bound loop in one
+process and in two processes at once (2.0 = two idle cores); a speed-up can only
+be as large as that.
 
 Run: ``python benchmarks/bench_sweep.py [--repeat N]``
 """
@@ -22,6 +25,32 @@ from pathlib import Path
 
 from orchestrator.study import find_study, load_study
 from orchestrator.sweep import prepare_study, run_sweep
+
+
+def _spin(n: int = 15_000_000) -> None:
+    x = 0
+    for i in range(n):
+        x += i
+
+
+def free_cores() -> float:
+    """Parallel capacity now: 2 x (time of one spin loop) / (time of two running at once)."""
+    import multiprocessing
+
+    ctx = multiprocessing.get_context("spawn")
+
+    def timed(k: int) -> float:
+        procs = [ctx.Process(target=_spin) for _ in range(k)]
+        t0 = time.perf_counter()
+        for p in procs:
+            p.start()
+        for p in procs:
+            p.join()
+        return time.perf_counter() - t0
+
+    one = timed(1)
+    two = timed(2)
+    return 2.0 * one / two
 
 
 def _run(prepared, workers: int, root: Path, tag: str) -> tuple[float, float]:
@@ -40,11 +69,13 @@ def main() -> None:
     args = parser.parse_args()
     prepared = prepare_study(load_study(find_study("paper-sensitivity")))
     runs: dict[int, list[tuple[float, float]]] = {1: [], 2: []}
+    capacity = [free_cores()]
     with tempfile.TemporaryDirectory(prefix="dtcosim-bench-sweep-") as tmp:
         root = Path(tmp)
         for k in range(args.repeat):
             for workers in (1, 2):
                 runs[workers].append(_run(prepared, workers, root, f"r{k}"))
+    capacity.append(free_cores())
     med = {w: (statistics.median(r[0] for r in rs), statistics.median(r[1] for r in rs)) for w, rs in runs.items()}
     n = len(prepared.points)
     print(f"paper-sensitivity, {n} points, monolithic engine, LocalCluster (processes, 1 thread each); "
@@ -52,6 +83,7 @@ def main() -> None:
     print(f"  {'workers':>7} {'sweep [s]':>10} {'compute [s]':>12}")
     for w in (1, 2):
         print(f"  {w:>7} {med[w][0]:>10.2f} {med[w][1]:>12.2f}")
+    print(f"  free cores measured before / after: {capacity[0]:.2f} / {capacity[1]:.2f} (2.00 = both cores idle)")
     print(f"  speed-up 2 vs 1 worker: sweep {med[1][0] / med[2][0]:.2f} x, compute {med[1][1] / med[2][1]:.2f} x "
           f"(target >= 1.6 x)")
 

@@ -38,3 +38,19 @@ def test_reference_reports_cpu_time_and_steps():
 def test_peak_rejects_an_empty_interval():
     with pytest.raises(ParameterError, match=r"t_end_s = 0.0: expected > t_start_s = 0"):
         peak_output_acceleration(presets.sensitivity_variant(10.0, 600.0), ConstantSpeed(1.0), 0.0)
+
+
+def test_r1_acts_on_the_peak_only_through_the_stage2_mass_scaling():
+    """Sec. 4.1's reason for the R1 trend, checked: without the 10/R1 scaling R1 changes nothing."""
+    from components.parameter_map import flatten, unflatten
+
+    driver = ConstantSpeed(units.rpm(5.0))
+    scaled_names = ("stage2.sun_mass", "stage2.planet_mass", "stage2.sun_inertia", "stage2.planet_inertia")
+    r10 = peak_output_acceleration(presets.sensitivity_variant(10.0, 600.0), driver, 1e-3).value_rad_s2
+    r6 = presets.sensitivity_variant(6.0, 600.0)
+    flat = flatten(r6)
+    unscaled = unflatten(r6, {k: flat[k] * 6.0 / 10.0 for k in scaled_names})
+    with_scaling = peak_output_acceleration(r6, driver, 1e-3).value_rad_s2
+    without = peak_output_acceleration(unscaled, driver, 1e-3).value_rad_s2
+    assert without == pytest.approx(r10, rel=1e-4)  # the stage-1/2 geometry does not reach the stage-3 impact
+    assert 1.02 < with_scaling / r10 < 1.06  # a 1.67 x heavier stage 2 raises the peak by ~3 %
