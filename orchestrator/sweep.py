@@ -365,10 +365,20 @@ def _prepare_scenario(study: Study, fmu_dir, build: bool) -> tuple[StudyPayload,
             solver={k: getattr(settings, k) for k in ("rtol", "atol_angle_rad", "atol_speed_rad_s", "max_step_s", "max_steps")},
         )
     identity = {
-        "scenario_sha256": hashlib.sha256(Path(study.base.path).read_bytes()).hexdigest(),
+        "scenario_sha256": _content_sha256(Path(study.base.path)),
         "fmus": {c: i.sha256 for c, i in system.interfaces.items()},
     }
     return payload, identity, dict(system.fmu_paths)
+
+
+def _content_sha256(path: Path) -> str:
+    """SHA-256 of a file's content, or of every file under a directory (an SSP directory) with its name."""
+    if path.is_file():
+        return hashlib.sha256(path.read_bytes()).hexdigest()
+    h = hashlib.sha256()
+    for f in sorted(p for p in path.rglob("*") if p.is_file()):
+        h.update(str(f.relative_to(path)).encode() + b"\0" + f.read_bytes())
+    return h.hexdigest()
 
 
 def prepare_study(study: Study, fmu_dir: str | Path | None = None, build: bool = True) -> PreparedStudy:
@@ -591,7 +601,6 @@ def run_sweep(
     wall0 = time.perf_counter()
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    study = prepared.study
     report = SweepReport(total=len(prepared.points), out_dir=out)
     journal_path = out / JOURNAL_FILE
     with Journal(journal_path) as journal:
