@@ -8,6 +8,7 @@ stages, drivetrain, presets gear stages, shafts, topology, paper presets (Tables
 assembly                    bodies, mesh/shaft matrices, forces and analytic Jacobian
 wind, generator             rotor-speed process (eq. 13-14), generator rotor and load events
 reference                   monolithic LSODA reference solver and energy audit
+acceleration                peak output-gear acceleration at every solver step (eq. 11)
 cases                       the paper's reference cases (Tables 2, 4, 7; Fig. 10-11)
 modes, modal_verification   linearisation, undamped/complex modes, free-response check
 campbell                    natural frequencies over rotor speed vs 1P/3P and gear-mesh lines

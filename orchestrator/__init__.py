@@ -19,4 +19,15 @@ ssp             SSP 1.0 export and import
 libcosim_host   running an SSP in libcosim (child process with libpython preloaded)
 fmu_store       locating/building the project's FMUs
 runner          one run from scenario to files (used by ``dtcosim run``)
+
+Study modules (``dtcosim sweep``, docs/studies.md)
+-------------------------------------------------
+study           the study file: axes, explicit points, seeds, measures, plots (StudyError)
+measures        built-in measures (eq. 11-12, times, solver work) and summary statistics
+study_models    built-in monolithic models (the Sec. 4.1 variant)
+study_engine    one point in a Dask worker: monolithic and co-simulation engines, FMUs from bytes
+sweep           checking a study against its base, point keys, the Dask loop
+journal         the append-only results journal (one JSON line per finished point)
+study_report    results.csv and study.json regenerated from the journal
+study_plots     heat maps (Fig. 12-13) and line plots of the measures
 """

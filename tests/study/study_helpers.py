@@ -1,4 +1,4 @@
-"""Helpers of the study tests (a module of its own: several conftest.py share that module name)."""
+"""Helpers of the study tests: small study files, free ports, the CLI."""
 
 from __future__ import annotations
 

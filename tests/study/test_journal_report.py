@@ -11,7 +11,7 @@ from orchestrator.study import load_study
 from orchestrator.study_engine import PointTask, run_point
 from orchestrator.study_report import read_table, write_outputs
 from orchestrator.sweep import pending_points, prepare_study
-from study_helpers import SMALL_FAILURE, SMALL_HEAD, SMALL_STUDY, SMALL_TABLES, STAGE3_FORCE_N
+from .study_helpers import SMALL_FAILURE, SMALL_HEAD, SMALL_STUDY, SMALL_TABLES, STAGE3_FORCE_N
 
 
 def test_torn_last_line_is_skipped_and_the_next_record_starts_a_new_line(tmp_path):

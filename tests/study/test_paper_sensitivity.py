@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from orchestrator.study_report import read_table
-from study_helpers import run_cli
+from .study_helpers import run_cli
 
 pytestmark = pytest.mark.slow
 

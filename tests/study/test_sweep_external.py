@@ -14,7 +14,7 @@ import pytest
 
 from orchestrator.journal import read_journal
 from orchestrator.study_report import read_table
-from study_helpers import SMALL_FAILURE, SMALL_STUDY, free_port, run_cli
+from .study_helpers import SMALL_FAILURE, SMALL_STUDY, free_port, run_cli
 
 pytestmark = pytest.mark.slow
 
