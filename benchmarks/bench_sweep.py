@@ -24,7 +24,8 @@ import time
 from pathlib import Path
 
 from orchestrator.study import find_study, load_study
-from orchestrator.sweep import prepare_study, run_sweep
+from orchestrator.study_prepare import prepare_study
+from orchestrator.sweep import run_sweep
 
 
 def _spin(n: int = 15_000_000) -> None:

@@ -26,7 +26,8 @@ study           the study file: axes, explicit points, seeds, measures, plots (S
 measures        built-in measures (eq. 11-12, times, solver work) and summary statistics
 study_models    built-in monolithic models (the Sec. 4.1 variant)
 study_engine    one point in a Dask worker: monolithic and co-simulation engines, FMUs from bytes
-sweep           checking a study against its base, point keys, the Dask loop
+study_prepare   checking a study against its base, the workers' payload, point keys
+sweep           the Dask loop: LocalCluster or existing cluster, re-runs, Ctrl-C
 journal         the append-only results journal (one JSON line per finished point)
 study_report    results.csv and study.json regenerated from the journal
 study_plots     heat maps (Fig. 12-13) and line plots of the measures

@@ -5,7 +5,7 @@ design variants, load cases and wind seeds of a wind-turbine drivetrain study,
 or the paper's sensitivity analysis (Sec. 4.1). It is a frozen, validated value;
 every structural mistake raises :class:`StudyError` naming the key, before
 anything runs. The checks that need the base system (parameter names and types,
-recorded variables) are made by :func:`orchestrator.sweep.prepare_study`, also
+recorded variables) are made by :func:`orchestrator.study_prepare.prepare_study`, also
 before anything runs. See ``docs/studies.md`` for the format in full::
 
     name = "seeds-and-stiffness"          # optional, default: file stem

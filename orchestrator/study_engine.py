@@ -95,7 +95,7 @@ class PointTask:
     Attributes
     ----------
     key : str
-        The point's identity (see :func:`orchestrator.sweep.point_key`).
+        The point's identity (see :func:`orchestrator.study_prepare.point_key`).
     index : int
         Position in the study.
     parameters : mapping of str -> value

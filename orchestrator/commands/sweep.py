@@ -70,7 +70,8 @@ def run(args: argparse.Namespace) -> int:
     """Validate the study, run its pending points, write the results."""
     from ..study import StudyError, find_study, load_study
     from ..study_report import status_counts, point_records, write_outputs
-    from ..sweep import pending_points, prepare_study, run_sweep
+    from ..study_prepare import prepare_study
+    from ..sweep import pending_points, run_sweep
     from ..journal import JOURNAL_FILE, read_journal
 
     quiet = args.quiet

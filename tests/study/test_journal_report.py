@@ -10,7 +10,8 @@ from orchestrator.journal import Journal, JournalError, latest_by_key, read_jour
 from orchestrator.study import load_study
 from orchestrator.study_engine import PointTask, run_point
 from orchestrator.study_report import read_table, write_outputs
-from orchestrator.sweep import pending_points, prepare_study
+from orchestrator.study_prepare import prepare_study
+from orchestrator.sweep import pending_points
 from .study_helpers import SMALL_FAILURE, SMALL_HEAD, SMALL_STUDY, SMALL_TABLES, STAGE3_FORCE_N
 
 

@@ -7,7 +7,7 @@ import pytest
 
 from components.errors import DtcosimError
 from orchestrator.study import StudyError, find_study, load_study, study_from_dict
-from orchestrator.sweep import prepare_study
+from orchestrator.study_prepare import prepare_study
 from .study_helpers import SMALL_STUDY, run_cli
 
 MODEL_BASE = """

@@ -9,7 +9,8 @@ import pytest
 
 from orchestrator.study import load_study
 from orchestrator.study_report import read_table
-from orchestrator.sweep import prepare_study, run_sweep
+from orchestrator.study_prepare import prepare_study
+from orchestrator.sweep import run_sweep
 
 pytestmark = pytest.mark.slow
 

@@ -15,7 +15,8 @@ import pytest
 from orchestrator.journal import read_journal
 from orchestrator.study import load_study
 from orchestrator.study_report import read_table
-from orchestrator.sweep import prepare_study, run_sweep
+from orchestrator.study_prepare import prepare_study
+from orchestrator.sweep import run_sweep
 from .study_helpers import SMALL_FAILURE, SMALL_HEAD, SMALL_STUDY, SMALL_TABLES, STAGE3_FORCE_N
 
 pytestmark = pytest.mark.slow
