@@ -120,10 +120,14 @@ def run(args: argparse.Namespace) -> int:
     counts = status_counts(point_records(prepared, out_dir=out_dir))
     if not quiet:
         finished = report.ok + report.failed + report.errors
-        print(f"{study.name}: {finished} of {report.submitted} submitted points finished ({report.ok} ok, "
-              f"{report.failed} failed, {report.errors} errors) on {report.workers} workers in "
-              f"{report.compute_time_s:.2f} s (whole command {report.wall_time_s:.2f} s); "
-              f"{report.skipped} skipped (already in the journal)")
+        if report.submitted:
+            print(f"{study.name}: {finished} of {report.submitted} submitted points finished ({report.ok} ok, "
+                  f"{report.failed} failed, {report.errors} errors) on {report.workers} workers in "
+                  f"{report.compute_time_s:.2f} s (whole command {report.wall_time_s:.2f} s); "
+                  f"{report.skipped} skipped (already in the journal)")
+        else:
+            print(f"{study.name}: nothing to run, all {report.skipped} points are in the journal "
+                  f"(--retry-failed runs failed points again)")
         print(f"table: {counts['ok']} ok, {counts['failed']} failed, {counts['error']} error, "
               f"{counts['pending']} pending")
         print(f"results in {out_dir}/: " + ", ".join(p.name for p in report.files.values()))
