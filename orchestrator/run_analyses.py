@@ -75,6 +75,12 @@ def _is_force(column: str) -> bool:
     return column.rsplit(".", 1)[-1].startswith("F_")
 
 
+def _stage_of(column: str) -> str:
+    """Stage of a contact-force column: ``"gearbox.stage1.F_sp[1]"`` -> ``"stage1"``."""
+    parts = column.split(".")
+    return parts[-2] if len(parts) >= 2 else ""
+
+
 def _is_shaft_torque(column: str) -> bool:
     parts = column.split(".")
     return len(parts) >= 2 and parts[-1] == "torque" and parts[-2].startswith("shaft")
@@ -222,6 +228,7 @@ def analyse_run(system: ResolvedSystem, outcome: RunOutcome, out_dir: str | Path
 
                 result.files["plot:contact_force_spectra"] = plot_force_spectra(
                     t, {n: series[n] for n in chosen}, out / SPECTRUM_PLOT, marks, window, fmax)
+                summary["file"] = SPECTRUM_PLOT
         else:
             result.notes.append("no spectrum: the samples are not uniformly spaced")
     return result
@@ -232,7 +239,7 @@ def _first_per_stage(forces: list[str]) -> list[str]:
     seen: set[str] = set()
     out = []
     for n in forces:
-        stage = n.rsplit(".", 2)[-2] if "." in n else n
+        stage = _stage_of(n)
         if stage not in seen:
             seen.add(stage)
             out.append(n)
@@ -266,7 +273,7 @@ def _spectrum(series, t, window, forces, info: _Drivetrain | None):
     chosen: list[str] = []
     kinds: set[tuple[str, str]] = set()
     for n in forces:
-        stage = n.rsplit(".", 2)[-2] if n.count(".") >= 1 else ""
+        stage = _stage_of(n)
         kind = n.rsplit(".", 1)[-1].split("[", 1)[0]
         if (stage, kind) not in kinds:
             kinds.add((stage, kind))
@@ -280,26 +287,25 @@ def _spectrum(series, t, window, forces, info: _Drivetrain | None):
     per_force = {}
     for n in chosen:
         f, amp = amplitude_spectrum(series[n][sel], h)
-        entry: dict[str, Any] = {}
-        stage = n.rsplit(".", 2)[-2]
+        df = f[1] - f[0]
+        stage = _stage_of(n)
         fm = mesh_hz.get(stage)
-        if fm is not None:
-            entry["stage"] = stage
-            entry["mesh_frequency_hz"] = fm
-            band = (f >= 0.8 * fm) & (f <= min(1.2 * fm, nyquist))
-            if fm < nyquist and band.any():
-                k = int(np.flatnonzero(band)[np.argmax(amp[band])])
-                entry["peak_near_mesh_frequency_hz"] = float(f[k])
-                entry["peak_amplitude_n"] = float(amp[k])
-        k = int(np.argmax(amp[1:])) + 1
-        entry["largest_peak_hz"] = float(f[k])
-        entry["largest_peak_amplitude_n"] = float(amp[k])
-        per_force[n] = entry
+        if fm is None or fm >= nyquist:
+            continue
+        near = np.abs(f - fm) <= df  # the bins next to f_mesh (scalloping)
+        band = np.abs(f - fm) <= max(0.05 * fm, df)
+        k = int(np.flatnonzero(band)[np.argmax(amp[band])])
+        per_force[n] = {
+            "stage": stage,
+            "mesh_frequency_hz": fm,
+            "amplitude_at_mesh_frequency_n": float(amp[near].max()),
+            "peak_within_5_percent_hz": float(f[k]),
+            "peak_within_5_percent_amplitude_n": float(amp[k]),
+        }
     marks = {f"{stage} mesh": fm for stage, fm in mesh_hz.items() if fm < nyquist}
     top = max(marks.values(), default=0.0)
-    fmax = min(nyquist, 1.25 * top) if top > 0 else nyquist
+    fmax = min(nyquist, 2.2 * top) if top > 0 else nyquist  # up to the second mesh harmonic
     summary = {
-        "file": SPECTRUM_PLOT,
         "window_s": list(window),
         "sample_interval_s": h,
         "resolution_hz": 1.0 / (tw.size * h),  # FFT bin width
@@ -310,3 +316,37 @@ def _spectrum(series, t, window, forces, info: _Drivetrain | None):
         "forces": per_force,
     }
     return summary, chosen, marks, fmax
+
+
+def format_analyses(summary: dict[str, Any]) -> str:
+    """A few lines for the terminal: load events, contact loss per mesh, DELs of the shaft torques."""
+    lines = []
+    for ev in summary.get("events", []):
+        dur = "permanent" if ev["duration_s"] is None else f"{ev['duration_s']:g} s"
+        factor = "" if ev["factor"] is None else f", factor {ev['factor']:g}"
+        lines.append(f"load event: {ev['kind']} at {ev['start_s']:g} s for {dur}{factor} ({ev['component']}, slot {ev['slot']})")
+    cl = summary.get("contact_loss")
+    if cl:
+        w0, w1 = cl["window_s"]
+        head = f"contact loss over [{w0:g}, {w1:g}] s (|F| < {cl['threshold_n']:g} N): "
+        lost = cl["meshes_with_contact_loss"]
+        if not lost and not any(m["time_in_backlash_s"] > 0 for m in cl["meshes"].values()):
+            lines.append(head + f"none ({len(cl['meshes'])} meshes)")
+        else:
+            lines.append(head + f"{len(lost)} of {len(cl['meshes'])} meshes separate, {cl['total_separations']} "
+                         f"separations, {cl['total_flank_changes']} flank changes")
+            for name, m in cl["meshes"].items():
+                if m["separations"] or m["time_in_backlash_s"] > 0:
+                    lines.append(f"  {name:<32}{m['separations']:>3} separations {m['flank_changes']:>3} flank changes "
+                                 f"{1e3 * m['time_in_backlash_s']:9.2f} ms inside the backlash "
+                                 f"(longest {1e3 * m['longest_episode_s']:.2f} ms)")
+    fat = summary.get("fatigue")
+    if fat:
+        exps = [f"m={m:g}" for m in fat["wohler_exponents"]]
+        shafts = {n: d for n, d in fat["del"].items() if _is_shaft_torque(n)}
+        if shafts:
+            lines.append(f"damage-equivalent loads (N_ref = {fat['reference_frequency_hz'] or 0:g} Hz x T) [N m]: "
+                         + ", ".join(exps))
+            for n, d in shafts.items():
+                lines.append(f"  {n:<32}" + "".join(f"{d['del'][e]:14.6g}" for e in exps))
+    return "\n".join(lines)
