@@ -214,6 +214,35 @@ class AssignedEvent:
         return self.event.as_dict() | {"component": self.component, "slot": self.slot}
 
 
+def _events_in_slot_parameters(scenario, interfaces: Mapping[str, FmuInterface],
+                               slots: Mapping[str, int]) -> tuple[AssignedEvent, ...]:
+    """Events a scenario sets directly as slot parameters (e.g. an imported SSP, ``--set``), for the report."""
+    kinds = {code: kind for kind, code in EVENT_KIND_CODES.items()}
+    found = []
+    for comp in scenario.components:
+        params = comp.parameters
+        variables = interfaces[comp.name].variables
+        for slot in range(1, slots.get(comp.name, 0) + 1):
+            code = params.get(f"event{slot}.kind", variables[f"event{slot}.kind"].start)
+            if not code:
+                continue
+            value = {f: params.get(f"event{slot}.{f}", variables[f"event{slot}.{f}"].start)
+                     if f"event{slot}.{f}" in variables else None for f in _SLOT_FIELDS[1:]}
+            prefix = f"components.{comp.name}.parameters.event{slot}"
+            if code not in kinds:
+                raise ScenarioError(f"{prefix}.kind", code, "0 (none) or an event code: "
+                                    + ", ".join(f"{c} {k}" for c, k in kinds.items()), scenario.source)
+            kind = kinds[code]
+            try:
+                event = ScenarioEvent(kind, value["start"], value["duration"],
+                                      None if kind == "grid_fault" else value["factor"], comp.name)
+            except ScenarioError as exc:
+                raise ScenarioError(exc.key.replace("event.", f"{prefix}.", 1), exc.value, exc.expected,
+                                    scenario.source) from None
+            found.append(AssignedEvent(event, comp.name, slot))
+    return tuple(found)
+
+
 def assign_events(scenario, interfaces: Mapping[str, FmuInterface]):
     """Map a scenario's events onto its FMUs' event slots.
 
@@ -229,7 +258,9 @@ def assign_events(scenario, interfaces: Mapping[str, FmuInterface]):
         The scenario with the slot parameters added to the target components and no
         ``events`` left (so that checking it again is a no-op).
     assigned : tuple of AssignedEvent
-        Every event with its component and slot, in scenario order.
+        Every event with its component and slot, in scenario order. A scenario without
+        ``[[events]]`` reports the events its slot parameters set directly (an imported
+        SSP, ``dtcosim run --set generator.event1.kind=2 ...``).
 
     Raises
     ------
@@ -238,10 +269,10 @@ def assign_events(scenario, interfaces: Mapping[str, FmuInterface]):
         or slot parameters also given directly (names the ``events[i]`` key).
     """
     events = scenario.events
-    if not events:
-        return scenario, ()
     src = scenario.source
     slots = {name: event_slot_count(iface) for name, iface in interfaces.items()}
+    if not events:
+        return scenario, _events_in_slot_parameters(scenario, interfaces, slots)
     with_slots = [name for name, n in slots.items() if n > 0]
     assigned: list[AssignedEvent] = []
     used: dict[str, int] = {}

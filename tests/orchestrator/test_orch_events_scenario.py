@@ -153,3 +153,39 @@ def test_analysis_settings_are_read_and_give_the_fatigue_settings():
     fs = a.fatigue_settings()
     assert fs.wohler_exponents == (4.0, 9.0) and fs.reference_cycles_for(10.0) == 20.0 and fs.ldd_bins == (-1e5, 0.0, 1e5)
     assert load_scenario(find_scenario("paper-60s")).analysis == AnalysisSettings()
+
+
+def test_ssp_export_carries_events_and_analysis_settings(fmu_paths, tmp_path):
+    """Events travel as the generator's slot parameters (a permanent step as INF), non-default
+    [analysis] settings as the dtcosim annotation; the archive stays valid SSP 1.0."""
+    from fmpy.ssp.ssd import read_ssd
+
+    from orchestrator.ssp import export_ssp, import_ssp
+
+    data = tomllib.loads(find_scenario("torque-step").read_text())
+    data["analysis"] = {"woehler_exponents": [4, 9], "ldd_bins": [-1e5, 0.0, 1e5], "spectrum": "never"}
+    original = scenario_from_dict(data)
+    system = resolve_system(original, fmu_paths=fmu_paths)
+    ssp = export_ssp(system, tmp_path / "step.ssp")
+    read_ssd(str(ssp))  # validates against the SSP 1.0 schema
+    back = import_ssp(ssp)
+    assert back.analysis == original.analysis and back.events == ()
+    gen = back.component("generator").parameters
+    assert (gen["event1.kind"], gen["event1.start"], gen["event1.duration"], gen["event1.factor"]) == (1, 10.0, math.inf, 1.5)
+    again = resolve_system(back, fmu_paths=fmu_paths)
+    assert monolithic_setup(again).drivetrain.generator.events == (LoadEvent("torque_step", 10.0, math.inf, 1.5),)
+    # reported as events again (summary "events", event plot), read from the slot parameters
+    assert [a.as_dict() for a in again.events] == [a.as_dict() for a in system.events]
+
+
+def test_slot_parameters_set_directly_are_reported_and_checked(fmu_paths):
+    sc = load_scenario(find_scenario("paper-60s")).with_parameters(
+        "generator", **{"event2.kind": 3, "event2.start": 4.0, "event2.duration": 0.25})
+    (a,) = resolve_system(sc, fmu_paths=fmu_paths).events
+    assert (a.component, a.slot, a.event.kind, a.event.start_s, a.event.duration_s, a.event.factor) == (
+        "generator", 2, "emergency_stop", 4.0, 0.25, 1.0)
+    bad = sc.with_parameters("generator", **{"event2.duration": -1.0})
+    with pytest.raises(ScenarioError, match=r"components\.generator\.parameters\.event2\.duration = -1\.0"):
+        resolve_system(bad, fmu_paths=fmu_paths)
+    with pytest.raises(ScenarioError, match=r"event2\.kind = 7"):
+        resolve_system(sc.with_parameters("generator", **{"event2.kind": 7}), fmu_paths=fmu_paths)
