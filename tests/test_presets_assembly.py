@@ -1,12 +1,14 @@
 """Presets (Tables 3, 5, 6; Sec. 4.1) and the assembly matrices."""
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
 from components import units
 from components.assembly import Assembly
+from components.modes import static_equilibrium
 from components.parameter_map import flatten, unflatten
 from components.presets import cosim_preset, sensitivity_variant, table3_parallel, table5_planetary, table6_gearbox
 from components.stages import ParallelStage, PlanetaryStage, solid_disc
@@ -84,15 +86,7 @@ def test_kinematic_ratios_of_table6():
 
 
 def _static_equilibrium(a: Assembly, torque_nm: float) -> np.ndarray:
-    q = np.zeros(a.n_dof)
-    for _ in range(100):
-        loads = a.loads(q, np.zeros_like(q))
-        residual = a.acceleration(q, np.zeros_like(q), 0.0, torque_nm) * a.inertia_kgm2
-        if np.abs(residual).max() < 1e-7:
-            return q
-        dq, *_ = a.acceleration_jacobian(loads)
-        q = q + np.linalg.lstsq(dq * a.inertia_kgm2[:, None], -residual, rcond=None)[0]
-    raise AssertionError("no static equilibrium")
+    return static_equilibrium(a, torque_nm).q_rad
 
 
 def test_static_forces_are_torque_over_base_radius():
@@ -159,3 +153,29 @@ def test_table3_and_table5_geometry():
     assert (s.sun_radius_m, s.planet_radius_m, s.ring_radius_m) == pytest.approx((0.11, 0.16, 0.43))
     assert s.ratio == pytest.approx(4.909, rel=1e-3)
     assert units.kgmm2(3.16e5) == pytest.approx(s.planet_inertia_kgm2)
+
+
+def test_any_stage_sequence_parallel_then_planetary():
+    """A parallel stage driving a planetary stage through a shaft: kinematics and static forces."""
+    from components.drivetrain import Drivetrain
+    from components.stages import Shaft
+
+    (par,) = table3_parallel().stages
+    (pla,) = table5_planetary().stages
+    dt = Drivetrain(
+        stages=(par, replace(pla, name="stage2")),
+        shafts=(Shaft("shaft1", 1.0e7, 1.0e3),),
+        output_torque_nm=500.0,
+    )
+    a = Assembly(dt)
+    assert dt.ratio == pytest.approx(par.ratio * pla.ratio)
+    kappa = dict(zip(a.dof_names, a.kinematic_ratio))
+    assert kappa["stage1.driven"] == pytest.approx(par.ratio)
+    assert kappa["stage2.carrier"] == pytest.approx(par.ratio)
+    assert kappa["stage2.sun"] == pytest.approx(par.ratio * pla.ratio)
+    q = _static_equilibrium(a, 500.0)
+    f = dict(zip(a.mesh_names, a.loads(q, np.zeros_like(q)).contact_force_n))
+    sun_torque = 500.0
+    carrier_torque = sun_torque * pla.ratio
+    assert f["stage2.F_sp[1]"] == pytest.approx(sun_torque / (3 * pla.sun_radius_m * COS20), rel=1e-9)
+    assert f["stage1.F_mesh"] == pytest.approx(carrier_torque / (par.driven_radius_m * COS20), rel=1e-9)

@@ -84,3 +84,18 @@ def test_reference_cli_table7_names(capsys):
 
 def test_all_cases_are_listed():
     assert set(CASES) == {"table2", "table4", "sine", "table7"}
+
+
+def test_impact_law_stands_in_for_the_paper_cfa_on_table2():
+    """Table 2 compares CFS with CAD contact (CFA, 9.68e3 N); the impact law of eq. 1 gives the same mean."""
+    from components import units
+    from components.presets import table3_parallel
+    from components.reference import simulate_monolithic
+    from components.wind import ConstantSpeed
+
+    dt = table3_parallel().with_meshes(law="impact")
+    result = simulate_monolithic(dt, ConstantSpeed(units.rpm(5.0)), 1.0)
+    assert result.complete
+    mean = result.statistics((0.5, 1.0), ["stage1.F_mesh"])["stage1.F_mesh"]["mean"]
+    assert mean == pytest.approx(9.68e3, rel=0.01)
+    assert result.energy.relative_residual < 0.005

@@ -6,6 +6,8 @@ import argparse
 
 from fmus.build import add_arguments, run
 
+from ..system import default_fmu_dir
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``build`` subcommand."""
@@ -14,5 +16,5 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="build the FMUs WindSource, Gearbox and GeneratorRotor",
         description="Build the self-contained pythonfmu FMUs WindSource.fmu, Gearbox.fmu and GeneratorRotor.fmu.",
     )
-    add_arguments(p, default_out="fmus")
+    add_arguments(p, default_out=default_fmu_dir())  # where `dtcosim run` looks for them
     p.set_defaults(func=run)

@@ -7,6 +7,8 @@ from pathlib import Path
 
 from fmus.validation import check_fmu, fmu_files
 
+from ..system import default_fmu_dir
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``validate`` subcommand."""
@@ -15,8 +17,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="validate FMUs (fmpy validation plus units, descriptions and state support)",
         description="Validate FMU files, or every *.fmu in the given directories; exit code 1 on any problem.",
     )
-    p.add_argument("paths", nargs="*", type=Path, default=[Path("fmus")], metavar="PATH",
-                   help="FMU files or directories holding them (default: fmus)")
+    p.add_argument("paths", nargs="*", type=Path, default=[default_fmu_dir()], metavar="PATH",
+                   help="FMU files or directories holding them (default: the FMU directory `dtcosim run` uses)")
     p.set_defaults(func=run)
 
 
