@@ -271,15 +271,15 @@ class Scenario:
         ``*``/``?`` wildcards; empty means every output of every component.
     description : str
         Free text.
-    events : tuple of ScenarioEvent
-        Generator load events (``[[events]]``); each must start inside the run.
-    analysis : AnalysisSettings
-        Settings of the result analyses (``[analysis]``).
     base_dir : pathlib.Path, optional
         Directory relative FMU paths are resolved against first (the scenario
         file's directory).
     source : str, optional
         File the scenario was read from (used in error messages).
+    events : tuple of ScenarioEvent
+        Generator load events (``[[events]]``); each must start inside the run.
+    analysis : AnalysisSettings
+        Settings of the result analyses (``[analysis]``).
     """
 
     name: str
@@ -289,10 +289,10 @@ class Scenario:
     initial: tuple[InitialBinding, ...] = ()
     record: tuple[str, ...] = ()
     description: str = ""
-    events: tuple[ScenarioEvent, ...] = ()
-    analysis: AnalysisSettings = field(default_factory=AnalysisSettings)
     base_dir: Path | None = None
     source: str | None = None
+    events: tuple[ScenarioEvent, ...] = ()
+    analysis: AnalysisSettings = field(default_factory=AnalysisSettings)
 
     def __post_init__(self) -> None:
         src = self.source

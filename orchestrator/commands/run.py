@@ -131,7 +131,7 @@ def run(args: argparse.Namespace) -> int:
     system = resolve_system(scenario, fmu_paths=paths)
     if args.check:
         print(f"{scenario.name}: valid ({len(scenario.components)} FMUs, {len(scenario.connections)} connections, "
-              f"{len(system.recorded)} recorded variables; stepping order {', '.join(system.order)}; "
+              f"{len(system.recorded)} recorded variables, {len(system.events)} load event(s); stepping order {', '.join(system.order)}; "
               f"initialisation order {', '.join(system.init_order)})")
         return 0
     out_dir = args.out if args.out is not None else Path("results") / scenario.name
