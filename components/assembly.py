@@ -307,6 +307,12 @@ class Assembly:
         self._mesh_offset = np.array([m.phase_offset_rad for m in self.meshes])
         self._mesh_variation = np.array([m.contact.stiffness_variation for m in self.meshes])
         self._mesh_contact_ratio = np.array([m.contact.contact_ratio for m in self.meshes])
+        self.phasing = None
+        if self.time_varying_stiffness:
+            from .mesh_stiffness import MeshPhasing
+
+            self.phasing = MeshPhasing(self._mesh_rate, self._mesh_offset, self._mesh_contact_ratio, self._mesh_variation)
+        self._force_rows = np.ascontiguousarray(self._fast_matrix[: self.n_mesh])  # d q_ddot / d F, (n_mesh, n_dof)
 
     # ------------------------------------------------------------------ names
     @property
@@ -339,10 +345,49 @@ class Assembly:
         """
         if not self.time_varying_stiffness:
             return 1.0
+        if np.ndim(driver_angle_rad) == 0:
+            return self.phasing.factor(float(driver_angle_rad))
         from .mesh_stiffness import stiffness_factor
 
         phase = np.multiply.outer(driver_angle_rad, self._mesh_rate) + self._mesh_offset
         return stiffness_factor(phase, self._mesh_contact_ratio, self._mesh_variation)
+
+    def stiffness_rate_acceleration(
+        self,
+        y: np.ndarray,
+        port_angle_rad: float,
+        port_speed_rad_s: float,
+        stiffness_factor: np.ndarray,
+        stiffness_factor_rate: np.ndarray,
+    ) -> np.ndarray:
+        """Rate of change of ``q_ddot`` at a fixed state caused by the mesh stiffness varying in time.
+
+        ``(dF/df * df/dt) @ dq_ddot/dF``: the part of the partial time derivative of the
+        acceleration that the time-varying mesh stiffness adds (analytic, for the
+        Rosenbrock integrator of the co-simulation gearbox).
+
+        Parameters
+        ----------
+        y : ndarray, shape (2 n_dof,)
+            State ``[q, v]`` [rad, rad/s].
+        port_angle_rad, port_speed_rad_s : float
+            Deviation angle [rad] and speed [rad/s] of the prescribed port (0 without one).
+        stiffness_factor : ndarray, shape (n_mesh,)
+            Current stiffness multiplier f [-].
+        stiffness_factor_rate : ndarray, shape (n_mesh,)
+            Its time derivative df/dt [1/s].
+
+        Returns
+        -------
+        ndarray, shape (n_dof,)
+            [rad/s^3].
+        """
+        D = y.reshape(2, self.n_dof) @ self._A_T
+        if self._port_meshes:
+            D[0] += self.A_port[:, 0] * port_angle_rad
+            D[1] += self.A_port[:, 0] * port_speed_rad_s
+        sensitivity = self.law.stiffness_sensitivity(D[0], D[1], stiffness_factor)
+        return (sensitivity * stiffness_factor_rate) @ self._force_rows
 
     # ----------------------------------------------------------------- loads
     def loads(

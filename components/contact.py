@@ -348,6 +348,38 @@ class ContactLaw:
         signed = flank * abs_bl * (self._k * stiffness_factor * sgn * root + self._c * rate_bl)  # sgn(delta) * eq. 2
         return flank * np.maximum(signed, 0.0)  # flank-consistent clipping
 
+    def stiffness_sensitivity(
+        self, deflection: np.ndarray, rate: np.ndarray, stiffness_factor: np.ndarray | float = 1.0
+    ) -> np.ndarray:
+        """``dF / d(stiffness factor)`` of every mesh at one state [N], shape (n_mesh,).
+
+        The force is linear in the stiffness multiplier ``f`` on ``k0`` (time-varying
+        mesh stiffness) wherever the flank is in contact, ``dF/df = k0 sgn(d_BL)
+        |d_BL|^e``, and 0 where the flank-consistent clipping applies.
+
+        Parameters
+        ----------
+        deflection, rate : ndarray, shape (n_mesh,)
+            Deflection [m] and its rate [m/s].
+        stiffness_factor : ndarray or float
+            Current multiplier f [-] (decides which meshes are clipped).
+        """
+        if self._any_impact or not self._sqrt_law:
+            cf = self.evaluate(deflection, rate, stiffness_factor)
+            return np.where(cf.force != 0.0, cf.elastic / stiffness_factor, 0.0)
+        X = deflection + self._pm_half_jt
+        U = X * self._lam2
+        T = np.tanh(U)
+        XT = X * T
+        UST = U * (1.0 - T * T) + T
+        d_bl = deflection + 0.5 * (XT[0] - XT[1])  # eq. 3, 4
+        abs_bl = np.abs(d_bl)
+        elastic = self._k * np.sign(d_bl) * abs_bl * np.sqrt(abs_bl)  # per unit stiffness factor
+        rate_bl = (1.0 + 0.5 * (UST[0] - UST[1])) * rate
+        flank = np.sign(deflection)
+        active = flank * (elastic * stiffness_factor + self._c * abs_bl * rate_bl) > 0.0
+        return np.where(active, elastic, 0.0)
+
     def _impact_law(self, deflection: np.ndarray, rate: np.ndarray, k: np.ndarray) -> ContactForces:
         """Eq. 1 with a sharp backlash and the cubic STEP damping of MSC.Adams."""
         p = self.hard_backlash(deflection)

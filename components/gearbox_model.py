@@ -86,7 +86,7 @@ class _StepSystem:
         a = self.assembly
         if not a.time_varying_stiffness:
             return 1.0
-        return a.stiffness_factor(self.angle0 + self.driver.value(tau))
+        return a.phasing.factor(self.angle0 + self.driver.value(tau))
 
     def acceleration(self, tau: float, y: np.ndarray) -> np.ndarray:
         alpha = self.driver.accel(tau)
@@ -129,15 +129,15 @@ class _StepSystem:
 
     def time_derivative(self, tau: float, y: np.ndarray) -> np.ndarray:
         a = self.assembly
-        if a.time_varying_stiffness:  # stiffness varies with time too: difference the whole a(t)
-            eps = 1e-7
-            saved = self.cache()
-            da = (self.acceleration(tau + eps, y) - self.acceleration(tau, y)) / eps
-            self.restore(saved)
-            return da
         # prescribed motions: port angle/speed and driver jerk
         pj = self.port_jacobian
-        return pj[0] * self.port.rate(tau) + pj[1] * self.port.accel(tau) - a.kinematic_ratio * self.driver.jerk()
+        da = pj[0] * self.port.rate(tau) + pj[1] * self.port.accel(tau) - a.kinematic_ratio * self.driver.jerk()
+        if a.time_varying_stiffness:  # the mesh stiffness varies with the driver angle: df/dt = slope x speed
+            factor, slope = a.phasing.factor_and_slope(self.angle0 + self.driver.value(tau))
+            da = da + a.stiffness_rate_acceleration(
+                y, self.port.value(tau), self.port.rate(tau), factor, slope * self.driver.rate(tau)
+            )
+        return da
 
 
 class GearboxModel:

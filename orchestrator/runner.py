@@ -16,6 +16,7 @@ from .derived import generator_vs_ideal
 from .master import CoSimulation, RunOutcome
 from .plots import plot_run
 from .results import SUMMARY_FILE, TIMESERIES_FILE, build_summary, write_summary, write_timeseries
+from .run_analyses import analyse_run
 from .scenario import Scenario, load_scenario
 from .system import ResolvedSystem
 
@@ -54,7 +55,11 @@ class RunReport:
 def run_scenario(system: ResolvedSystem, out_dir: str | Path, *, compare_reference: bool = False, plots: bool = True,
                  progress: Callable[[int, int], None] | None = None, handle_sigint: bool = True,
                  profile: bool = False) -> RunReport:
-    """Run a checked scenario and write ``timeseries.csv``, ``summary.json`` and the plots.
+    """Run a checked scenario and write ``timeseries.csv``, ``summary.json``, the analyses and the plots.
+
+    The analyses (:func:`orchestrator.run_analyses.analyse_run`: contact loss, fatigue
+    loads, contact-force spectra) add ``contact_loss.csv``, ``fatigue_del.csv``,
+    ``fatigue_ldd.csv`` and their plots.
 
     Parameters
     ----------
@@ -87,6 +92,14 @@ def run_scenario(system: ResolvedSystem, out_dir: str | Path, *, compare_referen
     fig16 = generator_vs_ideal(system, outcome)
     if fig16 is not None:
         derived["generator_vs_ideal"] = fig16
+    if system.events:
+        derived["events"] = [a.as_dict() for a in system.events]
+    derived["analysis_settings"] = system.scenario.analysis.as_dict()
+    analyses = analyse_run(system, outcome, out, plots=plots)
+    derived.update(analyses.summary)
+    if analyses.notes:
+        derived["analysis_notes"] = analyses.notes
+    files.update(analyses.files)
     comparison = None
     comparison_text = ""
     if compare_reference:

@@ -39,6 +39,14 @@ TOML format (units SI; see ``docs/orchestrator.md`` for the full reference)::
 
     [record]
     variables = ["wind.omega", "gearbox.stage*.F_sp[1]"]  # names or * / ? patterns
+
+    [[events]]                            # generator load events (orchestrator.load_events)
+    kind = "grid_fault"                   # torque_step | grid_fault | emergency_stop
+    start = 10.0                          # s
+    duration = 0.5                        # s
+
+    [analysis]                            # result analyses (orchestrator.analysis_settings)
+    woehler_exponents = [3, 5, 8, 10]
 """
 
 from __future__ import annotations
@@ -51,7 +59,9 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any, Mapping
 
+from .analysis_settings import AnalysisSettings
 from .errors import ScenarioError
+from .load_events import ScenarioEvent, check_events_in_run, events_from_toml
 
 ALGORITHMS = ("gauss-seidel", "jacobi")
 EXTRAPOLATIONS = ("hold", "linear")
@@ -266,6 +276,10 @@ class Scenario:
         file's directory).
     source : str, optional
         File the scenario was read from (used in error messages).
+    events : tuple of ScenarioEvent
+        Generator load events (``[[events]]``); each must start inside the run.
+    analysis : AnalysisSettings
+        Settings of the result analyses (``[analysis]``).
     """
 
     name: str
@@ -277,6 +291,8 @@ class Scenario:
     description: str = ""
     base_dir: Path | None = None
     source: str | None = None
+    events: tuple[ScenarioEvent, ...] = ()
+    analysis: AnalysisSettings = field(default_factory=AnalysisSettings)
 
     def __post_init__(self) -> None:
         src = self.source
@@ -325,6 +341,13 @@ class Scenario:
         order = self.simulation.order
         if order is not None and sorted(order) != sorted(names):
             raise ScenarioError("simulation.order", list(order), "each component exactly once: " + ", ".join(names), src)
+        object.__setattr__(self, "events", tuple(self.events))
+        for i, ev in enumerate(self.events):
+            if not isinstance(ev, ScenarioEvent):
+                raise ScenarioError(f"events[{i}]", ev, "a ScenarioEvent", src)
+        check_events_in_run(self.events, self.simulation.start_s, self.simulation.stop_s, names, src)
+        if not isinstance(self.analysis, AnalysisSettings):
+            raise ScenarioError("analysis", self.analysis, "an AnalysisSettings", src)
 
     # ------------------------------------------------------------------ access
     def component(self, name: str) -> Component:
@@ -371,7 +394,7 @@ class Scenario:
 
 
 # ---------------------------------------------------------------------- TOML
-_TOP_KEYS = {"name", "description", "simulation", "components", "connections", "initial", "record"}
+_TOP_KEYS = {"name", "description", "simulation", "components", "connections", "initial", "record", "events", "analysis"}
 _SIM_KEYS = {
     "start": "start_s",
     "stop": "stop_s",
@@ -525,6 +548,9 @@ def scenario_from_dict(data: Mapping[str, Any], name: str | None = None, base_di
             raise ScenarioError("record.variables", variables, 'a list of "component.variable" strings', source)
         record = tuple(variables)
 
+    events = events_from_toml(data["events"], source) if "events" in data else ()
+    analysis = AnalysisSettings.from_toml(data["analysis"], source) if "analysis" in data else AnalysisSettings()
+
     return Scenario(
         name=sc_name,
         description=description,
@@ -533,6 +559,8 @@ def scenario_from_dict(data: Mapping[str, Any], name: str | None = None, base_di
         initial=initial,
         simulation=settings,
         record=record,
+        events=events,
+        analysis=analysis,
         base_dir=base_dir,
         source=source,
     )

@@ -14,7 +14,9 @@ the scenario connects, binds, sets or records (the units are defined in
   which libcosim's SSP loader needs;
 * ``org.dtcosim.scenario``: what SSP 1.0 has no element for - sampling interval,
   analysis window, algorithm, extrapolation, stepping order, recorded variables
-  and the initial bindings (``[[initial]]``).
+  and the initial bindings (``[[initial]]``), and the ``[analysis]`` settings when
+  they differ from the defaults. Load events (``[[events]]``) need no annotation:
+  they are the generator FMU's event-slot parameters in the parameter set.
 
 An initial binding (a parameter set from another FMU's output during
 initialisation) cannot be an SSP/libcosim connection (targets must be inputs),
@@ -44,6 +46,7 @@ import zipfile
 from pathlib import Path
 from typing import Any, Mapping
 
+from .analysis_settings import AnalysisSettings
 from .errors import ScenarioError, SspError
 from .scenario import Component, Connection, InitialBinding, Scenario, SimulationSettings, VariableRef
 from .system import ResolvedSystem
@@ -68,7 +71,10 @@ def _q(tag: str) -> str:
 
 
 def _num(x: float) -> str:
-    return repr(float(x))
+    x = float(x)
+    if math.isinf(x):  # xs:double spelling (e.g. a permanent torque step's duration)
+        return "INF" if x > 0 else "-INF"
+    return repr(x)
 
 
 # ----------------------------------------------------------------------------- export
@@ -206,6 +212,14 @@ def system_structure(system: ResolvedSystem, initial_values: Mapping[str, float]
         ET.SubElement(dtc, _q("dtc:Initial"), source=str(b.source), target=str(b.target))
     for pattern in sc.record:
         ET.SubElement(dtc, _q("dtc:Record"), variable=pattern)
+    if sc.analysis != AnalysisSettings():
+        a = sc.analysis
+        bins = a.ldd_bins
+        ET.SubElement(dtc, _q("dtc:Analysis"), woehlerExponents=" ".join(_num(m) for m in a.woehler_exponents),
+                      referenceFrequencyHz=_num(a.reference_frequency_hz),
+                      lddBins=str(bins) if isinstance(bins, int) else " ".join(_num(x) for x in bins),
+                      rainflowResidue=a.rainflow_residue, contactLossThresholdN=_num(a.contact_loss_threshold_n),
+                      spectrum=a.spectrum)
     ET.indent(root, space="  ")
     return ET.ElementTree(root)
 
@@ -292,6 +306,30 @@ def _float_attr(el: ET.Element, name: str, where: str, default: float | None = N
     return out
 
 
+def _analysis_settings(el: ET.Element, source: str) -> AnalysisSettings:
+    """The ``[analysis]`` settings from a ``dtc:Analysis`` element (absent attributes: defaults)."""
+    try:
+        kwargs: dict[str, Any] = {}
+        if el.get("woehlerExponents"):
+            kwargs["woehler_exponents"] = tuple(float(x) for x in el.get("woehlerExponents").split())
+        if el.get("referenceFrequencyHz"):
+            kwargs["reference_frequency_hz"] = float(el.get("referenceFrequencyHz"))
+        if el.get("lddBins"):
+            parts = el.get("lddBins").split()
+            kwargs["ldd_bins"] = int(parts[0]) if len(parts) == 1 else tuple(float(x) for x in parts)
+        if el.get("contactLossThresholdN"):
+            kwargs["contact_loss_threshold_n"] = float(el.get("contactLossThresholdN"))
+    except ValueError as exc:
+        raise SspError(f"{source}: dtc:Analysis has a malformed number ({exc})") from None
+    for attr, key in (("rainflowResidue", "rainflow_residue"), ("spectrum", "spectrum")):
+        if el.get(attr):
+            kwargs[key] = el.get(attr)
+    try:
+        return AnalysisSettings(**kwargs)
+    except ScenarioError as exc:
+        raise ScenarioError(exc.key, exc.value, exc.expected, source) from None
+
+
 def import_ssp(path: str | Path) -> Scenario:
     """Read a scenario from an ``.ssp`` archive, an SSP directory or a ``.ssd`` file.
 
@@ -344,6 +382,7 @@ def import_ssp(path: str | Path) -> Scenario:
     sim_kwargs: dict[str, Any] = {"start_s": start, "stop_s": stop}
     initial: list[InitialBinding] = []
     record: list[str] = []
+    analysis = AnalysisSettings()
     if dtc is not None:
         s = dtc.find("dtc:Simulation", NS)
         if s is not None:
@@ -362,6 +401,9 @@ def import_ssp(path: str | Path) -> Scenario:
             initial.append(InitialBinding(VariableRef.parse(b.get("source"), f"initial[{i}].from", source),
                                           VariableRef.parse(b.get("target"), f"initial[{i}].to", source)))
         record = [r.get("variable") for r in dtc.findall("dtc:Record", NS) if r.get("variable")]
+        an = dtc.find("dtc:Analysis", NS)
+        if an is not None:
+            analysis = _analysis_settings(an, source)
     if step is None:
         raise ScenarioError("simulation.step", None, "osp:FixedStepAlgorithm baseStepSize or a dtcosim annotation", source)
     sim_kwargs["step_s"] = step
@@ -393,5 +435,5 @@ def import_ssp(path: str | Path) -> Scenario:
     return Scenario(
         name=name, description=system.get("description", ""), components=tuple(components),
         connections=tuple(connections), initial=tuple(initial), simulation=settings, record=tuple(record),
-        base_dir=base, source=source,
+        analysis=analysis, base_dir=base, source=source,
     )

@@ -21,6 +21,7 @@ from typing import Mapping
 from .errors import AlgebraicLoopError, ScenarioError
 from .fmu_interface import FmuInterface, FmuVariable, read_fmu_interface
 from .graph import find_algebraic_loop, initialization_order, stepping_order
+from .load_events import AssignedEvent, assign_events
 from .scenario import Scenario, VariableRef
 
 #: causalities a scenario may give a value to
@@ -77,6 +78,8 @@ class ResolvedSystem:
     Attributes
     ----------
     scenario : Scenario
+        The checked scenario; its load events (``[[events]]``) are already written into
+        the event-slot parameters of their component (see :mod:`orchestrator.load_events`).
     fmu_paths : mapping of str -> pathlib.Path
         Absolute FMU file of each component.
     interfaces : mapping of str -> FmuInterface
@@ -87,6 +90,8 @@ class ResolvedSystem:
         Order of the initialisation sweeps (connections and initial bindings).
     recorded : tuple of RecordedVariable
         Recorded variables in the order of the record patterns.
+    events : tuple of AssignedEvent
+        The scenario's load events with the component and slot that apply them.
     """
 
     scenario: Scenario
@@ -95,6 +100,7 @@ class ResolvedSystem:
     order: tuple[str, ...]
     init_order: tuple[str, ...]
     recorded: tuple[RecordedVariable, ...]
+    events: tuple[AssignedEvent, ...] = ()
 
     def variable(self, ref: VariableRef) -> FmuVariable:
         """Model-description entry of a ``component.variable`` reference."""
@@ -191,6 +197,7 @@ def resolve_system(
     src = scenario.source
     paths = dict(fmu_paths) if fmu_paths is not None else resolve_fmu_paths(scenario, fmu_dir)
     interfaces = {c.name: read_fmu_interface(paths[c.name], f"components.{c.name}.fmu") for c in scenario.components}
+    scenario, events = assign_events(scenario, interfaces)
 
     connected_inputs = {str(c.target) for c in scenario.connections}
     for comp in scenario.components:
@@ -240,6 +247,7 @@ def resolve_system(
         order=order,
         init_order=init_order,
         recorded=recorded,
+        events=events,
     )
 
 

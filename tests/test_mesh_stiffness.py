@@ -168,3 +168,56 @@ def test_time_varying_stiffness_keeps_the_mean_force(stage3_varying_run):
     quasi_static = 25.4e3 / (0.08 * math.cos(math.radians(20.0)))
     assert x.mean() == pytest.approx(quasi_static, rel=2e-3)
     assert x.min() > 0.98 * quasi_static  # the heavy mesh damping absorbs most of the stiffness change
+
+
+def test_mesh_phasing_matches_the_stiffness_factor_and_its_slope_is_the_derivative():
+    """The integrators' fast path (validated once, analytic slope) is the same model as stiffness_factor."""
+    from components.mesh_stiffness import MeshPhasing
+
+    dt = table6_gearbox().with_meshes(stiffness_variation=0.3)
+    dt = with_stage(dt, 2, mesh=replace(dt.stages[2].mesh, contact_ratio=2.0))  # integer ratio: constant
+    a = Assembly(dt)
+    ph = MeshPhasing(a._mesh_rate, a._mesh_offset, a._mesh_contact_ratio, a._mesh_variation)
+    eps = 1e-9
+    largest_slope = 0.3 * 30 / 16 / TRANSITION_FRACTION * a._mesh_rate.max() / (2 * math.pi)  # v S'(1/2) / w x cycles/rad
+    for angle in np.linspace(0.0, 0.05, 997):  # many stage-1/2 mesh transitions
+        phase = angle * a._mesh_rate + a._mesh_offset
+        expected = stiffness_factor(phase, a._mesh_contact_ratio, a._mesh_variation)
+        f, slope = ph.factor_and_slope(angle)
+        np.testing.assert_allclose(ph.factor(angle), expected, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(f, expected, rtol=0, atol=1e-12)
+        fd = (ph.factor(angle + eps) - ph.factor(angle - eps)) / (2 * eps)
+        np.testing.assert_allclose(slope, fd, rtol=1e-5, atol=1e-6 * largest_slope)
+    assert np.all(ph.factor(0.0123)[-1] == 1.0)  # the integer-ratio stage-3 mesh
+    with pytest.raises(ParameterError, match="stiffness_variation"):
+        MeshPhasing(a._mesh_rate, a._mesh_offset, a._mesh_contact_ratio, np.full(a.n_mesh, 2.0))
+
+
+def test_gearbox_step_system_time_derivative_is_analytic_with_tvms():
+    """da/dt of the co-simulation gearbox (stiffness varying with the driver angle) against a central
+    difference of the acceleration in time at a fixed state, inside a stage-3 stiffness transition."""
+    from components.gearbox_model import GearboxModel
+
+    base = table6_gearbox()
+    dt = with_stage(base, 2, mesh=replace(base.stages[2].mesh, stiffness_variation=0.3))
+    gb = GearboxModel(dt)
+    w = units.rpm(16.0)
+    gb.initialize(0.0, w, 0.0, gb.ratio * w, 0.0)
+    gb.step(0.0, 1e-3, w, 0.0, gb.ratio * w, 0.0)
+    # loaded state: the static equilibrium of the whole drivetrain, generator (the port) removed
+    eq = static_equilibrium(dt, dt.generator.counter_torque_nm)
+    names = Assembly(dt).dof_names
+    keep = [names.index(b) for b in gb.assembly.dof_names]
+    gb.y = np.concatenate((eq.q_rad[keep], np.zeros(len(keep))))
+    sysm = gb.system
+    sysm.port.fit(1e-3, eq.q_rad[names.index("generator")], 0.0, eq.q_rad[names.index("generator")], 0.0)
+    sysm.jacobian(0.0, gb.y)  # port part of da/dt uses the current Jacobian
+    # a local time inside the rising stage-3 transition of this step
+    taus = np.linspace(0.0, 1e-3, 20001)
+    slope = np.array([gb.assembly.phasing.factor_and_slope(sysm.angle0 + sysm.driver.value(t))[1][-1] for t in taus])
+    tau = float(taus[np.argmax(np.abs(slope))])
+    h = 1e-9
+    fd = (sysm.acceleration(tau + h, gb.y) - sysm.acceleration(tau - h, gb.y)) / (2 * h)
+    analytic = sysm.time_derivative(tau, gb.y)
+    assert np.abs(analytic).max() > 1e3  # the stiffness term dominates here
+    np.testing.assert_allclose(analytic, fd, rtol=1e-4, atol=1e-5 * np.abs(fd).max())

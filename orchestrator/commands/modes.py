@@ -1,8 +1,19 @@
-"""``dtcosim modes``: modal analysis and Campbell diagram of a drivetrain preset."""
+"""``dtcosim modes [SCENARIO]``: modal analysis and Campbell diagram of a scenario's drivetrain or a preset.
+
+With a scenario (packaged name, TOML or SSP file) the drivetrain is the one behind
+its FMUs - the Gearbox FMU's effective parameters and the generator's inertia and
+counter torque, rebuilt as for the monolithic reference
+(:func:`orchestrator.compare.monolithic_setup`) - and the operating point is the
+scenario's: the WindSource's mean rotor speed ``omega0`` and the generator's
+base counter torque (load events and the wind's fluctuation are not part of a
+linearisation). ``--rotor-speed-rpm`` and ``--torque-nm`` override either.
+Without a scenario: ``--preset`` (default table6) at 16 rpm and the preset's load.
+"""
 
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 import numpy as np
 
@@ -26,11 +37,18 @@ def register(sub: argparse._SubParsersAction) -> None:
             "modes.json, modes.png, campbell.csv, campbell_crossings.csv and campbell.png."
         ),
     )
-    p.add_argument("--preset", choices=PRESETS, default="table6", help="drivetrain preset (default: table6)")
-    p.add_argument("--rotor-speed-rpm", type=float, default=16.0, help="rotor speed of the operating point [rpm] (default 16)")
+    p.add_argument("scenario", nargs="?", default=None, metavar="SCENARIO",
+                   help="take drivetrain and operating point from this scenario (TOML/SSP file or packaged name, "
+                        "e.g. paper-60s); default: --preset")
+    p.add_argument("--preset", choices=PRESETS, default=None, help="drivetrain preset without a scenario (default: table6)")
+    p.add_argument("--rotor-speed-rpm", type=float, default=None,
+                   help="rotor speed of the operating point [rpm] (default: the scenario's omega0, else 16)")
     p.add_argument("--torque-nm", type=float, default=None,
-                   help="output (generator) counter torque [N m] (default: the preset's, 25400 for table6)")
-    p.add_argument("--out", default="results/modes", help="output directory (default: results/modes)")
+                   help="output (generator) counter torque [N m] (default: the scenario's or the preset's, 25400 for table6)")
+    p.add_argument("--fmu-dir", type=Path, default=None,
+                   help="with a scenario: directory searched for its FMUs (default: $DTCOSIM_FMU_DIR or the project's fmus/)")
+    p.add_argument("--out", default=None,
+                   help="output directory (default: results/<scenario>/modes with a scenario, else results/modes)")
     p.add_argument("--load-law", choices=LOAD_LAWS, default="quadratic",
                    help="Campbell load law: torque ~ speed^2 up to the operating point, constant above (quadratic), "
                         "or the operating torque at every speed (constant)")
@@ -43,10 +61,53 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
+def scenario_drivetrain(spec: str, fmu_dir: Path | None = None):
+    """Drivetrain, mean rotor speed [rad/s] and scenario name of a scenario (its FMUs are built if missing).
+
+    Returns
+    -------
+    drivetrain : components.drivetrain.Drivetrain
+        With the generator's inertia and base counter torque (no load events).
+    omega0_rad_s : float
+        The WindSource's mean rotor speed.
+    name : str
+    """
+    from dataclasses import replace
+
+    from components.generator import GeneratorParameters
+
+    from ..compare import ReferenceError, monolithic_setup
+    from ..errors import ScenarioError
+    from ..fmu_store import ensure_fmus
+    from ..runner import load_any
+    from ..scenario import find_scenario
+    from ..system import resolve_system
+
+    scenario = load_any(find_scenario(spec))
+    system = resolve_system(scenario, fmu_paths=ensure_fmus(scenario, fmu_dir, build=True))
+    try:
+        setup = monolithic_setup(system)
+    except ReferenceError as exc:
+        raise ScenarioError("(scenario)", scenario.name, f"a scenario with a dtcosim drivetrain ({exc})") from None
+    dt = setup.drivetrain
+    if dt.generator is not None and dt.generator.events:
+        dt = replace(dt, generator=GeneratorParameters(dt.generator.inertia_kgm2, dt.generator.counter_torque_nm))
+    return dt, setup.wind.mean_speed_rad_s, scenario.name
+
+
 def run(args: argparse.Namespace) -> int:
     """Run the modal analysis and write the files."""
-    drivetrain = preset(args.preset)
-    speed = rpm(args.rotor_speed_rpm)
+    if args.scenario is not None and args.preset is not None:
+        raise ParameterError("--preset", args.preset, f"no preset together with the scenario {args.scenario!r}")
+    if args.scenario is not None:
+        drivetrain, omega0, source = scenario_drivetrain(args.scenario, args.fmu_dir)
+        origin = f"scenario {source}"
+        out_dir = args.out if args.out is not None else Path("results") / source / "modes"
+    else:
+        name = args.preset or "table6"
+        drivetrain, omega0, origin = preset(name), rpm(16.0), f"preset {name}"
+        out_dir = args.out if args.out is not None else Path("results") / "modes"
+    speed = rpm(args.rotor_speed_rpm) if args.rotor_speed_rpm is not None else omega0
     op = OperatingPoint(speed, args.torque_nm) if args.torque_nm is not None else OperatingPoint.of_drivetrain(drivetrain, speed)
     lo, hi = args.speed_range
     if not 0.0 < lo < hi:
@@ -55,11 +116,11 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError("speed_points", args.speed_points, ">= 2")
     law = LoadLaw(args.load_law, abs(speed) if speed != 0.0 else rpm(16.0), op.output_torque_nm)
     report = modal_report(
-        drivetrain, op, args.out, law, rpm(np.linspace(lo, hi, args.speed_points)), args.shapes, args.verify
+        drivetrain, op, out_dir, law, rpm(np.linspace(lo, hi, args.speed_points)), args.shapes, args.verify
     )
     an = report["analysis"]
     eq = an.model.equilibrium
-    print(f"dtcosim modes: preset {args.preset} at {op.rotor_speed_rpm:g} rpm, output torque {op.output_torque_nm:g} N m")
+    print(f"dtcosim modes: {origin} at {op.rotor_speed_rpm:.6g} rpm, output torque {op.output_torque_nm:.6g} N m")
     print(f"static equilibrium: residual {eq.residual_nm:.2g} N m after {eq.iterations} Newton iteration(s) "
           f"from the secant-stiffness start; rotor torque {eq.rotor_torque_nm:.6g} N m")
     print(format_mode_table(an))

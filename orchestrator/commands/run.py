@@ -118,6 +118,7 @@ def _progress_bar(sim):
 def run(args: argparse.Namespace) -> int:
     """Run the scenario; write results; print a summary."""
     from ..fmu_store import ensure_fmus, stale_project_fmus
+    from ..run_analyses import format_analyses
     from ..runner import load_any, run_scenario
     from ..system import resolve_system
 
@@ -130,7 +131,7 @@ def run(args: argparse.Namespace) -> int:
     system = resolve_system(scenario, fmu_paths=paths)
     if args.check:
         print(f"{scenario.name}: valid ({len(scenario.components)} FMUs, {len(scenario.connections)} connections, "
-              f"{len(system.recorded)} recorded variables; stepping order {', '.join(system.order)}; "
+              f"{len(system.recorded)} recorded variables, {len(system.events)} load event(s); stepping order {', '.join(system.order)}; "
               f"initialisation order {', '.join(system.init_order)})")
         return 0
     out_dir = args.out if args.out is not None else Path("results") / scenario.name
@@ -163,6 +164,9 @@ def run(args: argparse.Namespace) -> int:
             if dev.get("max_abs") is not None:
                 print(f"generator vs {fig16['ratio']:.6g} x rotor speed: mean {dev['mean']:+.2e}, "
                       f"max |deviation| {dev['max_abs']:.2e} (relative)")
+        analyses = format_analyses(s)
+        if analyses:
+            print(analyses)
         if outcome.profile:
             steps = max(outcome.steps, 1)
             print("time per communication step in FMI calls [us]:")
