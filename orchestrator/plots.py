@@ -58,11 +58,11 @@ def _plot(ax, t, y, **kwargs) -> None:
     ax.plot(*envelope(t, y), **kwargs)
 
 
-def _figure(rows: int = 1, height: float = 4.0, sharex: bool = True):
+def _figure(rows: int = 1, height: float = 4.0, sharex: bool = True, width: float = 10.0):
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    fig = Figure(figsize=(10.0, height), dpi=110, layout="constrained")
+    fig = Figure(figsize=(width, height), dpi=110, layout="constrained")
     FigureCanvasAgg(fig)
     axes = fig.subplots(rows, 1, sharex=sharex, squeeze=False)[:, 0]
     return fig, axes
@@ -149,7 +149,7 @@ def plot_contact_forces(outcome: RunOutcome, gearbox: str, window, path: Path, t
     if not stages:
         return None
     names = sorted(stages, key=lambda s: int(s[5:]))
-    fig, axes = _figure(len(names), height=2.6 * len(names) + 0.8)
+    fig, axes = _figure(len(names), height=2.6 * len(names) + 0.8, width=12.5)
     t = outcome.time_s
     styles = {"sp": "-", "rp": "--", "mesh": "-"}
     labels = {"sp": "sun-planet", "rp": "ring-planet", "mesh": "mesh"}
@@ -161,7 +161,8 @@ def plot_contact_forces(outcome: RunOutcome, gearbox: str, window, path: Path, t
         ax.set_ylabel("force [kN]")
         ax.set_title(f"{prefix}{stage}", fontsize=10, loc="left")
         ax.grid(True, lw=0.3)
-        ax.legend(loc="upper right", fontsize=7, ncol=3)
+        # outside the axes: inside, it hid the peaks of load events and start-up swings
+        ax.legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), fontsize=7, ncol=1, borderaxespad=0.0)
     axes[-1].set_xlabel("time [s]")
     axes[-1].set_xlim(t[0], t[-1])
     fig.suptitle("Gear contact forces of all stages (paper Fig. 17)" + title_suffix)
