@@ -3,16 +3,12 @@
 from __future__ import annotations
 
 import json
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
+from orch_helpers import TOY_SCENARIO, dtcosim, write_scenario
 from toy_fmus import build_toys
-
-REPO = Path(__file__).resolve().parents[2]
 
 
 @pytest.fixture(scope="session")
@@ -33,21 +29,6 @@ def paper_fmu_dir(tmp_path_factory) -> Path:
     return out
 
 
-def write_scenario(folder: Path, text: str, name: str = "scenario.toml") -> Path:
-    """Write a scenario TOML file into ``folder``."""
-    path = folder / name
-    path.write_text(text)
-    return path
-
-
-def dtcosim(*args: str, cwd: Path, env: dict | None = None, timeout: float = 600) -> subprocess.CompletedProcess:
-    """Run the installed ``dtcosim`` console script."""
-    exe = Path(sys.executable).parent / "dtcosim"
-    full_env = dict(os.environ)
-    full_env.update(env or {})
-    return subprocess.run([str(exe), *args], cwd=cwd, env=full_env, capture_output=True, text=True, timeout=timeout)
-
-
 @pytest.fixture(scope="session")
 def paper_run(tmp_path_factory):
     """``dtcosim run`` with no arguments, once per session, into a fresh directory.
@@ -63,35 +44,6 @@ def paper_run(tmp_path_factory):
     out = work / "results" / "paper-60s"
     summary = json.loads((out / "summary.json").read_text())
     return out, summary, proc
-
-
-#: a valid toy scenario: sine -> integrator, plus an unconnected ToyFailer (Integer parameter)
-TOY_SCENARIO = """
-name = "toy"
-[simulation]
-stop = 0.1
-step = 0.01
-
-[components.src]
-fmu = "ToySine.fmu"
-[components.src.parameters]
-amplitude = 2.0
-
-[components.int]
-fmu = "ToyIntegrator.fmu"
-
-[components.fail]
-fmu = "ToyFailer.fmu"
-[components.fail.parameters]
-mode = 0
-
-[[connections]]
-from = "src.y"
-to = "int.u"
-
-[record]
-variables = ["src.y", "int.x", "int.u_seen", "int.t_seen"]
-"""
 
 
 @pytest.fixture

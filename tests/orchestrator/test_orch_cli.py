@@ -6,7 +6,7 @@ import json
 
 import pytest
 
-from conftest import dtcosim
+from orch_helpers import dtcosim
 
 pytestmark = pytest.mark.slow
 
@@ -77,7 +77,7 @@ def _run_on_terminal(args, cwd):
 
 
 def test_progress_bar_on_a_terminal_and_quiet(toy_scenario, tmp_path):
-    from conftest import TOY_SCENARIO
+    from orch_helpers import TOY_SCENARIO
 
     path = toy_scenario(TOY_SCENARIO.replace("stop = 0.1", "stop = 5.0"))
     shown = _run_on_terminal(["run", str(path), "--out", str(tmp_path / "a"), "--no-plots"], tmp_path)

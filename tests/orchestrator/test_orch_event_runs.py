@@ -13,7 +13,7 @@ import pytest
 
 from components.events import contact_loss_summary
 from components.spectrum import amplitude_spectrum
-from conftest import dtcosim, write_scenario
+from orch_helpers import dtcosim, write_scenario
 from orchestrator.cli import main
 from orchestrator.compare import run_reference
 from orchestrator.results import read_timeseries

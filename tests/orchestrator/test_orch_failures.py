@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import TOY_SCENARIO, dtcosim
+from orch_helpers import TOY_SCENARIO, dtcosim
 from orchestrator.results import read_timeseries
 
 pytestmark = pytest.mark.slow

@@ -6,7 +6,7 @@ import re
 
 import pytest
 
-from conftest import TOY_SCENARIO
+from orch_helpers import TOY_SCENARIO
 from orchestrator import cli
 from orchestrator.errors import AlgebraicLoopError, ScenarioError
 from orchestrator.fmi_runtime import FmuInstance

@@ -8,7 +8,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 
-from conftest import dtcosim
+from orch_helpers import dtcosim
 from orchestrator.master import CoSimulation
 from orchestrator.runner import load_any
 from orchestrator.scenario import find_scenario, load_scenario
