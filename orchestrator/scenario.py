@@ -141,6 +141,10 @@ class Component:
                 raise ScenarioError(f"components.{self.name}.parameters.{pname}", value, "a number, boolean or string")
         object.__setattr__(self, "parameters", MappingProxyType(params))
 
+    def __reduce__(self):
+        # a read-only mappingproxy cannot be pickled; rebuild (and re-validate) from a dict
+        return (type(self), (self.name, self.fmu, dict(self.parameters)))
+
 
 @dataclass(frozen=True)
 class Connection:

@@ -165,3 +165,17 @@ def test_cli_check_validates_without_instantiating(toy_scenario, monkeypatch, ca
     assert cli.main(["run", str(toy_scenario()), "--check", "--out", str(tmp_path / "o")]) == 0
     assert "toy: valid (3 FMUs, 1 connections, 4 recorded variables" in capsys.readouterr().out
     assert instantiated == [] and not (tmp_path / "o").exists()
+
+
+def test_scenario_pickles_with_plain_pickle():
+    """A Scenario crosses process boundaries (multiprocessing, Dask) with the standard pickle."""
+    import pickle
+
+    from orchestrator.scenario import packaged_scenarios
+
+    scenario = load_scenario(packaged_scenarios()["grid-fault"])
+    clone = pickle.loads(pickle.dumps(scenario))
+    assert clone == scenario
+    gen = next(c for c in clone.components if c.name == "generator")
+    with pytest.raises(TypeError):
+        gen.parameters["inertia"] = 1.0  # still read-only after the round trip
