@@ -180,7 +180,7 @@ class GearboxModel:
     _SCALARS = (
         "time_s", "driver_angle_rad", "driver_speed_rad_s", "driver_accel_rad_s2", "port_angle_rad",
         "port_speed_rad_s", "last_step_s", "last_omega_rotor", "last_omega_gen", "shaft_torque_average_nm",
-        "output_twist_rad",
+        "output_twist_rad", "alpha_out_max_rad_s2", "alpha_out_average_rad_s2",
     )
 
     def __init__(
@@ -214,6 +214,13 @@ class GearboxModel:
         self._twist_q = np.concatenate((a.S[-1], np.zeros(a.n_dof)))
         self._twist_port = float(a.S_port[-1, 0])
         self._output_matrix = self._build_output_matrix()
+        self._out_kinematic = float(a.kinematic_ratio[self._out_member])
+        self._out_acc_index = a.n_dof + self._out_member  # in the derivative [v, a]
+        #: eq. 11: largest |d omega_out / dt| since initialisation over every accepted internal step [rad/s^2]
+        self.alpha_out_max_rad_s2 = 0.0
+        #: d omega_out / dt averaged over the last step [rad/s^2] (instantaneous before the first step)
+        self.alpha_out_average_rad_s2 = 0.0
+        self.integrator.on_accept = self._track_output_acceleration
 
     # ------------------------------------------------------------ outputs
     @property
@@ -268,6 +275,24 @@ class GearboxModel:
         return float(self.speeds_rad_s[self._out_member])
 
     @property
+    def output_acceleration_rad_s2(self) -> float:
+        """Angular acceleration of the last stage's output member at the current time [rad/s^2].
+
+        Within a step the driver and generator ends follow C1 Hermite curves whose
+        acceleration is piecewise linear, so at the step ends this value carries the
+        input model's acceleration jumps (shaft 3's damping locks the output gear to the
+        generator end); :attr:`alpha_out_average_rad_s2` does not.
+        """
+        sysm = self.system
+        return float(self._out_kinematic * sysm.last_alpha + sysm.last_acceleration[self._out_member])
+
+    def _track_output_acceleration(self, tau: float, f: np.ndarray) -> None:
+        # absolute acceleration = kinematic part of the driver's + relative (deviation) part
+        alpha = abs(self._out_kinematic * self.system.driver.accel(tau) + f[self._out_acc_index])
+        if alpha > self.alpha_out_max_rad_s2:
+            self.alpha_out_max_rad_s2 = float(alpha)
+
+    @property
     def rotor_torque_nm(self) -> float:
         """Torque the rotor applies to the gearbox [N m] (driven carrier inertia + mesh/shaft reactions)."""
         return self.rotor_torque_from(self.shaft_torques_nm)
@@ -290,6 +315,7 @@ class GearboxModel:
             + a.mesh_names
             + [f"{s}.torque" for s in a.shaft_names]
             + [f"{b}.omega" for b in a.dof_names]
+            + ["alpha_out", "alpha_out_max"]
         )
 
     def _build_output_matrix(self) -> np.ndarray:
@@ -320,13 +346,17 @@ class GearboxModel:
     def output_vector(self) -> np.ndarray:
         """Every output at the current time in one pass, ordered as :attr:`output_names`.
 
-        Units: torques [N m], speeds [rad/s], contact forces [N].
+        Units: torques [N m], speeds [rad/s], contact forces [N], accelerations [rad/s^2]
+        (``alpha_out``: the output member's acceleration averaged over the last step;
+        ``alpha_out_max``: eq. 11's running maximum of its magnitude over every accepted
+        internal step since initialisation).
         """
         z = np.concatenate((self.system.last_force, self.y, self._output_extra()))
         linear = z @ self._output_matrix
         avg = self.shaft_torque_average_nm
         head = (avg if self.shaft_torque_mode == "average" else linear[0], avg)
-        return np.concatenate((head, linear))
+        tail = (self.alpha_out_average_rad_s2, self.alpha_out_max_rad_s2)
+        return np.concatenate((head, linear, tail))
 
     def _output_extra(self) -> tuple[float, float, float, float]:
         return (self.port_angle_rad, self.port_speed_rad_s, self.driver_speed_rad_s, self.driver_accel_rad_s2)
@@ -360,6 +390,8 @@ class GearboxModel:
         sysm.driver.fit(1.0, 0.0, self.driver_speed_rad_s, self.driver_speed_rad_s, self.driver_speed_rad_s)
         sysm.port.fit(1.0, self.port_angle_rad, self.port_speed_rad_s, self.port_angle_rad + self.port_speed_rad_s, self.port_speed_rad_s)
         sysm.acceleration(0.0, self.y)  # loads at the initial state
+        self.alpha_out_average_rad_s2 = self.output_acceleration_rad_s2
+        self.alpha_out_max_rad_s2 = abs(self.alpha_out_average_rad_s2)
         self.output_twist_rad = self._output_twist()
         self.shaft_torque_average_nm = self.shaft_torque_end_nm
         self.initialized = True
@@ -392,16 +424,18 @@ class GearboxModel:
         sysm.driver.fit(h, 0.0, self.driver_speed_rad_s, angle1 - self.driver_angle_rad, speed1)
         sysm.port.fit(h, self.port_angle_rad, self.port_speed_rad_s, port1, port_speed1)
         twist_start = self.output_twist_rad
+        speed_start = self._out_kinematic * self.driver_speed_rad_s + self.y[self._out_acc_index]
         # first stage reuses the loads at the end of the previous step: the prescribed
         # motions are C1, so only the driver-acceleration term changes
         a0 = sysm.last_acceleration + a.kinematic_ratio * (sysm.last_alpha - sysm.driver.accel(0.0))
-        saved = (self.integrator.snapshot(), sysm.cache(), sysm.port_jacobian)
+        saved = (self.integrator.snapshot(), sysm.cache(), sysm.port_jacobian, self.alpha_out_max_rad_s2)
         try:
             self.y, _ = self.integrator.advance(0.0, self.y, h, a0=a0)
         except SolverError as exc:
             self.integrator.restore(saved[0])
             sysm.restore(saved[1])
             sysm.port_jacobian = saved[2]
+            self.alpha_out_max_rad_s2 = saved[3]
             raise SolverError(str(exc).rsplit(" (at t =", 1)[0], t + exc.time_s) from None
         self.time_s = t + h
         self.driver_angle_rad = angle1
@@ -416,6 +450,8 @@ class GearboxModel:
         twist_end = self.output_twist_rad = self._output_twist()
         k = a.shaft_k[-1]
         self.shaft_torque_average_nm = k * 0.5 * (twist_start + twist_end) + a.shaft_c[-1] * (twist_end - twist_start) / h
+        speed_end = self._out_kinematic * speed1 + self.y[self._out_acc_index]
+        self.alpha_out_average_rad_s2 = float(speed_end - speed_start) / h
 
     def _output_twist(self) -> float:
         """Twist of the output shaft (shaft 3) [rad]."""

@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Protocol
+from typing import Callable, Protocol
 
 import numpy as np
 
@@ -134,6 +134,9 @@ class Rosenbrock23:
         self._basis_form = basis is not None and basis() is not None
         c = self.control
         self._atol = np.concatenate((np.full(n, c.atol_q), np.full(n, c.atol_v)))
+        #: called as ``on_accept(t, f)`` after every accepted step, ``t`` its end time [s] and
+        #: ``f = [v, a]`` the derivative there (shape (2n,), not to be modified); None: no call
+        self.on_accept: Callable[[float, np.ndarray], None] | None = None
 
     # ------------------------------------------------------------- linear algebra
     def _refresh_jacobian(self, t: float, y: np.ndarray) -> None:
@@ -229,6 +232,8 @@ class Rosenbrock23:
                 self._age += 1
                 t = t_end if last else t + h
                 y, f = yn, fn
+                if self.on_accept is not None:
+                    self.on_accept(t, f)
                 factor = 5.0 if err == 0.0 else min(5.0, 0.9 * err ** (-1.0 / 3.0))
                 # keep the step (and the factorisation) unless it clearly should change
                 factor = 1.0 if 1.0 <= factor <= 2.0 else factor

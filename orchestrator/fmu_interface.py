@@ -12,10 +12,10 @@ import hashlib
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
-from types import MappingProxyType
 from typing import Any, Mapping
 
 from .errors import ScenarioError
+from .frozen_map import FrozenMap
 
 FMI_TYPES = ("Real", "Integer", "Boolean", "String", "Enumeration")
 
@@ -214,13 +214,13 @@ def read_fmu_interface(path: str | Path, key: str = "fmu") -> FmuInterface:
         guid=md.guid,
         fmi_version=md.fmiVersion,
         generation_tool=md.generationTool or "",
-        variables=MappingProxyType(variables),
-        output_dependencies=MappingProxyType(deps),
+        variables=FrozenMap(variables),
+        output_dependencies=FrozenMap(deps),
         can_handle_variable_step=bool(cs.canHandleVariableCommunicationStepSize),
         can_get_and_set_state=bool(cs.canGetAndSetFMUstate),
         sha256=file_sha256(p),
         default_step_s=default_step,
-        unit_definitions=MappingProxyType(units),
+        unit_definitions=FrozenMap(units),
         _inputs=inputs,
     )
     _CACHE[cache_key] = iface

@@ -9,8 +9,13 @@ Measures are written as text in a study file:
     LSODA step and refined with the solver's interpolant around the maximum
     (:func:`components.acceleration.peak_output_acceleration`), a second
     integration whose cost is not part of ``cpu_time``. Co-simulation engine:
-    the largest finite difference of the recorded ``omega_out`` samples, which
-    cannot resolve pulses shorter than the sampling interval (a lower bound).
+    the Gearbox FMU's ``alpha_out_max`` at the end of the run, the running
+    maximum of ``|d omega_out/dt|`` over every accepted internal step of its
+    integrator (it resolves tooth impacts far shorter than the communication
+    step; no interpolant refinement, so it can sit slightly below the monolithic
+    value). A Gearbox FMU without that output (built by an older dtcosim): the
+    largest finite difference of the recorded ``omega_out`` samples, a lower
+    bound that cannot resolve pulses shorter than the sampling interval.
 ``cpu_time`` [s]
     Eq. 12: process CPU time of the integration, measured in the worker with
     ``time.process_time``. Monolithic: the LSODA integration alone (not the

@@ -56,11 +56,11 @@ import re
 import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from types import MappingProxyType
 from typing import Any, Mapping
 
 from .analysis_settings import AnalysisSettings
 from .errors import ScenarioError
+from .frozen_map import FrozenMap
 from .load_events import ScenarioEvent, check_events_in_run, events_from_toml
 
 ALGORITHMS = ("gauss-seidel", "jacobi")
@@ -139,11 +139,7 @@ class Component:
         for pname, value in params.items():
             if not isinstance(value, (int, float, bool, str)):
                 raise ScenarioError(f"components.{self.name}.parameters.{pname}", value, "a number, boolean or string")
-        object.__setattr__(self, "parameters", MappingProxyType(params))
-
-    def __reduce__(self):
-        # a read-only mappingproxy cannot be pickled; rebuild (and re-validate) from a dict
-        return (type(self), (self.name, self.fmu, dict(self.parameters)))
+        object.__setattr__(self, "parameters", FrozenMap(params))
 
 
 @dataclass(frozen=True)

@@ -41,13 +41,13 @@ import re
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
-from types import MappingProxyType
 from typing import Any, Mapping
 
 import numpy as np
 
 from components.errors import DtcosimError
 
+from .frozen_map import FrozenMap
 from .measures import Measure, MeasureError, parse_measure
 
 ENGINES = ("cosim", "monolithic")
@@ -242,7 +242,7 @@ class Base:
     parameters: Mapping[str, ParameterValue] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "parameters", MappingProxyType(dict(self.parameters)))
+        object.__setattr__(self, "parameters", FrozenMap(dict(self.parameters)))
 
 
 @dataclass(frozen=True)
@@ -266,7 +266,7 @@ class Point:
     coords: tuple[int, ...]
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "parameters", MappingProxyType(dict(self.parameters)))
+        object.__setattr__(self, "parameters", FrozenMap(dict(self.parameters)))
 
 
 @dataclass(frozen=True)
@@ -322,9 +322,9 @@ class Study:
         src = self.source
         for attr in ("measures", "axes", "points", "seeds", "plots"):
             object.__setattr__(self, attr, tuple(getattr(self, attr)))
-        object.__setattr__(self, "points", tuple(MappingProxyType(dict(p)) for p in self.points))
-        object.__setattr__(self, "simulation", MappingProxyType(dict(self.simulation)))
-        object.__setattr__(self, "solver", MappingProxyType(dict(self.solver)))
+        object.__setattr__(self, "points", tuple(FrozenMap(dict(p)) for p in self.points))
+        object.__setattr__(self, "simulation", FrozenMap(dict(self.simulation)))
+        object.__setattr__(self, "solver", FrozenMap(dict(self.solver)))
         if not isinstance(self.name, str) or not _NAME_RE.match(self.name):
             raise StudyError("name", self.name, "a name of letters, digits, '_' or '-'", src)
         if self.engine not in ENGINES:

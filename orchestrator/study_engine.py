@@ -229,7 +229,11 @@ def _cosim(payload: StudyPayload, task: PointTask) -> dict[str, float]:
         elif m.name == "wall_time":
             out[m.name] = float(outcome.wall_time_s)
         elif m.name == "I_max_acc":
-            out[m.name] = max_abs_rate(outcome.time_s, outcome.column(payload.series_names["I_max_acc"]))
+            variable = payload.series_names["I_max_acc"]
+            if variable.endswith(".alpha_out_max"):  # running maximum: its last value is eq. 11
+                out[m.name] = float(outcome.column(variable)[-1])
+            else:
+                out[m.name] = max_abs_rate(outcome.time_s, outcome.column(variable))
         else:
             values = outcome.column(m.variable)
             out[m.name] = statistic(window_values(outcome.time_s, values, system.scenario.simulation.window_s), m.statistic)

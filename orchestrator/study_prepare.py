@@ -297,7 +297,10 @@ def _prepare_scenario(study: Study, fmu_dir, build: bool) -> tuple[StudyPayload,
                 if len(gearbox) != 1:
                     raise StudyError(f"measures[{i}]", m.name, "a base scenario with exactly one Gearbox FMU "
                                      f"(its omega_out); found {len(gearbox)}", src)
-                variable = f"{gearbox[0]}.omega_out"
+                # the FMU's running peak over its internal steps (eq. 11 exactly) where it has one;
+                # FMUs built before it existed: finite differences of omega_out (a lower bound)
+                peak = "alpha_out_max" in system.interfaces[gearbox[0]].variables
+                variable = f"{gearbox[0]}.{'alpha_out_max' if peak else 'omega_out'}"
                 series_names["I_max_acc"] = variable
             else:
                 variable = m.variable

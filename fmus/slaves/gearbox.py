@@ -6,7 +6,10 @@ and ``omega_gen``, ``phi_gen`` (far end of shaft 3). Outputs: ``shaft_torque``
 ``shaft_torque_mode``), ``shaft_torque_end``, ``shaft_torque_avg``,
 ``omega_out``, ``torque_rotor``, every contact force (``stage1.F_sp[1]``,
 ``stage1.F_rp[1]``, ..., ``stage3.F_mesh``), every shaft torque
-(``shaft1.torque``, ...) and every body speed (``stage1.sun.omega``, ...).
+(``shaft1.torque``, ...), every body speed (``stage1.sun.omega``, ...), the
+output member's acceleration ``alpha_out`` (averaged over the last step) and
+its running peak magnitude ``alpha_out_max`` (eq. 11, over every internal
+solver step).
 
 The structure (stages, planets, shafts) is fixed at build time by the preset;
 every number is a parameter (see :mod:`fmus.slaves.gearbox_parameters`).
@@ -81,6 +84,14 @@ class Gearbox(DtcosimSlave):
                                          f"torque of {shaft.name} ({shaft.upstream} -> {shaft.downstream})"))
         for body in assembly.dof_names:
             variables.append(real_output(f"{body}.omega", "rad/s", f"absolute speed of {body}"))
+        out_member = assembly.stage_members[template.stages[-1].name]["output"]
+        variables += [  # after the body speeds: the same order as GearboxModel.output_names
+            real_output("alpha_out", "rad/s2",
+                        f"angular acceleration of the output member {out_member}, averaged over the last step"),
+            real_output("alpha_out_max", "rad/s2",
+                        "largest |d omega_out/dt| since initialisation over every internal solver step "
+                        "(paper eq. 11; resolves tooth impacts shorter than the communication step)"),
+        ]
         return variables
 
     def __init__(self, **kwargs) -> None:

@@ -67,7 +67,7 @@ def test_gearbox_exposes_every_mesh_shaft_and_body_of_the_preset(fmu_path):
     speeds = {f"stage1.{b}.omega" for b in ("sun", "planet[1]", "planet[2]", "planet[3]")}
     speeds |= {f"stage2.{b}.omega" for b in ("carrier", "sun", "planet[1]", "planet[2]", "planet[3]")}
     speeds |= {"stage3.drive.omega", "stage3.driven.omega"}
-    main = {"shaft_torque", "shaft_torque_end", "shaft_torque_avg", "omega_out", "torque_rotor"}
+    main = {"shaft_torque", "shaft_torque_end", "shaft_torque_avg", "omega_out", "torque_rotor", "alpha_out", "alpha_out_max"}
     assert outputs == main | forces | speeds | {"shaft1.torque", "shaft2.torque", "shaft3.torque"}
 
 
