@@ -37,7 +37,7 @@ from typing import Mapping
 from .contact import CONTACT_LAWS, MeshContact
 from .drivetrain import Drivetrain
 from .errors import ParameterError
-from .stages import ParallelStage, PlanetaryStage, Shaft
+from .stages import PlanetaryStage, Shaft
 
 UNITS: dict[str, str] = {
     "sun_radius": "m", "ring_radius": "m", "drive_radius": "m", "driven_radius": "m", "module": "m", "width": "m",

@@ -25,8 +25,11 @@ def status_label(status: int) -> str:
     return FMI_STATUS_LABELS[status] if 0 <= status < len(FMI_STATUS_LABELS) else f"illegal status {status}"
 
 
-class ScenarioError(DtcosimError, ValueError):
-    """A scenario (TOML file, SSP or the objects built from them) is invalid.
+class EntryError(DtcosimError, ValueError):
+    """An entry of a user's input file (or of the objects built from it) is invalid.
+
+    The message reads ``"<source>: invalid <kind> entry <key> = <value>: expected <expected>"``,
+    ``kind`` a class attribute of each subclass.
 
     Parameters
     ----------
@@ -37,8 +40,10 @@ class ScenarioError(DtcosimError, ValueError):
     expected : str
         What would have been accepted.
     source : str, optional
-        File the scenario was read from (prefixed to the message).
+        File the entry was read from (prefixed to the message).
     """
+
+    kind = "input"
 
     def __init__(self, key: str, value: Any, expected: str, source: str | None = None) -> None:
         self.key = key
@@ -46,10 +51,16 @@ class ScenarioError(DtcosimError, ValueError):
         self.expected = expected
         self.source = source
         where = f"{source}: " if source else ""
-        super().__init__(f"{where}invalid scenario entry {key} = {value!r}: expected {expected}")
+        super().__init__(f"{where}invalid {self.kind} entry {key} = {value!r}: expected {expected}")
 
-    def __reduce__(self):
+    def __reduce__(self):  # picklable: Dask may ship it between processes
         return (type(self), (self.key, self.value, self.expected, self.source))
+
+
+class ScenarioError(EntryError):
+    """A scenario (TOML file, SSP or the objects built from them) is invalid."""
+
+    kind = "scenario"
 
 
 class AlgebraicLoopError(ScenarioError):

@@ -53,7 +53,6 @@ from __future__ import annotations
 
 import math
 import re
-import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Mapping
@@ -61,6 +60,7 @@ from typing import Any, Mapping
 from .analysis_settings import AnalysisSettings
 from .errors import ScenarioError
 from .frozen_map import FrozenMap
+from .input_files import find_input_file, packaged_files, read_toml
 from .load_events import ScenarioEvent, check_events_in_run, events_from_toml
 
 ALGORITHMS = ("gauss-seidel", "jacobi")
@@ -578,33 +578,16 @@ def load_scenario(path: str | Path) -> Scenario:
         On a missing/unreadable file, a TOML syntax error, or any invalid entry.
     """
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise ScenarioError("(file)", str(path), f"a readable scenario file ({exc.strerror})") from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ScenarioError("(syntax)", str(path), f"valid TOML ({exc})") from None
+    data = read_toml(path, ScenarioError)
     return scenario_from_dict(data, name=path.stem, base_dir=path.resolve().parent, source=str(path))
 
 
 def packaged_scenarios() -> dict[str, Path]:
     """Scenario files shipped with dtcosim, by name (e.g. ``"paper-60s"``)."""
-    folder = Path(__file__).resolve().parent / "scenarios"
-    return {p.stem: p for p in sorted(folder.glob("*.toml"))}
+    return packaged_files("scenarios")
 
 
 def find_scenario(spec: str | Path | None) -> Path:
     """A scenario file from a path or the name of a packaged scenario (default ``paper-60s``)."""
-    if spec is None:
-        spec = "paper-60s"
-    p = Path(spec)
-    if p.suffix in (".toml", ".ssp", ".ssd") or p.exists():
-        if not p.exists():
-            raise ScenarioError("(file)", str(p), "an existing scenario file")
-        return p
-    shipped = packaged_scenarios()
-    if str(spec) in shipped:
-        return shipped[str(spec)]
-    raise ScenarioError("(scenario)", str(spec), "a scenario file or one of the packaged scenarios: " + ", ".join(shipped))
+    return find_input_file("paper-60s" if spec is None else spec, "scenarios", ScenarioError,
+                           suffixes=(".toml", ".ssp", ".ssd"), directories=True)

@@ -38,16 +38,15 @@ from __future__ import annotations
 import difflib
 import math
 import re
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
 
 import numpy as np
 
-from components.errors import DtcosimError
-
+from .errors import EntryError
 from .frozen_map import FrozenMap
+from .input_files import find_input_file, packaged_files, read_toml
 from .measures import Measure, MeasureError, parse_measure
 
 ENGINES = ("cosim", "monolithic")
@@ -68,31 +67,10 @@ _AXIS_KEYS = {"parameter", "parameters", "values", "start", "stop", "num", "spac
 _PLOT_KEYS = {"measure", "title", "file", "x", "y", "log", "vmin", "vmax"}
 
 
-class StudyError(DtcosimError, ValueError):
-    """A study file (or the objects built from it) is invalid.
+class StudyError(EntryError):
+    """A study file (or the objects built from it) is invalid (key, value, expected, source)."""
 
-    Parameters
-    ----------
-    key : str
-        Dotted path of the offending entry, e.g. ``"axes[1].values"``.
-    value : Any
-        The rejected value.
-    expected : str
-        What would have been accepted.
-    source : str, optional
-        File the study was read from (prefixed to the message).
-    """
-
-    def __init__(self, key: str, value: Any, expected: str, source: str | None = None) -> None:
-        self.key = key
-        self.value = value
-        self.expected = expected
-        self.source = source
-        where = f"{source}: " if source else ""
-        super().__init__(f"{where}invalid study entry {key} = {value!r}: expected {expected}")
-
-    def __reduce__(self):  # picklable: Dask may ship it between processes
-        return (type(self), (self.key, self.value, self.expected, self.source))
+    kind = "study"
 
 
 def _is_number(value: Any) -> bool:
@@ -679,31 +657,15 @@ def load_study(path: str | Path) -> Study:
         On a missing/unreadable file, a TOML syntax error, or any invalid entry.
     """
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise StudyError("(file)", str(path), f"a readable study file ({exc.strerror})") from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise StudyError("(syntax)", str(path), f"valid TOML ({exc})") from None
+    data = read_toml(path, StudyError)
     return study_from_dict(data, name=path.stem, base_dir=path.resolve().parent, source=str(path))
 
 
 def packaged_studies() -> dict[str, Path]:
     """Study files shipped with dtcosim, by name (e.g. ``"paper-sensitivity"``)."""
-    folder = Path(__file__).resolve().parent / "studies"
-    return {p.stem: p for p in sorted(folder.glob("*.toml"))}
+    return packaged_files("studies")
 
 
 def find_study(spec: str | Path) -> Path:
     """A study file from a path or the name of a packaged study."""
-    p = Path(spec)
-    if p.suffix == ".toml" or p.exists():
-        if not p.is_file():
-            raise StudyError("(file)", str(p), "an existing study file")
-        return p
-    shipped = packaged_studies()
-    if str(spec) in shipped:
-        return shipped[str(spec)]
-    raise StudyError("(study)", str(spec), "a study TOML file or one of the packaged studies: " + ", ".join(shipped))
+    return find_input_file(spec, "studies", StudyError, described="a study TOML file", plural="studies")

@@ -7,7 +7,7 @@ import pytest
 
 from components.errors import SolverError
 from components.gearbox_model import GearboxModel
-from components.generator import GeneratorParameters, GeneratorRotor
+from components.generator import GeneratorRotor
 from components.integrators import Rosenbrock23, StepControl
 from components.presets import table6_gearbox
 from components.reference import simulate_monolithic

@@ -13,7 +13,6 @@ from components.modal_verification import free_response_check
 from components.modes import (
     OperatingPoint,
     drivetrain_modes,
-    linearise,
     modal_analysis,
     state_space_modes,
     static_equilibrium,

@@ -96,7 +96,6 @@ class Gearbox(DtcosimSlave):
 
     def __init__(self, **kwargs) -> None:
         super().__init__(**kwargs)
-        assembly = _assembly(self.preset)
         self._template = cosim_preset(self.preset)
         vr = self.vr
         self._vr_inputs = tuple(vr[n] for n in ("omega_rotor", "phi_rotor", "omega_gen", "phi_gen"))
