@@ -334,16 +334,10 @@ class ContactLaw:
             k = self._k if type(stiffness_factor) is float and stiffness_factor == 1.0 else self._k * stiffness_factor
             signed = pen * (k * np.sqrt(pen) + self._c * flank * rate)
             return flank * np.maximum(signed, 0.0)
-        X = deflection + self._pm_half_jt  # rows: delta - j_t/2, delta + j_t/2
-        U = X * self._lam2
-        T = np.tanh(U)
-        XT = X * T
-        UST = U * (1.0 - T * T) + T
-        d_bl = deflection + 0.5 * (XT[0] - XT[1])  # eq. 3, 4
+        d_bl, rate_bl = self._regularised(deflection, rate)
         abs_bl = np.abs(d_bl)
         sgn = np.sign(d_bl)
         root = np.sqrt(abs_bl) if self._sqrt_law else abs_bl ** (self._e - 1.0)
-        rate_bl = (1.0 + 0.5 * (UST[0] - UST[1])) * rate
         flank = np.sign(deflection)
         signed = flank * abs_bl * (self._k * stiffness_factor * sgn * root + self._c * rate_bl)  # sgn(delta) * eq. 2
         return flank * np.maximum(signed, 0.0)  # flank-consistent clipping
@@ -367,18 +361,24 @@ class ContactLaw:
         if self._any_impact or not self._sqrt_law:
             cf = self.evaluate(deflection, rate, stiffness_factor)
             return np.where(cf.force != 0.0, cf.elastic / stiffness_factor, 0.0)
-        X = deflection + self._pm_half_jt
-        U = X * self._lam2
-        T = np.tanh(U)
-        XT = X * T
-        UST = U * (1.0 - T * T) + T
-        d_bl = deflection + 0.5 * (XT[0] - XT[1])  # eq. 3, 4
+        d_bl, rate_bl = self._regularised(deflection, rate)
         abs_bl = np.abs(d_bl)
         elastic = self._k * np.sign(d_bl) * abs_bl * np.sqrt(abs_bl)  # per unit stiffness factor
-        rate_bl = (1.0 + 0.5 * (UST[0] - UST[1])) * rate
         flank = np.sign(deflection)
         active = flank * (elastic * stiffness_factor + self._c * abs_bl * rate_bl) > 0.0
         return np.where(active, elastic, 0.0)
+
+    def _regularised(self, deflection: np.ndarray, rate: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Backlash-regularised deflection d_BL [m] (eq. 3, 4) and its rate [m/s], shapes (n_mesh,).
+
+        The two tanh terms (delta -/+ j_t / 2) are evaluated as the rows of one array.
+        """
+        X = deflection + self._pm_half_jt  # rows: delta - j_t/2, delta + j_t/2
+        U = X * self._lam2
+        T = np.tanh(U)
+        XT = X * T
+        UST = U * (1.0 - T * T) + T  # d(X tanh(lambda X))/dX, per row
+        return deflection + 0.5 * (XT[0] - XT[1]), (1.0 + 0.5 * (UST[0] - UST[1])) * rate
 
     def _impact_law(self, deflection: np.ndarray, rate: np.ndarray, k: np.ndarray) -> ContactForces:
         """Eq. 1 with a sharp backlash and the cubic STEP damping of MSC.Adams."""

@@ -28,7 +28,7 @@ import numpy as np
 
 from .cases import CONTACT_LOSS_THRESHOLD_N
 from .errors import ParameterError
-from .results import SimulationResult, select_window
+from .results import SimulationResult, select_window, series_and_time
 from .validation import positive
 
 
@@ -192,12 +192,7 @@ def contact_loss_summary(
     dict of str -> ContactLossStatistics
         In the order of the series; ``as_dict()`` of each is JSON-ready.
     """
-    if isinstance(result, SimulationResult):
-        series, t = result.series, result.time_s
-    else:
-        series, t = result, time_s
-        if t is None:
-            raise ParameterError("time_s", None, "sample times for a plain mapping of series")
+    series, t = series_and_time(result, time_s)
     if names is None:
         names = [n for n in series if n.rsplit(".", 1)[-1].startswith("F_")]
     missing = [n for n in names if n not in series]

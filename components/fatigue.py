@@ -51,8 +51,8 @@ import fatpack
 import numpy as np
 
 from .errors import ParameterError
-from .results import SimulationResult, select_window, unit_of
-from .validation import non_negative, one_of, positive
+from .results import SimulationResult, select_window, series_and_time, unit_of
+from .validation import finite_series, non_negative, one_of, positive
 
 #: Default Woehler exponents (welded steel 3, shafts 5, gear teeth 8 and 10).
 DEFAULT_WOHLER_EXPONENTS = (3.0, 5.0, 8.0, 10.0)
@@ -81,11 +81,7 @@ def reversals(signal: np.ndarray, gate: float = 0.0) -> np.ndarray:
         Alternating peaks and valleys, starting with the first sample and ending
         with the last one (unless it is not a turning point of the gated sequence).
     """
-    y = np.asarray(signal, dtype=float)
-    if y.ndim != 1 or y.size < 2:
-        raise ParameterError("signal", y.shape, "a 1-D series of at least 2 samples")
-    if not np.all(np.isfinite(y)):
-        raise ParameterError("signal", "non-finite samples", "finite values")
+    y = finite_series("signal", signal, 2)
     g = non_negative("gate", gate)
     # exact turning points: drop repeated values, keep sign changes of the slope
     keep = np.concatenate(([True], np.diff(y) != 0.0))
@@ -166,11 +162,7 @@ def rainflow(signal: np.ndarray, gate: float | None = None, residue: str = "half
     RainflowCycles
     """
     method = one_of("residue", residue, RESIDUE_METHODS)
-    y = np.asarray(signal, dtype=float)
-    if y.ndim != 1 or y.size < 2:
-        raise ParameterError("signal", y.shape, "a 1-D series of at least 2 samples")
-    if not np.all(np.isfinite(y)):
-        raise ParameterError("signal", "non-finite samples", "finite values")
+    y = finite_series("signal", signal, 2)
     span = float(y.max() - y.min())
     g = DEFAULT_GATE_FRACTION * span if gate is None else non_negative("gate", gate)
     rev = reversals(y, g)
@@ -581,12 +573,7 @@ def fatigue_report(
     FatigueReport
     """
     s = settings or FatigueSettings()
-    if isinstance(result, SimulationResult):
-        series, t = result.series, result.time_s
-    else:
-        series, t = result, time_s
-        if t is None:
-            raise ParameterError("time_s", None, "sample times for a plain mapping of series")
+    series, t = series_and_time(result, time_s)
     names = _default_load_names(series) if names is None else list(names)
     missing = [n for n in names if n not in series]
     if missing:

@@ -15,8 +15,11 @@ co-simulated results can be compared name by name:
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Mapping
 
 import numpy as np
+
+from .errors import ParameterError
 
 UNITS = {
     "F": "N",
@@ -202,3 +205,20 @@ class SimulationResult:
         """Statistics of each variable over ``window`` [s]."""
         names = self.names if names is None else names
         return {n: window_statistics(self.time_s, self.series[n], window) for n in names}
+
+
+def series_and_time(
+    result: SimulationResult | Mapping[str, np.ndarray], time_s: np.ndarray | None
+) -> tuple[Mapping[str, np.ndarray], np.ndarray]:
+    """The series and sample times [s] of a :class:`SimulationResult` or of a plain mapping.
+
+    Raises
+    ------
+    ParameterError
+        If ``result`` is a plain mapping and ``time_s`` is None.
+    """
+    if isinstance(result, SimulationResult):
+        return result.series, result.time_s
+    if time_s is None:
+        raise ParameterError("time_s", None, "sample times for a plain mapping of series")
+    return result, time_s

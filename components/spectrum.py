@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from .errors import ParameterError
-from .validation import positive
+from .validation import finite_series, positive
 
 WINDOWS = ("hann", "rect")
 
@@ -51,11 +51,7 @@ def amplitude_spectrum(
     amplitude : ndarray, shape (M,)
         Amplitude [unit of the signal], corrected for the window's coherent gain.
     """
-    x = np.asarray(signal, dtype=float)
-    if x.ndim != 1 or x.size < 4:
-        raise ParameterError("signal", x.shape, "a 1-D series of at least 4 samples")
-    if not np.all(np.isfinite(x)):
-        raise ParameterError("signal", "non-finite samples", "finite values")
+    x = finite_series("signal", signal, 4)
     dt = positive("sample_interval_s", sample_interval_s)
     w = _window(window, x.size)
     n_fft = x.size if pad_to is None else int(pad_to)
@@ -96,11 +92,7 @@ def spectral_peak_hz(
         Peak frequency [Hz] from a parabola through the log magnitudes of the
         largest bin and its neighbours.
     """
-    x = np.asarray(signal)
-    if x.ndim != 1 or x.size < 4:
-        raise ParameterError("signal", x.shape, "a 1-D series of at least 4 samples")
-    if not np.all(np.isfinite(x)):
-        raise ParameterError("signal", "non-finite samples", "finite values")
+    x = finite_series("signal", signal, 4)
     dt = positive("sample_interval_s", sample_interval_s)
     n_fft = 1 << int(np.ceil(np.log2(max(min_padded_length, 8 * x.size))))
     w = _window(window, x.size)

@@ -10,6 +10,8 @@ from __future__ import annotations
 import math
 from typing import Any
 
+import numpy as np
+
 from .errors import ParameterError
 
 
@@ -80,3 +82,19 @@ def set_fields(obj: Any, **values: Any) -> None:
     """Assign normalised values to a frozen dataclass inside ``__post_init__``."""
     for key, val in values.items():
         object.__setattr__(obj, key, val)
+
+
+def finite_series(name: str, values: Any, min_samples: int) -> np.ndarray:
+    """``values`` as a 1-D float array of at least ``min_samples`` finite samples.
+
+    Raises
+    ------
+    ParameterError
+        Naming ``name`` and the array's shape, or ``"non-finite samples"``.
+    """
+    y = np.asarray(values, dtype=float)
+    if y.ndim != 1 or y.size < min_samples:
+        raise ParameterError(name, y.shape, f"a 1-D series of at least {min_samples} samples")
+    if not np.all(np.isfinite(y)):
+        raise ParameterError(name, "non-finite samples", "finite values")
+    return y
