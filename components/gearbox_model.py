@@ -215,7 +215,7 @@ class GearboxModel:
         self._twist_port = float(a.S_port[-1, 0])
         self._output_matrix = self._build_output_matrix()
         self._out_kinematic = float(a.kinematic_ratio[self._out_member])
-        self._out_acc_index = a.n_dof + self._out_member  # in the derivative [v, a]
+        self._out_rate_index = a.n_dof + self._out_member  # its speed in [q, v], its acceleration in [v, a]
         #: eq. 11: largest |d omega_out / dt| since initialisation over every accepted internal step [rad/s^2]
         self.alpha_out_max_rad_s2 = 0.0
         #: d omega_out / dt averaged over the last step [rad/s^2] (instantaneous before the first step)
@@ -288,7 +288,7 @@ class GearboxModel:
 
     def _track_output_acceleration(self, tau: float, f: np.ndarray) -> None:
         # absolute acceleration = kinematic part of the driver's + relative (deviation) part
-        alpha = abs(self._out_kinematic * self.system.driver.accel(tau) + f[self._out_acc_index])
+        alpha = abs(self._out_kinematic * self.system.driver.accel(tau) + f[self._out_rate_index])
         if alpha > self.alpha_out_max_rad_s2:
             self.alpha_out_max_rad_s2 = float(alpha)
 
@@ -424,7 +424,7 @@ class GearboxModel:
         sysm.driver.fit(h, 0.0, self.driver_speed_rad_s, angle1 - self.driver_angle_rad, speed1)
         sysm.port.fit(h, self.port_angle_rad, self.port_speed_rad_s, port1, port_speed1)
         twist_start = self.output_twist_rad
-        speed_start = self._out_kinematic * self.driver_speed_rad_s + self.y[self._out_acc_index]
+        speed_start = self._out_kinematic * self.driver_speed_rad_s + self.y[self._out_rate_index]
         # first stage reuses the loads at the end of the previous step: the prescribed
         # motions are C1, so only the driver-acceleration term changes
         a0 = sysm.last_acceleration + a.kinematic_ratio * (sysm.last_alpha - sysm.driver.accel(0.0))
@@ -450,7 +450,7 @@ class GearboxModel:
         twist_end = self.output_twist_rad = self._output_twist()
         k = a.shaft_k[-1]
         self.shaft_torque_average_nm = k * 0.5 * (twist_start + twist_end) + a.shaft_c[-1] * (twist_end - twist_start) / h
-        speed_end = self._out_kinematic * speed1 + self.y[self._out_acc_index]
+        speed_end = self._out_kinematic * speed1 + self.y[self._out_rate_index]
         self.alpha_out_average_rad_s2 = float(speed_end - speed_start) / h
 
     def _output_twist(self) -> float:
