@@ -102,7 +102,8 @@ def peak_output_acceleration(
     ParameterError
         ``t_end_s <= t_start_s``.
     SolverError
-        The integrator failed (the message says where).
+        The integrator failed (the message says where); a
+        :class:`~components.errors.WallTimeLimitError` past ``settings.wall_time_limit_s``.
     """
     settings = settings or SolverSettings()
     t0 = finite("t_start_s", t_start_s)
@@ -127,6 +128,7 @@ def peak_output_acceleration(
         return float(system.rhs(t, y)[n + j] + kappa * float(driver.acceleration(t)))
 
     y = np.zeros(2 * n + 3)
+    system.start_clock(settings.wall_time_limit_s)
     best = (abs(alpha(t0, y)), alpha(t0, y), t0)
     steps = 0
     breaks = [t for t in system.schedule.event_times if t0 < t < t1]

@@ -54,3 +54,22 @@ class SolverError(DtcosimError, RuntimeError):
 
     def __reduce__(self):
         return (type(self), (str(self).rsplit(" (at t =", 1)[0], self.time_s))
+
+
+class WallTimeLimitError(SolverError):
+    """The integration ran into its wall-clock time limit (``SolverSettings.wall_time_limit_s``).
+
+    Parameters
+    ----------
+    limit_s : float
+        The limit [s] of wall-clock time.
+    time_s : float
+        Simulation time [s] reached.
+    """
+
+    def __init__(self, limit_s: float, time_s: float) -> None:
+        self.limit_s = float(limit_s)
+        SolverError.__init__(self, f"wall-time limit of {self.limit_s:g} s reached", time_s)
+
+    def __reduce__(self):
+        return (type(self), (self.limit_s, self.time_s))

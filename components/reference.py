@@ -23,9 +23,9 @@ from scipy.integrate import odeint
 
 from .assembly import Assembly
 from .drivetrain import Drivetrain
-from .errors import ParameterError, SolverError
+from .errors import ParameterError, SolverError, WallTimeLimitError
 from .results import EnergyAudit, SimulationResult
-from .validation import finite, positive
+from .validation import finite, non_negative, positive
 
 
 class SpeedDriver(Protocol):
@@ -56,6 +56,9 @@ class SolverSettings:
         (:func:`components.mesh_stiffness.max_step_s`).
     max_steps : int
         Maximum internal steps between two output times.
+    wall_time_limit_s : float
+        Wall-clock time [s] one integration may take (0: unlimited); past it the
+        right-hand side raises :class:`~components.errors.WallTimeLimitError`.
     """
 
     rtol: float = 1e-7
@@ -63,11 +66,13 @@ class SolverSettings:
     atol_speed_rad_s: float = 1e-7
     max_step_s: float = 0.0
     max_steps: int = 200_000
+    wall_time_limit_s: float = 0.0
 
     def __post_init__(self) -> None:
         positive("rtol", self.rtol)
         positive("atol_angle_rad", self.atol_angle_rad)
         positive("atol_speed_rad_s", self.atol_speed_rad_s)
+        non_negative("wall_time_limit_s", self.wall_time_limit_s)
 
 
 class MonolithicSystem:
@@ -94,6 +99,13 @@ class MonolithicSystem:
         self._jac[: self.n, self.n : 2 * self.n] = np.eye(self.n)
         self.rhs_calls = 0
         self.jac_calls = 0
+        self.deadline = math.inf  # time.perf_counter() value past which rhs raises (see start_clock)
+        self.wall_time_limit_s = 0.0
+
+    def start_clock(self, wall_time_limit_s: float) -> None:
+        """Let :meth:`rhs` raise :class:`WallTimeLimitError` ``wall_time_limit_s`` [s] from now (0: never)."""
+        self.wall_time_limit_s = float(wall_time_limit_s)
+        self.deadline = time.perf_counter() + wall_time_limit_s if wall_time_limit_s > 0 else math.inf
 
     def _driver_state(self, t: float) -> tuple[float, float, float | np.ndarray]:
         alpha = float(self.driver.acceleration(t))
@@ -104,6 +116,8 @@ class MonolithicSystem:
     def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
         """dy/dt at time t [s]."""
         self.rhs_calls += 1
+        if time.perf_counter() > self.deadline:
+            raise WallTimeLimitError(self.wall_time_limit_s, t)
         a = self.assembly
         n = self.n
         q = y[:n]
@@ -226,22 +240,32 @@ def simulate_monolithic(
     steps = 0
     start = time.perf_counter()
     cpu_start = time.process_time()
+    system.start_clock(settings.wall_time_limit_s)
     for a, b in zip(edges[:-1], edges[1:]):
         system.load_torque_nm = float(system.schedule(0.5 * (a + b)))
         inside = np.flatnonzero((t_out > a + 1e-12) & (t_out < b - 1e-12))
         times = np.concatenate([[a], t_out[inside], [b]])
-        sol, info = odeint(
-            system.rhs,
-            y,
-            times,
-            Dfun=system.jacobian,
-            tfirst=True,
-            rtol=settings.rtol,
-            atol=atol,
-            hmax=hmax,
-            mxstep=settings.max_steps,
-            full_output=True,
-        )
+        try:
+            sol, info = odeint(
+                system.rhs,
+                y,
+                times,
+                Dfun=system.jacobian,
+                tfirst=True,
+                rtol=settings.rtol,
+                atol=atol,
+                hmax=hmax,
+                mxstep=settings.max_steps,
+                full_output=True,
+            )
+        except WallTimeLimitError as exc:
+            # odeint returns nothing when the right-hand side raises: the samples up to
+            # the start of this load segment are kept
+            complete = False
+            message = f"{exc}; samples kept up to t = {float(t_out[reached]):.6g} s"
+            if raise_on_failure:
+                raise
+            break
         ok = info["message"].startswith("Integration successful")
         nst = np.asarray(info.get("nst", [0]))
         steps += int(nst.max()) if nst.size else 0

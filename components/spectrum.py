@@ -92,7 +92,7 @@ def spectral_peak_hz(
         Peak frequency [Hz] from a parabola through the log magnitudes of the
         largest bin and its neighbours.
     """
-    x = finite_series("signal", signal, 4)
+    x = finite_series("signal", signal, 4, dtype=None)  # real or complex
     dt = positive("sample_interval_s", sample_interval_s)
     n_fft = 1 << int(np.ceil(np.log2(max(min_padded_length, 8 * x.size))))
     w = _window(window, x.size)

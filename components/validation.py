@@ -84,15 +84,17 @@ def set_fields(obj: Any, **values: Any) -> None:
         object.__setattr__(obj, key, val)
 
 
-def finite_series(name: str, values: Any, min_samples: int) -> np.ndarray:
-    """``values`` as a 1-D float array of at least ``min_samples`` finite samples.
+def finite_series(name: str, values: Any, min_samples: int, dtype: type | None = float) -> np.ndarray:
+    """``values`` as a 1-D array of at least ``min_samples`` finite samples.
+
+    ``dtype`` float by default; None keeps the input's type (e.g. a complex modal coordinate).
 
     Raises
     ------
     ParameterError
         Naming ``name`` and the array's shape, or ``"non-finite samples"``.
     """
-    y = np.asarray(values, dtype=float)
+    y = np.asarray(values, dtype=dtype)
     if y.ndim != 1 or y.size < min_samples:
         raise ParameterError(name, y.shape, f"a 1-D series of at least {min_samples} samples")
     if not np.all(np.isfinite(y)):

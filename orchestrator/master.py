@@ -200,7 +200,8 @@ class CoSimulation:
         self.step_loop_source = ""
 
     # ------------------------------------------------------------------ run
-    def run(self, progress: Callable[[int, int], None] | None = None, handle_sigint: bool = True) -> RunOutcome:
+    def run(self, progress: Callable[[int, int], None] | None = None, handle_sigint: bool = True,
+            wall_time_limit_s: float | None = None) -> RunOutcome:
         """Instantiate, initialise, step to the stop time and free the FMUs.
 
         Parameters
@@ -210,6 +211,10 @@ class CoSimulation:
         handle_sigint : bool
             Catch Ctrl-C between blocks of steps (main thread only) and return
             the partial results instead of raising KeyboardInterrupt.
+        wall_time_limit_s : float, optional
+            Stop stepping (between blocks of steps) once the run has taken this
+            much wall-clock time [s]; the outcome is then incomplete, with an error
+            naming the limit and the time reached. None or 0: no limit.
 
         Returns
         -------
@@ -244,7 +249,9 @@ class CoSimulation:
             advance = compile_step_loop(slots, sim.algorithm, sim.extrapolation, stride, data, ring, timers)
             self.step_loop_source = advance.source
             loop0 = time.perf_counter()
-            k_done, error, interrupted = self._loop(advance, slots, data, n_steps, stride, progress, handle_sigint)
+            deadline = wall0 + wall_time_limit_s if wall_time_limit_s else math.inf
+            k_done, error, interrupted = self._loop(advance, slots, data, n_steps, stride, progress, handle_sigint,
+                                                    deadline, wall_time_limit_s)
             loop_time = time.perf_counter() - loop0
         finally:
             self._close()
@@ -375,8 +382,9 @@ class CoSimulation:
         return slots, columns
 
     # ----------------------------------------------------------------- loop
-    def _loop(self, advance, slots, data, n_steps, stride, progress, handle_sigint) -> tuple[int, str | None, bool]:
-        """Step until the stop time, an FMU failure or Ctrl-C.
+    def _loop(self, advance, slots, data, n_steps, stride, progress, handle_sigint, deadline=math.inf,
+              wall_time_limit_s=None) -> tuple[int, str | None, bool]:
+        """Step until the stop time, an FMU failure, Ctrl-C or the ``time.perf_counter()`` deadline.
 
         Returns (communication steps completed, error message or None, interrupted).
         """
@@ -409,6 +417,9 @@ class CoSimulation:
                     break
                 if progress is not None:
                     progress(k, n_steps)
+                if k < n_steps and time.perf_counter() > deadline:
+                    error = f"wall-time limit of {wall_time_limit_s:g} s reached at t = {t0 + k * H:.6g} s"
+                    break
         except KeyboardInterrupt:  # a second Ctrl-C, or no handler outside the main thread
             interrupted = True
             error = f"interrupted by the user (Ctrl-C) at t = {t0 + k * H:.6g} s"

@@ -58,7 +58,7 @@ ParameterValue = float | int | bool | str
 
 _NAME_RE = re.compile(r"^[A-Za-z_][A-Za-z0-9_\-]*$")
 _TOP_KEYS = {"name", "description", "engine", "base", "simulation", "solver", "axes", "points", "seeds",
-             "seed_parameter", "measures", "plots"}
+             "seed_parameter", "measures", "plots", "timeout"}
 _BASE_KEYS = {"scenario", "model", "parameters"}
 _SIMULATION_KEYS = {"start", "stop", "step", "output_interval", "window", "algorithm", "extrapolation"}
 _SOLVER_KEYS = {"rtol": "rtol", "atol_angle": "atol_angle_rad", "atol_speed": "atol_speed_rad_s",
@@ -274,6 +274,10 @@ class Study:
     solver : mapping
         Monolithic solver tolerances (:class:`components.reference.SolverSettings` fields).
     plots : tuple of PlotSpec
+    timeout_s : float or None
+        Wall-clock time [s] one point may take; past it the point fails with a
+        message naming the limit and the simulation time reached. Not part of the
+        point keys (it does not change a result). None: no limit.
     description : str
     base_dir : pathlib.Path, optional
         Directory of the study file.
@@ -292,6 +296,7 @@ class Study:
     simulation: Mapping[str, Any] = field(default_factory=dict)
     solver: Mapping[str, Any] = field(default_factory=dict)
     plots: tuple[PlotSpec, ...] = ()
+    timeout_s: float | None = None
     description: str = ""
     base_dir: Path | None = None
     source: str | None = None
@@ -305,6 +310,9 @@ class Study:
         object.__setattr__(self, "solver", FrozenMap(dict(self.solver)))
         if not isinstance(self.name, str) or not _NAME_RE.match(self.name):
             raise StudyError("name", self.name, "a name of letters, digits, '_' or '-'", src)
+        t = self.timeout_s
+        if t is not None and not (_is_number(t) and math.isfinite(t) and t > 0):
+            raise StudyError("timeout", t, "a finite number of seconds > 0 (wall-clock time per point)", src)
         if self.engine not in ENGINES:
             raise StudyError("engine", self.engine, "one of " + ", ".join(ENGINES), src)
         if not self.measures:
@@ -630,7 +638,7 @@ def study_from_dict(data: Mapping[str, Any], name: str | None = None, base_dir: 
     return Study(
         name=st_name, engine=engine, base=base, measures=tuple(measures), axes=axes, points=tuple(points),
         seeds=tuple(seeds), seed_parameter=seed_parameter, simulation=simulation, solver=solver, plots=plots,
-        description=description, base_dir=base_dir, source=source,
+        timeout_s=data.get("timeout"), description=description, base_dir=base_dir, source=source,
     )
 
 

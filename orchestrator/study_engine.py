@@ -37,7 +37,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Mapping
 
-from components.errors import DtcosimError, SolverError
+from components.errors import DtcosimError, WallTimeLimitError
 
 from .measures import Measure, max_abs_rate, statistic, window_values
 
@@ -73,6 +73,8 @@ class StudyPayload:
         :class:`components.results.SimulationResult`.
     fmu_blobs : mapping of str -> bytes
         Co-simulation: FMU file content by SHA-256.
+    timeout_s : float or None
+        Wall-clock time [s] one point may take (``Study.timeout_s``); None: no limit.
     """
 
     study: str
@@ -86,6 +88,7 @@ class StudyPayload:
     solver: Mapping[str, Any] = field(default_factory=dict)
     series_names: Mapping[str, str] = field(default_factory=dict)
     fmu_blobs: Mapping[str, bytes] = field(default_factory=dict)
+    timeout_s: float | None = None
 
 
 @dataclass(frozen=True)
@@ -175,7 +178,8 @@ def _monolithic(payload: StudyPayload, task: PointTask) -> dict[str, float]:
     from components.acceleration import peak_output_acceleration
     from components.reference import SolverSettings, simulate_monolithic
 
-    settings = SolverSettings(**payload.solver)
+    wall0 = time.perf_counter()
+    settings = SolverSettings(**payload.solver, wall_time_limit_s=payload.timeout_s or 0.0)
     if payload.model is not None:
         from .study_models import MODELS
 
@@ -192,9 +196,8 @@ def _monolithic(payload: StudyPayload, task: PointTask) -> dict[str, float]:
         drivetrain, driver = setup.drivetrain, RotorSpeedProcess(setup.wind)
         sim = system.scenario.simulation
         start, stop, interval = sim.start_s, sim.stop_s, sim.output_interval_s
-    result = simulate_monolithic(drivetrain, driver, stop, output_interval_s=interval, settings=settings, t_start_s=start)
-    if not result.complete:
-        raise SolverError(result.message, float(result.time_s[-1]) if result.time_s.size else start)
+    result = simulate_monolithic(drivetrain, driver, stop, output_interval_s=interval, settings=settings,
+                                 t_start_s=start, raise_on_failure=True)
     out: dict[str, float] = {}
     for m in payload.measures:
         if m.name == "cpu_time":
@@ -206,7 +209,16 @@ def _monolithic(payload: StudyPayload, task: PointTask) -> dict[str, float]:
         elif m.name == "rhs_calls":
             out[m.name] = float(result.info["rhs_calls"])
         elif m.name == "I_max_acc":
-            out[m.name] = peak_output_acceleration(drivetrain, driver, stop, settings=settings, t_start_s=start).value_rad_s2
+            if payload.timeout_s:  # the point's limit covers this second integration too
+                left = payload.timeout_s - (time.perf_counter() - wall0)
+                if left <= 0.0:
+                    raise WallTimeLimitError(payload.timeout_s, stop)
+                settings = replace(settings, wall_time_limit_s=left)
+            try:
+                peak = peak_output_acceleration(drivetrain, driver, stop, settings=settings, t_start_s=start)
+            except WallTimeLimitError as exc:  # name the point's limit, not what was left of it
+                raise WallTimeLimitError(payload.timeout_s, exc.time_s) from None
+            out[m.name] = peak.value_rad_s2
         else:
             series = result.series[payload.series_names[m.variable]]
             out[m.name] = statistic(window_values(result.time_s, series, payload.window_s), m.statistic)
@@ -218,7 +230,7 @@ def _cosim(payload: StudyPayload, task: PointTask) -> dict[str, float]:
 
     system = _point_system(payload, task, local_files=True)
     cpu0 = time.process_time()
-    outcome = CoSimulation(system).run(handle_sigint=False)
+    outcome = CoSimulation(system).run(handle_sigint=False, wall_time_limit_s=payload.timeout_s)
     cpu = time.process_time() - cpu0
     if not outcome.complete:
         raise DtcosimError(outcome.error or "the co-simulation stopped early")

@@ -396,6 +396,7 @@ def prepare_study(study: Study, fmu_dir: str | Path | None = None, build: bool =
         "measures": [m.name for m in study.measures],
         "code": code_version(),
     }
+    payload = replace(payload, timeout_s=study.timeout_s)  # not in the identity: it changes no result
     points = tuple(study.expand())
     keys = tuple(point_key(identity, p) for p in points)
     return PreparedStudy(study, points, keys, payload, identity, fmu_paths)

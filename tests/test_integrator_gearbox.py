@@ -176,3 +176,24 @@ def test_output_acceleration_and_its_running_peak():
     # a new initialisation starts the maximum afresh
     model.initialize(0.0, wind.speed(0.0), wind.angle(0.0), dt.ratio * wind.speed(0.0), 0.0)
     assert model.alpha_out_max_rad_s2 < 1e-6 * ref
+
+
+def test_monolithic_wall_time_limit():
+    """SolverSettings.wall_time_limit_s stops LSODA from inside the right-hand side."""
+    from components.acceleration import peak_output_acceleration
+    from components.errors import ParameterError, WallTimeLimitError
+    from components.reference import SolverSettings
+
+    dt, wind = _paper_setup()
+    tiny = SolverSettings(wall_time_limit_s=1e-9)
+    result = simulate_monolithic(dt, wind, 1.0, settings=tiny)
+    assert not result.complete
+    assert result.message.startswith("wall-time limit of 1e-09 s reached (at t = ")
+    assert result.time_s.size == 1  # one load segment: only the initial sample survives
+    with pytest.raises(WallTimeLimitError, match=r"wall-time limit of 1e-09 s reached \(at t = "):
+        simulate_monolithic(dt, wind, 1.0, settings=tiny, raise_on_failure=True)
+    with pytest.raises(WallTimeLimitError, match="wall-time limit"):
+        peak_output_acceleration(dt, wind, 1.0, settings=tiny)
+    with pytest.raises(ParameterError, match=r"wall_time_limit_s = -1\.0: expected >= 0"):
+        SolverSettings(wall_time_limit_s=-1.0)
+    assert simulate_monolithic(dt, wind, 0.05, settings=SolverSettings(wall_time_limit_s=60.0)).complete

@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 
@@ -42,6 +43,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="only regenerate results.csv, study.json and the plots from the journal (nothing runs)")
     p.add_argument("--no-plots", action="store_true", help="do not write the PNG plots")
     p.add_argument("--quiet", "-q", action="store_true", help="no progress bar and no summary")
+    p.add_argument("--timeout", type=float, default=None, metavar="SECONDS",
+                   help="wall-clock time one point may take; past it the point fails (overrides the study's "
+                        "timeout; not part of the point keys: with --retry-failed, a larger value re-runs "
+                        "the points that ran out of time)")
     p.set_defaults(func=run)
 
 
@@ -78,6 +83,11 @@ def run(args: argparse.Namespace) -> int:
     if args.workers is not None and args.workers < 1:
         raise StudyError("--workers", args.workers, "an integer >= 1")
     study = load_study(find_study(args.study))
+    if args.timeout is not None:
+        try:
+            study = replace(study, timeout_s=args.timeout)
+        except StudyError as exc:
+            raise StudyError("--timeout", exc.value, exc.expected) from None
     prepared = prepare_study(study, fmu_dir=args.fmu_dir, build=not args.no_build)
     out_dir = args.out if args.out is not None else Path("results") / study.name
     say = (lambda msg: None) if quiet else (lambda msg: print(msg, file=sys.stderr))

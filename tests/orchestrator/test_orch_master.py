@@ -214,3 +214,15 @@ def test_failure_between_samples_keeps_the_sampled_rows(toy_scenario):
     assert out.time_s.size == 17 and out.time_s[-1] == pytest.approx(0.48)
     every = CoSimulation(resolve_system(load_scenario(toy_scenario(FAIL, "every.toml")))).run(handle_sigint=False)
     np.testing.assert_array_equal(out.values, every.values[::3][:17])
+
+
+def test_wall_time_limit_stops_between_blocks_and_keeps_the_samples(toy_scenario):
+    text = CHAIN.format(algorithm="gauss-seidel", extrapolation="hold", order="", stop=100.3)
+    system = resolve_system(load_scenario(toy_scenario(text)))
+    out = CoSimulation(system).run(handle_sigint=False, wall_time_limit_s=1e-9)
+    assert not out.complete and not out.interrupted
+    assert 0 < out.steps < 1000 and out.steps % 250 == 0  # stopped after a whole block of steps
+    assert out.error == f"wall-time limit of 1e-09 s reached at t = {out.stopped_at_s:.6g} s"
+    assert out.time_s.size == out.steps + 1 and np.all(np.isfinite(out.values))
+    # no limit (None or 0): the same run completes
+    assert CoSimulation(system).run(handle_sigint=False, wall_time_limit_s=0).complete

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -78,6 +80,8 @@ def test_expansion_points_times_grid_times_seeds():
     (lambda d: d.update(solver={"rtol": -1.0}), r"solver\.rtol = -1.0"),
     (lambda d: d.update(seeds=[1, "2"]), r"entry seeds = "),
     (lambda d: d.update(points=[{"gearbox.R1": [6, 7]}]), r"points\[0\]\.gearbox\.R1 = \[6, 7\]"),
+    (lambda d: d.update(timeout=0.0), r"entry timeout = 0\.0: expected a finite number of seconds > 0"),
+    (lambda d: d.update(timeout="1 min"), r"entry timeout = '1 min'"),
 ])
 def test_structural_mistakes_name_the_key(edit, key):
     import tomllib
@@ -137,3 +141,24 @@ def test_cli_reports_an_invalid_study_and_runs_nothing(write_study, tmp_path):
     assert proc.returncode == 1
     assert "dtcosim sweep: error:" in proc.stderr and "simulation.stop = -1.0" in proc.stderr
     assert not (tmp_path / "out").exists()
+
+
+def test_point_timeout_fails_the_point_and_leaves_the_keys_alone(write_study):
+    """A point past the study's timeout fails with the limit and the time reached; keys ignore the limit."""
+    from orchestrator.study_engine import PointTask, run_point
+
+    text = MODEL_BASE.replace("stop = 0.01", "stop = 1.0") + '[[axes]]\nparameter = "gearbox.R1"\nvalues = [6.0]\n'
+    free = prepare_study(load_study(write_study(text, "free.toml")))
+    limited = prepare_study(load_study(write_study("timeout = 0.001\n" + text, "limited.toml")))
+    assert limited.payload.timeout_s == 0.001 and free.payload.timeout_s is None
+    assert limited.keys == free.keys  # a larger timeout with --retry-failed re-runs the same points
+    point = limited.points[0]
+    record = run_point(limited.payload, PointTask(limited.keys[0], 0, point.parameters))
+    assert record["status"] == "failed" and record["error_type"] == "WallTimeLimitError"
+    assert re.fullmatch(r"wall-time limit of 0\.001 s reached \(at t = [0-9.e-]+ s\)", record["error"])
+
+
+def test_cli_timeout_overrides_the_study_and_is_checked(write_study, tmp_path):
+    path = write_study(MODEL_BASE)
+    proc = run_cli("sweep", str(path), "--check", "--timeout", "-5", cwd=tmp_path)
+    assert proc.returncode == 1 and "invalid study entry --timeout = -5.0" in proc.stderr
