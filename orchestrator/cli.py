@@ -25,12 +25,32 @@ COMMAND_MODULES = (
 )
 
 
+def _version_text() -> str:
+    """``dtcosim X (python ..., numpy ..., fmpy ..., pythonfmu ...)``: what a result depends on."""
+    from components import __version__
+
+    from .results import versions
+
+    deps = ", ".join(f"{k} {v}" for k, v in versions().items() if k != "dtcosim")
+    return f"dtcosim {__version__} ({deps})"
+
+
+class _VersionAction(argparse.Action):
+    """``--version``: looks the package versions up only when asked."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        print(_version_text())
+        parser.exit()
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The ``dtcosim`` argument parser with every registered subcommand."""
     parser = argparse.ArgumentParser(
         prog="dtcosim",
         description="Wind-turbine drivetrain torsional vibration as an FMI 2.0 co-simulation.",
     )
+    parser.add_argument("--version", action=_VersionAction, nargs=0,
+                        help="print the versions of dtcosim and of what its results depend on, and exit")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name in COMMAND_MODULES:
         importlib.import_module(name).register(sub)

@@ -84,3 +84,15 @@ def test_progress_bar_on_a_terminal_and_quiet(toy_scenario, tmp_path):
     assert "co-simulation: 100%" in shown and "5.00/5.00 s simulated" in shown
     quiet = _run_on_terminal(["run", str(path), "--out", str(tmp_path / "b"), "--no-plots", "--quiet"], tmp_path)
     assert quiet.strip() == ""
+
+
+def test_version_names_dtcosim_and_what_results_depend_on(capsys):
+    from components import __version__
+    from orchestrator import cli
+
+    with pytest.raises(SystemExit) as done:
+        cli.main(["--version"])
+    assert done.value.code == 0
+    out = capsys.readouterr().out
+    assert out.startswith(f"dtcosim {__version__} (python ")
+    assert all(f"{name} " in out for name in ("numpy", "scipy", "fmpy", "pythonfmu"))
