@@ -24,7 +24,9 @@ from .system import ResolvedSystem
 RPM_PER_RAD_S = 60.0 / (2.0 * math.pi)
 #: above this many samples a curve is drawn as its min/max envelope over this many bins
 ENVELOPE_BINS = 2000
-_FORCE_RE = re.compile(r"^(stage\d+)\.F_(sp|rp|mesh)(?:\[(\d+)\])?$")
+FORCE_KIND_LABELS = {"sp": "sun-planet", "rp": "ring-planet", "mesh": "mesh"}
+#: contact-force variable names: stage, kind (sp, rp, mesh), planet
+FORCE_NAME_RE = re.compile(r"^(stage\d+)\.F_(sp|rp|mesh)(?:\[(\d+)\])?$")
 
 
 def envelope(t: np.ndarray, y: np.ndarray, bins: int = ENVELOPE_BINS) -> tuple[np.ndarray, np.ndarray]:
@@ -54,11 +56,13 @@ def envelope(t: np.ndarray, y: np.ndarray, bins: int = ENVELOPE_BINS) -> tuple[n
     return tt, yy
 
 
-def _plot(ax, t, y, **kwargs) -> None:
+def plot_envelope(ax, t, y, **kwargs) -> None:
+    """``ax.plot`` of a long curve as its :func:`envelope` (every extreme kept)."""
     ax.plot(*envelope(t, y), **kwargs)
 
 
-def _figure(rows: int = 1, height: float = 4.0, sharex: bool = True, width: float = 10.0):
+def new_figure(rows: int = 1, height: float = 4.0, sharex: bool = True, width: float = 10.0):
+    """A headless figure of ``rows`` stacked axes, ``width`` x ``height`` inches: (figure, axes array)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -72,7 +76,8 @@ def _shade_window(ax, window) -> None:
     ax.axvspan(window[0], window[1], color="0.93", zorder=0, label=f"analysis window {window[0]:g}-{window[1]:g} s")
 
 
-def _finish(fig, path: Path) -> Path:
+def save_figure(fig, path: Path) -> Path:
+    """Write the figure as PNG; returns ``path``."""
     fig.savefig(path)
     return path
 
@@ -81,9 +86,9 @@ def plot_rotor_speed(outcome: RunOutcome, column: str, window, path: Path, title
     """Rotor speed [rpm] over time (Fig. 15)."""
     t = outcome.time_s
     w = outcome.column(column) * RPM_PER_RAD_S
-    fig, (ax,) = _figure()
+    fig, (ax,) = new_figure()
     _shade_window(ax, window)
-    _plot(ax, t, w, lw=0.8, color="C0", label=f"rotor speed {column}")
+    plot_envelope(ax, t, w, lw=0.8, color="C0", label=f"rotor speed {column}")
     sel = (t >= window[0]) & (t <= window[1])
     if sel.any():
         ax.axhline(w[sel].mean(), color="C3", lw=1.0, ls="--", label=f"mean over window: {w[sel].mean():.4g} rpm")
@@ -93,7 +98,7 @@ def plot_rotor_speed(outcome: RunOutcome, column: str, window, path: Path, title
     ax.grid(True, lw=0.3)
     ax.legend(loc="best", fontsize=8)
     ax.set_xlim(t[0], t[-1])
-    return _finish(fig, path)
+    return save_figure(fig, path)
 
 
 def plot_generator_speed(outcome: RunOutcome, rotor_column: str, gen_column: str, ratio: float, window,
@@ -102,10 +107,10 @@ def plot_generator_speed(outcome: RunOutcome, rotor_column: str, gen_column: str
     t = outcome.time_s
     gen = outcome.column(gen_column) * RPM_PER_RAD_S
     ideal = ratio * outcome.column(rotor_column) * RPM_PER_RAD_S
-    fig, (ax, ax2) = _figure(2, height=6.0)
+    fig, (ax, ax2) = new_figure(2, height=6.0)
     _shade_window(ax, window)
-    _plot(ax, t, ideal, lw=1.6, color="C1", label=f"ideal gearbox: {ratio:.6g} x rotor speed")
-    _plot(ax, t, gen, lw=0.8, color="C0", label=f"simulated generator speed {gen_column}")
+    plot_envelope(ax, t, ideal, lw=1.6, color="C1", label=f"ideal gearbox: {ratio:.6g} x rotor speed")
+    plot_envelope(ax, t, gen, lw=0.8, color="C0", label=f"simulated generator speed {gen_column}")
     ax.set_ylabel("speed [rpm]")
     ax.set_title("Generator speed vs ideal gearbox (paper Fig. 16)" + title_suffix)
     ax.grid(True, lw=0.3)
@@ -113,7 +118,7 @@ def plot_generator_speed(outcome: RunOutcome, rotor_column: str, gen_column: str
     with np.errstate(divide="ignore", invalid="ignore"):
         dev = 100.0 * (gen / ideal - 1.0)
     _shade_window(ax2, window)
-    _plot(ax2, t, dev, lw=0.7, color="C2", label="generator / ideal - 1")
+    plot_envelope(ax2, t, dev, lw=0.7, color="C2", label="generator / ideal - 1")
     ax2.axhline(0.0, color="0.3", lw=0.6)
     ax2.set_xlabel("time [s]")
     ax2.set_ylabel("difference [%]")
@@ -133,7 +138,7 @@ def plot_generator_speed(outcome: RunOutcome, rotor_column: str, gen_column: str
                 axis.set_ylim(lo - pad, hi + pad)
                 axis.text(0.005, 0.02, "scaled to the analysis window (start-up transient clipped)",
                           transform=axis.transAxes, fontsize=7, color="0.35")
-    return _finish(fig, path)
+    return save_figure(fig, path)
 
 
 def plot_contact_forces(outcome: RunOutcome, gearbox: str, window, path: Path, title_suffix: str = "") -> Path | None:
@@ -143,21 +148,20 @@ def plot_contact_forces(outcome: RunOutcome, gearbox: str, window, path: Path, t
     for i, c in enumerate(outcome.columns):
         if c.component != gearbox:
             continue
-        m = _FORCE_RE.match(c.variable)
+        m = FORCE_NAME_RE.match(c.variable)
         if m:
             stages.setdefault(m.group(1), []).append((c.variable, m.group(2), i))
     if not stages:
         return None
     names = sorted(stages, key=lambda s: int(s[5:]))
-    fig, axes = _figure(len(names), height=2.6 * len(names) + 0.8, width=12.5)
+    fig, axes = new_figure(len(names), height=2.6 * len(names) + 0.8, width=12.5)
     t = outcome.time_s
     styles = {"sp": "-", "rp": "--", "mesh": "-"}
-    labels = {"sp": "sun-planet", "rp": "ring-planet", "mesh": "mesh"}
     for ax, stage in zip(axes, names):
         _shade_window(ax, window)
         for k, (var, kind, i) in enumerate(stages[stage]):
-            _plot(ax, t, outcome.values[:, i] / 1e3, lw=0.7, ls=styles[kind], color=f"C{k % 10}",
-                  label=f"{var} ({labels[kind]})")
+            plot_envelope(ax, t, outcome.values[:, i] / 1e3, lw=0.7, ls=styles[kind], color=f"C{k % 10}",
+                  label=f"{var} ({FORCE_KIND_LABELS[kind]})")
         ax.set_ylabel("force [kN]")
         ax.set_title(f"{prefix}{stage}", fontsize=10, loc="left")
         ax.grid(True, lw=0.3)
@@ -166,7 +170,7 @@ def plot_contact_forces(outcome: RunOutcome, gearbox: str, window, path: Path, t
     axes[-1].set_xlabel("time [s]")
     axes[-1].set_xlim(t[0], t[-1])
     fig.suptitle("Gear contact forces of all stages (paper Fig. 17)" + title_suffix)
-    return _finish(fig, path)
+    return save_figure(fig, path)
 
 
 def plot_run(system: ResolvedSystem, outcome: RunOutcome, out_dir: str | Path) -> list[Path]:

@@ -56,9 +56,14 @@ def column_header(component: str, variable: str, unit: str) -> str:
 
 def write_timeseries(path: str | Path, outcome: RunOutcome) -> Path:
     """Write the sampled time series as CSV (full double precision, 17 significant digits)."""
-    path = Path(path)
     header = ["time [s]"] + [column_header(c.component, c.variable, c.unit) for c in outcome.columns]
-    table = np.column_stack([outcome.time_s, outcome.values]) if outcome.values.size else outcome.time_s[:, None]
+    return write_series_csv(path, header, outcome.time_s, outcome.values)
+
+
+def write_series_csv(path: str | Path, header: list[str], time_s: np.ndarray, values: np.ndarray) -> Path:
+    """CSV of ``time_s`` (N,) and ``values`` (N, M) under ``header`` (M + 1 fields), 17 significant digits."""
+    path = Path(path)
+    table = np.column_stack([time_s, values]) if values.size else np.asarray(time_s)[:, None]
     with open(path, "w", encoding="utf-8", newline="\n") as fh:
         fh.write(",".join(_csv_field(h) for h in header) + "\n")
         np.savetxt(fh, table, delimiter=",", fmt="%.17g")

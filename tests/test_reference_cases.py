@@ -99,3 +99,31 @@ def test_impact_law_stands_in_for_the_paper_cfa_on_table2():
     mean = result.statistics((0.5, 1.0), ["stage1.F_mesh"])["stage1.F_mesh"]["mean"]
     assert mean == pytest.approx(9.68e3, rel=0.01)
     assert result.energy.relative_residual < 0.005
+
+
+def test_backlash_intervals_of_a_hand_made_force():
+    from orchestrator.reference_output import _backlash_intervals
+
+    t = np.arange(10.0)
+    force = np.array([0.0, 0.5, 5.0, 6.0, 0.2, -0.3, -4.0, 0.0, 0.0, 3.0])
+    assert _backlash_intervals(t, force) == [(0.0, 1.0), (4.0, 5.0), (7.0, 8.0)]
+    assert _backlash_intervals(t, np.full(10, 7.0)) == []
+    assert _backlash_intervals(t, np.zeros(10)) == [(0.0, 9.0)]
+
+
+def test_reference_out_writes_series_summary_and_the_fig10_11_plot(tmp_path, capsys):
+    from orchestrator.results import read_timeseries
+
+    out = tmp_path / "sine"
+    assert main(["reference", "--case", "sine", "--t-end", "0.4", "--out", str(out)]) == 0
+    assert f"results in {out}/: timeseries.csv, summary.json, reference.png" in capsys.readouterr().out
+    header, data = read_timeseries(out / "timeseries.csv")
+    assert header[:4] == ["time [s]", "omega_rotor [rad/s]", "phi_rotor [rad]", "stage1.F_sp[1] [N]"]
+    assert data.shape == (2001, len(header)) and data[-1, 0] == pytest.approx(0.4)
+    # the same force as the in-process run, and both flanks inside 0.4 s
+    force = data[:, header.index("stage1.F_sp[1] [N]")]
+    assert force.min() < -1.0 and force.max() > 1.0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["case"] == "sine" and summary["complete"] is True
+    assert summary["statistics"]["stage1.F_sp[1]"]["max"] == pytest.approx(force.max())
+    assert (out / "reference.png").stat().st_size > 20_000

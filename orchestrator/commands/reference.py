@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 import time
+from pathlib import Path
 
 from components.cases import CASES, TABLE7_PAPER, run_case
 
@@ -19,6 +20,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--case", choices=sorted(CASES), default="table7", help="paper case (default: table7)")
     p.add_argument("--json", action="store_true", help="print a JSON object instead of a table")
     p.add_argument("--t-end", type=float, default=None, help="override the end time [s]")
+    p.add_argument("--out", type=Path, default=None, metavar="DIR",
+                   help="also write timeseries.csv, summary.json and reference.png (input speed and every "
+                        "contact force, backlash intervals shaded: Fig. 10-11 for --case sine) into DIR")
+    p.add_argument("--no-plots", action="store_true", help="with --out: no PNG")
     p.set_defaults(func=run)
 
 
@@ -28,20 +33,26 @@ def run(args: argparse.Namespace) -> int:
     start = time.perf_counter()
     result, stats = run_case(args.case, **overrides)
     wall = time.perf_counter() - start
-    if args.json:
-        out = {
-            "case": args.case,
-            "statistics": {k: {m: v[m] for m in ("mean", "std", "min", "max")} for k, v in stats.items()},
-            "wall_time_s": wall,
-            "solver_wall_time_s": result.wall_time_s,
-            "complete": result.complete,
-            "window_s": list(CASES[args.case].window_s),
-        }
-        if result.energy is not None:
-            out["energy"] = result.energy.as_dict()
-        print(json.dumps(out, indent=2))
-        return 0 if result.complete else 1
     case = CASES[args.case]
+    summary = {
+        "case": args.case,
+        "statistics": {k: {m: v[m] for m in ("mean", "std", "min", "max")} for k, v in stats.items()},
+        "wall_time_s": wall,
+        "solver_wall_time_s": result.wall_time_s,
+        "complete": result.complete,
+        "window_s": list(case.window_s),
+    }
+    if not result.complete:
+        summary["message"] = result.message
+    if result.energy is not None:
+        summary["energy"] = result.energy.as_dict()
+    if args.out is not None:
+        from ..reference_output import write_reference_outputs
+
+        files = write_reference_outputs(result, case, summary, args.out, plot=not args.no_plots)
+    if args.json:
+        print(json.dumps(summary, indent=2))
+        return 0 if result.complete else 1
     print(f"{case.name}: {case.description}")
     print(f"window {case.window_s[0]:g}-{case.window_s[1]:g} s, wall time {wall:.3f} s, complete: {result.complete}")
     print(f"{'variable':<24}{'mean':>14}{'std':>14}{'min':>14}{'max':>14}{'paper mean':>14}{'paper std':>14}")
@@ -57,4 +68,6 @@ def run(args: argparse.Namespace) -> int:
         e = result.energy
         print(f"energy audit: input {e.input_work_j:.6g} J = output {e.output_work_j:.6g} + dissipated "
               f"{e.dissipated_j:.6g} + stored change {e.stored_change_j:.6g} (residual {e.relative_residual:.2e} of input)")
+    if args.out is not None:
+        print(f"results in {args.out}/: " + ", ".join(f.name for f in files))
     return 0 if result.complete else 1
