@@ -170,12 +170,36 @@ FAILING_HOST = textwrap.dedent('''
 ''')
 
 
+def _upstream_exit_race(result) -> bool:
+    """The known pythonfmu shutdown race: SIGABRT with glibc's heap message, after the host's last line."""
+    return (result.returncode == -6 and "failures " in result.stdout
+            and ("corrupted double-linked list" in result.stderr or "double free" in result.stderr))
+
+
 @pytest.mark.slow
 def test_host_survives_many_failed_instances_and_sees_the_message_without_logging(fmu_path, tmp_path, this_python):
     script = tmp_path / "failing_host.py"
     script.write_text(FAILING_HOST)
     result = run_python(this_python, str(script), str(fmu_path("Gearbox")), "12")
+    if _upstream_exit_race(result):
+        # pythonfmu 0.7's library destructor can tear down its Python thread state while the
+        # interpreter shuts down (glibc "corrupted double-linked list", SIGABRT after all output);
+        # seen in well under 1 of 30 runs here and not ours to fix: one retry, a repeat fails
+        result = run_python(this_python, str(script), str(fmu_path("Gearbox")), "12")
     assert result.returncode == 0, f"exit code {result.returncode}; stdout {result.stdout[-500:]!r}; stderr {result.stderr[-1500:]}"
     assert "failures 12" in result.stdout and "good instance stepped" in result.stdout
     # loggingOn = false: pythonfmu drops logger messages, the slave echoes errors to stderr
     assert result.stderr.count("invalid parameter stage1.sun_mass = -1.0: expected > 0") == 12
+
+
+@pytest.mark.parametrize("code, stdout, stderr, known", [
+    (-6, "good instance stepped\nfailures 12\n", "corrupted double-linked list\n", True),
+    (-6, "", "corrupted double-linked list\n", False),  # before the host finished: a real crash
+    (-11, "failures 12\n", "corrupted double-linked list\n", False),  # another signal
+    (-6, "failures 12\n", "Fatal Python error: ...\n", False),  # another abort
+    (0, "failures 12\n", "", False),
+])
+def test_only_the_known_upstream_exit_race_is_retried(code, stdout, stderr, known):
+    import subprocess
+
+    assert _upstream_exit_race(subprocess.CompletedProcess([], code, stdout, stderr)) is known
