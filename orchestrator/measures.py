@@ -30,12 +30,18 @@ Measures are written as text in a study file:
 ``<component>.<variable>:<statistic>``
     A statistic of a recorded variable over the analysis window, e.g.
     ``gearbox.stage1.F_sp[1]:std``; statistics ``mean``, ``std``, ``min``,
-    ``max``, ``absmax`` (largest magnitude), ``rms``. Units as in
+    ``max``, ``absmax`` (largest magnitude), ``rms``, or ``del<m>`` (e.g.
+    ``del4``): the damage-equivalent load for the Woehler exponent ``m``,
+    rainflow-counted over the window with :class:`components.fatigue.FatigueSettings`'
+    defaults (``N_ref`` = 1 Hz x window length, half-cycle residue), the value a
+    run's ``fatigue_del.csv`` gives with a default ``[analysis]``. Units as in
     ``timeseries.csv`` (SI).
 """
 
 from __future__ import annotations
 
+import math
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -52,6 +58,15 @@ BUILTIN: dict[str, tuple[str, str, tuple[str, ...]]] = {
     "rhs_calls": ("1", "right-hand-side evaluations", ("monolithic",)),
 }
 STATISTICS = ("mean", "std", "min", "max", "absmax", "rms")
+#: ``del<m>``: damage-equivalent load for the Woehler exponent m (> 0)
+_DEL_RE = re.compile(r"^del(\d+(?:\.\d+)?)$")
+
+
+def wohler_exponent_of(stat: str) -> float | None:
+    """``m`` of a ``del<m>`` statistic (``"del4"`` -> 4.0), None for any other name."""
+    match = _DEL_RE.match(stat)
+    m = float(match.group(1)) if match else None
+    return m if m is not None and math.isfinite(m) and m > 0 else None
 
 
 class MeasureError(DtcosimError, ValueError):
@@ -114,7 +129,7 @@ def parse_measure(text: object) -> Measure:
         Neither a built-in name nor ``component.variable:statistic``.
     """
     expected = ("a built-in measure (" + ", ".join(BUILTIN) + ") or 'component.variable:statistic' with statistic "
-                + " | ".join(STATISTICS))
+                + " | ".join(STATISTICS) + " | del<m> (damage-equivalent load, e.g. del4)")
     if not isinstance(text, str) or not text:
         raise MeasureError(text, expected)
     if text in BUILTIN:
@@ -122,9 +137,11 @@ def parse_measure(text: object) -> Measure:
         return Measure(text, None, None, unit, description)
     variable, colon, stat = text.rpartition(":")
     comp, dot, var = variable.partition(".")
-    if not colon or not dot or not comp or not var or stat not in STATISTICS:
+    m = wohler_exponent_of(stat)
+    if not colon or not dot or not comp or not var or (stat not in STATISTICS and m is None):
         raise MeasureError(text, expected)
-    return Measure(text, variable, stat, unit_of(var), f"{stat} of {variable}")
+    what = stat if m is None else f"damage-equivalent load (m = {m:g}, N_ref = 1 Hz x window)"
+    return Measure(text, variable, stat, unit_of(var), f"{what} of {variable}")
 
 
 def statistic(values: np.ndarray, name: str) -> float:
@@ -145,6 +162,21 @@ def statistic(values: np.ndarray, name: str) -> float:
     if name == "rms":
         return float(np.sqrt(np.mean(x * x)))
     raise MeasureError(name, "one of " + ", ".join(STATISTICS))
+
+
+def window_statistic(time_s: np.ndarray, values: np.ndarray, window: tuple[float, float], name: str) -> float:
+    """A statistic (:data:`STATISTICS` or ``del<m>``) of ``values`` over ``window`` [s] (NaN for no samples)."""
+    m = wohler_exponent_of(name)
+    if m is None:
+        return statistic(window_values(time_s, values, window), name)
+    from components.fatigue import FatigueSettings, fatigue_loads
+
+    t = np.asarray(time_s, dtype=float)
+    inside = (t >= window[0] - 1e-12) & (t <= window[1] + 1e-12)
+    if np.count_nonzero(inside) < 2:
+        return float("nan")
+    loads = fatigue_loads(t[inside], np.asarray(values, dtype=float)[inside], FatigueSettings(wohler_exponents=(m,)))
+    return float(loads.del_by_exponent[m])
 
 
 def window_values(time_s: np.ndarray, values: np.ndarray, window: tuple[float, float]) -> np.ndarray:

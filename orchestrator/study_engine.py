@@ -39,7 +39,7 @@ from typing import Any, Mapping
 
 from components.errors import DtcosimError, WallTimeLimitError
 
-from .measures import Measure, max_abs_rate, statistic, window_values
+from .measures import Measure, max_abs_rate, window_statistic
 
 #: outcome statuses of a point
 OK, FAILED = "ok", "failed"
@@ -221,7 +221,7 @@ def _monolithic(payload: StudyPayload, task: PointTask) -> dict[str, float]:
             out[m.name] = peak.value_rad_s2
         else:
             series = result.series[payload.series_names[m.variable]]
-            out[m.name] = statistic(window_values(result.time_s, series, payload.window_s), m.statistic)
+            out[m.name] = window_statistic(result.time_s, series, payload.window_s, m.statistic)
     return out
 
 
@@ -248,7 +248,7 @@ def _cosim(payload: StudyPayload, task: PointTask) -> dict[str, float]:
                 out[m.name] = max_abs_rate(outcome.time_s, outcome.column(variable))
         else:
             values = outcome.column(m.variable)
-            out[m.name] = statistic(window_values(outcome.time_s, values, system.scenario.simulation.window_s), m.statistic)
+            out[m.name] = window_statistic(outcome.time_s, values, system.scenario.simulation.window_s, m.statistic)
     return out
 
 

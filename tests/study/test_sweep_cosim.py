@@ -18,7 +18,8 @@ COSIM_STUDY = """
 name = "cosim-seeds"
 engine = "cosim"
 seeds = [1, 2]
-measures = ["I_max_acc", "cpu_time", "wall_time", "gearbox.stage1.F_sp[1]:mean", "generator.omega:std"]
+measures = ["I_max_acc", "cpu_time", "wall_time", "gearbox.stage1.F_sp[1]:mean", "generator.omega:std",
+            "gearbox.shaft3.torque:del4"]
 
 [base]
 scenario = "{scenario}"
@@ -57,6 +58,8 @@ def test_cosim_sweep_runs_from_shipped_fmu_bytes(write_study, study_fmu_dir, tmp
     std = np.array([float(r["generator.omega:std [rad/s]"]) for r in rows])
     assert np.all(force > 1e5) and np.all(std > 0)
     assert std[0] != std[1] and force[0] != force[2]  # seeds and stiffness change the runs
+    del4 = np.array([float(r["gearbox.shaft3.torque:del4 [N.m]"]) for r in rows])
+    assert np.all(del4 > 0) and len(set(del4)) == 4
     # the Gearbox FMU's running peak over its internal steps: the start-up tooth impact, ~1.5e4 rad/s^2
     assert all(1.4e4 < float(r["I_max_acc [rad/s2]"]) < 1.6e4 for r in rows)
 
