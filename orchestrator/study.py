@@ -158,8 +158,11 @@ class Axis:
             object.__setattr__(self, "label", self.parameters[0])
 
     def display(self, value: ParameterValue) -> ParameterValue:
-        """A value as shown on plots (``value * scale`` for numbers)."""
-        return value * self.scale if _is_number(value) else value
+        """A value as shown on plots and in the table (``value * scale`` for numbers, to 12 digits).
+
+        Rounded so that 2864.8 x 1e-3 reads 2.8648, not 2.8648000000000002.
+        """
+        return float(f"{value * self.scale:.12g}") if _is_number(value) else value
 
     @property
     def axis_label(self) -> str:

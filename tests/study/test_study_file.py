@@ -162,3 +162,15 @@ def test_cli_timeout_overrides_the_study_and_is_checked(write_study, tmp_path):
     path = write_study(MODEL_BASE)
     proc = run_cli("sweep", str(path), "--check", "--timeout", "-5", cwd=tmp_path)
     assert proc.returncode == 1 and "invalid study entry --timeout = -5.0" in proc.stderr
+
+
+@pytest.mark.parametrize("name", ["paper-sensitivity", "shaft3-seeds"])
+def test_every_packaged_study_is_valid_against_its_base(name, study_fmu_dir):
+    from orchestrator.study import packaged_studies
+
+    assert set(packaged_studies()) == {"paper-sensitivity", "shaft3-seeds"}
+    prepared = prepare_study(load_study(find_study(name)), fmu_dir=study_fmu_dir, build=False)
+    assert len(prepared.keys) == len(set(prepared.keys)) == prepared.study.n_points
+    if name == "shaft3-seeds":
+        assert prepared.study.shape == (1, 3, 6) and prepared.payload.engine == "cosim"
+        assert [prepared.study.axes[0].display(v) for v in prepared.study.axes[0].values] == [2.8648, 5.7296, 11.4592]
