@@ -3,8 +3,9 @@
 A heat map shows one measure over two axes of the grid (Fig. 12 and 13 of the
 paper: I_max,acc and CPU time over R1 x lambda), every cell annotated with its
 value; the colour bar carries the measure's unit. Where several points fall in
-one cell (seeds, explicit points, further axes) the cell shows their mean and
-says so. Cells of failed points are hatched grey and marked "failed"; cells not
+one cell (seeds, explicit points, further axes) the cell shows their mean (for a
+damage-equivalent load ``del<m>`` the damage-consistent ``(mean DEL^m)^(1/m)``)
+and says so. Cells of failed points are hatched grey and marked "failed"; cells not
 run yet are blank. With one axis, a line plot shows every point and the mean.
 
 Each ``[[plots]]`` entry of the study gives one PNG; without any, every measure
@@ -18,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .measures import wohler_exponent_of
 from .study import PlotSpec
 
 _UNIT_TEXT = {"rad/s2": "rad/s²", "N.m": "N m", "1": "-", "kg.m2": "kg m²"}
@@ -52,19 +54,30 @@ def plot_specs(study) -> list[PlotSpec]:
     return [PlotSpec(measure=m.name) for m in study.measures]
 
 
+def cell_exponent(measure: str) -> float:
+    """Power of the per-cell mean: ``m`` for a damage-equivalent load ``...:del<m>``, else 1.
+
+    Runs of equal length add damage, so the DEL of a cell of n runs is
+    ``(sum DEL_i^m / n)^(1/m)``, not the arithmetic mean of the DELs.
+    """
+    return wohler_exponent_of(measure.rpartition(":")[2]) or 1.0
+
+
 def grid(prepared, recs, measure: str, x: int, y: int | None):
     """Cell means of a measure over axes x (and y).
 
     Returns
     -------
     mean : ndarray, shape (ny, nx)
-        Mean of the ``ok`` points of each cell (NaN: none).
+        Mean of the ``ok`` points of each cell (NaN: none); for a ``del<m>``
+        measure the damage-equivalent mean ``(mean DEL^m)^(1/m)`` (:func:`cell_exponent`).
     count : ndarray of int, shape (ny, nx)
         Number of ``ok`` points per cell.
     failed : ndarray of int, shape (ny, nx)
         Number of failed (or errored) points per cell.
     """
     study = prepared.study
+    p = cell_exponent(measure)
     nx = len(study.axes[x].values)
     ny = 1 if y is None else len(study.axes[y].values)
     total = np.zeros((ny, nx))
@@ -77,21 +90,25 @@ def grid(prepared, recs, measure: str, x: int, y: int | None):
         j = 0 if y is None else point.coords[1 + y]
         value = (rec.get("measures") or {}).get(measure)
         if rec["status"] == "ok" and value is not None and math.isfinite(value):
-            total[j, i] += value
+            total[j, i] += value if p == 1.0 else abs(value) ** p
             count[j, i] += 1
         elif rec["status"] != "ok":
             failed[j, i] += 1
     with np.errstate(invalid="ignore", divide="ignore"):
         mean = np.where(count > 0, total / np.maximum(count, 1), np.nan)
+    if p != 1.0:
+        mean = mean ** (1.0 / p)
     return mean, count, failed
 
 
-def _title(text: str, per_cell: int, width_in: float) -> str:
+def _title(text: str, per_cell: int, width_in: float, measure: str = "") -> str:
     """A plot title wrapped to the figure width, noting the runs averaged per cell."""
     import textwrap
 
     if per_cell > 1:
-        text += f" (mean of {per_cell} runs per cell)"
+        p = cell_exponent(measure)
+        text += (f" (mean of {per_cell} runs per cell)" if p == 1.0 else
+                 f" ({per_cell} runs per cell combined as (mean DEL^{p:g})^(1/{p:g}))")
     return "\n".join(textwrap.wrap(text, width=max(30, int(width_in * 11))))
 
 
@@ -152,7 +169,7 @@ def heatmap(prepared, recs, spec: PlotSpec, path: Path) -> Path:
         bar.formatter = ScalarFormatter(useOffset=False)
         bar.formatter.set_powerlimits((-3, 4))
         bar.update_ticks()
-    ax.set_title(_title(spec.title or f"{study.name}: {m.description}", _per_cell(study, spec.x, spec.y), width),
+    ax.set_title(_title(spec.title or f"{study.name}: {m.description}", _per_cell(study, spec.x, spec.y), width, m.name),
                  fontsize=10)
     fig.savefig(path, dpi=130)
     plt.close(fig)
@@ -187,7 +204,8 @@ def line_plot(prepared, recs, spec: PlotSpec, path: Path) -> Path:
     mean, count, failed = grid(prepared, recs, m.name, spec.x, None)
     ax.plot(px, py, "o", color="#1f77b4", alpha=0.5, label="runs")
     ok = count[0] > 0
-    ax.plot(np.asarray(pos)[ok], mean[0][ok], "-", color="#1f77b4", label="mean")
+    ax.plot(np.asarray(pos)[ok], mean[0][ok], "-", color="#1f77b4",
+            label="mean" if cell_exponent(m.name) == 1.0 else "damage-equivalent mean")
     if fx:
         ax.plot(fx, [ax.get_ylim()[0]] * len(fx), "x", color="#b00020", label="failed")
     if not numeric:
@@ -198,7 +216,7 @@ def line_plot(prepared, recs, spec: PlotSpec, path: Path) -> Path:
         ax.set_ylim(spec.vmin, spec.vmax)
     ax.set_xlabel(axis.axis_label)
     ax.set_ylabel(f"{m.name} [{unit_text(m.unit)}]")
-    ax.set_title(_title(spec.title or f"{study.name}: {m.description}", _per_cell(study, spec.x, None), 6.4),
+    ax.set_title(_title(spec.title or f"{study.name}: {m.description}", _per_cell(study, spec.x, None), 6.4, m.name),
                  fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)

@@ -44,3 +44,21 @@ def test_del_over_a_window_is_what_the_run_analysis_computes():
     assert window_statistic(t, load, window, "del4") == pytest.approx(expected, rel=1e-12)
     assert np.isnan(window_statistic(t, load, (100.0, 200.0), "del4"))
     assert window_statistic(t, load, window, "max") == pytest.approx(load[t >= 5.0 - 1e-12].max())
+
+
+def test_cells_combine_dels_by_damage_and_other_measures_arithmetically(study_fmu_dir):
+    """Six seeds per cell of shaft3-seeds: a DEL cell is (mean DEL^m)^(1/m), a std cell the plain mean."""
+    from orchestrator.study import find_study, load_study
+    from orchestrator.study_plots import grid
+    from orchestrator.study_prepare import prepare_study
+
+    prepared = prepare_study(load_study(find_study("shaft3-seeds")), fmu_dir=study_fmu_dir, build=False)
+    values = np.array([500.0, 520.0, 610.0, 640.0, 660.0, 700.0])  # the six seeds of every cell
+    recs = [{"status": "ok", "measures": {"gearbox.shaft3.torque:del4": values[p.coords[-1]],
+                                          "generator.omega:std": values[p.coords[-1]]}} for p in prepared.points]
+    recs[0] = {"status": "failed", "measures": {}}  # seed 1 of the first stiffness
+    dels, count, failed = grid(prepared, recs, "gearbox.shaft3.torque:del4", 0, None)
+    assert count.tolist() == [[5, 6, 6]] and failed.tolist() == [[1, 0, 0]]
+    np.testing.assert_allclose(dels[0], [np.mean(values[1:] ** 4) ** 0.25] + [np.mean(values**4) ** 0.25] * 2)
+    stds, _, _ = grid(prepared, recs, "generator.omega:std", 0, None)
+    np.testing.assert_allclose(stds[0], [values[1:].mean(), values.mean(), values.mean()])
