@@ -24,6 +24,7 @@ import numpy as np
 from . import units
 from .drivetrain import Drivetrain
 from .errors import ParameterError
+from .events import CONTACT_LOSS_THRESHOLD_N
 from .presets import table3_parallel, table5_planetary, table6_gearbox
 from .reference import SpeedDriver, simulate_monolithic
 from .results import SimulationResult, window_statistics
@@ -36,8 +37,6 @@ TABLE7_PAPER = {
     "stage3.F_mesh": (3.3786e5, 5.6738e3),
 }
 
-#: Contact-force magnitude below which a mesh counts as "inside the backlash" [N].
-CONTACT_LOSS_THRESHOLD_N = 1.0
 
 
 @dataclass(frozen=True)

@@ -2,7 +2,7 @@
 
 A mesh is *out of contact* (inside the backlash) while its contact force is smaller
 in magnitude than a threshold (default
-:data:`components.cases.CONTACT_LOSS_THRESHOLD_N` = 1 N; the CFS force is exactly 0
+:data:`CONTACT_LOSS_THRESHOLD_N` = 1 N; the CFS force is exactly 0
 once the flank-consistent clipping applies). Between samples the force is taken as
 linear in time, so
 
@@ -26,10 +26,12 @@ from typing import Mapping
 
 import numpy as np
 
-from .cases import CONTACT_LOSS_THRESHOLD_N
 from .errors import ParameterError
 from .results import SimulationResult, select_window, series_and_time
 from .validation import positive
+
+#: Contact-force magnitude below which a mesh counts as "inside the backlash" [N].
+CONTACT_LOSS_THRESHOLD_N = 1.0
 
 
 @dataclass(frozen=True)

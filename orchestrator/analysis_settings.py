@@ -22,7 +22,7 @@ import math
 from dataclasses import dataclass
 from typing import Any, Mapping
 
-from components.cases import CONTACT_LOSS_THRESHOLD_N
+from components.events import CONTACT_LOSS_THRESHOLD_N
 from components.fatigue import DEFAULT_REFERENCE_FREQUENCY_HZ, DEFAULT_WOHLER_EXPONENTS, RESIDUE_METHODS, FatigueSettings
 
 from .errors import ScenarioError

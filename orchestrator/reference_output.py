@@ -15,7 +15,8 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from components.cases import CONTACT_LOSS_THRESHOLD_N, ReferenceCase
+from components.cases import ReferenceCase
+from components.events import CONTACT_LOSS_THRESHOLD_N
 from components.results import SimulationResult, unit_of
 
 from .plots import FORCE_KIND_LABELS, FORCE_NAME_RE, new_figure, plot_envelope, save_figure

@@ -22,7 +22,6 @@ parameters, simulation and solver overrides, the measures and the code version
 
 from __future__ import annotations
 
-import difflib
 import hashlib
 import json
 from dataclasses import dataclass, field, replace
@@ -32,6 +31,7 @@ from typing import Any, Mapping
 from .errors import ScenarioError
 from .study import Point, Study, StudyError, split_parameter
 from .study_engine import StudyPayload
+from .system import suggestion
 
 #: modules left out of the code version: they present results, they do not change a point's numbers
 _PRESENTATION_MODULES = ("plots.py", "analysis_plots.py", "study_plots.py", "study_report.py", "modal_report.py",
@@ -121,11 +121,6 @@ def _origins(study: Study) -> list[tuple[str, str, list]]:
     return out
 
 
-def _suggest(name: str, choices) -> str:
-    close = difflib.get_close_matches(name, list(choices), n=3, cutoff=0.6)
-    return f" (did you mean {', '.join(close)}?)" if close else ""
-
-
 def _study_key_of(exc: ScenarioError) -> str:
     """``components.gearbox.parameters.stage1.k0`` -> ``base.parameters.gearbox.stage1.k0``."""
     parts = exc.key.split(".", 3)
@@ -155,18 +150,16 @@ def _simulation_changes(scenario, overrides: Mapping[str, Any]) -> dict[str, Any
 
 def _check_value(system, name: str, value: Any, key: str, source: str | None) -> None:
     """A varied scenario parameter exists, is settable, not connected, and the value has its type."""
-    from .system import SETTABLE_CAUSALITIES, _value_matches
+    from .system import _value_matches, parameter_problem
 
     comp, param = split_parameter(name)
     if comp not in system.interfaces:
         raise StudyError(key, name, "a parameter of a component of the base scenario: " + ", ".join(system.interfaces), source)
     iface = system.interfaces[comp]
-    var = iface.variables.get(param)
-    if var is None:
-        settable = [n for n, v in iface.variables.items() if v.causality in SETTABLE_CAUSALITIES]
-        raise StudyError(key, name, f"a parameter of {iface.model_name}{_suggest(param, settable)}", source)
-    if var.causality not in SETTABLE_CAUSALITIES or var.variability == "constant":
-        raise StudyError(key, name, f"a settable parameter; {param} has causality {var.causality}", source)
+    problem = parameter_problem(iface, param)
+    if problem is not None:
+        raise StudyError(key, name, problem, source)
+    var = iface.variables[param]
     if any(str(c.target) == name for c in system.scenario.connections):
         raise StudyError(key, name, "a parameter, not an input a connection drives", source)
     if any(str(b.target) == name for b in system.scenario.initial):
@@ -210,7 +203,7 @@ def _prepare_model(study: Study) -> tuple[StudyPayload, dict[str, Any]]:
     checks = [(f"base.parameters.{p}", p, [v]) for p, v in study.base.parameters.items()] + _origins(study)
     for key, name, values in checks:
         if name not in defaults:
-            raise StudyError(key, name, f"a parameter of the built-in model {model.name}{_suggest(name, defaults)}", src)
+            raise StudyError(key, name, f"a parameter of the built-in model {model.name}{suggestion(name, defaults)}", src)
         for v in values:
             if isinstance(v, bool) or not isinstance(v, (int, float)):
                 raise StudyError(key, v, f"a number for {name}", src)
@@ -241,7 +234,7 @@ def _prepare_model(study: Study) -> tuple[StudyPayload, dict[str, Any]]:
             comp, var = split_parameter(m.variable)
             if comp != MODEL_COMPONENT or var not in names:
                 raise StudyError(f"measures[{i}]", m.name, f"a variable {MODEL_COMPONENT}.<series> of the monolithic "
-                                 f"result{_suggest(var, names)}", src)
+                                 f"result{suggestion(var, names)}", src)
             series_names[m.variable] = var
     payload = StudyPayload(
         study=study.name, engine="monolithic", measures=study.measures, model=model.name,
@@ -309,7 +302,7 @@ def _prepare_scenario(study: Study, fmu_dir, build: bool) -> tuple[StudyPayload,
                 fv = iface.variables.get(var) if iface is not None else None
                 if fv is None or fv.type != "Real":
                     choices = [f"{c}.{n}" for c, f in system.interfaces.items() for n, v in f.variables.items() if v.type == "Real"]
-                    raise StudyError(f"measures[{i}]", m.name, f"a Real variable of the base scenario's FMUs{_suggest(variable, choices)}", src)
+                    raise StudyError(f"measures[{i}]", m.name, f"a Real variable of the base scenario's FMUs{suggestion(variable, choices)}", src)
             if scenario.record and variable not in {r.column for r in system.recorded}:
                 extra.append(variable)
         if extra:

@@ -138,9 +138,25 @@ def resolve_fmu_paths(scenario: Scenario, fmu_dir: str | Path | None = None) -> 
     return out
 
 
-def _suggest(name: str, choices) -> str:
+def suggestion(name: str, choices) -> str:
+    """`` (did you mean a, b?)`` with up to three close matches of ``name`` among ``choices``, or ``""``."""
     close = difflib.get_close_matches(name, list(choices), n=3, cutoff=0.6)
     return f" (did you mean {', '.join(close)}?)" if close else ""
+
+
+def parameter_problem(iface: FmuInterface, pname: str) -> str | None:
+    """What a value for variable ``pname`` of an FMU would have to be, or None if it may be set.
+
+    A scenario or a study may give values to parameters and inputs that are not
+    constants; an unknown name gets the closest settable names as a suggestion.
+    """
+    var = iface.variables.get(pname)
+    if var is None:
+        settable = [n for n, v in iface.variables.items() if v.causality in SETTABLE_CAUSALITIES]
+        return f"a parameter of {iface.model_name} ({iface.path.name}){suggestion(pname, settable)}"
+    if var.causality not in SETTABLE_CAUSALITIES or var.variability == "constant":
+        return f"a settable parameter or input; {pname} has causality {var.causality}, variability {var.variability}"
+    return None
 
 
 def _value_matches(var: FmuVariable, value) -> bool:
@@ -163,7 +179,7 @@ def _lookup(iface: FmuInterface, ref: VariableRef, key: str, source: str | None,
     var = iface.variables.get(ref.variable)
     if var is None:
         names = [n for n, v in iface.variables.items() if v.causality in causalities]
-        raise ScenarioError(key, str(ref), f"{role} of {iface.model_name} ({iface.path.name}){_suggest(ref.variable, names)}", source)
+        raise ScenarioError(key, str(ref), f"{role} of {iface.model_name} ({iface.path.name}){suggestion(ref.variable, names)}", source)
     if var.causality not in causalities:
         raise ScenarioError(key, str(ref), f"{role} (causality {' or '.join(causalities)}); {ref.variable} has causality {var.causality}", source)
     if var.type != "Real":
@@ -204,12 +220,10 @@ def resolve_system(
         iface = interfaces[comp.name]
         for pname, value in comp.parameters.items():
             key = f"components.{comp.name}.parameters.{pname}"
-            var = iface.variables.get(pname)
-            if var is None:
-                settable = [n for n, v in iface.variables.items() if v.causality in SETTABLE_CAUSALITIES]
-                raise ScenarioError(key, value, f"a parameter of {iface.model_name} ({iface.path.name}){_suggest(pname, settable)}", src)
-            if var.causality not in SETTABLE_CAUSALITIES or var.variability == "constant":
-                raise ScenarioError(key, value, f"a settable parameter or input; {pname} has causality {var.causality}, variability {var.variability}", src)
+            problem = parameter_problem(iface, pname)
+            if problem is not None:
+                raise ScenarioError(key, value, problem, src)
+            var = iface.variables[pname]
             if f"{comp.name}.{pname}" in connected_inputs:
                 raise ScenarioError(key, value, "no value for an input that a connection drives", src)
             if not _value_matches(var, value):
@@ -289,6 +303,6 @@ def _resolve_record(scenario: Scenario, interfaces: Mapping[str, FmuInterface]) 
                 matched += 1
         if not matched:
             comp = ref.component if ref.component in interfaces else None
-            hint = _suggest(ref.variable, interfaces[comp].variables) if comp else ""
+            hint = suggestion(ref.variable, interfaces[comp].variables) if comp else ""
             raise ScenarioError(key, pattern, f"a name or pattern matching at least one Real variable{hint}", src)
     return tuple(out)
