@@ -17,7 +17,7 @@ table7    Table 6 gearbox + generator, wind defaults,  mean/std of every contact
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Callable
+from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
@@ -26,9 +26,11 @@ from .drivetrain import Drivetrain
 from .errors import ParameterError
 from .events import CONTACT_LOSS_THRESHOLD_N
 from .presets import table3_parallel, table5_planetary, table6_gearbox
-from .reference import SpeedDriver, simulate_monolithic
 from .results import SimulationResult, window_statistics
 from .wind import ConstantSpeed, RotorSpeedProcess, SineSpeed, WindParameters
+
+if TYPE_CHECKING:
+    from .reference import SpeedDriver
 
 #: Table 7 of the paper: mean and std of F_SP1 of stages 1-3 [N] over [5, 60] s.
 TABLE7_PAPER = {
@@ -114,6 +116,8 @@ def run_case(name: str, **overrides) -> tuple[SimulationResult, dict[str, dict[s
     dt = overrides.pop("output_interval_s", case.output_interval_s)
     if overrides:
         raise ParameterError("overrides", sorted(overrides), "only t_end_s and output_interval_s")
+    from .reference import simulate_monolithic  # scipy.integrate: only when a case runs
+
     result = simulate_monolithic(drivetrain, driver, t_end, output_interval_s=dt)
     window = (min(case.window_s[0], t_end), min(case.window_s[1], t_end))
     return result, case_statistics(result, drivetrain, window)

@@ -23,7 +23,6 @@ from components.modes import OperatingPoint
 from components.presets import PRESETS, preset
 from components.units import rpm
 
-from ..modal_report import format_mode_table, format_verification, modal_report
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -115,6 +114,8 @@ def run(args: argparse.Namespace) -> int:
     if args.speed_points < 2:
         raise ParameterError("speed_points", args.speed_points, ">= 2")
     law = LoadLaw(args.load_law, abs(speed) if speed != 0.0 else rpm(16.0), op.output_torque_nm)
+    from ..modal_report import format_mode_table, format_verification, modal_report  # matplotlib: only to run
+
     report = modal_report(
         drivetrain, op, out_dir, law, rpm(np.linspace(lo, hi, args.speed_points)), args.shapes, args.verify
     )
