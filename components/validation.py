@@ -15,6 +15,11 @@ import numpy as np
 from .errors import ParameterError
 
 
+def is_number(value: Any) -> bool:
+    """True for an ``int`` or ``float`` that is not a ``bool`` (a TOML/JSON number)."""
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
 def _as_real(name: str, value: Any) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)) and not hasattr(value, "__float__"):
         raise ParameterError(name, value, "a real number")

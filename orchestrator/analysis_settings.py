@@ -24,6 +24,7 @@ from typing import Any, Mapping
 
 from components.events import CONTACT_LOSS_THRESHOLD_N
 from components.fatigue import DEFAULT_REFERENCE_FREQUENCY_HZ, DEFAULT_WOHLER_EXPONENTS, RESIDUE_METHODS, FatigueSettings
+from components.validation import is_number
 
 from .errors import ScenarioError
 
@@ -33,7 +34,7 @@ ANALYSIS_KEYS = ("woehler_exponents", "reference_frequency_hz", "ldd_bins", "rai
 
 
 def _positive_number(value: Any) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value) and value > 0
+    return is_number(value) and math.isfinite(value) and value > 0
 
 
 @dataclass(frozen=True)
@@ -85,7 +86,7 @@ class AnalysisSettings:
                 raise ScenarioError("analysis.ldd_bins", bins, "a bin count >= 1 or a list of increasing edges [N m]")
         else:
             ok = (isinstance(bins, (list, tuple)) and len(bins) >= 2
-                  and all(isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) for x in bins)
+                  and all(is_number(x) and math.isfinite(x) for x in bins)
                   and all(b > a for a, b in zip(bins[:-1], bins[1:])))
             if not ok:
                 raise ScenarioError("analysis.ldd_bins", bins, "a bin count >= 1 or a list of >= 2 increasing edges [N m]")

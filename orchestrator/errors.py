@@ -13,11 +13,18 @@ the simulation time and the status, plus the FMU's last log messages.
 
 from __future__ import annotations
 
+import difflib
 from typing import Any
 
 from components.errors import DtcosimError
 
 FMI_STATUS_LABELS = ("ok", "warning", "discard", "error", "fatal", "pending")
+
+
+def suggestion(name: str, choices, n: int = 3) -> str:
+    """`` (did you mean a, b?)`` with up to ``n`` close matches of ``name`` among ``choices``, or ``""``."""
+    close = difflib.get_close_matches(name, list(choices), n=n, cutoff=0.6)
+    return f" (did you mean {', '.join(close)}?)" if close else ""
 
 
 def status_label(status: int) -> str:

@@ -37,6 +37,7 @@ from dataclasses import dataclass, replace
 from typing import Any, Mapping
 
 from components.generator import EVENT_KINDS, LoadEvent
+from components.validation import is_number
 
 from .errors import ScenarioError
 from .fmu_interface import FmuInterface
@@ -45,10 +46,6 @@ from .fmu_interface import FmuInterface
 EVENT_KIND_CODES = {kind: i + 1 for i, kind in enumerate(EVENT_KINDS)}
 EVENT_KEYS = ("kind", "start", "duration", "factor", "component")
 _SLOT_FIELDS = ("kind", "start", "duration", "factor")
-
-
-def _number(value: Any) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool)
 
 
 @dataclass(frozen=True)
@@ -83,9 +80,9 @@ class ScenarioEvent:
     def __post_init__(self) -> None:
         if self.kind not in EVENT_KINDS:
             raise ScenarioError("event.kind", self.kind, "one of " + ", ".join(repr(k) for k in EVENT_KINDS))
-        if not _number(self.start_s) or not math.isfinite(self.start_s) or self.start_s < 0.0:
+        if not is_number(self.start_s) or not math.isfinite(self.start_s) or self.start_s < 0.0:
             raise ScenarioError("event.start", self.start_s, "a finite time >= 0 [s]")
-        if not _number(self.duration_s) or math.isnan(self.duration_s) or not self.duration_s > 0.0:
+        if not is_number(self.duration_s) or math.isnan(self.duration_s) or not self.duration_s > 0.0:
             raise ScenarioError("event.duration", self.duration_s, "a duration > 0 [s]")
         if math.isinf(self.duration_s) and self.kind != "torque_step":
             raise ScenarioError("event.duration", self.duration_s,
@@ -98,7 +95,7 @@ class ScenarioEvent:
             raise ScenarioError("event.factor", factor, "no factor for a grid_fault (the counter torque drops to zero)")
         if self.kind == "emergency_stop" and factor is None:
             factor = 1.0
-        if factor is not None and (not _number(factor) or not math.isfinite(factor)):
+        if factor is not None and (not is_number(factor) or not math.isfinite(factor)):
             raise ScenarioError("event.factor", factor, "a finite number [-]")
         if self.component is not None and not isinstance(self.component, str):
             raise ScenarioError("event.component", self.component, "a component name (string)")

@@ -57,6 +57,8 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Mapping
 
+from components.validation import is_number
+
 from .analysis_settings import AnalysisSettings
 from .errors import ScenarioError
 from .frozen_map import FrozenMap
@@ -72,10 +74,6 @@ ParameterValue = float | int | bool | str
 _NAME_RE = re.compile(r"^[A-Za-z_][A-Za-z0-9_\-]*$")
 #: relative tolerance when checking that times are whole multiples of the step
 _MULTIPLE_RTOL = 1e-9
-
-
-def _is_number(value: Any) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool)
 
 
 def steps_between(duration_s: float, step_s: float) -> int | None:
@@ -205,7 +203,7 @@ class SimulationSettings:
 
     def __post_init__(self) -> None:
         for key, value in (("simulation.start", self.start_s), ("simulation.stop", self.stop_s), ("simulation.step", self.step_s)):
-            if not _is_number(value) or not math.isfinite(value):
+            if not is_number(value) or not math.isfinite(value):
                 raise ScenarioError(key, value, "a finite number [s]")
         start, stop, step = float(self.start_s), float(self.stop_s), float(self.step_s)
         if not step > 0.0:
@@ -215,12 +213,12 @@ class SimulationSettings:
         if steps_between(stop - start, step) is None:
             raise ScenarioError("simulation.step", self.step_s, f"a step that divides stop - start = {stop - start:g} s into whole steps")
         out = step if self.output_interval_s is None else self.output_interval_s
-        if not _is_number(out) or not math.isfinite(out) or not out > 0:
+        if not is_number(out) or not math.isfinite(out) or not out > 0:
             raise ScenarioError("simulation.output_interval", self.output_interval_s, "a number > 0 [s]")
         if steps_between(float(out), step) in (None, 0):
             raise ScenarioError("simulation.output_interval", self.output_interval_s, f"a whole multiple of the step {step:g} s")
         window = (start, stop) if self.window_s is None else self.window_s
-        if (not isinstance(window, (tuple, list)) or len(window) != 2 or not all(_is_number(w) for w in window)):
+        if (not isinstance(window, (tuple, list)) or len(window) != 2 or not all(is_number(w) for w in window)):
             raise ScenarioError("simulation.window", self.window_s, "[begin, end] in seconds")
         w0, w1 = float(window[0]), float(window[1])
         if not (start <= w0 < w1 <= stop):
@@ -483,10 +481,10 @@ def scenario_from_dict(data: Mapping[str, Any], name: str | None = None, base_di
         value = sim[key]
         path = f"simulation.{key}"
         if key in ("start", "stop", "step", "output_interval"):
-            if not _is_number(value):
+            if not is_number(value):
                 raise ScenarioError(path, value, "a number [s]", source)
         elif key == "window":
-            if not isinstance(value, list) or len(value) != 2 or not all(_is_number(v) for v in value):
+            if not isinstance(value, list) or len(value) != 2 or not all(is_number(v) for v in value):
                 raise ScenarioError(path, value, "[begin, end] in seconds", source)
             value = (float(value[0]), float(value[1]))
         elif key in ("algorithm", "extrapolation"):

@@ -35,7 +35,6 @@ combination of axis values x every seed, in that nesting order (seeds fastest).
 
 from __future__ import annotations
 
-import difflib
 import math
 import re
 from dataclasses import dataclass, field
@@ -44,7 +43,9 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from .errors import EntryError
+from components.validation import is_number
+
+from .errors import EntryError, suggestion
 from .frozen_map import FrozenMap
 from .input_files import find_input_file, packaged_files, read_toml
 from .measures import Measure, MeasureError, parse_measure
@@ -71,10 +72,6 @@ class StudyError(EntryError):
     """A study file (or the objects built from it) is invalid (key, value, expected, source)."""
 
     kind = "study"
-
-
-def _is_number(value: Any) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool)
 
 
 def _is_scalar(value: Any) -> bool:
@@ -162,7 +159,7 @@ class Axis:
 
         Rounded so that 2864.8 x 1e-3 reads 2.8648, not 2.8648000000000002.
         """
-        return float(f"{value * self.scale:.12g}") if _is_number(value) else value
+        return float(f"{value * self.scale:.12g}") if is_number(value) else value
 
     @property
     def axis_label(self) -> str:
@@ -314,7 +311,7 @@ class Study:
         if not isinstance(self.name, str) or not _NAME_RE.match(self.name):
             raise StudyError("name", self.name, "a name of letters, digits, '_' or '-'", src)
         t = self.timeout_s
-        if t is not None and not (_is_number(t) and math.isfinite(t) and t > 0):
+        if t is not None and not (is_number(t) and math.isfinite(t) and t > 0):
             raise StudyError("timeout", t, "a finite number of seconds > 0 (wall-clock time per point)", src)
         if self.engine not in ENGINES:
             raise StudyError("engine", self.engine, "one of " + ", ".join(ENGINES), src)
@@ -409,8 +406,7 @@ def _check_keys(table: Mapping[str, Any], allowed: set[str] | Mapping[str, Any],
     for key in table:
         if key not in allowed:
             where = f"{prefix}.{key}" if prefix else key
-            close = difflib.get_close_matches(key, list(allowed), n=1)
-            hint = f" (did you mean {close[0]}?)" if close else ""
+            hint = suggestion(key, allowed, n=1)
             if prefix and key in _TOP_KEYS:
                 hint += f" ({key} is a top-level key: in TOML it must come before the first [table] header)"
             raise StudyError(where, table[key], "a known key here: " + ", ".join(sorted(allowed)) + hint, source)
@@ -431,7 +427,7 @@ def _axis_values(tab: Mapping[str, Any], key: str, source: str | None) -> tuple[
     for k in ("start", "stop"):
         if k not in tab:
             raise StudyError(f"{key}.{k}", None, "a number (missing)", source)
-        if not _is_number(tab[k]) or not math.isfinite(tab[k]):
+        if not is_number(tab[k]) or not math.isfinite(tab[k]):
             raise StudyError(f"{key}.{k}", tab[k], "a finite number", source)
     num = tab.get("num")
     if not isinstance(num, int) or isinstance(num, bool) or num < 1:
@@ -472,7 +468,7 @@ def _axis(tab: Any, i: int, source: str | None) -> Axis:
     for k, v in (("label", label), ("unit", unit)):
         if not isinstance(v, str):
             raise StudyError(f"{key}.{k}", v, "a string", source)
-    if not _is_number(scale) or not math.isfinite(scale) or scale == 0:
+    if not is_number(scale) or not math.isfinite(scale) or scale == 0:
         raise StudyError(f"{key}.scale", scale, "a finite number other than 0", source)
     try:
         return Axis(tuple(params), values, label=label, unit=unit, scale=float(scale))
@@ -499,7 +495,7 @@ def _plot(tab: Any, i: int, source: str | None) -> PlotSpec:
         if k in tab and (not isinstance(tab[k], int) or isinstance(tab[k], bool)):
             raise StudyError(f"{key}.{k}", tab[k], "an axis index (integer)", source)
     for k in ("vmin", "vmax"):
-        if k in tab and (not _is_number(tab[k]) or not math.isfinite(tab[k])):
+        if k in tab and (not is_number(tab[k]) or not math.isfinite(tab[k])):
             raise StudyError(f"{key}.{k}", tab[k], "a finite number in the measure's unit", source)
     if "vmin" in tab and "vmax" in tab and not tab["vmax"] > tab["vmin"]:
         raise StudyError(f"{key}.vmax", tab["vmax"], f"> vmin = {tab['vmin']}", source)
@@ -572,10 +568,10 @@ def study_from_dict(data: Mapping[str, Any], name: str | None = None, base_dir: 
     for key, value in simulation.items():
         path = f"simulation.{key}"
         if key in ("start", "stop", "step", "output_interval"):
-            if not _is_number(value) or not math.isfinite(value):
+            if not is_number(value) or not math.isfinite(value):
                 raise StudyError(path, value, "a finite number [s]", source)
         elif key == "window":
-            if not isinstance(value, list) or len(value) != 2 or not all(_is_number(v) for v in value):
+            if not isinstance(value, list) or len(value) != 2 or not all(is_number(v) for v in value):
                 raise StudyError(path, value, "[begin, end] in seconds", source)
         elif not isinstance(value, str):
             raise StudyError(path, value, "a string", source)
@@ -594,7 +590,7 @@ def study_from_dict(data: Mapping[str, Any], name: str | None = None, base_dir: 
         raise StudyError("solver", dict(solver), "no [solver] table with the co-simulation engine (the Gearbox FMU has "
                          "its own solver parameters: set them as gearbox parameters)", source)
     for key, value in solver.items():
-        if not _is_number(value) or not math.isfinite(value) or value < 0 or (key != "max_step" and value == 0):
+        if not is_number(value) or not math.isfinite(value) or value < 0 or (key != "max_step" and value == 0):
             raise StudyError(f"solver.{key}", value, "a finite number > 0 (max_step >= 0)", source)
         if key == "max_steps" and not isinstance(value, int):
             raise StudyError(f"solver.{key}", value, "an integer", source)

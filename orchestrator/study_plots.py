@@ -19,6 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
+from components.validation import is_number
+
 from .measures import wohler_exponent_of
 from .study import PlotSpec
 
@@ -187,7 +189,7 @@ def line_plot(prepared, recs, spec: PlotSpec, path: Path) -> Path:
     m = study.measure(spec.measure)
     axis = study.axes[spec.x]
     xs = [axis.display(v) for v in axis.values]
-    numeric = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in xs)
+    numeric = all(is_number(v) for v in xs)
     pos = xs if numeric else list(range(len(xs)))
     fig, ax = plt.subplots(figsize=(6.4, 4.2), constrained_layout=True)
     px, py, fx = [], [], []

@@ -28,10 +28,9 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Mapping
 
-from .errors import ScenarioError
+from .errors import ScenarioError, suggestion
 from .study import Point, Study, StudyError, split_parameter
 from .study_engine import StudyPayload
-from .system import suggestion
 
 #: modules left out of the code version: they present results, they do not change a point's numbers
 _PRESENTATION_MODULES = ("plots.py", "analysis_plots.py", "study_plots.py", "study_report.py", "modal_report.py",

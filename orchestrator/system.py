@@ -11,14 +11,15 @@ a :class:`ResolvedSystem`, is what the master runs.
 
 from __future__ import annotations
 
-import difflib
 import os
 import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Mapping
 
-from .errors import AlgebraicLoopError, ScenarioError
+from components.validation import is_number
+
+from .errors import AlgebraicLoopError, ScenarioError, suggestion
 from .fmu_interface import FmuInterface, FmuVariable, read_fmu_interface
 from .graph import find_algebraic_loop, initialization_order, stepping_order
 from .load_events import AssignedEvent, assign_events
@@ -138,12 +139,6 @@ def resolve_fmu_paths(scenario: Scenario, fmu_dir: str | Path | None = None) -> 
     return out
 
 
-def suggestion(name: str, choices) -> str:
-    """`` (did you mean a, b?)`` with up to three close matches of ``name`` among ``choices``, or ``""``."""
-    close = difflib.get_close_matches(name, list(choices), n=3, cutoff=0.6)
-    return f" (did you mean {', '.join(close)}?)" if close else ""
-
-
 def parameter_problem(iface: FmuInterface, pname: str) -> str | None:
     """What a value for variable ``pname`` of an FMU would have to be, or None if it may be set.
 
@@ -161,7 +156,7 @@ def parameter_problem(iface: FmuInterface, pname: str) -> str | None:
 
 def _value_matches(var: FmuVariable, value) -> bool:
     if var.type == "Real":
-        return isinstance(value, (int, float)) and not isinstance(value, bool)
+        return is_number(value)
     if var.type in ("Integer", "Enumeration"):
         return isinstance(value, int) and not isinstance(value, bool)
     if var.type == "Boolean":
