@@ -47,7 +47,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from components.errors import DtcosimError
-from components.results import unit_of
+from components.results import unit_of, window_mask
 
 #: built-in measures: name -> (unit, description, engines)
 BUILTIN: dict[str, tuple[str, str, tuple[str, ...]]] = {
@@ -165,25 +165,22 @@ def statistic(values: np.ndarray, name: str) -> float:
 
 
 def window_statistic(time_s: np.ndarray, values: np.ndarray, window: tuple[float, float], name: str) -> float:
-    """A statistic (:data:`STATISTICS` or ``del<m>``) of ``values`` over ``window`` [s] (NaN for no samples)."""
+    """A statistic (:data:`STATISTICS` or ``del<m>``) of ``values`` over ``window`` [s].
+
+    Samples with ``window[0] <= t <= window[1]`` (:func:`components.results.window_mask`);
+    NaN without samples (a DEL needs two).
+    """
+    t = np.asarray(time_s, dtype=float)
+    inside = window_mask(t, window)
+    x = np.asarray(values, dtype=float)[inside]
     m = wohler_exponent_of(name)
     if m is None:
-        return statistic(window_values(time_s, values, window), name)
+        return statistic(x, name)
+    if x.size < 2:
+        return float("nan")
     from components.fatigue import FatigueSettings, fatigue_loads
 
-    t = np.asarray(time_s, dtype=float)
-    inside = (t >= window[0] - 1e-12) & (t <= window[1] + 1e-12)
-    if np.count_nonzero(inside) < 2:
-        return float("nan")
-    loads = fatigue_loads(t[inside], np.asarray(values, dtype=float)[inside], FatigueSettings(wohler_exponents=(m,)))
-    return float(loads.del_by_exponent[m])
-
-
-def window_values(time_s: np.ndarray, values: np.ndarray, window: tuple[float, float]) -> np.ndarray:
-    """Samples with ``window[0] <= t <= window[1]`` (1e-12 s slack)."""
-    t = np.asarray(time_s, dtype=float)
-    sel = (t >= window[0] - 1e-12) & (t <= window[1] + 1e-12)
-    return np.asarray(values, dtype=float)[sel]
+    return float(fatigue_loads(t[inside], x, FatigueSettings(wohler_exponents=(m,))).del_by_exponent[m])
 
 
 def max_abs_rate(time_s: np.ndarray, values: np.ndarray) -> float:
