@@ -271,8 +271,8 @@ class GearboxModel:
 
     @property
     def output_speed_rad_s(self) -> float:
-        """Speed of the last stage's output member [rad/s]."""
-        return float(self.speeds_rad_s[self._out_member])
+        """Speed of the last stage's output member [rad/s] (its entry of :attr:`speeds_rad_s`)."""
+        return float(self._out_kinematic * self.driver_speed_rad_s + self.y[self._out_rate_index])
 
     @property
     def output_acceleration_rad_s2(self) -> float:
@@ -424,7 +424,7 @@ class GearboxModel:
         sysm.driver.fit(h, 0.0, self.driver_speed_rad_s, angle1 - self.driver_angle_rad, speed1)
         sysm.port.fit(h, self.port_angle_rad, self.port_speed_rad_s, port1, port_speed1)
         twist_start = self.output_twist_rad
-        speed_start = self._out_kinematic * self.driver_speed_rad_s + self.y[self._out_rate_index]
+        speed_start = self.output_speed_rad_s
         # first stage reuses the loads at the end of the previous step: the prescribed
         # motions are C1, so only the driver-acceleration term changes
         a0 = sysm.last_acceleration + a.kinematic_ratio * (sysm.last_alpha - sysm.driver.accel(0.0))
@@ -450,8 +450,7 @@ class GearboxModel:
         twist_end = self.output_twist_rad = self._output_twist()
         k = a.shaft_k[-1]
         self.shaft_torque_average_nm = k * 0.5 * (twist_start + twist_end) + a.shaft_c[-1] * (twist_end - twist_start) / h
-        speed_end = self._out_kinematic * speed1 + self.y[self._out_rate_index]
-        self.alpha_out_average_rad_s2 = float(speed_end - speed_start) / h
+        self.alpha_out_average_rad_s2 = (self.output_speed_rad_s - speed_start) / h
 
     def _output_twist(self) -> float:
         """Twist of the output shaft (shaft 3) [rad]."""

@@ -22,6 +22,8 @@ from components.fatigue import LoadDurationDistribution  # noqa: E402
 from components.modes import DrivetrainModalAnalysis  # noqa: E402
 from components.spectrum import amplitude_spectrum  # noqa: E402
 
+from .plots import shade_inside_backlash  # noqa: E402
+
 _STAGE_COLOURS = {"stage1": "tab:blue", "stage2": "tab:orange", "stage3": "tab:green", "generator": "tab:red"}
 
 
@@ -254,10 +256,7 @@ def plot_event_response(
         f = np.asarray(y)[sel]
         ax.plot(ts, f * 1e-3, lw=1.0, color="black", label=name)
         ax.axhline(0.0, color="black", lw=0.6)
-        inside = np.abs(f) < threshold_n
-        if inside.any():
-            ax.fill_between(ts, 0, 1, where=inside, transform=ax.get_xaxis_transform(), color="tab:red", alpha=0.35,
-                            lw=0, label=f"inside the backlash (|F| < {threshold_n:g} N)")
+        shade_inside_backlash(ax, ts, f, threshold_n)
         ax.set_ylabel("force [kN]")
         ax.legend(fontsize=7.5, loc="upper right")
     axes[-1].set_xlabel("time [s]")

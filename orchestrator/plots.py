@@ -61,6 +61,18 @@ def plot_envelope(ax, t, y, **kwargs) -> None:
     ax.plot(*envelope(t, y), **kwargs)
 
 
+def shade_inside_backlash(ax, t: np.ndarray, force: np.ndarray, threshold_n: float, label: str | None = None) -> None:
+    """Shade the full height of ``ax`` wherever ``|force| < threshold_n`` (teeth inside the backlash).
+
+    ``t`` [s] and ``force`` [N] at full resolution; ``label`` (default ``inside the
+    backlash (|F| < ... N)``) goes into the legend only if something is shaded.
+    """
+    inside = np.abs(force) < threshold_n
+    if inside.any():
+        ax.fill_between(t, 0, 1, where=inside, transform=ax.get_xaxis_transform(), color="tab:red", alpha=0.35,
+                        lw=0, label=label or f"inside the backlash (|F| < {threshold_n:g} N)")
+
+
 def new_figure(rows: int = 1, height: float = 4.0, sharex: bool = True, width: float = 10.0):
     """A headless figure of ``rows`` stacked axes, ``width`` x ``height`` inches: (figure, axes array)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg

@@ -19,22 +19,9 @@ from components.cases import ReferenceCase
 from components.events import CONTACT_LOSS_THRESHOLD_N
 from components.results import SimulationResult, unit_of
 
-from .plots import FORCE_KIND_LABELS, FORCE_NAME_RE, new_figure, plot_envelope, save_figure
+from .plots import FORCE_KIND_LABELS, FORCE_NAME_RE, new_figure, plot_envelope, save_figure, shade_inside_backlash
 from .results import write_series_csv, write_summary
 
-
-
-def _backlash_intervals(t: np.ndarray, force: np.ndarray) -> list[tuple[float, float]]:
-    """(start, end) [s] of every run of samples with |F| below :data:`CONTACT_LOSS_THRESHOLD_N`."""
-    inside = np.abs(force) < CONTACT_LOSS_THRESHOLD_N
-    edges = np.flatnonzero(np.diff(inside.astype(np.int8)))
-    starts = list(edges[~inside[edges]] + 1) if edges.size else []
-    ends = list(edges[inside[edges]]) if edges.size else []
-    if inside[0]:
-        starts.insert(0, 0)
-    if inside[-1]:
-        ends.append(t.size - 1)
-    return [(float(t[a]), float(t[b])) for a, b in zip(starts, ends)]
 
 
 def plot_reference(result: SimulationResult, case: ReferenceCase, path: str | Path) -> Path:
@@ -56,10 +43,8 @@ def plot_reference(result: SimulationResult, case: ReferenceCase, path: str | Pa
         for k, (name, kind) in enumerate(forces):
             plot_envelope(ax, t, result[name] / scale, lw=0.7, ls="--" if kind == "rp" else "-", color=f"C{k % 10}",
                   label=f"{name} ({FORCE_KIND_LABELS[kind]})")
-        shaded = _backlash_intervals(t, result[forces[0][0]])
-        for i, (a, b) in enumerate(shaded):
-            ax.axvspan(a, b, color="#f4b6b6", alpha=0.5, lw=0, zorder=0,
-                       label=f"{forces[0][0]} inside the backlash (|F| < {CONTACT_LOSS_THRESHOLD_N:g} N)" if i == 0 else None)
+        shade_inside_backlash(ax, t, result[forces[0][0]], CONTACT_LOSS_THRESHOLD_N,
+                              f"{forces[0][0]} inside the backlash (|F| < {CONTACT_LOSS_THRESHOLD_N:g} N)")
         ax.axhline(0.0, color="k", lw=0.5)
         ax.set_ylabel(f"contact force [{unit}]")
         ax.set_title(stage, fontsize=10, loc="left")

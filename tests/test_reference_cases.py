@@ -101,14 +101,20 @@ def test_impact_law_stands_in_for_the_paper_cfa_on_table2():
     assert result.energy.relative_residual < 0.005
 
 
-def test_backlash_intervals_of_a_hand_made_force():
-    from orchestrator.reference_output import _backlash_intervals
+def test_backlash_shading_of_a_hand_made_force():
+    """The shaded spans are exactly the runs of samples with |F| < 1 N (plots of runs and of reference cases)."""
+    from orchestrator.plots import new_figure, shade_inside_backlash
 
-    t = np.arange(10.0)
+    def shaded(force):
+        fig, (ax,) = new_figure()
+        shade_inside_backlash(ax, np.arange(10.0), force, 1.0)
+        return sorted((float(p.vertices[:, 0].min()), float(p.vertices[:, 0].max()))
+                      for c in ax.collections for p in c.get_paths())
+
     force = np.array([0.0, 0.5, 5.0, 6.0, 0.2, -0.3, -4.0, 0.0, 0.0, 3.0])
-    assert _backlash_intervals(t, force) == [(0.0, 1.0), (4.0, 5.0), (7.0, 8.0)]
-    assert _backlash_intervals(t, np.full(10, 7.0)) == []
-    assert _backlash_intervals(t, np.zeros(10)) == [(0.0, 9.0)]
+    assert shaded(force) == [(0.0, 1.0), (4.0, 5.0), (7.0, 8.0)]
+    assert shaded(np.full(10, 7.0)) == []
+    assert shaded(np.zeros(10)) == [(0.0, 9.0)]
 
 
 def test_reference_out_writes_series_summary_and_the_fig10_11_plot(tmp_path, capsys):
