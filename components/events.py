@@ -27,7 +27,7 @@ from typing import Mapping
 import numpy as np
 
 from .errors import ParameterError
-from .results import SimulationResult, select_window, series_and_time
+from .results import SimulationResult, is_contact_force, select_window, series_and_time
 from .validation import positive
 
 #: Contact-force magnitude below which a mesh counts as "inside the backlash" [N].
@@ -196,7 +196,7 @@ def contact_loss_summary(
     """
     series, t = series_and_time(result, time_s)
     if names is None:
-        names = [n for n in series if n.rsplit(".", 1)[-1].startswith("F_")]
+        names = [n for n in series if is_contact_force(n)]
     missing = [n for n in names if n not in series]
     if missing:
         raise ParameterError("names", missing, "names of recorded contact forces")

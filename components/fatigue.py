@@ -51,7 +51,7 @@ import fatpack
 import numpy as np
 
 from .errors import ParameterError
-from .results import SimulationResult, select_window, series_and_time, unit_of
+from .results import SimulationResult, is_contact_force, is_shaft_torque, select_window, series_and_time, unit_of
 from .validation import finite_series, non_negative, one_of, positive
 
 #: Default Woehler exponents (welded steel 3, shafts 5, gear teeth 8 and 10).
@@ -502,12 +502,7 @@ def load_duration_distribution(
 # --------------------------------------------------------------------------- run level
 def _default_load_names(series: Mapping[str, np.ndarray]) -> list[str]:
     """Contact forces ``*.F_*`` and shaft torques ``*shaft<k>.torque`` (with or without a ``gearbox.`` prefix)."""
-    out = []
-    for n in series:
-        parts = n.split(".")
-        if parts[-1].startswith("F_") or (len(parts) >= 2 and parts[-1] == "torque" and parts[-2].startswith("shaft")):
-            out.append(n)
-    return out
+    return [n for n in series if is_contact_force(n) or is_shaft_torque(n)]
 
 
 @dataclass

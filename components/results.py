@@ -30,6 +30,17 @@ UNITS = {
 }
 
 
+def is_contact_force(name: str) -> bool:
+    """A contact-force variable: last part ``F_...`` (``stage1.F_sp[1]``, ``gearbox.stage3.F_mesh``)."""
+    return name.rsplit(".", 1)[-1].startswith("F_")
+
+
+def is_shaft_torque(name: str) -> bool:
+    """A shaft-torque variable: ``...shaft<k>.torque`` (``shaft1.torque``, ``gearbox.shaft3.torque``)."""
+    parts = name.split(".")
+    return len(parts) >= 2 and parts[-1] == "torque" and parts[-2].startswith("shaft")
+
+
 def unit_of(name: str) -> str:
     """SI unit string of a result variable (FMI/SSP unit names: ``N``, ``N.m``, ``rad/s``)."""
     last = name.rsplit(".", 1)[-1]

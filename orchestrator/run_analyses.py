@@ -38,6 +38,7 @@ import numpy as np
 from components.errors import DtcosimError
 from components.events import contact_loss_summary, write_contact_loss_csv
 from components.fatigue import fatigue_report, write_del_csv, write_ldd_csv
+from components.results import is_contact_force, is_shaft_torque
 from components.spectrum import amplitude_spectrum
 
 from .master import RunOutcome
@@ -71,19 +72,10 @@ class RunAnalyses:
     notes: list[str] = field(default_factory=list)
 
 
-def _is_force(column: str) -> bool:
-    return column.rsplit(".", 1)[-1].startswith("F_")
-
-
 def _stage_of(column: str) -> str:
     """Stage of a contact-force column: ``"gearbox.stage1.F_sp[1]"`` -> ``"stage1"``."""
     parts = column.split(".")
     return parts[-2] if len(parts) >= 2 else ""
-
-
-def _is_shaft_torque(column: str) -> bool:
-    parts = column.split(".")
-    return len(parts) >= 2 and parts[-1] == "torque" and parts[-2].startswith("shaft")
 
 
 @dataclass(frozen=True)
@@ -164,8 +156,8 @@ def analyse_run(system: ResolvedSystem, outcome: RunOutcome, out_dir: str | Path
         result.notes.append(f"run incomplete: analyses over [{window[0]:g}, {window[1]:g}] s only")
     t = outcome.time_s
     series = {c.column: outcome.values[:, i] for i, c in enumerate(outcome.columns)}
-    forces = [c for c in series if _is_force(c)]
-    torques = [c for c in series if _is_shaft_torque(c)]
+    forces = [c for c in series if is_contact_force(c)]
+    torques = [c for c in series if is_shaft_torque(c)]
     info = _drivetrain_info(system)
 
     if forces:
@@ -343,7 +335,7 @@ def format_analyses(summary: dict[str, Any]) -> str:
     fat = summary.get("fatigue")
     if fat:
         exps = [f"m={m:g}" for m in fat["wohler_exponents"]]
-        shafts = {n: d for n, d in fat["del"].items() if _is_shaft_torque(n)}
+        shafts = {n: d for n, d in fat["del"].items() if is_shaft_torque(n)}
         if shafts:
             lines.append(f"damage-equivalent loads (N_ref = {fat['reference_frequency_hz'] or 0:g} Hz x T) [N m]: "
                          + ", ".join(exps))
