@@ -352,6 +352,14 @@ class Assembly:
         phase = np.multiply.outer(driver_angle_rad, self._mesh_rate) + self._mesh_offset
         return stiffness_factor(phase, self._mesh_contact_ratio, self._mesh_variation)
 
+    def _mesh_deflections(self, y: np.ndarray, port_angle_rad: float, port_speed_rad_s: float) -> np.ndarray:
+        """Mesh deflections [m] (row 0) and their rates [m/s] (row 1) of state ``[q, v]``, shape (2, n_mesh)."""
+        D = y.reshape(2, self.n_dof) @ self._A_T
+        if self._port_meshes:
+            D[0] += self.A_port[:, 0] * port_angle_rad
+            D[1] += self.A_port[:, 0] * port_speed_rad_s
+        return D
+
     def stiffness_rate_acceleration(
         self,
         y: np.ndarray,
@@ -382,10 +390,7 @@ class Assembly:
         ndarray, shape (n_dof,)
             [rad/s^3].
         """
-        D = y.reshape(2, self.n_dof) @ self._A_T
-        if self._port_meshes:
-            D[0] += self.A_port[:, 0] * port_angle_rad
-            D[1] += self.A_port[:, 0] * port_speed_rad_s
+        D = self._mesh_deflections(y, port_angle_rad, port_speed_rad_s)
         sensitivity = self.law.stiffness_sensitivity(D[0], D[1], stiffness_factor)
         return (sensitivity * stiffness_factor_rate) @ self._force_rows
 
@@ -456,10 +461,7 @@ class Assembly:
         deflection : ndarray, shape (2, n_mesh)
             Deflections [m] (row 0) and their rates [m/s] (row 1).
         """
-        D = y.reshape(2, self.n_dof) @ self._A_T
-        if self._port_meshes:
-            D[0] += self.A_port[:, 0] * port_angle_rad
-            D[1] += self.A_port[:, 0] * port_speed_rad_s
+        D = self._mesh_deflections(y, port_angle_rad, port_speed_rad_s)
         force = self.law.force(D[0], D[1], stiffness_factor)
         extra = self._fast_extra
         extra[0] = port_angle_rad
