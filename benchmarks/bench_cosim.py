@@ -6,7 +6,7 @@ only its ``simulate_until`` is timed):
 1. dtcosim co-simulation of ``paper-60s`` at H = 1 ms through WindSource, Gearbox and
    GeneratorRotor FMUs, recording the scenario's 22 variables every step (wall time of
    instantiation, initialisation and stepping; the stepping loop alone also printed);
-2. the monolithic reference (LSODA, :func:`components.reference.simulate_monolithic`) of the
+2. the monolithic reference (LSODA, :func:`components.reference.solver.simulate_monolithic`) of the
    same scenario, same seed, 1 ms output;
 3. the same FMUs, exported as SSP, stepped by libcosim (libcosimpy) at the same H, observing
    the same variables.

@@ -35,10 +35,10 @@ from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 from pythonfmu import FmuBuilder
 
-from components.gearbox_model import GearboxModel
-from components.generator import GeneratorRotor
-from components.presets import cosim_preset
-from components.wind import RotorSpeedProcess, WindParameters
+from components.model.gearbox_model import GearboxModel
+from components.model.generator import GeneratorRotor
+from components.model.presets import cosim_preset
+from components.model.wind import RotorSpeedProcess, WindParameters
 from fmus.build import build_fmu
 
 STEP_S = 1.0e-3

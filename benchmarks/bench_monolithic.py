@@ -13,9 +13,9 @@ import argparse
 import statistics
 import time
 
-from components.presets import table6_gearbox
-from components.reference import MonolithicSystem, simulate_monolithic
-from components.wind import RotorSpeedProcess, WindParameters
+from components.model.presets import table6_gearbox
+from components.reference.solver import MonolithicSystem, simulate_monolithic
+from components.model.wind import RotorSpeedProcess, WindParameters
 
 
 def _run(analytic: bool) -> tuple[float, dict]:
@@ -25,7 +25,7 @@ def _run(analytic: bool) -> tuple[float, dict]:
     if not analytic:
         MonolithicSystem.jacobian = None  # odeint then builds the Jacobian by finite differences
     try:
-        from components import reference
+        from components.reference import solver as reference
 
         if not analytic:
             real_odeint = reference.odeint

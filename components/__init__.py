@@ -1,19 +1,18 @@
 """dtcosim physics core: pure numpy/scipy, SI units inside, no FMI.
 
-Modules
--------
-units, validation, errors   unit conversions from the paper, validators, exceptions
-contact                     CFS (eq. 2-4) and impact (eq. 1) contact laws
-stages, drivetrain, presets gear stages, shafts, topology, paper presets (Tables 3, 5, 6)
-assembly                    bodies, mesh/shaft matrices, forces and analytic Jacobian
-wind, generator             rotor-speed process (eq. 13-14), generator rotor and load events
-reference                   monolithic LSODA reference solver and energy audit
-acceleration                peak output-gear acceleration at every solver step (eq. 11)
-cases                       the paper's reference cases (Tables 2, 4, 7; Fig. 10-11)
-modes, modal_verification   linearisation, undamped/complex modes, free-response check
-campbell                    natural frequencies over rotor speed vs 1P/3P and gear-mesh lines
-fatigue, events             rainflow/DEL/LDD; contact-loss events per mesh
-mesh_stiffness, spectrum    time-varying mesh stiffness; amplitude spectra and peaks
+Imports go one way: ``analysis`` -> ``reference`` -> ``model`` -> the base modules.
+
+Base modules
+------------
+errors, units, validation   exceptions, unit conversions from the paper, validators
+
+Subpackages
+-----------
+model       what the FMUs carry: contact laws, stages, drivetrain, presets, parameter map,
+            assembly, integrators, the co-simulation gearbox model, generator, wind
+reference   the monolithic reference solver, its results, the paper's cases, eq. 11
+analysis    modes (equilibrium, eigen, modes), modal verification, Campbell, fatigue,
+            contact loss, spectra
 """
 
 __version__ = "0.1.0"

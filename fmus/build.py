@@ -2,12 +2,15 @@
 
 Each FMU is self-contained and collision-free:
 
-* its ``resources/`` hold a package ``_dtcosim_<fmu>_<hash>`` with a copy of
-  ``components/`` and of the slave modules it needs (``slaves/``), where
-  ``<hash>`` is a hash of that code, the FMU name, the preset and the
+* its ``resources/`` hold a package ``_dtcosim_<fmu>_<hash>`` with exactly the
+  code its slave imports (the import closure of the slave module,
+  :func:`fmus.source_closure.import_closure`: the slave modules under
+  ``slaves/`` and the ``components`` modules they need, in their subpackages),
+  where ``<hash>`` is a hash of that code, the FMU name, the preset and the
   pythonfmu version. The slave modules' ``from components...`` imports are
   rewritten to package-relative imports, so the FMU never imports an installed
-  ``components`` (or another FMU's copy);
+  ``components`` (or another FMU's copy); analysis and reference code is not
+  embedded and does not change an FMU's build id;
 * the pythonfmu entry script is ``_dtcosim_<fmu>_<hash>_slave.py`` (pythonfmu
   imports it by file stem, and module names are shared by every FMU in a
   host process): it only subclasses the slave with the build's preset.
@@ -26,7 +29,6 @@ import hashlib
 import importlib
 import json
 import re
-import shutil
 import sys
 import tempfile
 from dataclasses import dataclass
@@ -38,10 +40,11 @@ from pythonfmu import FmuBuilder
 
 import components
 from components.errors import DtcosimError
-from components.presets import PRESETS
+from components.model.presets import PRESETS
 
 from . import model_description
 from .slaves import base as slave_base
+from .source_closure import SourceModule, import_closure
 
 #: Bump when the layout of the generated FMUs changes.
 BUILD_FORMAT = 1
@@ -53,8 +56,6 @@ FMU_SLAVES: dict[str, tuple[str, tuple[str, ...]]] = {
     "GeneratorRotor": ("generator_rotor", ()),
 }
 FMU_NAMES = tuple(FMU_SLAVES)
-#: slave modules every FMU carries
-COMMON_SLAVE_MODULES = ("__init__", "interface", "base")
 
 _COMPONENTS_IMPORT = re.compile(r"^(\s*)from components((?:\.\w+)*) import ", re.MULTILINE)
 _FORBIDDEN_IMPORT = re.compile(r"^\s*(?:from|import)\s+(?:components|fmus|orchestrator)\b", re.MULTILINE)
@@ -126,13 +127,32 @@ def _check_pythonfmu() -> None:
         )
 
 
-def _python_files(directory: Path) -> list[Path]:
-    return sorted(p for p in directory.rglob("*.py") if "__pycache__" not in p.parts)
+def embedded_modules(name: str, source: SourceTree | None = None) -> dict[str, SourceModule]:
+    """The modules FMU ``name`` carries: the import closure of its slave module.
+
+    Returns
+    -------
+    dict of str -> SourceModule
+        By dotted name: ``fmus.slaves.*`` (the slave, the base slave and what they import)
+        and the ``components`` modules and packages they need.
+    """
+    source = source or SourceTree.installed()
+    module, _ = FMU_SLAVES[name]
+    packages = {"components": source.components_dir, "fmus": source.slaves_dir.parent}
+    found = import_closure([f"fmus.slaves.{module}"], packages)
+    return {k: m for k, m in found.items() if k.startswith(("components", "fmus.slaves"))}
 
 
-def _slave_files(name: str, source: SourceTree) -> list[Path]:
-    module, extra = FMU_SLAVES[name]
-    return [source.slaves_dir / f"{m}.py" for m in (*COMMON_SLAVE_MODULES, *extra, module)]
+def _embedded_files(name: str, source: SourceTree) -> list[tuple[str, Path]]:
+    """(path inside the embedded package, source file) of every module FMU ``name`` carries."""
+    out = []
+    for mod in embedded_modules(name, source).values():
+        if mod.name.startswith("fmus.slaves"):
+            rel = "slaves/" + mod.path.relative_to(source.slaves_dir).as_posix()
+        else:
+            rel = "components/" + mod.path.relative_to(source.components_dir).as_posix()
+        out.append((rel, mod.path))
+    return out
 
 
 def build_config(name: str, preset: str) -> dict:
@@ -145,9 +165,7 @@ def code_hash(name: str, preset: str, source: SourceTree | None = None) -> str:
     """12-hex-digit hash of the code embedded in FMU ``name`` and of its build configuration."""
     source = source or SourceTree.installed()
     digest = hashlib.sha256(json.dumps(build_config(name, preset), sort_keys=True).encode())
-    files = [(f"components/{p.relative_to(source.components_dir).as_posix()}", p) for p in _python_files(source.components_dir)]
-    files += [(f"slaves/{p.name}", p) for p in _slave_files(name, source)]
-    for rel, path in files:
+    for rel, path in _embedded_files(name, source):
         digest.update(rel.encode() + b"\0" + path.read_bytes() + b"\0")
     return digest.hexdigest()[:12]
 
@@ -198,11 +216,13 @@ def stage(name: str, preset: str, staging_dir: Path, source: SourceTree | None =
     build_id = code_hash(name, preset, source)
     package = f"_dtcosim_{name.lower()}_{build_id}"
     package_dir = Path(staging_dir) / package
-    shutil.copytree(source.components_dir, package_dir / "components", ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
-    (package_dir / "slaves").mkdir()
-    for path in _slave_files(name, source):
-        code = rewrite_slave_imports(path.read_text(encoding="utf-8"), path.name)
-        (package_dir / "slaves" / path.name).write_text(code, encoding="utf-8")
+    for rel, path in _embedded_files(name, source):
+        target = package_dir / rel
+        target.parent.mkdir(parents=True, exist_ok=True)
+        code = path.read_text(encoding="utf-8")
+        if rel.startswith("slaves/"):
+            code = rewrite_slave_imports(code, path.name)
+        target.write_text(code, encoding="utf-8")
     info = build_config(name, preset) | {"build_id": build_id}
     (package_dir / "__init__.py").write_text(
         f'"""Code embedded in the dtcosim {name} FMU (generated by fmus.build)."""\n\nBUILD_INFO = {info!r}\n',

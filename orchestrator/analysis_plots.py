@@ -1,8 +1,8 @@
 """PNG plots of the analyses: mode shapes, Campbell diagram, contact-force spectra, LDD, load events.
 
 matplotlib with the Agg backend (no display needed). Every function takes the
-plain result objects of :mod:`components.modes`, :mod:`components.campbell` and
-:mod:`components.fatigue` (or arrays) and a path, writes one PNG and returns the path.
+plain result objects of :mod:`components.analysis.modes`, :mod:`components.analysis.campbell` and
+:mod:`components.analysis.fatigue` (or arrays) and a path, writes one PNG and returns the path.
 """
 
 from __future__ import annotations
@@ -17,10 +17,10 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from components.campbell import CampbellDiagram  # noqa: E402
-from components.fatigue import LoadDurationDistribution  # noqa: E402
-from components.modes import DrivetrainModalAnalysis  # noqa: E402
-from components.spectrum import amplitude_spectrum  # noqa: E402
+from components.analysis.campbell import CampbellDiagram  # noqa: E402
+from components.analysis.fatigue import LoadDurationDistribution  # noqa: E402
+from components.analysis.modes import DrivetrainModalAnalysis  # noqa: E402
+from components.analysis.spectrum import amplitude_spectrum  # noqa: E402
 
 from .plots import shade_inside_backlash  # noqa: E402
 

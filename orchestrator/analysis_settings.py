@@ -22,8 +22,8 @@ import math
 from dataclasses import dataclass
 from typing import Any, Mapping
 
-from components.events import CONTACT_LOSS_THRESHOLD_N
-from components.fatigue import DEFAULT_REFERENCE_FREQUENCY_HZ, DEFAULT_WOHLER_EXPONENTS, RESIDUE_METHODS, FatigueSettings
+from components.model.contact import CONTACT_LOSS_THRESHOLD_N
+from components.analysis.fatigue import DEFAULT_REFERENCE_FREQUENCY_HZ, DEFAULT_WOHLER_EXPONENTS, RESIDUE_METHODS, FatigueSettings
 from components.validation import is_number
 
 from .errors import ScenarioError
@@ -114,7 +114,7 @@ class AnalysisSettings:
             raise ScenarioError(exc.key, exc.value, exc.expected, source) from None
 
     def fatigue_settings(self) -> FatigueSettings:
-        """The :class:`components.fatigue.FatigueSettings` these settings describe."""
+        """The :class:`components.analysis.fatigue.FatigueSettings` these settings describe."""
         return FatigueSettings(
             wohler_exponents=self.woehler_exponents,
             reference_frequency_hz=self.reference_frequency_hz,

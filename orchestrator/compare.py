@@ -1,10 +1,10 @@
 """Monolithic reference of a co-simulation scenario and the co-simulation-vs-monolithic report.
 
-The reference is :func:`components.reference.simulate_monolithic` (one stiff ODE,
+The reference is :func:`components.reference.solver.simulate_monolithic` (one stiff ODE,
 LSODA, analytic Jacobian) on the *same* system: the drivetrain is rebuilt from the
 scenario's effective Gearbox FMU parameter values with
-:func:`components.parameter_map.unflatten` (template: the
-:func:`~components.presets.cosim_preset` whose flat parameter names the FMU
+:func:`components.model.parameter_map.unflatten` (template: the
+:func:`~components.model.presets.cosim_preset` whose flat parameter names the FMU
 has), the rotor-speed process from the WindSource parameters (same seed, same
 harmonics), the generator from the GeneratorRotor parameters (inertia, counter
 torque, load events).
@@ -22,7 +22,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from components.errors import DtcosimError, ParameterError
-from components.results import SimulationResult, window_statistics
+from components.reference.results import SimulationResult, window_statistics
 
 from .master import RunOutcome
 from .system import ResolvedSystem
@@ -41,8 +41,8 @@ class MonolithicSetup:
 
     Attributes
     ----------
-    drivetrain : components.drivetrain.Drivetrain
-    wind : components.wind.WindParameters
+    drivetrain : components.model.drivetrain.Drivetrain
+    wind : components.model.wind.WindParameters
     roles : dict of str -> str
         Component name -> role (``WindSource``, ``Gearbox``, ``GeneratorRotor``).
     preset : str
@@ -83,10 +83,10 @@ def monolithic_setup(system: ResolvedSystem) -> MonolithicSetup:
         If the scenario lacks one of the three FMUs or uses parameters the
         monolithic model cannot represent.
     """
-    from components.generator import EVENT_KINDS, GeneratorParameters, LoadEvent
-    from components.parameter_map import flatten, unflatten
-    from components.presets import PRESETS, cosim_preset
-    from components.wind import AMPLITUDE_CONVENTIONS, WindParameters
+    from components.model.generator import EVENT_KINDS, GeneratorParameters, LoadEvent
+    from components.model.parameter_map import flatten, unflatten
+    from components.model.presets import PRESETS, cosim_preset
+    from components.model.wind import AMPLITUDE_CONVENTIONS, WindParameters
 
     roles = component_roles(system)
     by_role = {r: n for n, r in roles.items()}
@@ -117,7 +117,7 @@ def monolithic_setup(system: ResolvedSystem) -> MonolithicSetup:
             break
     if template is None:
         raise ReferenceError(
-            "the Gearbox FMU's parameters match no drivetrain preset of components.parameter_map "
+            "the Gearbox FMU's parameters match no drivetrain preset of components.model.parameter_map "
             f"(presets tried: {', '.join(PRESETS)})"
         )
     keys = set(flatten(template)) - set(gen_keys)
@@ -176,8 +176,8 @@ def reference_name(column: str, roles: Mapping[str, str], series: Mapping[str, n
 
 def run_reference(system: ResolvedSystem, setup: MonolithicSetup | None = None) -> SimulationResult:
     """The monolithic solution on the scenario's time grid (start, stop, output interval)."""
-    from components.reference import simulate_monolithic
-    from components.wind import RotorSpeedProcess
+    from components.reference.solver import simulate_monolithic
+    from components.model.wind import RotorSpeedProcess
 
     setup = setup or monolithic_setup(system)
     sim = system.scenario.simulation
@@ -236,7 +236,7 @@ def compare(outcome: RunOutcome, reference: SimulationResult, system: ResolvedSy
             entry["rms_relative_to_std"] = rms / s_ref["std"] if s_ref["std"] > 0 else math.inf
         result[col.column] = entry
     return {
-        "reference": "monolithic LSODA (components.reference.simulate_monolithic)",
+        "reference": "monolithic LSODA (components.reference.solver.simulate_monolithic)",
         "preset": setup.preset,
         "window_s": list(window),
         "reference_complete": bool(reference.complete),

@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from components.results import window_statistics
+from components.reference.results import window_statistics
 
 from .master import RunOutcome
 from .system import ResolvedSystem
@@ -44,7 +44,7 @@ def ideal_ratio(system: ResolvedSystem, outcome: RunOutcome) -> tuple[float | No
     from .compare import ReferenceError, monolithic_setup
 
     try:
-        return float(monolithic_setup(system).drivetrain.ratio), "gearbox parameters (components.parameter_map)"
+        return float(monolithic_setup(system).drivetrain.ratio), "gearbox parameters (components.model.parameter_map)"
     except ReferenceError:  # a system the reference model cannot express
         pass
     r = roles(system)

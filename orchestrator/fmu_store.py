@@ -86,7 +86,7 @@ def stale_project_fmus(paths: Mapping[str, Path]) -> list[str]:
     the current sources for no preset. Other FMUs are not checked.
     """
     try:
-        from components.presets import PRESETS
+        from components.model.presets import PRESETS
         from fmus.build import FMU_NAMES, code_hash
     except ImportError:
         return []

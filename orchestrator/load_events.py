@@ -11,7 +11,7 @@ A scenario lists load events in time order of declaration::
     #                         # grid_fault: not allowed (the torque drops to zero)
     # component = "generator" # optional: the FMU that takes the event (default: the only one with event slots)
 
-Meaning (:class:`components.generator.LoadEvent`): ``torque_step`` sets the
+Meaning (:class:`components.model.generator.LoadEvent`): ``torque_step`` sets the
 generator counter torque to ``factor`` x base torque from ``start`` for
 ``duration``; ``grid_fault`` drops it to zero for ``duration``, then it returns;
 ``emergency_stop`` reverses it, ``-|factor|`` x base torque, for ``duration``.
@@ -36,7 +36,7 @@ import math
 from dataclasses import dataclass, replace
 from typing import Any, Mapping
 
-from components.generator import EVENT_KINDS, LoadEvent
+from components.model.generator import EVENT_KINDS, LoadEvent
 from components.validation import is_number
 
 from .errors import ScenarioError
@@ -109,7 +109,7 @@ class ScenarioEvent:
         return self.start_s + self.duration_s
 
     def load_event(self) -> LoadEvent:
-        """The physics-core event (:class:`components.generator.LoadEvent`)."""
+        """The physics-core event (:class:`components.model.generator.LoadEvent`)."""
         return LoadEvent(self.kind, self.start_s, self.duration_s, 1.0 if self.factor is None else self.factor)
 
     def slot_values(self, slot: int) -> dict[str, int | float]:

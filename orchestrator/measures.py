@@ -7,7 +7,7 @@ Measures are written as text in a study file:
     analysis window), the output gear being the last stage's output member.
     Monolithic engine: evaluated from the ODE right-hand side at every accepted
     LSODA step and refined with the solver's interpolant around the maximum
-    (:func:`components.acceleration.peak_output_acceleration`), a second
+    (:func:`components.reference.acceleration.peak_output_acceleration`), a second
     integration whose cost is not part of ``cpu_time``. Co-simulation engine:
     the Gearbox FMU's ``alpha_out_max`` at the end of the run, the running
     maximum of ``|d omega_out/dt|`` over every accepted internal step of its
@@ -32,7 +32,7 @@ Measures are written as text in a study file:
     ``gearbox.stage1.F_sp[1]:std``; statistics ``mean``, ``std``, ``min``,
     ``max``, ``absmax`` (largest magnitude), ``rms``, or ``del<m>`` (e.g.
     ``del4``): the damage-equivalent load for the Woehler exponent ``m``,
-    rainflow-counted over the window with :class:`components.fatigue.FatigueSettings`'
+    rainflow-counted over the window with :class:`components.analysis.fatigue.FatigueSettings`'
     defaults (``N_ref`` = 1 Hz x window length, half-cycle residue), the value a
     run's ``fatigue_del.csv`` gives with a default ``[analysis]``. Units as in
     ``timeseries.csv`` (SI).
@@ -47,7 +47,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from components.errors import DtcosimError
-from components.results import unit_of, window_mask
+from components.reference.results import unit_of, window_mask
 
 #: built-in measures: name -> (unit, description, engines)
 BUILTIN: dict[str, tuple[str, str, tuple[str, ...]]] = {
@@ -167,7 +167,7 @@ def statistic(values: np.ndarray, name: str) -> float:
 def window_statistic(time_s: np.ndarray, values: np.ndarray, window: tuple[float, float], name: str) -> float:
     """A statistic (:data:`STATISTICS` or ``del<m>``) of ``values`` over ``window`` [s].
 
-    Samples with ``window[0] <= t <= window[1]`` (:func:`components.results.window_mask`);
+    Samples with ``window[0] <= t <= window[1]`` (:func:`components.reference.results.window_mask`);
     NaN without samples (a DEL needs two).
     """
     t = np.asarray(time_s, dtype=float)
@@ -178,7 +178,7 @@ def window_statistic(time_s: np.ndarray, values: np.ndarray, window: tuple[float
         return statistic(x, name)
     if x.size < 2:
         return float("nan")
-    from components.fatigue import FatigueSettings, fatigue_loads
+    from components.analysis.fatigue import FatigueSettings, fatigue_loads
 
     return float(fatigue_loads(t[inside], x, FatigueSettings(wohler_exponents=(m,))).del_by_exponent[m])
 

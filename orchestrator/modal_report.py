@@ -19,10 +19,10 @@ from pathlib import Path
 
 import numpy as np
 
-from components.campbell import CampbellDiagram, LoadLaw, campbell_diagram, write_rows_csv
-from components.drivetrain import Drivetrain
-from components.modal_verification import FreeResponseCheck, free_response_check
-from components.modes import DrivetrainModalAnalysis, OperatingPoint, drivetrain_modes
+from components.analysis.campbell import CampbellDiagram, LoadLaw, campbell_diagram, write_rows_csv
+from components.model.drivetrain import Drivetrain
+from components.analysis.modal_verification import FreeResponseCheck, free_response_check
+from components.analysis.modes import DrivetrainModalAnalysis, OperatingPoint, drivetrain_modes
 
 from .analysis_plots import plot_campbell, plot_mode_shapes
 
@@ -77,7 +77,7 @@ def modal_report(
     n_shapes : int
         Modes shown in ``modes.png``.
     verify : bool
-        Also run :func:`components.modal_verification.free_response_check`.
+        Also run :func:`components.analysis.modal_verification.free_response_check`.
 
     Returns
     -------

@@ -15,9 +15,9 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from components.cases import ReferenceCase
-from components.events import CONTACT_LOSS_THRESHOLD_N
-from components.results import SimulationResult, unit_of
+from components.reference.cases import ReferenceCase
+from components.model.contact import CONTACT_LOSS_THRESHOLD_N
+from components.reference.results import SimulationResult, unit_of
 
 from .plots import FORCE_KIND_LABELS, FORCE_NAME_RE, new_figure, plot_envelope, save_figure, shade_inside_backlash
 from .results import write_series_csv, write_summary

@@ -28,7 +28,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from components.results import window_statistics
+from components.reference.results import window_statistics
 
 from .master import RunOutcome
 from .system import ResolvedSystem

@@ -5,16 +5,16 @@ window (``simulation.window``) with the scenario's ``[analysis]`` settings
 (:class:`~orchestrator.analysis_settings.AnalysisSettings`) and returns the
 ``summary.json`` entries and the files it wrote:
 
-* **contact loss** (:mod:`components.events`) of every recorded contact force
+* **contact loss** (:mod:`components.analysis.contact_loss`) of every recorded contact force
   (``*.F_*``): separations, flank changes, time inside the backlash (``|F| <
   contact_loss_threshold_n``) -> ``summary["contact_loss"]``, ``contact_loss.csv``;
-* **fatigue** (:mod:`components.fatigue`): rainflow counts and damage-equivalent
+* **fatigue** (:mod:`components.analysis.fatigue`): rainflow counts and damage-equivalent
   loads of every recorded contact force and shaft torque (``*shaftK.torque``) for the
   Woehler exponents, and the load duration distribution of every shaft torque
   (with the load revolution distribution where the shaft's speed is recorded)
   -> ``summary["fatigue"]``, ``fatigue_del.csv``, ``fatigue_ldd.csv``,
   ``load_duration.png``;
-* **spectra** (:mod:`components.spectrum`) of one contact force per mesh kind and
+* **spectra** (:mod:`components.analysis.spectrum`) of one contact force per mesh kind and
   stage, with every stage's gear-mesh frequency at the mean rotor speed marked ->
   ``summary["spectrum"]``, ``contact_force_spectra.png``; written when a mesh
   stiffness varies in time (``spectrum = "auto"``), always, or never.
@@ -36,10 +36,10 @@ from typing import Any
 import numpy as np
 
 from components.errors import DtcosimError
-from components.events import contact_loss_summary, write_contact_loss_csv
-from components.fatigue import fatigue_report, write_del_csv, write_ldd_csv
-from components.results import is_contact_force, is_shaft_torque
-from components.spectrum import amplitude_spectrum
+from components.analysis.contact_loss import contact_loss_summary, write_contact_loss_csv
+from components.analysis.fatigue import fatigue_report, write_del_csv, write_ldd_csv
+from components.reference.results import is_contact_force, is_shaft_torque
+from components.analysis.spectrum import amplitude_spectrum
 
 from .master import RunOutcome
 from .system import ResolvedSystem
@@ -92,7 +92,7 @@ class _Drivetrain:
 
 
 def _drivetrain_info(system: ResolvedSystem) -> _Drivetrain | None:
-    from components.assembly import Assembly
+    from components.model.assembly import Assembly
 
     from .compare import GEARBOX, GENERATOR, WIND, ReferenceError, monolithic_setup
 

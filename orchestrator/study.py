@@ -257,7 +257,7 @@ class Study:
         Names the results directory.
     engine : {"cosim", "monolithic"}
         ``cosim``: the FMUs stepped by the orchestrator's master; ``monolithic``:
-        :func:`components.reference.simulate_monolithic` on the base's monolithic model.
+        :func:`components.reference.solver.simulate_monolithic` on the base's monolithic model.
     base : Base
     measures : tuple of Measure
         Computed for every point.
@@ -272,7 +272,7 @@ class Study:
         Overrides of the base's time grid (``start``, ``stop``, ``step``,
         ``output_interval``, ``window``, ``algorithm``, ``extrapolation``).
     solver : mapping
-        Monolithic solver tolerances (:class:`components.reference.SolverSettings` fields).
+        Monolithic solver tolerances (:class:`components.reference.solver.SolverSettings` fields).
     plots : tuple of PlotSpec
     timeout_s : float or None
         Wall-clock time [s] one point may take; past it the point fails with a

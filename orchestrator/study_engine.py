@@ -10,7 +10,7 @@ its own temporary directory, once per FMU content (SHA-256), and runs from there
 Engines
 -------
 ``monolithic``
-    :func:`components.reference.simulate_monolithic` (LSODA with the analytic
+    :func:`components.reference.solver.simulate_monolithic` (LSODA with the analytic
     Jacobian) on the monolithic model: a scenario's (same drivetrain, wind seed and
     generator, :func:`orchestrator.compare.monolithic_setup`) or a built-in model
     (:mod:`orchestrator.study_models`).
@@ -67,10 +67,10 @@ class StudyPayload:
     window_s : (float, float)
         Analysis window of the statistics [s].
     solver : mapping
-        :class:`components.reference.SolverSettings` fields (monolithic engine).
+        :class:`components.reference.solver.SolverSettings` fields (monolithic engine).
     series_names : mapping of str -> str
         Monolithic engine: measure variable ``component.variable`` -> series name of
-        :class:`components.results.SimulationResult`.
+        :class:`components.reference.results.SimulationResult`.
     fmu_blobs : mapping of str -> bytes
         Co-simulation: FMU file content by SHA-256.
     timeout_s : float or None
@@ -175,8 +175,8 @@ def _point_system(payload: StudyPayload, task: PointTask, local_files: bool):
 
 # -------------------------------------------------------------------- engines
 def _monolithic(payload: StudyPayload, task: PointTask) -> dict[str, float]:
-    from components.acceleration import peak_output_acceleration
-    from components.reference import SolverSettings, simulate_monolithic
+    from components.reference.acceleration import peak_output_acceleration
+    from components.reference.solver import SolverSettings, simulate_monolithic
 
     wall0 = time.perf_counter()
     settings = SolverSettings(**payload.solver, wall_time_limit_s=payload.timeout_s or 0.0)
@@ -187,7 +187,7 @@ def _monolithic(payload: StudyPayload, task: PointTask) -> dict[str, float]:
         drivetrain, driver = MODELS[payload.model].build(values)
         start, stop, interval = payload.time_grid
     else:
-        from components.wind import RotorSpeedProcess
+        from components.model.wind import RotorSpeedProcess
 
         from .compare import monolithic_setup
 

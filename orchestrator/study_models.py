@@ -5,22 +5,22 @@ shaft 3). The paper's sensitivity analysis (Sec. 4.1) has no generator: a
 1 kN m counter torque acts directly on the output gear, the input turns at a
 constant 5 rpm and the stage-1 ratio R1 is a real number that changes the
 geometry of two stages. That system is a built-in model here, run with the
-monolithic solver (:mod:`components.reference`).
+monolithic solver (:mod:`components.reference.solver`).
 
 ``sensitivity-variant``
-    :func:`components.presets.sensitivity_variant`: the Table 6 gearbox with
+    :func:`components.model.presets.sensitivity_variant`: the Table 6 gearbox with
     R1 in [6, 10], R2 = 100 / (1.25 R1), stage-2 masses and inertias x 10 / R1,
     no generator, counter torque on the output gear. Parameters:
 
     * ``gearbox.R1`` [-]: stage-1 ratio (default 10);
     * ``gearbox.<name>``: any flat drivetrain parameter of
-      :mod:`components.parameter_map` (SI), applied after the variant is built,
+      :mod:`components.model.parameter_map` (SI), applied after the variant is built,
       e.g. ``gearbox.stage1.lambda`` [1/m], ``gearbox.output_torque`` [N m]
       (default 1000), ``gearbox.shaft2.stiffness`` [N m/rad];
     * ``input.speed`` [rad/s]: constant input (stage-1 carrier) speed, default 5 rpm.
 
     Result variables for measures: ``gearbox.<series>`` with the series names of
-    :func:`components.reference.simulate_monolithic` (``gearbox.stage3.F_mesh``,
+    :func:`components.reference.solver.simulate_monolithic` (``gearbox.stage3.F_mesh``,
     ``gearbox.omega_out``, ``gearbox.alpha_out``, ...).
 """
 
@@ -65,8 +65,8 @@ _BUILD_LAMBDA_PER_MM = 600.0
 
 
 def _variant_defaults() -> dict[str, float]:
-    from components.parameter_map import flatten
-    from components.presets import sensitivity_variant
+    from components.model.parameter_map import flatten
+    from components.model.presets import sensitivity_variant
 
     out = {_R1: _DEFAULT_R1, _SPEED: _DEFAULT_SPEED}
     out.update({f"{MODEL_COMPONENT}.{k}": v for k, v in flatten(sensitivity_variant(_DEFAULT_R1, _BUILD_LAMBDA_PER_MM)).items()})
@@ -74,9 +74,9 @@ def _variant_defaults() -> dict[str, float]:
 
 
 def _variant_build(values: Mapping[str, Any]):
-    from components.parameter_map import unflatten
-    from components.presets import sensitivity_variant
-    from components.wind import ConstantSpeed
+    from components.model.parameter_map import unflatten
+    from components.model.presets import sensitivity_variant
+    from components.model.wind import ConstantSpeed
 
     r1 = values.get(_R1, _DEFAULT_R1)
     drivetrain = sensitivity_variant(r1, _BUILD_LAMBDA_PER_MM)

@@ -169,7 +169,7 @@ def _check_value(system, name: str, value: Any, key: str, source: str | None) ->
 
 def _solver_settings(study: Study):
     from components.errors import ParameterError
-    from components.reference import SolverSettings
+    from components.reference.solver import SolverSettings
 
     try:
         return SolverSettings(**study.solver)
@@ -179,7 +179,7 @@ def _solver_settings(study: Study):
 
 def _micro_run_series(drivetrain, driver, start: float) -> list[str]:
     """Names of the series the monolithic solver records for this model (a 2-sample run)."""
-    from components.reference import simulate_monolithic
+    from components.reference.solver import simulate_monolithic
 
     return list(simulate_monolithic(drivetrain, driver, start + 1e-7, output_interval_s=1e-7, t_start_s=start).series)
 
@@ -314,7 +314,7 @@ def _prepare_scenario(study: Study, fmu_dir, build: bool) -> tuple[StudyPayload,
                                window_s=scenario.simulation.window_s, series_names=series_names, fmu_blobs=blobs)
         settings = None
     else:
-        from components.wind import RotorSpeedProcess
+        from components.model.wind import RotorSpeedProcess
 
         from .compare import ReferenceError, monolithic_setup, reference_name
 

@@ -5,13 +5,13 @@ from dataclasses import replace
 
 import pytest
 
-from components.contact import MeshContact
+from components.model.contact import MeshContact
 from components.errors import ParameterError
-from components.generator import GeneratorParameters, LoadEvent
-from components.parameter_map import unflatten
-from components.presets import table6_gearbox
-from components.stages import PlanetaryStage, Shaft
-from components.wind import WindParameters
+from components.model.generator import GeneratorParameters, LoadEvent
+from components.model.parameter_map import unflatten
+from components.model.presets import table6_gearbox
+from components.model.stages import PlanetaryStage, Shaft
+from components.model.wind import WindParameters
 
 NAN = float("nan")
 
@@ -60,7 +60,7 @@ def test_error_carries_name_value_expectation():
 
 def test_bad_parameter_raises_before_integration(monkeypatch):
     """A bad drivetrain never reaches the integrator."""
-    import components.reference as ref
+    import components.reference.solver as ref
 
     called = []
     monkeypatch.setattr(ref, "odeint", lambda *a, **k: called.append(1))

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from components.contact import ContactLaw, MeshContact
+from components.model.contact import ContactLaw, MeshContact
 
 K0 = 1.0e9  # N/m^1.5
 C0 = 1.0e8  # N s/m^2

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from components.errors import ParameterError
-from components.fatigue import (
+from components.analysis.fatigue import (
     FatigueSettings,
     damage_equivalent_load,
     fatigue_loads,
@@ -19,10 +19,10 @@ from components.fatigue import (
     write_del_csv,
     write_ldd_csv,
 )
-from components.modes import static_equilibrium
-from components.presets import table6_gearbox
-from components.reference import simulate_monolithic
-from components.wind import RotorSpeedProcess, WindParameters
+from components.analysis.modes import static_equilibrium
+from components.model.presets import table6_gearbox
+from components.reference.solver import simulate_monolithic
+from components.model.wind import RotorSpeedProcess, WindParameters
 
 M = (3.0, 5.0, 8.0, 10.0)
 

@@ -6,12 +6,12 @@ import numpy as np
 import pytest
 
 from components.errors import SolverError
-from components.gearbox_model import GearboxModel
-from components.generator import GeneratorRotor
-from components.integrators import Rosenbrock23, StepControl
-from components.presets import table6_gearbox
-from components.reference import simulate_monolithic
-from components.wind import RotorSpeedProcess, WindParameters
+from components.model.gearbox_model import GearboxModel
+from components.model.generator import GeneratorRotor
+from components.model.integrators import Rosenbrock23, StepControl
+from components.model.presets import table6_gearbox
+from components.reference.solver import simulate_monolithic
+from components.model.wind import RotorSpeedProcess, WindParameters
 
 
 class Oscillator:
@@ -143,7 +143,7 @@ def test_averaged_torque_conserves_the_exchanged_impulse():
 
 def test_output_acceleration_and_its_running_peak():
     """``alpha_out`` is d omega_out/dt over the step; ``alpha_out_max`` is eq. 11 over every internal step."""
-    from components.acceleration import peak_output_acceleration
+    from components.reference.acceleration import peak_output_acceleration
 
     dt, wind = _paper_setup()
     h = 1e-3
@@ -180,9 +180,9 @@ def test_output_acceleration_and_its_running_peak():
 
 def test_monolithic_wall_time_limit():
     """SolverSettings.wall_time_limit_s stops LSODA from inside the right-hand side."""
-    from components.acceleration import peak_output_acceleration
+    from components.reference.acceleration import peak_output_acceleration
     from components.errors import ParameterError, WallTimeLimitError
-    from components.reference import SolverSettings
+    from components.reference.solver import SolverSettings
 
     dt, wind = _paper_setup()
     tiny = SolverSettings(wall_time_limit_s=1e-9)

@@ -7,11 +7,11 @@ import numpy as np
 import pytest
 
 from components import units
-from components.assembly import Assembly
-from components.campbell import excitation_frequencies
-from components.contact import MeshContact
+from components.model.assembly import Assembly
+from components.analysis.campbell import excitation_frequencies
+from components.model.contact import MeshContact
 from components.errors import ParameterError
-from components.mesh_stiffness import (
+from components.model.mesh_stiffness import (
     TRANSITION_FRACTION,
     max_step_s,
     mesh_frequency_hz,
@@ -19,12 +19,12 @@ from components.mesh_stiffness import (
     pair_fraction,
     stiffness_factor,
 )
-from components.modes import static_equilibrium
-from components.presets import table6_gearbox, with_stage
-from components.reference import simulate_monolithic
-from components.spectrum import amplitude_spectrum, spectral_peak_hz
-from components.stages import PlanetaryStage
-from components.wind import ConstantSpeed
+from components.analysis.modes import static_equilibrium
+from components.model.presets import table6_gearbox, with_stage
+from components.reference.solver import simulate_monolithic
+from components.analysis.spectrum import amplitude_spectrum, spectral_peak_hz
+from components.model.stages import PlanetaryStage
+from components.model.wind import ConstantSpeed
 
 CYCLE = np.linspace(0.0, 2.0 * math.pi, 200_000, endpoint=False)
 
@@ -172,7 +172,7 @@ def test_time_varying_stiffness_keeps_the_mean_force(stage3_varying_run):
 
 def test_mesh_phasing_matches_the_stiffness_factor_and_its_slope_is_the_derivative():
     """The integrators' fast path (validated once, analytic slope) is the same model as stiffness_factor."""
-    from components.mesh_stiffness import MeshPhasing
+    from components.model.mesh_stiffness import MeshPhasing
 
     dt = table6_gearbox().with_meshes(stiffness_variation=0.3)
     dt = with_stage(dt, 2, mesh=replace(dt.stages[2].mesh, contact_ratio=2.0))  # integer ratio: constant
@@ -196,7 +196,7 @@ def test_mesh_phasing_matches_the_stiffness_factor_and_its_slope_is_the_derivati
 def test_gearbox_step_system_time_derivative_is_analytic_with_tvms():
     """da/dt of the co-simulation gearbox (stiffness varying with the driver angle) against a central
     difference of the acceleration in time at a fixed state, inside a stage-3 stiffness transition."""
-    from components.gearbox_model import GearboxModel
+    from components.model.gearbox_model import GearboxModel
 
     base = table6_gearbox()
     dt = with_stage(base, 2, mesh=replace(base.stages[2].mesh, stiffness_variation=0.3))

@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 
 from components import units
-from components.assembly import Assembly
+from components.model.assembly import Assembly
 from components.errors import ParameterError
-from components.modal_verification import free_response_check
-from components.modes import (
+from components.analysis.modal_verification import free_response_check
+from components.analysis.modes import (
     OperatingPoint,
     drivetrain_modes,
     modal_analysis,
@@ -19,10 +19,10 @@ from components.modes import (
     two_inertia_frequency_hz,
     undamped_modes,
 )
-from components.presets import cosim_preset, table5_planetary, table6_gearbox
-from components.reference import MonolithicSystem
-from components.spectrum import spectral_peak_hz
-from components.wind import ConstantSpeed
+from components.model.presets import cosim_preset, table5_planetary, table6_gearbox
+from components.reference.solver import MonolithicSystem
+from components.analysis.spectrum import spectral_peak_hz
+from components.model.wind import ConstantSpeed
 
 COS20 = math.cos(math.radians(20.0))
 TABLE6_POINT = OperatingPoint.from_rpm(16.0, 25.4e3)

@@ -7,11 +7,11 @@ import numpy as np
 import pytest
 
 from components import units
-from components.assembly import Assembly
-from components.modes import static_equilibrium
-from components.parameter_map import flatten, unflatten
-from components.presets import cosim_preset, sensitivity_variant, table3_parallel, table5_planetary, table6_gearbox
-from components.stages import ParallelStage, PlanetaryStage, solid_disc
+from components.model.assembly import Assembly
+from components.analysis.modes import static_equilibrium
+from components.model.parameter_map import flatten, unflatten
+from components.model.presets import cosim_preset, sensitivity_variant, table3_parallel, table5_planetary, table6_gearbox
+from components.model.stages import ParallelStage, PlanetaryStage, solid_disc
 
 COS20 = math.cos(math.radians(20.0))
 
@@ -157,8 +157,8 @@ def test_table3_and_table5_geometry():
 
 def test_any_stage_sequence_parallel_then_planetary():
     """A parallel stage driving a planetary stage through a shaft: kinematics and static forces."""
-    from components.drivetrain import Drivetrain
-    from components.stages import Shaft
+    from components.model.drivetrain import Drivetrain
+    from components.model.stages import Shaft
 
     (par,) = table3_parallel().stages
     (pla,) = table5_planetary().stages

@@ -5,7 +5,7 @@ import json
 import numpy as np
 import pytest
 
-from components.cases import CASES, TABLE7_PAPER, run_case
+from components.reference.cases import CASES, TABLE7_PAPER, run_case
 from orchestrator.cli import main
 
 
@@ -89,9 +89,9 @@ def test_all_cases_are_listed():
 def test_impact_law_stands_in_for_the_paper_cfa_on_table2():
     """Table 2 compares CFS with CAD contact (CFA, 9.68e3 N); the impact law of eq. 1 gives the same mean."""
     from components import units
-    from components.presets import table3_parallel
-    from components.reference import simulate_monolithic
-    from components.wind import ConstantSpeed
+    from components.model.presets import table3_parallel
+    from components.reference.solver import simulate_monolithic
+    from components.model.wind import ConstantSpeed
 
     dt = table3_parallel().with_meshes(law="impact")
     result = simulate_monolithic(dt, ConstantSpeed(units.rpm(5.0)), 1.0)

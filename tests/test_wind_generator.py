@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from components import units
-from components.generator import GeneratorParameters, GeneratorRotor, LoadEvent, TorqueSchedule
-from components.wind import RotorSpeedProcess, WindParameters
+from components.model.generator import GeneratorParameters, GeneratorRotor, LoadEvent, TorqueSchedule
+from components.model.wind import RotorSpeedProcess, WindParameters
 
 
 def test_paper_defaults_in_si():

@@ -1,4 +1,4 @@
-"""Gearbox FMU: the gearbox side of the co-simulation cut (:class:`components.gearbox_model.GearboxModel`).
+"""Gearbox FMU: the gearbox side of the co-simulation cut (:class:`components.model.gearbox_model.GearboxModel`).
 
 Inputs ``omega_rotor``, ``phi_rotor`` (kinematic driver of the stage-1 carrier)
 and ``omega_gen``, ``phi_gen`` (far end of shaft 3). Outputs: ``shaft_torque``
@@ -22,12 +22,12 @@ from __future__ import annotations
 
 from typing import Hashable, Iterable
 
-from components.assembly import Assembly
+from components.model.assembly import Assembly
 from components.errors import ParameterError
-from components.gearbox_model import SHAFT_TORQUE_MODES, GearboxModel
-from components.integrators import StepControl
-from components.presets import cosim_preset
-from components.wind import WindParameters
+from components.model.gearbox_model import SHAFT_TORQUE_MODES, GearboxModel
+from components.model.integrators import StepControl
+from components.model.presets import cosim_preset
+from components.model.wind import WindParameters
 
 from .base import DtcosimSlave
 from .gearbox_parameters import control_from_values, drivetrain_from_values, drivetrain_variables, solver_variables

@@ -1,22 +1,22 @@
 """The Gearbox FMU's parameters: the drivetrain's flat names and the integrator's.
 
-Drivetrain parameters are exactly those of :mod:`components.parameter_map`
+Drivetrain parameters are exactly those of :mod:`components.model.parameter_map`
 (shared with the orchestrator's scenarios): per stage ``stageK.<field>`` (the
 sun-planet and ring-planet meshes of a planetary stage share one set of mesh
 parameters), per shaft ``shaftK.stiffness`` and ``shaftK.damping``; start values
 are the template's (the build preset's) values. The generator's parameters
 belong to the GeneratorRotor FMU and are not exposed. Integrator tolerances are
-``solver.<field>`` (:class:`~components.integrators.StepControl`).
+``solver.<field>`` (:class:`~components.model.integrators.StepControl`).
 """
 
 from __future__ import annotations
 
 from typing import Callable
 
-from components.drivetrain import Drivetrain
-from components.integrators import StepControl
-from components.parameter_map import description_of_parameter, flatten, unflatten, unit_of_parameter
-from components.stages import PlanetaryStage
+from components.model.drivetrain import Drivetrain
+from components.model.integrators import StepControl
+from components.model.parameter_map import description_of_parameter, flatten, unflatten, unit_of_parameter
+from components.model.stages import PlanetaryStage
 
 from .base import fmu_parameter_names
 from .interface import Value, Variable, integer_parameter, real_parameter
@@ -24,7 +24,7 @@ from .interface import Value, Variable, integer_parameter, real_parameter
 #: reads the current value of an FMU variable by name
 ValueOf = Callable[[str], Value]
 
-#: flat names of components.parameter_map that are not Gearbox FMU parameters
+#: flat names of components.model.parameter_map that are not Gearbox FMU parameters
 _NOT_GEARBOX = ("generator.", "output_torque")
 #: parameter_map parameters that are integer codes
 _INTEGER_CODES = ("contact_law",)

@@ -1,4 +1,4 @@
-"""GeneratorRotor FMU: generator inertia with counter torque and load events (:mod:`components.generator`).
+"""GeneratorRotor FMU: generator inertia with counter torque and load events (:mod:`components.model.generator`).
 
 Input ``shaft_torque`` [N m] (shaft 3, from the Gearbox FMU), held over a step;
 the rotor is integrated exactly. Parameters: ``inertia``, ``counter_torque``,
@@ -13,9 +13,9 @@ import math
 from typing import Hashable, Iterable
 
 from components.errors import ParameterError, SolverError
-from components.generator import EVENT_KINDS, GeneratorParameters, GeneratorRotor as RotorComponent, LoadEvent
-from components.presets import cosim_preset
-from components.wind import WindParameters
+from components.model.generator import EVENT_KINDS, GeneratorParameters, GeneratorRotor as RotorComponent, LoadEvent
+from components.model.presets import cosim_preset
+from components.model.wind import WindParameters
 
 from .base import DtcosimSlave, fmu_parameter_names
 from .interface import Variable, enumeration_text, integer_parameter, real_input, real_output, real_parameter

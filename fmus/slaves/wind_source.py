@@ -1,4 +1,4 @@
-"""WindSource FMU: the rotor-speed process of eq. 13-14 (:mod:`components.wind`).
+"""WindSource FMU: the rotor-speed process of eq. 13-14 (:mod:`components.model.wind`).
 
 Parameters (SI, paper defaults): ``omega0``, ``a``, ``sigma``, ``n_harmonics``,
 ``f_min``, ``f_max``, ``seed``, ``amplitude`` (0 = variance-preserving
@@ -13,7 +13,7 @@ from __future__ import annotations
 from typing import Hashable, Iterable
 
 from components.errors import ParameterError
-from components.wind import AMPLITUDE_CONVENTIONS, RotorSpeedProcess, WindParameters
+from components.model.wind import AMPLITUDE_CONVENTIONS, RotorSpeedProcess, WindParameters
 
 from .base import DtcosimSlave, fmu_parameter_names
 from .interface import Variable, enumeration_text, integer_parameter, real_output, real_parameter

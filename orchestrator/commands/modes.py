@@ -17,10 +17,10 @@ from pathlib import Path
 
 import numpy as np
 
-from components.campbell import LOAD_LAWS, LoadLaw
+from components.analysis.campbell import LOAD_LAWS, LoadLaw
 from components.errors import ParameterError
-from components.modes import OperatingPoint
-from components.presets import PRESETS, preset
+from components.analysis.modes import OperatingPoint
+from components.model.presets import PRESETS, preset
 from components.units import rpm
 
 
@@ -65,7 +65,7 @@ def scenario_drivetrain(spec: str, fmu_dir: Path | None = None):
 
     Returns
     -------
-    drivetrain : components.drivetrain.Drivetrain
+    drivetrain : components.model.drivetrain.Drivetrain
         With the generator's inertia and base counter torque (no load events).
     omega0_rad_s : float
         The WindSource's mean rotor speed.
@@ -73,7 +73,7 @@ def scenario_drivetrain(spec: str, fmu_dir: Path | None = None):
     """
     from dataclasses import replace
 
-    from components.generator import GeneratorParameters
+    from components.model.generator import GeneratorParameters
 
     from ..compare import ReferenceError, monolithic_setup
     from ..errors import ScenarioError

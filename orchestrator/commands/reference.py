@@ -7,7 +7,7 @@ import json
 import time
 from pathlib import Path
 
-from components.cases import CASES, TABLE7_PAPER, run_case
+from components.reference.cases import CASES, TABLE7_PAPER, run_case
 
 
 def register(sub: argparse._SubParsersAction) -> None:

@@ -11,7 +11,7 @@ from fmpy import read_model_description
 from fmpy.validation import validate_fmu
 from fmu_helpers import load_driver, run_python
 
-from components.presets import cosim_preset
+from components.model.presets import cosim_preset
 from fmus import build as fmu_build
 from fmus.build import BuildError, code_hash, rewrite_slave_imports
 from fmus.model_description import read_member, rewrite_archive
@@ -115,7 +115,8 @@ def test_archive_carries_its_code_under_private_names(built_fmus, name):
         files = archive.namelist()
         assert archive.read("resources/slavemodule.txt").decode().strip() == built.slave_module
         slave_sources = [archive.read(f).decode() for f in files if f.startswith(f"resources/{built.package}/slaves/")]
-    assert f"resources/{built.package}/components/gearbox_model.py" in files
+    assert f"resources/{built.package}/components/model/wind.py" in files
+    assert (f"resources/{built.package}/components/model/gearbox_model.py" in files) == (name == "Gearbox")
     assert f"resources/{built.slave_module}.py" in files
     assert not any(f.startswith(("resources/components/", "resources/fmus/")) for f in files)
     assert slave_sources and not any("\nfrom components" in code for code in slave_sources)
@@ -127,9 +128,9 @@ def test_code_hash_is_deterministic_and_names_the_configuration():
 
 
 def test_slave_imports_are_rewritten_to_the_embedding_package():
-    code = "from components.wind import X\n    from components import y\nfrom .base import Z\n"
+    code = "from components.model.wind import X\n    from components import y\nfrom .base import Z\n"
     assert rewrite_slave_imports(code, "m.py") == (
-        "from ..components.wind import X\n    from ..components import y\nfrom .base import Z\n")
+        "from ..components.model.wind import X\n    from ..components import y\nfrom .base import Z\n")
     with pytest.raises(BuildError, match="would not resolve inside an FMU"):
         rewrite_slave_imports("import fmus.build\n", "m.py")
 

@@ -14,7 +14,7 @@ import pytest
 from fmpy.fmi1 import FMICallException
 from fmu_helpers import FMI_ERROR, FMI_FATAL, Instance, gearbox_motion, run_python
 
-from components.presets import cosim_preset
+from components.model.presets import cosim_preset
 
 RATIO = cosim_preset("table6").ratio
 DISCARD = 2

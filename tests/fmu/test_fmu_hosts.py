@@ -14,10 +14,10 @@ import pytest
 from fmpy import read_model_description
 from fmu_helpers import Instance, load_driver, run_python
 
-from components.gearbox_model import GearboxModel
-from components.generator import GeneratorRotor
-from components.presets import cosim_preset
-from components.wind import RotorSpeedProcess, WindParameters
+from components.model.gearbox_model import GearboxModel
+from components.model.generator import GeneratorRotor
+from components.model.presets import cosim_preset
+from components.model.wind import RotorSpeedProcess, WindParameters
 from fmus.build import SourceTree, build_fmu
 
 H = 1.0e-3
@@ -109,7 +109,7 @@ def test_two_differently_built_fmus_each_run_their_own_code(built_fmus, tmp_path
     patched_root = tmp_path / "patched"
     shutil.copytree(installed.components_dir, patched_root / "components", ignore=shutil.ignore_patterns("__pycache__"))
     shutil.copytree(installed.slaves_dir, patched_root / "fmus" / "slaves", ignore=shutil.ignore_patterns("__pycache__"))
-    with open(patched_root / "components" / "gearbox_model.py", "a") as f:
+    with open(patched_root / "components" / "model" / "gearbox_model.py", "a") as f:
         f.write(PATCH)
     patched = build_fmu("Gearbox", tmp_path / "out", source=SourceTree.at(patched_root))
     original = built_fmus["Gearbox"]
@@ -131,8 +131,8 @@ def test_two_differently_built_fmus_each_run_their_own_code(built_fmus, tmp_path
     assert run_one_step(patched.path, "p2") == MARKER
     assert run_one_step(original.path, "o2") == first_original
     # each FMU imported its own copy; this process's components are untouched
-    assert sys.modules[f"{patched.package}.components.gearbox_model"].__file__ != \
-        sys.modules[f"{original.package}.components.gearbox_model"].__file__
+    assert sys.modules[f"{patched.package}.components.model.gearbox_model"].__file__ != \
+        sys.modules[f"{original.package}.components.model.gearbox_model"].__file__
     assert not isinstance(GearboxModel.rotor_torque_nm, float)
 
 

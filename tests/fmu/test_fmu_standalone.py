@@ -9,10 +9,10 @@ import pytest
 from fmpy import simulate_fmu
 from fmu_helpers import gearbox_motion
 
-from components.gearbox_model import GearboxModel
-from components.generator import GeneratorParameters, GeneratorRotor, LoadEvent
-from components.presets import cosim_preset, with_stage
-from components.wind import RotorSpeedProcess, WindParameters
+from components.model.gearbox_model import GearboxModel
+from components.model.generator import GeneratorParameters, GeneratorRotor, LoadEvent
+from components.model.presets import cosim_preset, with_stage
+from components.model.wind import RotorSpeedProcess, WindParameters
 
 H = 1.0e-3
 

@@ -8,7 +8,7 @@ import math
 import pytest
 from fmu_helpers import Instance, gearbox_motion
 
-from components.presets import cosim_preset
+from components.model.presets import cosim_preset
 
 H = 1.0e-3
 RATIO = cosim_preset("table6").ratio

@@ -11,8 +11,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from components.events import contact_loss_summary
-from components.spectrum import amplitude_spectrum
+from components.analysis.contact_loss import contact_loss_summary
+from components.analysis.spectrum import amplitude_spectrum
 from orch_helpers import dtcosim, write_scenario
 from orchestrator.cli import main
 from orchestrator.compare import run_reference
@@ -226,8 +226,8 @@ def test_dtcosim_modes_of_a_scenario(paper_fmu_dir, tmp_path, capsys):
     path = write_scenario(tmp_path, stiff, "stiff.toml")
     assert main(["modes", str(path), "--out", str(tmp_path / "b"), *args]) == 0
     assert "scenario stiff at 12 rpm" in capsys.readouterr().out
-    from components.modes import OperatingPoint, drivetrain_modes
-    from components.presets import table6_gearbox
+    from components.analysis.modes import OperatingPoint, drivetrain_modes
+    from components.model.presets import table6_gearbox
     from components.units import rpm
 
     base = table6_gearbox()

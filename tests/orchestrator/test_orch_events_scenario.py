@@ -9,7 +9,7 @@ import tomllib
 
 import pytest
 
-from components.generator import LoadEvent
+from components.model.generator import LoadEvent
 from orchestrator.analysis_settings import AnalysisSettings
 from orchestrator.compare import monolithic_setup
 from orchestrator.errors import ScenarioError

@@ -9,7 +9,7 @@ import json
 import numpy as np
 import pytest
 
-from components.cases import TABLE7_PAPER
+from components.reference.cases import TABLE7_PAPER
 from orchestrator.compare import compare, monolithic_setup, run_reference
 from orchestrator.master import CoSimulation
 from orchestrator.results import read_timeseries

@@ -5,11 +5,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from components import presets, units
-from components.acceleration import peak_output_acceleration
+from components import units
+from components.model import presets
+from components.reference.acceleration import peak_output_acceleration
 from components.errors import ParameterError
-from components.reference import simulate_monolithic
-from components.wind import ConstantSpeed
+from components.reference.solver import simulate_monolithic
+from components.model.wind import ConstantSpeed
 
 
 @pytest.mark.parametrize("lambda_per_mm", [10.0, 600.0])
@@ -42,7 +43,7 @@ def test_peak_rejects_an_empty_interval():
 
 def test_r1_acts_on_the_peak_only_through_the_stage2_mass_scaling():
     """Sec. 4.1's reason for the R1 trend, checked: without the 10/R1 scaling R1 changes nothing."""
-    from components.parameter_map import flatten, unflatten
+    from components.model.parameter_map import flatten, unflatten
 
     driver = ConstantSpeed(units.rpm(5.0))
     scaled_names = ("stage2.sun_mass", "stage2.planet_mass", "stage2.sun_inertia", "stage2.planet_inertia")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from components.fatigue import FatigueSettings, fatigue_loads
+from components.analysis.fatigue import FatigueSettings, fatigue_loads
 from orchestrator.measures import MeasureError, parse_measure, window_statistic
 
 

@@ -6,7 +6,7 @@ of microseconds: sampling ``alpha_out`` on a fixed output grid misses most of it
 (1e-4 s sampling under-estimates it about five times, 1e-5 s still by 5-10 %).
 
 :func:`peak_output_acceleration` integrates the same monolithic ODE as
-:func:`components.reference.simulate_monolithic` (LSODA, analytic Jacobian, the
+:func:`components.reference.solver.simulate_monolithic` (LSODA, analytic Jacobian, the
 same tolerances and load-event segments), one internal step at a time, and
 evaluates the output acceleration exactly from the right-hand side at every
 accepted step. The solver's step size follows the impact (steps of ~1e-7 s in
@@ -23,10 +23,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import LSODA
 
-from .drivetrain import Drivetrain
-from .errors import ParameterError, SolverError
-from .reference import MonolithicSystem, SolverSettings, SpeedDriver
-from .validation import finite
+from ..model.drivetrain import Drivetrain
+from ..errors import ParameterError, SolverError
+from .solver import MonolithicSystem, SolverSettings, SpeedDriver
+from ..validation import finite
 
 #: interpolated points searched in each of the steps around the largest step-end value
 REFINE_POINTS = 32
@@ -78,7 +78,7 @@ def peak_output_acceleration(
     """Largest absolute acceleration of the output gear over a run (eq. 11).
 
     The output gear is the last stage's output member (the parallel stage's driven
-    gear), as ``alpha_out`` of :func:`components.reference.simulate_monolithic`;
+    gear), as ``alpha_out`` of :func:`components.reference.solver.simulate_monolithic`;
     the initial state and the load steps are the same as there.
 
     Parameters
@@ -118,7 +118,7 @@ def peak_output_acceleration(
     )
     max_step = settings.max_step_s if settings.max_step_s > 0 else np.inf
     if system.assembly.time_varying_stiffness:
-        from .mesh_stiffness import max_step_s
+        from ..model.mesh_stiffness import max_step_s
 
         a = system.assembly
         omega_max = float(np.max(np.abs(np.asarray(driver.speed(np.linspace(t0, t1, 2001)), dtype=float))))

@@ -5,7 +5,7 @@ kinematic driver of the stage-1 carrier) and generator speed and angle (the
 far end of shaft 3, which stays in the gearbox). Over a step the inputs are
 interpreted consistently: speeds are held and angles advance with them,
 ``phi(t) = phi_n + omega_n (t - t_n)``. The internal state is integrated with
-:class:`~components.integrators.Rosenbrock23` (linearly implicit, analytic
+:class:`~components.model.integrators.Rosenbrock23` (linearly implicit, analytic
 Jacobian, one-step: no cold start at communication points).
 
 The state is kept in deviation coordinates relative to the rotor angle; when a
@@ -26,9 +26,9 @@ import numpy as np
 
 from .assembly import Assembly
 from .drivetrain import Drivetrain
-from .errors import ParameterError, SolverError
+from ..errors import ParameterError, SolverError
 from .integrators import Rosenbrock23, StepControl
-from .validation import finite, one_of
+from ..validation import finite, one_of
 
 SHAFT_TORQUE_MODES = ("average", "end")
 

@@ -27,7 +27,7 @@ share of every mesh group and shaft.
 
 In a torsional model with a kinematically driven input the linearisation does not
 depend on the rotor speed itself (no gyroscopic or centrifugal terms); the speed
-enters through the load law of the Campbell diagram (:mod:`components.campbell`).
+enters through the load law of the Campbell diagram (:mod:`components.analysis.campbell`).
 The time-varying mesh stiffness option averages to the paper's stiffness over a
 mesh cycle; the linearisation uses that mean (factor 1) unless given another factor.
 
@@ -46,11 +46,11 @@ import numpy as np
 import scipy.linalg as sla
 from scipy.optimize import linear_sum_assignment
 
-from .assembly import Assembly
-from .drivetrain import Drivetrain
-from .errors import DtcosimError, ParameterError
-from .units import rad_per_s_to_rpm, rpm
-from .validation import finite, set_fields
+from ..model.assembly import Assembly
+from ..model.drivetrain import Drivetrain
+from ..errors import DtcosimError, ParameterError
+from ..units import rad_per_s_to_rpm, rpm
+from ..validation import finite, set_fields
 
 #: |Im lambda| / |lambda| below which an eigenvalue counts as real (overdamped root).
 REAL_EIGENVALUE_TOLERANCE = 1e-7

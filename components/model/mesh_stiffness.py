@@ -41,7 +41,7 @@ overlap.
 
 Phasing
 -------
-:class:`~components.assembly.Assembly` gives each mesh a phase rate (mesh-cycle
+:class:`~components.model.assembly.Assembly` gives each mesh a phase rate (mesh-cycle
 radians per radian of rotor rotation: ``Z_ring`` x carrier ratio for both meshes
 of a planet, ``Z_drive`` x drive ratio for a parallel mesh) and an offset for
 sequential planet phasing (Parker and Lin, 2004): planet ``i`` at carrier angle
@@ -57,7 +57,7 @@ import math
 
 import numpy as np
 
-from .errors import ParameterError
+from ..errors import ParameterError
 
 #: Width of each smoothed transition between pair counts, as a fraction of one mesh cycle [-].
 TRANSITION_FRACTION = 0.05
@@ -154,7 +154,7 @@ class MeshPhasing:
     """Stiffness factors of all meshes as a function of the driver (rotor) angle, with their slope.
 
     The same model as :func:`stiffness_factor` (``phase = rate * angle + offset`` per
-    mesh, see :class:`~components.assembly.Mesh`), with the parameters validated and
+    mesh, see :class:`~components.model.assembly.Mesh`), with the parameters validated and
     the per-mesh constants formed once: this sits on the integrators' hot path, where
     :func:`stiffness_factor`'s checks cost more than the arithmetic. The slope
     ``d f / d angle`` is analytic (the smootherstep's derivative ``30 s^2 (1 - s)^2``),

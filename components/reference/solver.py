@@ -1,7 +1,7 @@
 """Monolithic reference solver: driver + gearbox + output as one stiff ODE.
 
 The state is ``y = [q, v, W_in, W_out, E_diss]``: deviation angles and speeds
-of every free body (see :mod:`components.assembly`) plus three quadrature
+of every free body (see :mod:`components.model.assembly`) plus three quadrature
 states (rotor work, output work, dissipated energy) for the energy audit.
 The ODE is integrated by LSODA (``scipy.integrate.odeint``, stiff BDF with the
 analytic Jacobian) segment by segment between load-event times, so the
@@ -21,11 +21,11 @@ from typing import Protocol
 import numpy as np
 from scipy.integrate import odeint
 
-from .assembly import Assembly
-from .drivetrain import Drivetrain
-from .errors import ParameterError, SolverError, WallTimeLimitError
+from ..model.assembly import Assembly
+from ..model.drivetrain import Drivetrain
+from ..errors import ParameterError, SolverError, WallTimeLimitError
 from .results import EnergyAudit, SimulationResult
-from .validation import finite, non_negative, positive
+from ..validation import finite, non_negative, positive
 
 
 class SpeedDriver(Protocol):
@@ -53,7 +53,7 @@ class SolverSettings:
     max_step_s : float
         Largest internal step [s] (0: unlimited). With time-varying mesh stiffness the
         solver caps the step at half a stiffness transition anyway
-        (:func:`components.mesh_stiffness.max_step_s`).
+        (:func:`components.model.mesh_stiffness.max_step_s`).
     max_steps : int
         Maximum internal steps between two output times.
     wall_time_limit_s : float
@@ -165,14 +165,14 @@ def simulate_monolithic(
     Initial state: by default kinematically consistent speeds at the initial driver
     speed and zero deflection (teeth centred in the backlash); loads act as steps at
     t = 0. ``initial_state`` starts from another state instead, e.g. the static
-    equilibrium of :func:`components.modes.static_equilibrium` (no load step).
+    equilibrium of :func:`components.analysis.modes.static_equilibrium` (no load step).
 
     Parameters
     ----------
     drivetrain : Drivetrain
         Gearbox, shafts and output (generator or counter torque).
     driver : SpeedDriver
-        Kinematic rotor-speed driver (e.g. :class:`~components.wind.RotorSpeedProcess`).
+        Kinematic rotor-speed driver (e.g. :class:`~components.model.wind.RotorSpeedProcess`).
     t_end_s : float
         End time [s].
     output_interval_s : float
@@ -227,7 +227,7 @@ def simulate_monolithic(
     a = system.assembly
     if a.time_varying_stiffness:
         # a step longer than a pair-count zone could skip it unseen: cap at half a transition
-        from .mesh_stiffness import max_step_s
+        from ..model.mesh_stiffness import max_step_s
 
         omega_max = float(np.max(np.abs(np.asarray(driver.speed(np.linspace(t0, t1, 2001)), dtype=float))))
         cap = max_step_s(a._mesh_rate, a._mesh_variation, 1.05 * omega_max)

@@ -36,10 +36,12 @@ from typing import Sequence
 
 import numpy as np
 
-from . import units
-from .validation import finite, in_range, non_negative, one_of, positive, set_fields
+from .. import units
+from ..validation import finite, in_range, non_negative, one_of, positive, set_fields
 
 CONTACT_LAWS = ("cfs", "impact")
+#: Contact-force magnitude below which a mesh counts as "inside the backlash" (out of contact) [N].
+CONTACT_LOSS_THRESHOLD_N = 1.0
 
 
 @dataclass(frozen=True)
@@ -75,7 +77,7 @@ class MeshContact:
         the time-varying mesh stiffness option.
     stiffness_variation : float
         Relative amplitude of time-varying mesh stiffness [-]: 0 (default) keeps the
-        paper's constant stiffness. See :mod:`components.mesh_stiffness`.
+        paper's constant stiffness. See :mod:`components.model.mesh_stiffness`.
     """
 
     stiffness: float

@@ -17,10 +17,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from . import units
+from .. import units
 from .contact import MeshContact
-from .errors import ParameterError
-from .validation import integer_at_least, non_negative, positive, set_fields
+from ..errors import ParameterError
+from ..validation import integer_at_least, non_negative, positive, set_fields
 
 STEEL_DENSITY_KG_M3 = 7800.0
 

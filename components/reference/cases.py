@@ -21,16 +21,16 @@ from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
-from . import units
-from .drivetrain import Drivetrain
-from .errors import ParameterError
-from .events import CONTACT_LOSS_THRESHOLD_N
-from .presets import table3_parallel, table5_planetary, table6_gearbox
+from .. import units
+from ..model.drivetrain import Drivetrain
+from ..errors import ParameterError
+from ..model.contact import CONTACT_LOSS_THRESHOLD_N
+from ..model.presets import table3_parallel, table5_planetary, table6_gearbox
 from .results import SimulationResult, window_statistics
-from .wind import ConstantSpeed, RotorSpeedProcess, SineSpeed, WindParameters
+from ..model.wind import ConstantSpeed, RotorSpeedProcess, SineSpeed, WindParameters
 
 if TYPE_CHECKING:
-    from .reference import SpeedDriver
+    from .solver import SpeedDriver
 
 #: Table 7 of the paper: mean and std of F_SP1 of stages 1-3 [N] over [5, 60] s.
 TABLE7_PAPER = {
@@ -116,7 +116,7 @@ def run_case(name: str, **overrides) -> tuple[SimulationResult, dict[str, dict[s
     dt = overrides.pop("output_interval_s", case.output_interval_s)
     if overrides:
         raise ParameterError("overrides", sorted(overrides), "only t_end_s and output_interval_s")
-    from .reference import simulate_monolithic  # scipy.integrate: only when a case runs
+    from .solver import simulate_monolithic  # scipy.integrate: only when a case runs
 
     result = simulate_monolithic(drivetrain, driver, t_end, output_interval_s=dt)
     window = (min(case.window_s[0], t_end), min(case.window_s[1], t_end))

@@ -36,7 +36,7 @@ from typing import Mapping
 
 from .contact import CONTACT_LAWS, MeshContact
 from .drivetrain import Drivetrain
-from .errors import ParameterError
+from ..errors import ParameterError
 from .stages import PlanetaryStage, Shaft
 
 UNITS: dict[str, str] = {
@@ -156,7 +156,7 @@ def unflatten(template: Drivetrain, values: Mapping[str, float]) -> Drivetrain:
     known = flatten(template)
     for name in values:
         if name not in known:
-            raise ParameterError(name, values[name], "a parameter of this drivetrain (see components.parameter_map)")
+            raise ParameterError(name, values[name], "a parameter of this drivetrain (see components.model.parameter_map)")
     stages = []
     for st in template.stages:
         fields = _PLANETARY_FIELDS if isinstance(st, PlanetaryStage) else _PARALLEL_FIELDS

@@ -1,8 +1,8 @@
 """Check the linearised modes against the nonlinear model's free response after an impulse.
 
-For every underdamped (oscillatory) mode of :func:`components.modes.drivetrain_modes`:
+For every underdamped (oscillatory) mode of :func:`components.analysis.modes.drivetrain_modes`:
 
-1. start the monolithic solver (:func:`components.reference.simulate_monolithic`,
+1. start the monolithic solver (:func:`components.reference.solver.simulate_monolithic`,
    the nonlinear CFS model) from the static equilibrium at constant rotor speed,
    plus an impulse: an initial deviation-speed perturbation along the velocity part
    of the mode's complex shape, scaled so that the linear prediction changes no
@@ -31,14 +31,14 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .drivetrain import Drivetrain
-from .errors import SolverError
+from ..model.drivetrain import Drivetrain
+from ..errors import SolverError
 from .modes import DrivetrainModalAnalysis, OperatingPoint, drivetrain_modes
-from .reference import SolverSettings, simulate_monolithic
-from .results import SimulationResult
+from ..reference.solver import SolverSettings, simulate_monolithic
+from ..reference.results import SimulationResult
 from .spectrum import spectral_peak_hz
-from .validation import positive
-from .wind import ConstantSpeed
+from ..validation import positive
+from ..model.wind import ConstantSpeed
 
 
 @dataclass(frozen=True)

@@ -19,7 +19,7 @@ from typing import Mapping
 
 import numpy as np
 
-from .errors import ParameterError
+from ..errors import ParameterError
 
 UNITS = {
     "F": "N",
@@ -93,7 +93,7 @@ def select_window(
         Shapes differ, times not increasing, non-finite samples, or fewer than
         2 samples in the window.
     """
-    from .errors import ParameterError
+    from ..errors import ParameterError
 
     t = np.asarray(time_s, dtype=float)
     x = np.asarray(values, dtype=float)

@@ -50,9 +50,9 @@ from typing import Mapping, Sequence
 import fatpack
 import numpy as np
 
-from .errors import ParameterError
-from .results import SimulationResult, is_contact_force, is_shaft_torque, select_window, series_and_time, unit_of
-from .validation import finite_series, non_negative, one_of, positive
+from ..errors import ParameterError
+from ..reference.results import SimulationResult, is_contact_force, is_shaft_torque, select_window, series_and_time, unit_of
+from ..validation import finite_series, non_negative, one_of, positive
 
 #: Default Woehler exponents (welded steel 3, shafts 5, gear teeth 8 and 10).
 DEFAULT_WOHLER_EXPONENTS = (3.0, 5.0, 8.0, 10.0)
@@ -353,7 +353,7 @@ def fatigue_loads(
     name : str
         Signal name.
     unit : str, optional
-        Unit; default from the name (:func:`components.results.unit_of`).
+        Unit; default from the name (:func:`components.reference.results.unit_of`).
 
     Returns
     -------

@@ -43,7 +43,7 @@ import numpy as np
 
 from .contact import ContactLaw, MeshContact
 from .drivetrain import Drivetrain
-from .errors import ParameterError
+from ..errors import ParameterError
 from .stages import PlanetaryStage
 
 
@@ -91,7 +91,7 @@ class Mesh:
     phase_offset_rad : float
         Mesh-cycle phase of this mesh at theta_in = 0 [rad] (sequential planet phasing:
         ``-Z_sun psi_i`` sun-planet, ``+Z_ring psi_i`` ring-planet, planet i at carrier
-        angle ``psi_i``; see :mod:`components.mesh_stiffness`).
+        angle ``psi_i``; see :mod:`components.model.mesh_stiffness`).
     """
 
     name: str
@@ -341,7 +341,7 @@ class Assembly:
     def stiffness_factor(self, driver_angle_rad: float | np.ndarray) -> np.ndarray | float:
         """Time-varying mesh-stiffness multiplier at a driver angle (1 when the option is off).
 
-        See :func:`components.mesh_stiffness.stiffness_factor`.
+        See :func:`components.model.mesh_stiffness.stiffness_factor`.
         """
         if not self.time_varying_stiffness:
             return 1.0

@@ -34,8 +34,8 @@ from typing import Callable, Protocol
 
 import numpy as np
 
-from .errors import SolverError
-from .validation import integer_at_least, positive
+from ..errors import SolverError
+from ..validation import integer_at_least, positive
 
 _D = 1.0 / (2.0 + math.sqrt(2.0))
 _E32 = 6.0 + math.sqrt(2.0)

@@ -13,10 +13,10 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 
 from .contact import MeshContact
-from .errors import ParameterError
+from ..errors import ParameterError
 from .generator import GeneratorParameters, LoadEvent, TorqueSchedule
 from .stages import ParallelStage, PlanetaryStage, Shaft, Stage
-from .validation import finite, set_fields
+from ..validation import finite, set_fields
 
 
 @dataclass(frozen=True)

@@ -14,8 +14,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .errors import ParameterError
-from .validation import finite_series, positive
+from ..errors import ParameterError
+from ..validation import finite_series, positive
 
 WINDOWS = ("hann", "rect")
 

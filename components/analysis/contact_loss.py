@@ -26,12 +26,11 @@ from typing import Mapping
 
 import numpy as np
 
-from .errors import ParameterError
-from .results import SimulationResult, is_contact_force, select_window, series_and_time
-from .validation import positive
+from ..errors import ParameterError
+from ..model.contact import CONTACT_LOSS_THRESHOLD_N
+from ..reference.results import SimulationResult, is_contact_force, select_window, series_and_time
+from ..validation import positive
 
-#: Contact-force magnitude below which a mesh counts as "inside the backlash" [N].
-CONTACT_LOSS_THRESHOLD_N = 1.0
 
 
 @dataclass(frozen=True)

@@ -16,9 +16,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import units
-from .errors import ParameterError
-from .validation import finite, non_negative, one_of, positive, set_fields
+from .. import units
+from ..errors import ParameterError
+from ..validation import finite, non_negative, one_of, positive, set_fields
 
 EVENT_KINDS = ("torque_step", "grid_fault", "emergency_stop")
 

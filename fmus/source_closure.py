@@ -1,0 +1,151 @@
+"""Which source files a module needs: the static import closure within the project's packages.
+
+Used for two questions whose answer must not depend on file names or folder layout:
+
+* what an FMU carries (:mod:`fmus.build` embeds exactly the closure of its slave
+  module, so its build id changes when that code changes and only then);
+* what a study point's result depends on (:func:`orchestrator.study.prepare.code_version`).
+
+Imports are read from the syntax tree (every ``import`` and ``from ... import``,
+also those inside functions), resolved to modules of the packages given, and
+followed recursively. Imports of other packages (numpy, scipy, fmpy, ...) end the walk.
+"""
+
+from __future__ import annotations
+
+import ast
+import hashlib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Iterable, Mapping
+
+
+@dataclass(frozen=True)
+class SourceModule:
+    """One module of the closure.
+
+    Attributes
+    ----------
+    name : str
+        Dotted module name (``components.model.assembly``).
+    path : pathlib.Path
+        Its file (``__init__.py`` for a package).
+    is_package : bool
+    """
+
+    name: str
+    path: Path
+    is_package: bool
+
+
+def _locate(name: str, packages: Mapping[str, Path]) -> SourceModule | None:
+    """The file of module ``name`` if it belongs to one of ``packages`` (top name -> directory)."""
+    top, *rest = name.split(".")
+    if top not in packages:
+        return None
+    base = Path(packages[top]).joinpath(*rest)
+    if (base / "__init__.py").is_file():
+        return SourceModule(name, base / "__init__.py", True)
+    if base.with_suffix(".py").is_file() and rest:
+        return SourceModule(name, base.with_suffix(".py"), False)
+    return None
+
+
+def _imported_names(module: SourceModule, tree: ast.AST) -> list[str]:
+    """Absolute names of every module an import statement of ``tree`` may refer to."""
+    package = module.name if module.is_package else module.name.rpartition(".")[0]
+    out: list[str] = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            for alias in node.names:
+                parts = alias.name.split(".")
+                out += [".".join(parts[:i]) for i in range(1, len(parts) + 1)]
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                parts = package.split(".")
+                parts = parts[: len(parts) - (node.level - 1)] if node.level > 1 else parts
+                base = ".".join(parts + ([node.module] if node.module else []))
+            else:
+                base = node.module or ""
+            pieces = base.split(".")
+            out += [".".join(pieces[:i]) for i in range(1, len(pieces) + 1)]
+            out += [f"{base}.{alias.name}" for alias in node.names if alias.name != "*"]
+    return out
+
+
+def import_closure(roots: Iterable[str], packages: Mapping[str, Path]) -> dict[str, SourceModule]:
+    """Every module of ``packages`` reachable by import from the modules ``roots``.
+
+    Parameters
+    ----------
+    roots : iterable of str
+        Dotted names of the starting modules (each must be found in ``packages``).
+    packages : mapping of str -> pathlib.Path
+        Top-level package name -> its directory, e.g. ``{"components": Path(".../components")}``.
+
+    Returns
+    -------
+    dict of str -> SourceModule
+        By module name, sorted; the parent packages of every module are included.
+
+    Raises
+    ------
+    LookupError
+        If a root is not a module of ``packages``.
+    """
+    found: dict[str, SourceModule] = {}
+    todo = []
+    for root in roots:
+        mod = _locate(root, packages)
+        if mod is None:
+            raise LookupError(f"module {root!r} is not in the packages {', '.join(packages)}")
+        todo.append(mod)
+    while todo:
+        mod = todo.pop()
+        if mod.name in found:
+            continue
+        found[mod.name] = mod
+        parts = mod.name.split(".")
+        candidates = [".".join(parts[:i]) for i in range(1, len(parts))]
+        candidates += _imported_names(mod, ast.parse(mod.path.read_bytes(), filename=str(mod.path)))
+        for name in candidates:
+            if name not in found:
+                dep = _locate(name, packages)
+                if dep is not None:
+                    todo.append(dep)
+    return dict(sorted(found.items()))
+
+
+def _without_docstrings_and_imports(tree: ast.Module) -> ast.Module:
+    """The tree with import statements and docstrings removed (they change no computed number)."""
+
+    class Strip(ast.NodeTransformer):
+        def generic_visit(self, node):
+            super().generic_visit(node)
+            body = getattr(node, "body", None)
+            if isinstance(body, list):
+                kept = [s for s in body if not isinstance(s, (ast.Import, ast.ImportFrom))]
+                if kept and isinstance(kept[0], ast.Expr) and isinstance(kept[0].value, ast.Constant) \
+                        and isinstance(kept[0].value.value, str):
+                    kept = kept[1:]
+                node.body = kept or [ast.Pass()]
+            return node
+
+    return Strip().visit(tree)
+
+
+def behaviour_digest(modules: Mapping[str, SourceModule]) -> str:
+    """SHA-256 of what the modules compute, independent of where they live.
+
+    Each module contributes the dump of its syntax tree without docstrings,
+    comments, formatting and import statements; the digests are combined in
+    sorted order, so moving a module to another package (and rewriting the
+    imports that name it) leaves the digest unchanged, while any change to code
+    that runs changes it. Which modules take part is decided by
+    :func:`import_closure`, so a new dependency is included wherever it lives.
+    """
+    digests = sorted(
+        hashlib.sha256(ast.dump(_without_docstrings_and_imports(ast.parse(m.path.read_bytes()))).encode()).hexdigest()
+        for m in modules.values()
+    )
+    return hashlib.sha256("\n".join(digests).encode()).hexdigest()
