@@ -32,13 +32,13 @@ def main() -> None:
     parser.add_argument("--no-libcosim", action="store_true", help="skip the libcosim run")
     args = parser.parse_args()
 
-    from orchestrator.compare import monolithic_setup, run_reference
-    from orchestrator.fmu_store import ensure_fmus
-    from orchestrator.libcosim_host import run_ssp_in_libcosim
-    from orchestrator.master import CoSimulation
-    from orchestrator.scenario import find_scenario, load_scenario
-    from orchestrator.ssp import export_ssp
-    from orchestrator.system import resolve_system
+    from orchestrator.cosim.fmu_store import ensure_fmus
+    from orchestrator.cosim.master import CoSimulation
+    from orchestrator.cosim.system import resolve_system
+    from orchestrator.inputs.scenario import find_scenario, load_scenario
+    from orchestrator.interop.libcosim import run_ssp_in_libcosim
+    from orchestrator.interop.ssp import export_ssp
+    from orchestrator.run.comparison import monolithic_setup, run_reference
 
     scenario = load_scenario(find_scenario("paper-60s"))
     if args.stop != scenario.simulation.stop_s:

@@ -14,8 +14,8 @@ import statistics
 import time
 
 from components.model.presets import table6_gearbox
-from components.reference.solver import MonolithicSystem, simulate_monolithic
 from components.model.wind import RotorSpeedProcess, WindParameters
+from components.reference.solver import MonolithicSystem, simulate_monolithic
 
 
 def _run(analytic: bool) -> tuple[float, dict]:

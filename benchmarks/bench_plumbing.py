@@ -182,9 +182,9 @@ def raw_loop(paths, steps: int, h: float = 1e-3) -> float:
 
 def master_loop(folder: Path, steps: int, algorithm: str, extrapolation: str) -> float:
     """The dtcosim master on the same FMUs (records every step); seconds per step of the loop."""
-    from orchestrator.master import CoSimulation
-    from orchestrator.scenario import load_scenario
-    from orchestrator.system import resolve_system
+    from orchestrator.cosim.master import CoSimulation
+    from orchestrator.cosim.system import resolve_system
+    from orchestrator.inputs.scenario import load_scenario
 
     path = folder / f"plumbing-{algorithm}-{extrapolation}.toml"
     path.write_text(SCENARIO.format(stop=steps * 1e-3, algorithm=algorithm, extrapolation=extrapolation))

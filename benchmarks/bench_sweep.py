@@ -3,7 +3,7 @@
 Runs the packaged study twice in this process, into fresh output directories
 (nothing is skipped), on a LocalCluster of 1 worker and of 2 workers (processes,
 one thread each), and prints both wall times and the speed-up. Two times per
-run: ``sweep`` is the whole :func:`orchestrator.sweep.run_sweep` call (cluster
+run: ``sweep`` is the whole :func:`orchestrator.study.sweep.run_sweep` call (cluster
 start-up, scatter, 49 points, journal, table and heat maps, cluster shutdown),
 ``compute`` the first submission to the last result. Target: at least 1.6 x on
 the 2-core machine. With ``--repeat N`` the pair is run N times, alternating, and
@@ -23,9 +23,9 @@ import tempfile
 import time
 from pathlib import Path
 
-from orchestrator.study import find_study, load_study
-from orchestrator.study_prepare import prepare_study
-from orchestrator.sweep import run_sweep
+from orchestrator.inputs.study import find_study, load_study
+from orchestrator.study.prepare import prepare_study
+from orchestrator.study.sweep import run_sweep
 
 
 def _spin(n: int = 15_000_000) -> None:

@@ -40,11 +40,11 @@ def main() -> None:
     parser.add_argument("--fmu-dir", default=None, help="FMU directory (default: the project's fmus/)")
     args = parser.parse_args()
 
-    from orchestrator.compare import compare, monolithic_setup, run_reference
-    from orchestrator.fmu_store import ensure_fmus
-    from orchestrator.master import CoSimulation
-    from orchestrator.scenario import find_scenario, load_scenario
-    from orchestrator.system import resolve_system
+    from orchestrator.cosim.fmu_store import ensure_fmus
+    from orchestrator.cosim.master import CoSimulation
+    from orchestrator.cosim.system import resolve_system
+    from orchestrator.inputs.scenario import find_scenario, load_scenario
+    from orchestrator.run.comparison import compare, monolithic_setup, run_reference
 
     steps = [float(h) * 1e-3 for h in args.steps.split(",")]
     window = (min(5.0, args.stop / 2), args.stop)

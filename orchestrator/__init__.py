@@ -1,34 +1,24 @@
-"""dtcosim orchestrator: scenarios, master algorithms, results, plots, studies and the CLI.
+"""dtcosim orchestrator: input files, the FMI master, runs, studies and the ``dtcosim`` command.
 
-The master talks to the FMUs only through FMI (fmpy). It imports
-:mod:`components` only for the monolithic reference and for analyses.
+Imports go one way, from the commands down to the base modules:
 
-Co-simulation modules
----------------------
-scenario        system description (frozen dataclasses) and its TOML format
-fmu_interface   what an FMU offers, read from modelDescription.xml
-system          a scenario checked against its FMUs (ResolvedSystem)
-graph           stepping/initialisation order, algebraic-loop detection
-fmi_runtime     FMU instances through fmpy's FMU2Slave, log capture
-master          fixed-step Gauss-Seidel/Jacobi master (generated stepping loop)
-results         timeseries.csv and summary.json
-derived         component roles, ideal gearbox ratio, Fig. 16 check
-plots           Fig. 15-17 as PNG
-compare         monolithic reference of a scenario and the comparison report
-ssp             SSP 1.0 export and import
-libcosim_host   running an SSP in libcosim (child process with libpython preloaded)
-fmu_store       locating/building the project's FMUs
-runner          one run from scenario to files (used by ``dtcosim run``)
+``commands`` -> ``study`` -> ``run`` -> ``interop`` -> ``cosim`` -> ``inputs`` -> base
+(``reports`` sits beside ``run`` and is used only by commands).
 
-Study modules (``dtcosim sweep``, docs/studies.md)
--------------------------------------------------
-study           the study file: axes, explicit points, seeds, measures, plots (StudyError)
-measures        built-in measures (eq. 11-12, times, solver work) and summary statistics
-study_models    built-in monolithic models (the Sec. 4.1 variant)
-study_engine    one point in a Dask worker: monolithic and co-simulation engines, FMUs from bytes
-study_prepare   checking a study against its base, the workers' payload, point keys
-sweep           the Dask loop: LocalCluster or existing cluster, re-runs, Ctrl-C
-journal         the append-only results journal (one JSON line per finished point)
-study_report    results.csv and study.json regenerated from the journal
-study_plots     heat maps (Fig. 12-13) and line plots of the measures
+Base modules
+------------
+errors          every user-facing error class (names file, key, value, expectation)
+frozen_map      immutable, picklable mappings for the frozen input objects
+plotting        figure, envelope and backlash-shading helpers shared by every plot
+result_files    CSV series, JSON summaries, the versions a result depends on
+
+Subpackages
+-----------
+inputs      the user's files: scenario and study schemas, load events, analysis settings, measures
+cosim       FMU interfaces and store, the checked system, graph, FMI runtime, the master
+interop     SSP 1.0 import/export, running a system in libcosim
+run         one scenario run: runner, results, analyses, comparison with the reference, plots
+study       parameter studies on Dask: preparation, engine, sweep, journal, report, plots
+reports     modal analysis and reference-case outputs (``dtcosim modes``, ``dtcosim reference``)
+commands    the ``dtcosim`` command line, one module per subcommand
 """

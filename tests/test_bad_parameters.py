@@ -5,8 +5,8 @@ from dataclasses import replace
 
 import pytest
 
-from components.model.contact import MeshContact
 from components.errors import ParameterError
+from components.model.contact import MeshContact
 from components.model.generator import GeneratorParameters, LoadEvent
 from components.model.parameter_map import unflatten
 from components.model.presets import table6_gearbox

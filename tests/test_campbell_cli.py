@@ -8,15 +8,23 @@ import numpy as np
 import pytest
 
 from components import units
-from components.analysis.campbell import LoadLaw, campbell_diagram, excitation_frequencies
-from components.errors import ParameterError
-from components.analysis.modes import OperatingPoint, drivetrain_modes, static_equilibrium
-from components.model.presets import table6_gearbox
-from components.reference.solver import simulate_monolithic
-from components.model.wind import ConstantSpeed
-from orchestrator.analysis_plots import plot_force_spectra, plot_load_duration
-from orchestrator.cli import main
+from components.analysis.campbell import (
+    LoadLaw,
+    campbell_diagram,
+    excitation_frequencies,
+)
 from components.analysis.fatigue import load_duration_distribution
+from components.analysis.modes import (
+    OperatingPoint,
+    drivetrain_modes,
+    static_equilibrium,
+)
+from components.errors import ParameterError
+from components.model.presets import table6_gearbox
+from components.model.wind import ConstantSpeed
+from components.reference.solver import simulate_monolithic
+from orchestrator.commands.cli import main
+from orchestrator.run.analysis_plots import plot_force_spectra, plot_load_duration
 
 
 @pytest.fixture(scope="module")

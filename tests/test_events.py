@@ -5,14 +5,18 @@ import csv
 import numpy as np
 import pytest
 
-from components.reference.cases import CONTACT_LOSS_THRESHOLD_N
-from components.errors import ParameterError
-from components.analysis.contact_loss import contact_loss_events, contact_loss_summary, write_contact_loss_csv
-from components.model.generator import LoadEvent
+from components.analysis.contact_loss import (
+    contact_loss_events,
+    contact_loss_summary,
+    write_contact_loss_csv,
+)
 from components.analysis.modes import static_equilibrium
+from components.errors import ParameterError
+from components.model.generator import LoadEvent
 from components.model.presets import table6_gearbox
-from components.reference.solver import simulate_monolithic
 from components.model.wind import RotorSpeedProcess, WindParameters
+from components.reference.cases import CONTACT_LOSS_THRESHOLD_N
+from components.reference.solver import simulate_monolithic
 
 
 def test_triangle_wave_crossings_are_counted_exactly():

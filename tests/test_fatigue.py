@@ -6,7 +6,6 @@ import json
 import numpy as np
 import pytest
 
-from components.errors import ParameterError
 from components.analysis.fatigue import (
     FatigueSettings,
     damage_equivalent_load,
@@ -20,9 +19,10 @@ from components.analysis.fatigue import (
     write_ldd_csv,
 )
 from components.analysis.modes import static_equilibrium
+from components.errors import ParameterError
 from components.model.presets import table6_gearbox
-from components.reference.solver import simulate_monolithic
 from components.model.wind import RotorSpeedProcess, WindParameters
+from components.reference.solver import simulate_monolithic
 
 M = (3.0, 5.0, 8.0, 10.0)
 

@@ -10,8 +10,8 @@ from components.model.gearbox_model import GearboxModel
 from components.model.generator import GeneratorRotor
 from components.model.integrators import Rosenbrock23, StepControl
 from components.model.presets import table6_gearbox
-from components.reference.solver import simulate_monolithic
 from components.model.wind import RotorSpeedProcess, WindParameters
+from components.reference.solver import simulate_monolithic
 
 
 class Oscillator:
@@ -180,8 +180,8 @@ def test_output_acceleration_and_its_running_peak():
 
 def test_monolithic_wall_time_limit():
     """SolverSettings.wall_time_limit_s stops LSODA from inside the right-hand side."""
-    from components.reference.acceleration import peak_output_acceleration
     from components.errors import ParameterError, WallTimeLimitError
+    from components.reference.acceleration import peak_output_acceleration
     from components.reference.solver import SolverSettings
 
     dt, wind = _paper_setup()

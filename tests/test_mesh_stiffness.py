@@ -7,10 +7,12 @@ import numpy as np
 import pytest
 
 from components import units
-from components.model.assembly import Assembly
 from components.analysis.campbell import excitation_frequencies
-from components.model.contact import MeshContact
+from components.analysis.modes import static_equilibrium
+from components.analysis.spectrum import amplitude_spectrum, spectral_peak_hz
 from components.errors import ParameterError
+from components.model.assembly import Assembly
+from components.model.contact import MeshContact
 from components.model.mesh_stiffness import (
     TRANSITION_FRACTION,
     max_step_s,
@@ -19,12 +21,10 @@ from components.model.mesh_stiffness import (
     pair_fraction,
     stiffness_factor,
 )
-from components.analysis.modes import static_equilibrium
 from components.model.presets import table6_gearbox, with_stage
-from components.reference.solver import simulate_monolithic
-from components.analysis.spectrum import amplitude_spectrum, spectral_peak_hz
 from components.model.stages import PlanetaryStage
 from components.model.wind import ConstantSpeed
+from components.reference.solver import simulate_monolithic
 
 CYCLE = np.linspace(0.0, 2.0 * math.pi, 200_000, endpoint=False)
 

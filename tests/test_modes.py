@@ -7,8 +7,6 @@ import numpy as np
 import pytest
 
 from components import units
-from components.model.assembly import Assembly
-from components.errors import ParameterError
 from components.analysis.modal_verification import free_response_check
 from components.analysis.modes import (
     OperatingPoint,
@@ -19,10 +17,12 @@ from components.analysis.modes import (
     two_inertia_frequency_hz,
     undamped_modes,
 )
-from components.model.presets import cosim_preset, table5_planetary, table6_gearbox
-from components.reference.solver import MonolithicSystem
 from components.analysis.spectrum import spectral_peak_hz
+from components.errors import ParameterError
+from components.model.assembly import Assembly
+from components.model.presets import cosim_preset, table5_planetary, table6_gearbox
 from components.model.wind import ConstantSpeed
+from components.reference.solver import MonolithicSystem
 
 COS20 = math.cos(math.radians(20.0))
 TABLE6_POINT = OperatingPoint.from_rpm(16.0, 25.4e3)

@@ -7,10 +7,16 @@ import numpy as np
 import pytest
 
 from components import units
-from components.model.assembly import Assembly
 from components.analysis.modes import static_equilibrium
+from components.model.assembly import Assembly
 from components.model.parameter_map import flatten, unflatten
-from components.model.presets import cosim_preset, sensitivity_variant, table3_parallel, table5_planetary, table6_gearbox
+from components.model.presets import (
+    cosim_preset,
+    sensitivity_variant,
+    table3_parallel,
+    table5_planetary,
+    table6_gearbox,
+)
 from components.model.stages import ParallelStage, PlanetaryStage, solid_disc
 
 COS20 = math.cos(math.radians(20.0))

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from components.reference.cases import CASES, TABLE7_PAPER, run_case
-from orchestrator.cli import main
+from orchestrator.commands.cli import main
 
 
 @pytest.fixture(scope="module")
@@ -90,8 +90,8 @@ def test_impact_law_stands_in_for_the_paper_cfa_on_table2():
     """Table 2 compares CFS with CAD contact (CFA, 9.68e3 N); the impact law of eq. 1 gives the same mean."""
     from components import units
     from components.model.presets import table3_parallel
-    from components.reference.solver import simulate_monolithic
     from components.model.wind import ConstantSpeed
+    from components.reference.solver import simulate_monolithic
 
     dt = table3_parallel().with_meshes(law="impact")
     result = simulate_monolithic(dt, ConstantSpeed(units.rpm(5.0)), 1.0)
@@ -103,7 +103,7 @@ def test_impact_law_stands_in_for_the_paper_cfa_on_table2():
 
 def test_backlash_shading_of_a_hand_made_force():
     """The shaded spans are exactly the runs of samples with |F| < 1 N (plots of runs and of reference cases)."""
-    from orchestrator.plots import new_figure, shade_inside_backlash
+    from orchestrator.plotting import new_figure, shade_inside_backlash
 
     def shaded(force):
         fig, (ax,) = new_figure()
@@ -118,7 +118,7 @@ def test_backlash_shading_of_a_hand_made_force():
 
 
 def test_reference_out_writes_series_summary_and_the_fig10_11_plot(tmp_path, capsys):
-    from orchestrator.results import read_timeseries
+    from orchestrator.result_files import read_timeseries
 
     out = tmp_path / "sine"
     assert main(["reference", "--case", "sine", "--t-end", "0.4", "--out", str(out)]) == 0

@@ -4,7 +4,12 @@ import numpy as np
 import pytest
 
 from components import units
-from components.model.generator import GeneratorParameters, GeneratorRotor, LoadEvent, TorqueSchedule
+from components.model.generator import (
+    GeneratorParameters,
+    GeneratorRotor,
+    LoadEvent,
+    TorqueSchedule,
+)
 from components.model.wind import RotorSpeedProcess, WindParameters
 
 

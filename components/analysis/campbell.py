@@ -37,13 +37,13 @@ from typing import Sequence
 
 import numpy as np
 
+from ..errors import ParameterError
 from ..model.assembly import Assembly
 from ..model.drivetrain import Drivetrain
-from ..errors import ParameterError
-from .modes import OperatingPoint, drivetrain_modes
 from ..model.stages import PlanetaryStage
 from ..units import rad_per_s_to_rpm, rpm
 from ..validation import finite, one_of, positive
+from .modes import OperatingPoint, drivetrain_modes
 
 LOAD_LAWS = ("quadratic", "constant")
 

@@ -28,9 +28,13 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..model.contact import CONTACT_LOSS_THRESHOLD_N
-from ..reference.results import SimulationResult, is_contact_force, select_window, series_and_time
+from ..reference.results import (
+    SimulationResult,
+    is_contact_force,
+    select_window,
+    series_and_time,
+)
 from ..validation import positive
-
 
 
 @dataclass(frozen=True)

@@ -51,7 +51,14 @@ import fatpack
 import numpy as np
 
 from ..errors import ParameterError
-from ..reference.results import SimulationResult, is_contact_force, is_shaft_torque, select_window, series_and_time, unit_of
+from ..reference.results import (
+    SimulationResult,
+    is_contact_force,
+    is_shaft_torque,
+    select_window,
+    series_and_time,
+    unit_of,
+)
 from ..validation import finite_series, non_negative, one_of, positive
 
 #: Default Woehler exponents (welded steel 3, shafts 5, gear teeth 8 and 10).

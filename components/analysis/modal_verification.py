@@ -31,14 +31,14 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..model.drivetrain import Drivetrain
 from ..errors import SolverError
-from .modes import DrivetrainModalAnalysis, OperatingPoint, drivetrain_modes
-from ..reference.solver import SolverSettings, simulate_monolithic
-from ..reference.results import SimulationResult
-from .spectrum import spectral_peak_hz
-from ..validation import positive
+from ..model.drivetrain import Drivetrain
 from ..model.wind import ConstantSpeed
+from ..reference.results import SimulationResult
+from ..reference.solver import SolverSettings, simulate_monolithic
+from ..validation import positive
+from .modes import DrivetrainModalAnalysis, OperatingPoint, drivetrain_modes
+from .spectrum import spectral_peak_hz
 
 
 @dataclass(frozen=True)

@@ -46,9 +46,9 @@ import numpy as np
 import scipy.linalg as sla
 from scipy.optimize import linear_sum_assignment
 
+from ..errors import DtcosimError, ParameterError
 from ..model.assembly import Assembly
 from ..model.drivetrain import Drivetrain
-from ..errors import DtcosimError, ParameterError
 from ..units import rad_per_s_to_rpm, rpm
 from ..validation import finite, set_fields
 

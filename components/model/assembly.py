@@ -41,9 +41,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import ParameterError
 from .contact import ContactLaw, MeshContact
 from .drivetrain import Drivetrain
-from ..errors import ParameterError
 from .stages import PlanetaryStage
 
 

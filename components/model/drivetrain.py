@@ -12,11 +12,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
 
-from .contact import MeshContact
 from ..errors import ParameterError
+from ..validation import finite, set_fields
+from .contact import MeshContact
 from .generator import GeneratorParameters, LoadEvent, TorqueSchedule
 from .stages import ParallelStage, PlanetaryStage, Shaft, Stage
-from ..validation import finite, set_fields
 
 
 @dataclass(frozen=True)

@@ -24,11 +24,11 @@ import math
 
 import numpy as np
 
+from ..errors import ParameterError, SolverError
+from ..validation import finite, one_of
 from .assembly import Assembly
 from .drivetrain import Drivetrain
-from ..errors import ParameterError, SolverError
 from .integrators import Rosenbrock23, StepControl
-from ..validation import finite, one_of
 
 SHAFT_TORQUE_MODES = ("average", "end")
 

@@ -34,9 +34,9 @@ import math
 from dataclasses import replace
 from typing import Mapping
 
+from ..errors import ParameterError
 from .contact import CONTACT_LAWS, MeshContact
 from .drivetrain import Drivetrain
-from ..errors import ParameterError
 from .stages import PlanetaryStage, Shaft
 
 UNITS: dict[str, str] = {

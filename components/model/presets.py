@@ -13,12 +13,12 @@ from __future__ import annotations
 from dataclasses import replace
 
 from .. import units
+from ..errors import ParameterError
+from ..validation import in_range, positive
 from .contact import MeshContact
 from .drivetrain import Drivetrain
-from ..errors import ParameterError
 from .generator import GeneratorParameters
 from .stages import ParallelStage, PlanetaryStage, Shaft
-from ..validation import in_range, positive
 
 PRESETS = ("table3", "table5", "table6")
 TOTAL_RATIO = 100.0

@@ -18,9 +18,9 @@ import math
 from dataclasses import dataclass
 
 from .. import units
-from .contact import MeshContact
 from ..errors import ParameterError
 from ..validation import integer_at_least, non_negative, positive, set_fields
+from .contact import MeshContact
 
 STEEL_DENSITY_KG_M3 = 7800.0
 

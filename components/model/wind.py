@@ -27,7 +27,14 @@ import numpy as np
 
 from .. import units
 from ..errors import ParameterError
-from ..validation import finite, integer_at_least, non_negative, one_of, positive, set_fields
+from ..validation import (
+    finite,
+    integer_at_least,
+    non_negative,
+    one_of,
+    positive,
+    set_fields,
+)
 
 AMPLITUDE_CONVENTIONS = ("variance", "paper")
 

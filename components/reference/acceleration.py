@@ -23,10 +23,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import LSODA
 
-from ..model.drivetrain import Drivetrain
 from ..errors import ParameterError, SolverError
-from .solver import MonolithicSystem, SolverSettings, SpeedDriver
+from ..model.drivetrain import Drivetrain
 from ..validation import finite
+from .solver import MonolithicSystem, SolverSettings, SpeedDriver
 
 #: interpolated points searched in each of the steps around the largest step-end value
 REFINE_POINTS = 32

@@ -22,12 +22,12 @@ from typing import TYPE_CHECKING, Callable
 import numpy as np
 
 from .. import units
-from ..model.drivetrain import Drivetrain
 from ..errors import ParameterError
 from ..model.contact import CONTACT_LOSS_THRESHOLD_N
+from ..model.drivetrain import Drivetrain
 from ..model.presets import table3_parallel, table5_planetary, table6_gearbox
-from .results import SimulationResult, window_statistics
 from ..model.wind import ConstantSpeed, RotorSpeedProcess, SineSpeed, WindParameters
+from .results import SimulationResult, window_statistics
 
 if TYPE_CHECKING:
     from .solver import SpeedDriver

@@ -21,11 +21,11 @@ from typing import Protocol
 import numpy as np
 from scipy.integrate import odeint
 
+from ..errors import ParameterError, SolverError, WallTimeLimitError
 from ..model.assembly import Assembly
 from ..model.drivetrain import Drivetrain
-from ..errors import ParameterError, SolverError, WallTimeLimitError
-from .results import EnergyAudit, SimulationResult
 from ..validation import finite, non_negative, positive
+from .results import EnergyAudit, SimulationResult
 
 
 class SpeedDriver(Protocol):

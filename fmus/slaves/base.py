@@ -42,7 +42,16 @@ from contextlib import contextmanager
 from functools import partial
 from typing import Any, Hashable, Iterable, Iterator, Mapping
 
-from pythonfmu import Boolean, DefaultExperiment, Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Integer, Real
+from pythonfmu import (
+    Boolean,
+    DefaultExperiment,
+    Fmi2Causality,
+    Fmi2Initial,
+    Fmi2Slave,
+    Fmi2Variability,
+    Integer,
+    Real,
+)
 from pythonfmu.enums import Fmi2Status
 
 from components import __version__ as COMPONENTS_VERSION

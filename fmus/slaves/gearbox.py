@@ -22,16 +22,28 @@ from __future__ import annotations
 
 from typing import Hashable, Iterable
 
-from components.model.assembly import Assembly
 from components.errors import ParameterError
+from components.model.assembly import Assembly
 from components.model.gearbox_model import SHAFT_TORQUE_MODES, GearboxModel
 from components.model.integrators import StepControl
 from components.model.presets import cosim_preset
 from components.model.wind import WindParameters
 
 from .base import DtcosimSlave
-from .gearbox_parameters import control_from_values, drivetrain_from_values, drivetrain_variables, solver_variables
-from .interface import Variable, boolean_parameter, enumeration_text, integer_parameter, real_input, real_output
+from .gearbox_parameters import (
+    control_from_values,
+    drivetrain_from_values,
+    drivetrain_variables,
+    solver_variables,
+)
+from .interface import (
+    Variable,
+    boolean_parameter,
+    enumeration_text,
+    integer_parameter,
+    real_input,
+    real_output,
+)
 
 _MESH_KINDS = {"sun_planet": "sun-planet mesh", "ring_planet": "ring-planet mesh", "parallel": "parallel-stage mesh"}
 

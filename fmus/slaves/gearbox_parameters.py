@@ -15,7 +15,12 @@ from typing import Callable
 
 from components.model.drivetrain import Drivetrain
 from components.model.integrators import StepControl
-from components.model.parameter_map import description_of_parameter, flatten, unflatten, unit_of_parameter
+from components.model.parameter_map import (
+    description_of_parameter,
+    flatten,
+    unflatten,
+    unit_of_parameter,
+)
 from components.model.stages import PlanetaryStage
 
 from .base import fmu_parameter_names

@@ -13,12 +13,20 @@ import math
 from typing import Hashable, Iterable
 
 from components.errors import ParameterError, SolverError
-from components.model.generator import EVENT_KINDS, GeneratorParameters, GeneratorRotor as RotorComponent, LoadEvent
+from components.model.generator import EVENT_KINDS, GeneratorParameters, LoadEvent
+from components.model.generator import GeneratorRotor as RotorComponent
 from components.model.presets import cosim_preset
 from components.model.wind import WindParameters
 
 from .base import DtcosimSlave, fmu_parameter_names
-from .interface import Variable, enumeration_text, integer_parameter, real_input, real_output, real_parameter
+from .interface import (
+    Variable,
+    enumeration_text,
+    integer_parameter,
+    real_input,
+    real_output,
+    real_parameter,
+)
 
 #: number of load-event slots
 N_EVENT_SLOTS = 4

@@ -13,10 +13,20 @@ from __future__ import annotations
 from typing import Hashable, Iterable
 
 from components.errors import ParameterError
-from components.model.wind import AMPLITUDE_CONVENTIONS, RotorSpeedProcess, WindParameters
+from components.model.wind import (
+    AMPLITUDE_CONVENTIONS,
+    RotorSpeedProcess,
+    WindParameters,
+)
 
 from .base import DtcosimSlave, fmu_parameter_names
-from .interface import Variable, enumeration_text, integer_parameter, real_output, real_parameter
+from .interface import (
+    Variable,
+    enumeration_text,
+    integer_parameter,
+    real_output,
+    real_parameter,
+)
 
 #: component parameter name -> FMU variable name
 _NAMES = {f"wind.{n}": n for n in ("omega0", "a", "sigma", "n_harmonics", "f_min", "f_max", "seed", "amplitude")}

@@ -6,7 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..scenario import find_scenario
+from ..inputs.scenario import find_scenario
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -32,11 +32,11 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Export the scenario."""
-    from ..fmu_store import ensure_fmus, stale_project_fmus
-    from ..master import CoSimulation
-    from ..runner import load_any
-    from ..ssp import export_ssp
-    from ..system import resolve_system
+    from ..cosim.fmu_store import ensure_fmus, stale_project_fmus
+    from ..cosim.master import CoSimulation
+    from ..cosim.system import resolve_system
+    from ..interop.ssp import export_ssp
+    from ..run.runner import load_any
 
     scenario = load_any(find_scenario(args.scenario))
     paths = ensure_fmus(scenario, args.fmu_dir, build=not args.no_build,

@@ -3,7 +3,7 @@
 With a scenario (packaged name, TOML or SSP file) the drivetrain is the one behind
 its FMUs - the Gearbox FMU's effective parameters and the generator's inertia and
 counter torque, rebuilt as for the monolithic reference
-(:func:`orchestrator.compare.monolithic_setup`) - and the operating point is the
+(:func:`orchestrator.run.comparison.monolithic_setup`) - and the operating point is the
 scenario's: the WindSource's mean rotor speed ``omega0`` and the generator's
 base counter torque (load events and the wind's fluctuation are not part of a
 linearisation). ``--rotor-speed-rpm`` and ``--torque-nm`` override either.
@@ -18,11 +18,10 @@ from pathlib import Path
 import numpy as np
 
 from components.analysis.campbell import LOAD_LAWS, LoadLaw
-from components.errors import ParameterError
 from components.analysis.modes import OperatingPoint
+from components.errors import ParameterError
 from components.model.presets import PRESETS, preset
 from components.units import rpm
-
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -75,12 +74,12 @@ def scenario_drivetrain(spec: str, fmu_dir: Path | None = None):
 
     from components.model.generator import GeneratorParameters
 
-    from ..compare import ReferenceError, monolithic_setup
+    from ..cosim.fmu_store import ensure_fmus
+    from ..cosim.system import resolve_system
     from ..errors import ScenarioError
-    from ..fmu_store import ensure_fmus
-    from ..runner import load_any
-    from ..scenario import find_scenario
-    from ..system import resolve_system
+    from ..inputs.scenario import find_scenario
+    from ..run.comparison import ReferenceError, monolithic_setup
+    from ..run.runner import load_any
 
     scenario = load_any(find_scenario(spec))
     system = resolve_system(scenario, fmu_paths=ensure_fmus(scenario, fmu_dir, build=True))
@@ -114,7 +113,11 @@ def run(args: argparse.Namespace) -> int:
     if args.speed_points < 2:
         raise ParameterError("speed_points", args.speed_points, ">= 2")
     law = LoadLaw(args.load_law, abs(speed) if speed != 0.0 else rpm(16.0), op.output_torque_nm)
-    from ..modal_report import format_mode_table, format_verification, modal_report  # matplotlib: only to run
+    from ..reports.modal import (  # matplotlib: only to run
+        format_mode_table,
+        format_verification,
+        modal_report,
+    )
 
     report = modal_report(
         drivetrain, op, out_dir, law, rpm(np.linspace(lo, hi, args.speed_points)), args.shapes, args.verify

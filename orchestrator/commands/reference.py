@@ -47,7 +47,7 @@ def run(args: argparse.Namespace) -> int:
     if result.energy is not None:
         summary["energy"] = result.energy.as_dict()
     if args.out is not None:
-        from ..reference_output import write_reference_outputs
+        from ..reports.reference_cases import write_reference_outputs
 
         files = write_reference_outputs(result, case, summary, args.out, plot=not args.no_plots)
     if args.json:

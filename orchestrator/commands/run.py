@@ -12,7 +12,7 @@ import sys
 from pathlib import Path
 
 from ..errors import ScenarioError
-from ..scenario import ALGORITHMS, EXTRAPOLATIONS, find_scenario
+from ..inputs.scenario import ALGORITHMS, EXTRAPOLATIONS, find_scenario
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -117,10 +117,10 @@ def _progress_bar(sim):
 
 def run(args: argparse.Namespace) -> int:
     """Run the scenario; write results; print a summary."""
-    from ..fmu_store import ensure_fmus, stale_project_fmus
-    from ..run_analyses import format_analyses
-    from ..runner import load_any, run_scenario
-    from ..system import resolve_system
+    from ..cosim.fmu_store import ensure_fmus, stale_project_fmus
+    from ..cosim.system import resolve_system
+    from ..run.analyses import format_analyses
+    from ..run.runner import load_any, run_scenario
 
     quiet = args.quiet
     say = (lambda msg: None) if quiet else (lambda msg: print(msg, file=sys.stderr))

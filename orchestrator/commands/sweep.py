@@ -73,11 +73,11 @@ def _progress_bar(total: int, initial_desc: str):
 
 def run(args: argparse.Namespace) -> int:
     """Validate the study, run its pending points, write the results."""
-    from ..study import StudyError, find_study, load_study
-    from ..study_report import status_counts, point_records, write_outputs
-    from ..study_prepare import prepare_study
-    from ..sweep import pending_points, run_sweep
-    from ..journal import JOURNAL_FILE, read_journal
+    from ..inputs.study import StudyError, find_study, load_study
+    from ..study.journal import JOURNAL_FILE, read_journal
+    from ..study.prepare import prepare_study
+    from ..study.report import point_records, status_counts, write_outputs
+    from ..study.sweep import pending_points, run_sweep
 
     quiet = args.quiet
     if args.workers is not None and args.workers < 1:

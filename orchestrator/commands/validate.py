@@ -7,7 +7,7 @@ from pathlib import Path
 
 from fmus.validation import check_fmu, fmu_files
 
-from ..system import default_fmu_dir
+from ..cosim.system import default_fmu_dir
 
 
 def register(sub: argparse._SubParsersAction) -> None:

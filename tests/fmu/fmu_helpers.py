@@ -11,8 +11,13 @@ from pathlib import Path
 from types import ModuleType
 
 from fmpy import calloc, extract, free, read_model_description
-from fmpy.fmi2 import (FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE, fmi2CallbackFunctions,
-                       fmi2CallbackLoggerTYPE)
+from fmpy.fmi2 import (
+    FMU2Slave,
+    fmi2CallbackAllocateMemoryTYPE,
+    fmi2CallbackFreeMemoryTYPE,
+    fmi2CallbackFunctions,
+    fmi2CallbackLoggerTYPE,
+)
 
 DRIVERS = Path(__file__).parent / "drivers"
 FMI_ERROR, FMI_FATAL = 3, 4

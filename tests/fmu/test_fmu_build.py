@@ -16,7 +16,7 @@ from fmus import build as fmu_build
 from fmus.build import BuildError, code_hash, rewrite_slave_imports
 from fmus.model_description import read_member, rewrite_archive
 from fmus.validation import check_fmu
-from orchestrator.cli import main as dtcosim
+from orchestrator.commands.cli import main as dtcosim
 
 FMU_NAMES = ("WindSource", "Gearbox", "GeneratorRotor")
 

@@ -6,7 +6,6 @@ import json
 from pathlib import Path
 
 import pytest
-
 from orch_helpers import TOY_SCENARIO, dtcosim, write_scenario
 from toy_fmus import build_toys
 

@@ -5,7 +5,6 @@ from __future__ import annotations
 import json
 
 import pytest
-
 from orch_helpers import dtcosim
 
 pytestmark = pytest.mark.slow
@@ -88,7 +87,7 @@ def test_progress_bar_on_a_terminal_and_quiet(toy_scenario, tmp_path):
 
 def test_version_names_dtcosim_and_what_results_depend_on(capsys):
     from components import __version__
-    from orchestrator import cli
+    from orchestrator.commands import cli
 
     with pytest.raises(SystemExit) as done:
         cli.main(["--version"])

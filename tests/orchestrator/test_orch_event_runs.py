@@ -10,16 +10,16 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from orch_helpers import dtcosim, write_scenario
 
 from components.analysis.contact_loss import contact_loss_summary
 from components.analysis.spectrum import amplitude_spectrum
-from orch_helpers import dtcosim, write_scenario
-from orchestrator.cli import main
-from orchestrator.compare import run_reference
-from orchestrator.results import read_timeseries
-from orchestrator.runner import run_scenario
-from orchestrator.scenario import find_scenario, load_scenario
-from orchestrator.system import resolve_system
+from orchestrator.commands.cli import main
+from orchestrator.cosim.system import resolve_system
+from orchestrator.inputs.scenario import find_scenario, load_scenario
+from orchestrator.result_files import read_timeseries
+from orchestrator.run.comparison import run_reference
+from orchestrator.run.runner import run_scenario
 
 pytestmark = pytest.mark.slow
 

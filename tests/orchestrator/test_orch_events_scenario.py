@@ -10,12 +10,18 @@ import tomllib
 import pytest
 
 from components.model.generator import LoadEvent
-from orchestrator.analysis_settings import AnalysisSettings
-from orchestrator.compare import monolithic_setup
+from orchestrator.cosim.event_slots import assign_events
+from orchestrator.cosim.system import resolve_system
 from orchestrator.errors import ScenarioError
-from orchestrator.load_events import ScenarioEvent, assign_events
-from orchestrator.scenario import find_scenario, load_scenario, packaged_scenarios, scenario_from_dict
-from orchestrator.system import resolve_system
+from orchestrator.inputs.analysis_settings import AnalysisSettings
+from orchestrator.inputs.load_events import ScenarioEvent
+from orchestrator.inputs.scenario import (
+    find_scenario,
+    load_scenario,
+    packaged_scenarios,
+    scenario_from_dict,
+)
+from orchestrator.run.comparison import monolithic_setup
 
 EVENT_SCENARIOS = ("grid-fault", "emergency-stop", "torque-step")
 
@@ -160,7 +166,7 @@ def test_ssp_export_carries_events_and_analysis_settings(fmu_paths, tmp_path):
     [analysis] settings as the dtcosim annotation; the archive stays valid SSP 1.0."""
     from fmpy.ssp.ssd import read_ssd
 
-    from orchestrator.ssp import export_ssp, import_ssp
+    from orchestrator.interop.ssp import export_ssp, import_ssp
 
     data = tomllib.loads(find_scenario("torque-step").read_text())
     data["analysis"] = {"woehler_exponents": [4, 9], "ldd_bins": [-1e5, 0.0, 1e5], "spectrum": "never"}

@@ -11,9 +11,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from orch_helpers import TOY_SCENARIO, dtcosim
-from orchestrator.results import read_timeseries
+
+from orchestrator.result_files import read_timeseries
 
 pytestmark = pytest.mark.slow
 

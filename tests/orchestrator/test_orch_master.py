@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 from scipy.linalg import expm
 
-from orchestrator.master import CoSimulation
-from orchestrator.scenario import load_scenario
-from orchestrator.system import resolve_system
+from orchestrator.cosim.master import CoSimulation
+from orchestrator.cosim.system import resolve_system
+from orchestrator.inputs.scenario import load_scenario
 
 CHAIN = """
 name = "chain"

@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 
 from components.reference.cases import TABLE7_PAPER
-from orchestrator.compare import compare, monolithic_setup, run_reference
-from orchestrator.master import CoSimulation
-from orchestrator.results import read_timeseries
-from orchestrator.scenario import find_scenario, load_scenario
-from orchestrator.system import resolve_system
+from orchestrator.cosim.master import CoSimulation
+from orchestrator.cosim.system import resolve_system
+from orchestrator.inputs.scenario import find_scenario, load_scenario
+from orchestrator.result_files import read_timeseries
+from orchestrator.run.comparison import compare, monolithic_setup, run_reference
 
 pytestmark = pytest.mark.slow
 

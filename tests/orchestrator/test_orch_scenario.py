@@ -5,14 +5,18 @@ from __future__ import annotations
 import re
 
 import pytest
-
 from orch_helpers import TOY_SCENARIO
-from orchestrator import cli
+
+from orchestrator.commands import cli
+from orchestrator.cosim.fmi_runtime import FmuInstance
+from orchestrator.cosim.graph import (
+    find_algebraic_loop,
+    initialization_order,
+    stepping_order,
+)
+from orchestrator.cosim.system import resolve_system
 from orchestrator.errors import AlgebraicLoopError, ScenarioError
-from orchestrator.fmi_runtime import FmuInstance
-from orchestrator.graph import find_algebraic_loop, initialization_order, stepping_order
-from orchestrator.scenario import load_scenario
-from orchestrator.system import resolve_system
+from orchestrator.inputs.scenario import load_scenario
 
 
 def _replace(old: str, new: str):
@@ -171,7 +175,7 @@ def test_scenario_pickles_with_plain_pickle():
     """A Scenario crosses process boundaries (multiprocessing, Dask) with the standard pickle."""
     import pickle
 
-    from orchestrator.scenario import packaged_scenarios
+    from orchestrator.inputs.scenario import packaged_scenarios
 
     scenario = load_scenario(packaged_scenarios()["grid-fault"])
     clone = pickle.loads(pickle.dumps(scenario))

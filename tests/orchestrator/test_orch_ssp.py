@@ -2,18 +2,18 @@
 
 from __future__ import annotations
 
-import zipfile
 import xml.etree.ElementTree as ET
+import zipfile
 
 import numpy as np
 import pytest
-
 from orch_helpers import dtcosim
-from orchestrator.master import CoSimulation
-from orchestrator.runner import load_any
-from orchestrator.scenario import find_scenario, load_scenario
-from orchestrator.ssp import NS, export_ssp, import_ssp
-from orchestrator.system import resolve_system
+
+from orchestrator.cosim.master import CoSimulation
+from orchestrator.cosim.system import resolve_system
+from orchestrator.inputs.scenario import find_scenario, load_scenario
+from orchestrator.interop.ssp import NS, export_ssp, import_ssp
+from orchestrator.run.runner import load_any
 
 TOY = """
 name = "toy-ssp"
@@ -112,7 +112,7 @@ def test_reimported_paper_ssp_runs_identically(paper_ssp, paper_fmu_dir):
 
 @pytest.mark.slow
 def test_exported_ssp_runs_in_libcosim_like_dtcosim(paper_ssp):
-    from orchestrator.libcosim_host import run_ssp_in_libcosim
+    from orchestrator.interop.libcosim import run_ssp_in_libcosim
 
     stop = 10.0
     lib = run_ssp_in_libcosim(paper_ssp, stop, ["generator.omega", "wind.omega"])

@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 
 from components import units
-from components.model import presets
-from components.reference.acceleration import peak_output_acceleration
 from components.errors import ParameterError
-from components.reference.solver import simulate_monolithic
+from components.model import presets
 from components.model.wind import ConstantSpeed
+from components.reference.acceleration import peak_output_acceleration
+from components.reference.solver import simulate_monolithic
 
 
 @pytest.mark.parametrize("lambda_per_mm", [10.0, 600.0])

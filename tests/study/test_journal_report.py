@@ -6,13 +6,25 @@ import json
 
 import pytest
 
-from orchestrator.journal import Journal, JournalError, latest_by_key, read_journal
-from orchestrator.study import load_study
-from orchestrator.study_engine import PointTask, run_point
-from orchestrator.study_report import read_table, write_outputs
-from orchestrator.study_prepare import prepare_study
-from orchestrator.sweep import pending_points
-from .study_helpers import SMALL_FAILURE, SMALL_HEAD, SMALL_STUDY, SMALL_TABLES, STAGE3_FORCE_N
+from orchestrator.inputs.study import load_study
+from orchestrator.study.engine import PointTask, run_point
+from orchestrator.study.journal import (
+    Journal,
+    JournalError,
+    latest_by_key,
+    read_journal,
+)
+from orchestrator.study.prepare import prepare_study
+from orchestrator.study.report import read_table, write_outputs
+from orchestrator.study.sweep import pending_points
+
+from .study_helpers import (
+    SMALL_FAILURE,
+    SMALL_HEAD,
+    SMALL_STUDY,
+    SMALL_TABLES,
+    STAGE3_FORCE_N,
+)
 
 
 def test_torn_last_line_is_skipped_and_the_next_record_starts_a_new_line(tmp_path):

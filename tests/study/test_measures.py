@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from components.analysis.fatigue import FatigueSettings, fatigue_loads
-from orchestrator.measures import MeasureError, parse_measure, window_statistic
+from orchestrator.inputs.measures import MeasureError, parse_measure
+from orchestrator.study.measure_values import window_statistic
 
 
 @pytest.mark.parametrize("text, statistic, unit", [
@@ -48,9 +49,9 @@ def test_del_over_a_window_is_what_the_run_analysis_computes():
 
 def test_cells_combine_dels_by_damage_and_other_measures_arithmetically(study_fmu_dir):
     """Six seeds per cell of shaft3-seeds: a DEL cell is (mean DEL^m)^(1/m), a std cell the plain mean."""
-    from orchestrator.study import find_study, load_study
-    from orchestrator.study_plots import grid
-    from orchestrator.study_prepare import prepare_study
+    from orchestrator.inputs.study import find_study, load_study
+    from orchestrator.study.plots import grid
+    from orchestrator.study.prepare import prepare_study
 
     prepared = prepare_study(load_study(find_study("shaft3-seeds")), fmu_dir=study_fmu_dir, build=False)
     values = np.array([500.0, 520.0, 610.0, 640.0, 660.0, 700.0])  # the six seeds of every cell

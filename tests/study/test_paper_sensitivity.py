@@ -14,7 +14,8 @@ import json
 import numpy as np
 import pytest
 
-from orchestrator.study_report import read_table
+from orchestrator.study.report import read_table
+
 from .study_helpers import run_cli
 
 pytestmark = pytest.mark.slow

@@ -8,8 +8,14 @@ import numpy as np
 import pytest
 
 from components.errors import DtcosimError
-from orchestrator.study import StudyError, find_study, load_study, study_from_dict
-from orchestrator.study_prepare import prepare_study
+from orchestrator.inputs.study import (
+    StudyError,
+    find_study,
+    load_study,
+    study_from_dict,
+)
+from orchestrator.study.prepare import prepare_study
+
 from .study_helpers import SMALL_STUDY, run_cli
 
 MODEL_BASE = """
@@ -145,7 +151,7 @@ def test_cli_reports_an_invalid_study_and_runs_nothing(write_study, tmp_path):
 
 def test_point_timeout_fails_the_point_and_leaves_the_keys_alone(write_study):
     """A point past the study's timeout fails with the limit and the time reached; keys ignore the limit."""
-    from orchestrator.study_engine import PointTask, run_point
+    from orchestrator.study.engine import PointTask, run_point
 
     text = MODEL_BASE.replace("stop = 0.01", "stop = 1.0") + '[[axes]]\nparameter = "gearbox.R1"\nvalues = [6.0]\n'
     free = prepare_study(load_study(write_study(text, "free.toml")))
@@ -166,7 +172,7 @@ def test_cli_timeout_overrides_the_study_and_is_checked(write_study, tmp_path):
 
 @pytest.mark.parametrize("name", ["paper-sensitivity", "shaft3-seeds"])
 def test_every_packaged_study_is_valid_against_its_base(name, study_fmu_dir):
-    from orchestrator.study import packaged_studies
+    from orchestrator.inputs.study import packaged_studies
 
     assert set(packaged_studies()) == {"paper-sensitivity", "shaft3-seeds"}
     prepared = prepare_study(load_study(find_study(name)), fmu_dir=study_fmu_dir, build=False)

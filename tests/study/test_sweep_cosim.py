@@ -7,10 +7,10 @@ import shutil
 import numpy as np
 import pytest
 
-from orchestrator.study import load_study
-from orchestrator.study_report import read_table
-from orchestrator.study_prepare import prepare_study
-from orchestrator.sweep import run_sweep
+from orchestrator.inputs.study import load_study
+from orchestrator.study.prepare import prepare_study
+from orchestrator.study.report import read_table
+from orchestrator.study.sweep import run_sweep
 
 pytestmark = pytest.mark.slow
 
@@ -36,7 +36,7 @@ values = [2000.0, 5729.6]
 
 
 def test_cosim_sweep_runs_from_shipped_fmu_bytes(write_study, study_fmu_dir, tmp_path):
-    from orchestrator.scenario import find_scenario
+    from orchestrator.inputs.scenario import find_scenario
 
     # the base scenario and its FMUs in a directory of their own, deleted before the sweep runs:
     # the workers can only use the bytes that travel with the tasks
@@ -89,8 +89,8 @@ def test_cosim_peak_acceleration_matches_the_monolithic_engine(write_study, stud
     Before the Gearbox FMU had ``alpha_out_max`` the co-simulation differenced
     ``omega_out`` on the 2 ms grid and found ~680 rad/s^2 here, 22 x too low.
     """
-    from orchestrator.scenario import find_scenario
-    from orchestrator.study_engine import PointTask, run_point
+    from orchestrator.inputs.scenario import find_scenario
+    from orchestrator.study.engine import PointTask, run_point
 
     shutil.copy(find_scenario("paper-60s"), tmp_path / "paper.toml")
     for fmu in study_fmu_dir.glob("*.fmu"):

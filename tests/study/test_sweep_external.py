@@ -12,8 +12,9 @@ from pathlib import Path
 import psutil
 import pytest
 
-from orchestrator.journal import read_journal
-from orchestrator.study_report import read_table
+from orchestrator.study.journal import read_journal
+from orchestrator.study.report import read_table
+
 from .study_helpers import SMALL_FAILURE, SMALL_STUDY, free_port, run_cli
 
 pytestmark = pytest.mark.slow

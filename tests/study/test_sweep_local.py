@@ -12,12 +12,19 @@ from pathlib import Path
 
 import pytest
 
-from orchestrator.journal import read_journal
-from orchestrator.study import load_study
-from orchestrator.study_report import read_table
-from orchestrator.study_prepare import prepare_study
-from orchestrator.sweep import run_sweep
-from .study_helpers import SMALL_FAILURE, SMALL_HEAD, SMALL_STUDY, SMALL_TABLES, STAGE3_FORCE_N
+from orchestrator.inputs.study import load_study
+from orchestrator.study.journal import read_journal
+from orchestrator.study.prepare import prepare_study
+from orchestrator.study.report import read_table
+from orchestrator.study.sweep import run_sweep
+
+from .study_helpers import (
+    SMALL_FAILURE,
+    SMALL_HEAD,
+    SMALL_STUDY,
+    SMALL_TABLES,
+    STAGE3_FORCE_N,
+)
 
 pytestmark = pytest.mark.slow
 

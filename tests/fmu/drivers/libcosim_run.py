@@ -21,12 +21,12 @@ from pathlib import Path
 
 import numpy as np
 from fmpy import read_model_description
+from libcosimpy._internal import get_last_error_message
 from libcosimpy.CosimEnums import CosimVariableType
 from libcosimpy.CosimExecution import CosimExecution
 from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
 from libcosimpy.CosimObserver import CosimObserver
 from libcosimpy.CosimSlave import CosimLocalSlave
-from libcosimpy._internal import get_last_error_message
 
 
 def value_references(path: Path) -> dict[str, int]:

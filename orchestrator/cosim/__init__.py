@@ -1,0 +1,12 @@
+"""The co-simulation: FMUs read and checked through FMI only, and the fixed-step master.
+
+Modules
+-------
+fmu_interface   what an FMU's ``modelDescription.xml`` declares (nothing instantiated)
+fmu_store       where a scenario's FMUs are; building the project's own when missing
+event_slots     load events placed into the FMUs' event slots
+system          a scenario checked against its FMUs (:class:`~orchestrator.cosim.system.ResolvedSystem`)
+graph           stepping and initialisation order, algebraic loops
+fmi_runtime     FMU instances driven through fmpy's raw FMI functions
+master          Gauss-Seidel / Jacobi master algorithm
+"""

@@ -1,0 +1,239 @@
+"""FMU instances driven through fmpy's ``FMU2Slave`` and its raw FMI functions.
+
+The master calls the C functions (``fmi2DoStep``, ``fmi2SetReal``,
+``fmi2GetReal``) directly with pre-built value-reference and value arrays, which
+saves fmpy's per-call list/array conversions (the plumbing cost per
+communication step is measured in ``benchmarks/bench_plumbing.py``).
+
+Every instance gets its own logger callback that keeps the FMU's last log
+messages, and is instantiated with logging on: pythonfmu slaves report a Python
+exception only through the logger, so this is how error messages reach the user.
+
+Each FMU file is extracted once per process (cached by SHA-256). Shared
+libraries are never unloaded: pythonfmu's runtime does not survive being
+unloaded and loaded again in one process.
+"""
+
+from __future__ import annotations
+
+import atexit
+import shutil
+import tempfile
+from collections import deque
+from ctypes import byref, c_double, c_uint
+from pathlib import Path
+from typing import Any, Iterable
+
+from ..errors import FmuStepError, status_label
+from .fmu_interface import FmuInterface
+
+FMI_OK, FMI_WARNING, FMI_DISCARD, FMI_ERROR, FMI_FATAL = 0, 1, 2, 3, 4
+
+_EXTRACTED: dict[str, Path] = {}
+#: log message lists of the live instances by instance name (see FmuInstance)
+_LOG_SINKS: dict[str, deque] = {}
+_EXTRACT_ROOT: Path | None = None
+
+
+def _extract(iface: FmuInterface) -> Path:
+    """Directory with the FMU's contents, extracted once per process."""
+    global _EXTRACT_ROOT
+    from fmpy import extract
+
+    if iface.sha256 in _EXTRACTED:
+        return _EXTRACTED[iface.sha256]
+    if _EXTRACT_ROOT is None:
+        _EXTRACT_ROOT = Path(tempfile.mkdtemp(prefix="dtcosim-fmus-"))
+        atexit.register(shutil.rmtree, _EXTRACT_ROOT, True)
+    target = _EXTRACT_ROOT / iface.sha256[:16]
+    extract(str(iface.path), str(target))
+    _EXTRACTED[iface.sha256] = target
+    return target
+
+
+class FmuInstance:
+    """One co-simulation FMU instance.
+
+    Parameters
+    ----------
+    name : str
+        Instance name (the scenario's component name).
+    interface : FmuInterface
+        The FMU's model description.
+    log_size : int
+        Number of log messages kept.
+
+    Attributes
+    ----------
+    component : int
+        The ``fmi2Component`` handle (as an integer address).
+    do_step, set_real, get_real : ctypes function
+        Raw FMI functions; call as ``do_step(component, t, h, 1)``,
+        ``set_real(component, vr_array, n, value_array)``.
+    log : collections.deque of str
+        Last log messages, formatted ``"[status] category: message"``.
+    """
+
+    def __init__(self, name: str, interface: FmuInterface, log_size: int = 50) -> None:
+        from fmpy import calloc, free
+        from fmpy.fmi2 import (
+            FMU2Slave,
+            fmi2CallbackAllocateMemoryTYPE,
+            fmi2CallbackFreeMemoryTYPE,
+            fmi2CallbackFunctions,
+            fmi2CallbackLoggerTYPE,
+        )
+
+        self.name = name
+        self.interface = interface
+        self.log: deque[str] = deque(maxlen=log_size)
+        self.state = "loaded"  # loaded, instantiated, initialization, step, failed, freed
+        self._failed_status = FMI_OK
+        unzip = _extract(interface)
+        self.slave = FMU2Slave(
+            guid=interface.guid,
+            unzipDirectory=str(unzip),
+            modelIdentifier=interface.model_identifier,
+            instanceName=name,
+        )
+
+        def logger(env, instance, status, category, message):
+            text = message.decode("utf-8", "replace") if message else ""
+            cat = category.decode("utf-8", "replace") if category else ""
+            name = instance.decode("utf-8", "replace") if instance else ""
+            # pythonfmu 0.7 may deliver a message through another instance's callbacks:
+            # route it by the instance name it carries
+            sink = _LOG_SINKS.get(name, self.log)
+            sink.append(f"[{status_label(status)}] {cat + ': ' if cat else ''}{text}")
+
+        cb = fmi2CallbackFunctions()
+        cb.logger = fmi2CallbackLoggerTYPE(logger)
+        cb.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+        cb.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+        try:
+            from fmpy.logging import addLoggerProxy
+
+            addLoggerProxy(byref(cb))
+        except Exception:  # pragma: no cover - the proxy only formats variadic arguments
+            pass
+        self._callbacks = cb
+        self._logger = logger  # keep the ctypes callback alive
+        fns = self.slave._functions
+        self.do_step = fns["fmi2DoStep"]
+        self.set_real = fns["fmi2SetReal"]
+        self.get_real = fns["fmi2GetReal"]
+        self.component: Any = None
+
+    # ----------------------------------------------------------------- checks
+    def _check(self, status: int, function: str, time_s: float) -> int:
+        if status > FMI_WARNING:
+            self.mark_failed(status)
+            raise FmuStepError(self.name, function, time_s, status, list(self.log))
+        return status
+
+    def mark_failed(self, status: int) -> None:
+        """Remember that the FMU returned ``status`` (>= discard): limits the cleanup calls."""
+        self.state = "failed"
+        self._failed_status = max(self._failed_status, int(status))
+
+    def _call(self, function: str, time_s: float, fn, *args) -> int:
+        """Call a high-level fmpy method; turn its exception into FmuStepError with the log."""
+        from fmpy.fmi1 import FMICallException
+
+        try:
+            fn(*args)
+        except FMICallException as exc:
+            self.mark_failed(exc.status)
+            raise FmuStepError(self.name, function, time_s, exc.status, list(self.log)) from None
+        except Exception as exc:  # instantiate returns NULL -> plain Exception
+            self.mark_failed(FMI_ERROR)
+            raise FmuStepError(self.name, function, time_s, FMI_ERROR, list(self.log) + [str(exc)]) from None
+        return FMI_OK
+
+    # -------------------------------------------------------------- lifecycle
+    def instantiate(self, start_s: float, stop_s: float | None) -> None:
+        """fmi2Instantiate (logging on) and fmi2SetupExperiment."""
+        _LOG_SINKS[self.name] = self.log
+        self._call("fmi2Instantiate", start_s, self.slave.instantiate, False, self._callbacks, True)
+        self.component = self.slave.component
+        self.state = "instantiated"
+        _LOG_SINKS[self.name] = self.log
+        self._call("fmi2SetupExperiment", start_s, self.slave.setupExperiment, None, start_s, stop_s)
+
+    def enter_initialization(self, start_s: float) -> None:
+        """fmi2EnterInitializationMode."""
+        self._call("fmi2EnterInitializationMode", start_s, self.slave.enterInitializationMode)
+        self.state = "initialization"
+
+    def exit_initialization(self, start_s: float) -> None:
+        """fmi2ExitInitializationMode."""
+        self._call("fmi2ExitInitializationMode", start_s, self.slave.exitInitializationMode)
+        self.state = "step"
+
+    def set_values(self, values: dict[str, Any], time_s: float) -> None:
+        """Set variables by name (any FMI type), e.g. parameters before initialisation."""
+        by_type: dict[str, tuple[list[int], list[Any]]] = {}
+        for name, value in values.items():
+            var = self.interface.variables[name]
+            vrs, vals = by_type.setdefault(var.type, ([], []))
+            vrs.append(var.value_reference)
+            vals.append(value)
+        setters = {
+            "Real": (self.slave.setReal, "fmi2SetReal", float),
+            "Integer": (self.slave.setInteger, "fmi2SetInteger", int),
+            "Enumeration": (self.slave.setInteger, "fmi2SetInteger", int),
+            "Boolean": (self.slave.setBoolean, "fmi2SetBoolean", bool),
+            "String": (self.slave.setString, "fmi2SetString", str),
+        }
+        for typ, (vrs, vals) in by_type.items():
+            fn, fname, conv = setters[typ]
+            self._call(fname, time_s, fn, vrs, [conv(v) for v in vals])
+
+    def get_reals(self, names: Iterable[str], time_s: float) -> list[float]:
+        """Real values by variable name."""
+        names = list(names)
+        vrs = (c_uint * len(names))(*(self.interface.variables[n].value_reference for n in names))
+        vals = (c_double * len(names))()
+        self._check(self.get_real(self.component, vrs, len(names), vals), "fmi2GetReal", time_s)
+        return list(vals)
+
+    def set_reals(self, values: dict[str, float], time_s: float) -> None:
+        """Real values by variable name."""
+        names = list(values)
+        vrs = (c_uint * len(names))(*(self.interface.variables[n].value_reference for n in names))
+        vals = (c_double * len(names))(*(float(values[n]) for n in names))
+        self._check(self.set_real(self.component, vrs, len(names), vals), "fmi2SetReal", time_s)
+
+    def check(self, status: int, function: str, time_s: float) -> int:
+        """Raise FmuStepError if ``status`` is discard, error or fatal."""
+        return self._check(status, function, time_s)
+
+    def close(self) -> None:
+        """fmi2Terminate and fmi2FreeInstance as far as the FMU's state allows.
+
+        After fmi2Error only fmi2FreeInstance is called; after fmi2Fatal nothing
+        (FMI 2: the instance is unusable). Never raises.
+        """
+        if self.component is None or self.state == "freed":
+            return
+        try:
+            if self.state in ("step", "initialization", "failed") and self._failed_status < FMI_ERROR:
+                self.slave.fmi2Terminate(self.component)
+        except Exception:
+            pass
+        if self._failed_status < FMI_FATAL:
+            try:
+                self.slave.fmi2FreeInstance(self.component)
+            except Exception:
+                pass
+        self.state = "freed"
+        self.component = None
+        if _LOG_SINKS.get(self.name) is self.log:
+            del _LOG_SINKS[self.name]
+
+
+def value_references(iface: FmuInterface, names: Iterable[str]):
+    """A ctypes ``fmi2ValueReference`` array for the named variables."""
+    names = list(names)
+    return (c_uint * len(names))(*(iface.variables[n].value_reference for n in names))
+

@@ -1,0 +1,227 @@
+"""What an FMU offers, read from its ``modelDescription.xml`` (no instantiation).
+
+:func:`read_fmu_interface` gives an :class:`FmuInterface`: the variables with
+value reference, type, causality, variability and unit, the direct-feedthrough
+dependencies of the outputs (ModelStructure), the co-simulation capabilities,
+and the file's SHA-256. Reading is cached per (path, size, mtime).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Mapping
+
+from ..errors import ScenarioError
+from ..frozen_map import FrozenMap
+
+FMI_TYPES = ("Real", "Integer", "Boolean", "String", "Enumeration")
+
+
+@dataclass(frozen=True)
+class FmuVariable:
+    """One scalar variable of an FMU.
+
+    Attributes
+    ----------
+    name : str
+    value_reference : int
+    type : {"Real", "Integer", "Boolean", "String", "Enumeration"}
+    causality : str
+        ``parameter``, ``calculatedParameter``, ``input``, ``output``, ``local``, ``independent``.
+    variability : str
+        ``constant``, ``fixed``, ``tunable``, ``discrete``, ``continuous``.
+    unit : str
+        Unit string ("" when the FMU declares none).
+    description : str
+    start : Any
+        Start value as declared (None when absent).
+    """
+
+    name: str
+    value_reference: int
+    type: str
+    causality: str
+    variability: str
+    unit: str = ""
+    description: str = ""
+    start: Any = None
+
+
+@dataclass(frozen=True)
+class FmuInterface:
+    """The interface of one FMU file.
+
+    Attributes
+    ----------
+    path : pathlib.Path
+        Absolute path of the ``.fmu``.
+    model_name, model_identifier, guid, fmi_version, generation_tool : str
+    variables : mapping of str -> FmuVariable
+        By variable name, in declaration order.
+    output_dependencies : mapping of str -> tuple of str or None
+        For each output (ModelStructure/Outputs): the inputs it depends on
+        directly; ``None`` when the FMU gives no ``dependencies`` attribute, which
+        per FMI 2 means "depends on all inputs".
+    can_handle_variable_step, can_get_and_set_state : bool
+    sha256 : str
+        Hex digest of the FMU file.
+    default_step_s : float or None
+        DefaultExperiment stepSize.
+    unit_definitions : mapping of str -> mapping of str -> float
+        FMI 2 UnitDefinitions: unit name -> SI base-unit exponents (``kg``, ``m``, ``s``,
+        ``A``, ``K``, ``mol``, ``cd``, ``rad``) and ``factor``, ``offset`` (non-default entries only).
+    """
+
+    path: Path
+    model_name: str
+    model_identifier: str
+    guid: str
+    fmi_version: str
+    generation_tool: str
+    variables: Mapping[str, FmuVariable]
+    output_dependencies: Mapping[str, tuple[str, ...] | None]
+    can_handle_variable_step: bool
+    can_get_and_set_state: bool
+    sha256: str
+    default_step_s: float | None = None
+    unit_definitions: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
+    _inputs: tuple[str, ...] = field(default=(), repr=False)
+
+    def variable(self, name: str) -> FmuVariable:
+        """The variable called ``name`` (KeyError if absent)."""
+        return self.variables[name]
+
+    @property
+    def inputs(self) -> tuple[str, ...]:
+        """Names of the input variables."""
+        return self._inputs
+
+    @property
+    def outputs(self) -> tuple[str, ...]:
+        """Names of the output variables."""
+        return tuple(n for n, v in self.variables.items() if v.causality == "output")
+
+    def direct_inputs_of(self, output: str) -> tuple[str, ...]:
+        """Inputs an output depends on directly (all inputs when undeclared)."""
+        deps = self.output_dependencies.get(output)
+        return self._inputs if deps is None else deps
+
+
+_CACHE: dict[tuple[str, int, int], FmuInterface] = {}
+
+
+def _typed_start(type_: str, start: Any) -> Any:
+    """A start value from the XML (a string) as a Python value of the variable's type."""
+    if start is None:
+        return None
+    try:
+        if type_ == "Real":
+            return float(start)
+        if type_ in ("Integer", "Enumeration"):
+            return int(start)
+        if type_ == "Boolean":
+            return str(start).strip().lower() in ("true", "1")
+    except ValueError:
+        return start
+    return str(start)
+
+
+def file_sha256(path: str | Path) -> str:
+    """SHA-256 hex digest of a file."""
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for chunk in iter(lambda: fh.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()
+
+
+def read_fmu_interface(path: str | Path, key: str = "fmu") -> FmuInterface:
+    """Read an FMU's model description (XML only; nothing is loaded or instantiated).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The ``.fmu`` file.
+    key : str
+        Scenario key reported in errors (e.g. ``"components.gearbox.fmu"``).
+
+    Raises
+    ------
+    ScenarioError
+        If the file is missing, unreadable, not FMI 2.0 or not co-simulation.
+    """
+    from fmpy import read_model_description
+
+    p = Path(path).resolve()
+    try:
+        st = os.stat(p)
+    except OSError:
+        raise ScenarioError(key, str(path), "an existing FMU file") from None
+    cache_key = (str(p), st.st_size, st.st_mtime_ns)
+    if cache_key in _CACHE:
+        return _CACHE[cache_key]
+    try:
+        md = read_model_description(str(p), validate=False)
+    except Exception as exc:  # fmpy raises plain Exceptions for broken archives/XML
+        raise ScenarioError(key, str(path), f"a readable FMU ({exc})") from None
+    if not str(md.fmiVersion).startswith("2."):
+        raise ScenarioError(key, str(path), f"an FMI 2.0 FMU (this is FMI {md.fmiVersion})")
+    if md.coSimulation is None:
+        raise ScenarioError(key, str(path), "a co-simulation FMU")
+    variables: dict[str, FmuVariable] = {}
+    for v in md.modelVariables:
+        unit = v.unit or (v.declaredType.unit if v.declaredType is not None and getattr(v.declaredType, "unit", None) else "")
+        variables[v.name] = FmuVariable(
+            name=v.name,
+            value_reference=int(v.valueReference),
+            type=str(v.type),
+            causality=str(v.causality or "local"),
+            variability=str(v.variability or ("continuous" if v.type == "Real" else "discrete")),
+            unit=unit or "",
+            description=v.description or "",
+            start=_typed_start(str(v.type), v.start),
+        )
+    inputs = tuple(n for n, v in variables.items() if v.causality == "input")
+    deps: dict[str, tuple[str, ...] | None] = {}
+    for u in md.outputs:
+        name = u.variable.name
+        deps[name] = None if u.dependencies is None else tuple(d.name for d in u.dependencies if d.causality == "input")
+    for name, v in variables.items():  # outputs missing from ModelStructure: depend on all inputs (FMI 2)
+        if v.causality == "output" and name not in deps:
+            deps[name] = None
+    cs = md.coSimulation
+    default_step = None
+    if md.defaultExperiment is not None and md.defaultExperiment.stepSize:
+        default_step = float(md.defaultExperiment.stepSize)
+    units: dict[str, dict[str, float]] = {}
+    for u in md.unitDefinitions or ():
+        b = u.baseUnit
+        if b is None:
+            continue
+        entry = {k: getattr(b, k) for k in ("kg", "m", "s", "A", "K", "mol", "cd", "rad") if getattr(b, k)}
+        if b.factor != 1.0:
+            entry["factor"] = float(b.factor)
+        if b.offset != 0.0:
+            entry["offset"] = float(b.offset)
+        units[u.name] = entry
+    iface = FmuInterface(
+        path=p,
+        model_name=md.modelName or "",
+        model_identifier=cs.modelIdentifier,
+        guid=md.guid,
+        fmi_version=md.fmiVersion,
+        generation_tool=md.generationTool or "",
+        variables=FrozenMap(variables),
+        output_dependencies=FrozenMap(deps),
+        can_handle_variable_step=bool(cs.canHandleVariableCommunicationStepSize),
+        can_get_and_set_state=bool(cs.canGetAndSetFMUstate),
+        sha256=file_sha256(p),
+        default_step_s=default_step,
+        unit_definitions=FrozenMap(units),
+        _inputs=inputs,
+    )
+    _CACHE[cache_key] = iface
+    return iface

@@ -1,0 +1,110 @@
+"""Locating the scenario's FMUs and building the project's own FMUs when they are missing.
+
+A relative FMU path is looked up next to the scenario file, then in the FMU
+directory (:func:`orchestrator.cosim.system.default_fmu_dir`). ``dtcosim run`` builds a
+missing ``WindSource.fmu``, ``Gearbox.fmu`` or ``GeneratorRotor.fmu`` (the FMUs
+this project makes, with ``fmus.build``) into the FMU directory; any other
+missing FMU is a scenario error naming the component.
+"""
+
+from __future__ import annotations
+
+import re
+import zipfile
+from pathlib import Path
+from typing import Callable, Mapping
+
+from ..inputs.scenario import Scenario
+from .system import default_fmu_dir, resolve_fmu_paths
+
+
+def buildable_fmu_names() -> tuple[str, ...]:
+    """FMU model names that ``fmus.build`` can make (empty if the builder is unavailable)."""
+    try:
+        from fmus.build import FMU_NAMES
+    except ImportError:
+        return ()
+    return tuple(FMU_NAMES)
+
+
+def missing_fmus(scenario: Scenario, fmu_dir: Path) -> dict[str, Path]:
+    """Components whose FMU file exists nowhere: ``{component: relative FMU path}``."""
+    out = {}
+    for comp in scenario.components:
+        if not any(p.is_file() for p in scenario.fmu_candidates(comp, fmu_dir)):
+            out[comp.name] = comp.fmu
+    return out
+
+
+def ensure_fmus(scenario: Scenario, fmu_dir: str | Path | None = None, build: bool = True,
+                report: Callable[[str], None] | None = None) -> dict[str, Path]:
+    """Resolve every FMU path, building the project's missing FMUs first.
+
+    Parameters
+    ----------
+    scenario : Scenario
+    fmu_dir : path, optional
+        FMU directory (default :func:`orchestrator.cosim.system.default_fmu_dir`).
+    build : bool
+        Build missing project FMUs into ``fmu_dir``; if False a missing FMU is an error.
+    report : callable(str), optional
+        Receives progress messages ("building Gearbox.fmu ...").
+
+    Returns
+    -------
+    dict of str -> pathlib.Path
+        Absolute FMU file per component.
+
+    Raises
+    ------
+    ScenarioError
+        ``components.<name>.fmu`` for a missing FMU that cannot be built.
+    """
+    fmu_dir = default_fmu_dir() if fmu_dir is None else Path(fmu_dir)
+    missing = missing_fmus(scenario, fmu_dir)
+    if missing and build:
+        buildable = buildable_fmu_names()
+        names = sorted({p.stem for p in missing.values() if p.parent == Path(".") and p.suffix == ".fmu" and p.stem in buildable})
+        if names:
+            from fmus.build import build_all
+
+            if report:
+                report(f"building {', '.join(n + '.fmu' for n in names)} into {fmu_dir} ...")
+            build_all(fmu_dir, names=names)
+    return resolve_fmu_paths(scenario, fmu_dir)
+
+
+
+_BUILD_ID = re.compile(r"^_dtcosim_[a-z]+_([0-9a-f]{12})_slave$")
+
+
+def stale_project_fmus(paths: Mapping[str, Path]) -> list[str]:
+    """Warnings for project FMUs built from other code than the installed ``components``/``fmus``.
+
+    A project FMU carries the hash of the code it embeds in its pythonfmu entry
+    module name (``resources/slavemodule.txt``); it is stale when that hash matches
+    the current sources for no preset. Other FMUs are not checked.
+    """
+    try:
+        from components.model.presets import PRESETS
+        from fmus.build import FMU_NAMES, code_hash
+    except ImportError:
+        return []
+    current: dict[str, set[str]] = {}
+    out = []
+    for comp, path in paths.items():
+        try:
+            with zipfile.ZipFile(path) as zf:
+                module = zf.read("resources/slavemodule.txt").decode().strip()
+        except (KeyError, OSError, zipfile.BadZipFile):
+            continue
+        m = _BUILD_ID.match(module)
+        name = path.stem
+        if not m or name not in FMU_NAMES:
+            continue
+        if name not in current:
+            current[name] = {code_hash(name, preset) for preset in PRESETS}
+        if m.group(1) not in current[name]:
+            out.append(f"{path} ({comp}) was built from other code than the installed dtcosim (build {m.group(1)}); "
+                       f"rebuild it with `dtcosim build --out {path.parent}`")
+    return out

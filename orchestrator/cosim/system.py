@@ -1,0 +1,307 @@
+"""A scenario checked against its FMUs' model descriptions.
+
+:func:`resolve_system` locates every FMU, reads its ``modelDescription.xml``
+(nothing is instantiated) and checks every name the scenario uses: parameters
+exist, are settable and have the right type; connections join a Real output to a
+Real input; initial bindings join a Real output to a Real parameter or input;
+record patterns match variables; no algebraic loop. The first problem raises
+:class:`~orchestrator.errors.ScenarioError` naming the scenario key. The result,
+a :class:`ResolvedSystem`, is what the master runs.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import os
+import re
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Mapping
+
+from components.validation import is_number
+
+from ..errors import AlgebraicLoopError, ScenarioError, suggestion
+from ..inputs.scenario import Scenario, VariableRef
+from .event_slots import AssignedEvent, assign_events
+from .fmu_interface import FmuInterface, FmuVariable, read_fmu_interface
+from .graph import find_algebraic_loop, initialization_order, stepping_order
+
+#: causalities a scenario may give a value to
+SETTABLE_CAUSALITIES = ("parameter", "input")
+#: causalities a connection or initial binding may read from
+READABLE_CAUSALITIES = ("output", "calculatedParameter")
+
+
+def default_fmu_dir() -> Path:
+    """Directory of the built FMUs.
+
+    ``$DTCOSIM_FMU_DIR`` if set; else the project's ``fmus/`` folder (the
+    ``fmus`` package's own folder, where ``build_fmus.py`` writes) when running
+    from a source checkout (``build_fmus.py`` beside that folder); else
+    ``$XDG_CACHE_HOME/dtcosim/fmus`` (default ``~/.cache/dtcosim/fmus``) for an
+    installed package, whose folder may not be writable.
+    """
+    env = os.environ.get("DTCOSIM_FMU_DIR")
+    if env:
+        return Path(env)
+    spec = importlib.util.find_spec("fmus")
+    if spec is not None and spec.origin:
+        package_dir = Path(spec.origin).resolve().parent
+        if (package_dir.parent / "build_fmus.py").is_file():
+            return package_dir
+    cache = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(cache) / "dtcosim" / "fmus"
+
+
+@dataclass(frozen=True)
+class RecordedVariable:
+    """A variable sampled into the results.
+
+    Attributes
+    ----------
+    component, variable : str
+    value_reference : int
+    unit : str
+        Unit declared by the FMU ("" if none).
+    """
+
+    component: str
+    variable: str
+    value_reference: int
+    unit: str
+
+    @property
+    def column(self) -> str:
+        """Result column name ``component.variable``."""
+        return f"{self.component}.{self.variable}"
+
+
+@dataclass(frozen=True)
+class ResolvedSystem:
+    """A scenario whose names have all been checked against the FMUs.
+
+    Attributes
+    ----------
+    scenario : Scenario
+        The checked scenario; its load events (``[[events]]``) are already written into
+        the event-slot parameters of their component (see :mod:`orchestrator.inputs.load_events`).
+    fmu_paths : mapping of str -> pathlib.Path
+        Absolute FMU file of each component.
+    interfaces : mapping of str -> FmuInterface
+        Model description of each component's FMU.
+    order : tuple of str
+        Stepping order (Gauss-Seidel sweep order; Jacobi ignores it).
+    init_order : tuple of str
+        Order of the initialisation sweeps (connections and initial bindings).
+    recorded : tuple of RecordedVariable
+        Recorded variables in the order of the record patterns.
+    events : tuple of AssignedEvent
+        The scenario's load events with the component and slot that apply them.
+    """
+
+    scenario: Scenario
+    fmu_paths: Mapping[str, Path]
+    interfaces: Mapping[str, FmuInterface]
+    order: tuple[str, ...]
+    init_order: tuple[str, ...]
+    recorded: tuple[RecordedVariable, ...]
+    events: tuple[AssignedEvent, ...] = ()
+
+    def variable(self, ref: VariableRef) -> FmuVariable:
+        """Model-description entry of a ``component.variable`` reference."""
+        return self.interfaces[ref.component].variables[ref.variable]
+
+    def parameter_values(self, component: str) -> dict[str, object]:
+        """Effective parameter values of a component: FMU start values overridden by the scenario."""
+        iface = self.interfaces[component]
+        values = {n: v.start for n, v in iface.variables.items() if v.causality == "parameter"}
+        values.update(self.scenario.component(component).parameters)
+        return values
+
+
+def resolve_fmu_paths(scenario: Scenario, fmu_dir: str | Path | None = None) -> dict[str, Path]:
+    """Absolute FMU path of every component.
+
+    Raises
+    ------
+    ScenarioError
+        ``components.<name>.fmu`` when the file is found nowhere; the message lists
+        the places searched.
+    """
+    fmu_dir = default_fmu_dir() if fmu_dir is None else Path(fmu_dir)
+    out = {}
+    for comp in scenario.components:
+        candidates = scenario.fmu_candidates(comp, fmu_dir)
+        found = next((p for p in candidates if p.is_file()), None)
+        if found is None:
+            raise ScenarioError(
+                f"components.{comp.name}.fmu", str(comp.fmu),
+                "an existing FMU file (looked in " + ", ".join(str(p.parent) for p in candidates) + ")",
+                scenario.source,
+            )
+        out[comp.name] = found.resolve()
+    return out
+
+
+def parameter_problem(iface: FmuInterface, pname: str) -> str | None:
+    """What a value for variable ``pname`` of an FMU would have to be, or None if it may be set.
+
+    A scenario or a study may give values to parameters and inputs that are not
+    constants; an unknown name gets the closest settable names as a suggestion.
+    """
+    var = iface.variables.get(pname)
+    if var is None:
+        settable = [n for n, v in iface.variables.items() if v.causality in SETTABLE_CAUSALITIES]
+        return f"a parameter of {iface.model_name} ({iface.path.name}){suggestion(pname, settable)}"
+    if var.causality not in SETTABLE_CAUSALITIES or var.variability == "constant":
+        return f"a settable parameter or input; {pname} has causality {var.causality}, variability {var.variability}"
+    return None
+
+
+def _value_matches(var: FmuVariable, value) -> bool:
+    if var.type == "Real":
+        return is_number(value)
+    if var.type in ("Integer", "Enumeration"):
+        return isinstance(value, int) and not isinstance(value, bool)
+    if var.type == "Boolean":
+        return isinstance(value, bool)
+    return isinstance(value, str)
+
+
+def _pattern_regex(pattern: str) -> re.Pattern:
+    """``*`` and ``?`` are wildcards; everything else (dots, brackets) is literal."""
+    return re.compile("".join(".*" if ch == "*" else "." if ch == "?" else re.escape(ch) for ch in pattern) + r"\Z")
+
+
+def _lookup(iface: FmuInterface, ref: VariableRef, key: str, source: str | None, causalities: tuple[str, ...],
+            role: str) -> FmuVariable:
+    var = iface.variables.get(ref.variable)
+    if var is None:
+        names = [n for n, v in iface.variables.items() if v.causality in causalities]
+        raise ScenarioError(key, str(ref), f"{role} of {iface.model_name} ({iface.path.name}){suggestion(ref.variable, names)}", source)
+    if var.causality not in causalities:
+        raise ScenarioError(key, str(ref), f"{role} (causality {' or '.join(causalities)}); {ref.variable} has causality {var.causality}", source)
+    if var.type != "Real":
+        raise ScenarioError(key, str(ref), f"a Real variable; {ref.variable} is {var.type}", source)
+    return var
+
+
+def resolve_system(
+    scenario: Scenario,
+    fmu_dir: str | Path | None = None,
+    fmu_paths: Mapping[str, Path] | None = None,
+) -> ResolvedSystem:
+    """Check a scenario against its FMUs' model descriptions (nothing is instantiated).
+
+    Parameters
+    ----------
+    scenario : Scenario
+    fmu_dir : path, optional
+        Directory searched for relative FMU paths after the scenario's own
+        directory (default :func:`default_fmu_dir`).
+    fmu_paths : mapping of str -> path, optional
+        Already-resolved FMU files (skips the search).
+
+    Raises
+    ------
+    ScenarioError
+        Naming the first offending scenario key.
+    AlgebraicLoopError
+        If the connections close a direct-feedthrough loop.
+    """
+    src = scenario.source
+    paths = dict(fmu_paths) if fmu_paths is not None else resolve_fmu_paths(scenario, fmu_dir)
+    interfaces = {c.name: read_fmu_interface(paths[c.name], f"components.{c.name}.fmu") for c in scenario.components}
+    scenario, events = assign_events(scenario, interfaces)
+
+    connected_inputs = {str(c.target) for c in scenario.connections}
+    for comp in scenario.components:
+        iface = interfaces[comp.name]
+        for pname, value in comp.parameters.items():
+            key = f"components.{comp.name}.parameters.{pname}"
+            problem = parameter_problem(iface, pname)
+            if problem is not None:
+                raise ScenarioError(key, value, problem, src)
+            var = iface.variables[pname]
+            if f"{comp.name}.{pname}" in connected_inputs:
+                raise ScenarioError(key, value, "no value for an input that a connection drives", src)
+            if not _value_matches(var, value):
+                raise ScenarioError(key, value, f"a {var.type} value for {pname}", src)
+
+    for i, con in enumerate(scenario.connections):
+        _lookup(interfaces[con.source.component], con.source, f"connections[{i}].from", src, READABLE_CAUSALITIES, "an output")
+        _lookup(interfaces[con.target.component], con.target, f"connections[{i}].to", src, ("input",), "an input")
+    for i, b in enumerate(scenario.initial):
+        _lookup(interfaces[b.source.component], b.source, f"initial[{i}].from", src, READABLE_CAUSALITIES, "an output")
+        var = _lookup(interfaces[b.target.component], b.target, f"initial[{i}].to", src, SETTABLE_CAUSALITIES, "a parameter or input")
+        if var.variability == "constant":
+            raise ScenarioError(f"initial[{i}].to", str(b.target), "a settable (fixed or tunable) parameter", src)
+
+    recorded = _resolve_record(scenario, interfaces)
+
+    feedthrough: dict[str, list[str]] = {}
+    for name, iface in interfaces.items():
+        for out in iface.outputs:
+            for inp in iface.direct_inputs_of(out):
+                feedthrough.setdefault(f"{name}.{inp}", []).append(f"{name}.{out}")
+    loop = find_algebraic_loop(((str(c.source), str(c.target)) for c in scenario.connections), feedthrough)
+    if loop is not None:
+        raise AlgebraicLoopError(loop, src)
+
+    names = scenario.component_names
+    edges = [(c.source.component, c.target.component) for c in scenario.connections]
+    order = tuple(scenario.simulation.order) if scenario.simulation.order else tuple(stepping_order(names, edges))
+    init_edges = edges + [(b.source.component, b.target.component) for b in scenario.initial]
+    init_order = tuple(initialization_order(names, init_edges))
+    return ResolvedSystem(
+        scenario=scenario,
+        fmu_paths=paths,
+        interfaces=interfaces,
+        order=order,
+        init_order=init_order,
+        recorded=recorded,
+        events=events,
+    )
+
+
+def _resolve_record(scenario: Scenario, interfaces: Mapping[str, FmuInterface]) -> tuple[RecordedVariable, ...]:
+    src = scenario.source
+    out: list[RecordedVariable] = []
+    seen: set[tuple[str, str]] = set()
+
+    def add(comp: str, var: FmuVariable) -> None:
+        if (comp, var.name) not in seen:
+            seen.add((comp, var.name))
+            out.append(RecordedVariable(comp, var.name, var.value_reference, var.unit))
+
+    if not scenario.record:
+        for comp in scenario.component_names:
+            for name in interfaces[comp].outputs:
+                var = interfaces[comp].variables[name]
+                if var.type == "Real":
+                    add(comp, var)
+        return tuple(out)
+    for i, pattern in enumerate(scenario.record):
+        key = f"record.variables[{i}]"
+        ref = VariableRef.parse(pattern, key, src)
+        comp_rx = _pattern_regex(ref.component)
+        var_rx = _pattern_regex(ref.variable)
+        matched = 0
+        for comp in scenario.component_names:
+            if not comp_rx.match(comp):
+                continue
+            iface = interfaces[comp]
+            exact = iface.variables.get(ref.variable)
+            candidates = [exact] if exact is not None else [v for n, v in iface.variables.items() if var_rx.match(n)]
+            for var in candidates:
+                if var.type != "Real":
+                    if exact is not None:
+                        raise ScenarioError(key, pattern, f"a Real variable; {var.name} is {var.type}", src)
+                    continue
+                add(comp, var)
+                matched += 1
+        if not matched:
+            comp = ref.component if ref.component in interfaces else None
+            hint = suggestion(ref.variable, interfaces[comp].variables) if comp else ""
+            raise ScenarioError(key, pattern, f"a name or pattern matching at least one Real variable{hint}", src)
+    return tuple(out)

@@ -1,0 +1,85 @@
+"""The user's input files: reading TOML, the packaged files, finding a file by path or name.
+
+Scenarios (:mod:`orchestrator.inputs.scenario`) and studies (:mod:`orchestrator.inputs.study`)
+are both TOML files that may also be named by the stem of a file shipped in a
+folder of this package; every failure is the caller's :class:`EntryError`
+subclass, raised before anything runs.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from ..errors import EntryError
+
+#: the package whose data folders (``scenarios/``, ``studies/``) hold the packaged input files
+DATA_PACKAGE = "orchestrator"
+
+
+def read_toml(path: str | Path, error: type[EntryError]) -> dict[str, Any]:
+    """The parsed TOML file at ``path``.
+
+    Raises
+    ------
+    EntryError
+        ``error`` with key ``(file)`` if the file cannot be read, ``(syntax)`` if it is
+        not valid TOML.
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise error("(file)", str(path), f"a readable {error.kind} file ({exc.strerror})") from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise error("(syntax)", str(path), f"valid TOML ({exc})") from None
+
+
+def packaged_files(folder: str) -> dict[str, Path]:
+    """The TOML files shipped in the data folder ``<folder>`` of :data:`DATA_PACKAGE`, by stem (e.g. ``"paper-60s"``)."""
+    root = Path(str(resources.files(DATA_PACKAGE) / folder))
+    return {p.stem: p for p in sorted(root.glob("*.toml"))}
+
+
+def find_input_file(
+    spec: str | Path,
+    folder: str,
+    error: type[EntryError],
+    suffixes: tuple[str, ...] = (".toml",),
+    directories: bool = False,
+    described: str | None = None,
+    plural: str | None = None,
+) -> Path:
+    """A file from a path, or the packaged file of that name.
+
+    Parameters
+    ----------
+    spec : str or pathlib.Path
+        A path (recognised by one of ``suffixes`` or by existing) or a packaged name.
+    folder : str
+        Folder of the packaged files (see :func:`packaged_files`).
+    error : type of EntryError
+        Raised, with key ``(file)`` or ``(<kind>)``, when nothing is found.
+    suffixes : tuple of str
+        Suffixes that mark ``spec`` as a path even if it does not exist.
+    directories : bool
+        Whether an existing directory is an acceptable path (an unpacked SSP).
+    described, plural : str, optional
+        Wording of the message: ``"a scenario file"``, ``"scenarios"`` (default from ``error.kind``).
+    """
+    kind = error.kind
+    p = Path(spec)
+    if p.suffix in suffixes or p.exists():
+        if not (p.exists() if directories else p.is_file()):
+            raise error("(file)", str(p), f"an existing {kind} file")
+        return p
+    shipped = packaged_files(folder)
+    if str(spec) in shipped:
+        return shipped[str(spec)]
+    described = described or f"a {kind} file"
+    plural = plural or f"{kind}s"
+    raise error(f"({kind})", str(spec), f"{described} or one of the packaged {plural}: " + ", ".join(shipped))

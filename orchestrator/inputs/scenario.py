@@ -1,0 +1,591 @@
+"""System description of a co-simulation scenario, and its TOML format.
+
+A :class:`Scenario` says which FMUs take part (with parameter values), how their
+variables are connected, which outputs set which parameters at initialisation,
+how the master steps them and what is recorded. It is a frozen, validated value:
+structural mistakes (unknown key, wrong type, step <= 0, stop <= start, an input
+connected twice, ...) raise :class:`~orchestrator.errors.ScenarioError` naming the
+key when the object is built, before any FMU file is opened. The checks that need
+the FMUs' model descriptions (variable names, causalities, types) are in
+:mod:`orchestrator.cosim.system`; they read XML only and instantiate nothing.
+
+TOML format (units SI; see ``docs/orchestrator.md`` for the full reference)::
+
+    name = "paper-60s"                    # optional, default: file stem
+    description = "..."                   # optional
+
+    [simulation]
+    start = 0.0                           # s, default 0
+    stop = 60.0                           # s, required, > start
+    step = 1e-3                           # s, communication step H, required, > 0
+    output_interval = 1e-3                # s, multiple of step, default step
+    window = [5.0, 60.0]                  # s, analysis window, default [start, stop]
+    algorithm = "gauss-seidel"            # or "jacobi"
+    extrapolation = "hold"                # or "linear"
+    order = ["wind", "gearbox", "generator"]  # optional stepping order
+
+    [components.gearbox]
+    fmu = "Gearbox.fmu"                   # relative to the scenario file or the FMU directory
+    [components.gearbox.parameters]
+    "stage1.k0" = 1.58e10                 # dotted names quoted, or as nested tables
+
+    [[connections]]
+    from = "wind.omega"                   # an output
+    to = "gearbox.omega_rotor"            # an input
+
+    [[initial]]                           # set a parameter from an output at initialisation
+    from = "gearbox.omega_out"
+    to = "generator.omega_start"
+
+    [record]
+    variables = ["wind.omega", "gearbox.stage*.F_sp[1]"]  # names or * / ? patterns
+
+    [[events]]                            # generator load events (orchestrator.inputs.load_events)
+    kind = "grid_fault"                   # torque_step | grid_fault | emergency_stop
+    start = 10.0                          # s
+    duration = 0.5                        # s
+
+    [analysis]                            # result analyses (orchestrator.inputs.analysis_settings)
+    woehler_exponents = [3, 5, 8, 10]
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any, Mapping
+
+from components.validation import is_number
+
+from ..errors import ScenarioError
+from ..frozen_map import FrozenMap
+from .analysis_settings import AnalysisSettings
+from .files import find_input_file, packaged_files, read_toml
+from .load_events import ScenarioEvent, check_events_in_run, events_from_toml
+
+ALGORITHMS = ("gauss-seidel", "jacobi")
+EXTRAPOLATIONS = ("hold", "linear")
+
+#: parameter values a scenario may give (FMI Real, Integer, Boolean, String)
+ParameterValue = float | int | bool | str
+
+_NAME_RE = re.compile(r"^[A-Za-z_][A-Za-z0-9_\-]*$")
+#: relative tolerance when checking that times are whole multiples of the step
+_MULTIPLE_RTOL = 1e-9
+
+
+def steps_between(duration_s: float, step_s: float) -> int | None:
+    """``duration / step`` if it is a whole number (relative tolerance 1e-9), else None."""
+    ratio = duration_s / step_s
+    n = round(ratio)
+    if n >= 0 and abs(ratio - n) <= _MULTIPLE_RTOL * max(1.0, abs(ratio)):
+        return int(n)
+    return None
+
+
+@dataclass(frozen=True)
+class VariableRef:
+    """A variable of one component, written ``"component.variable"`` in a scenario.
+
+    The component name is the part before the first dot; the variable name (which
+    may itself contain dots and brackets, e.g. ``stage1.F_sp[1]``) is the rest.
+    """
+
+    component: str
+    variable: str
+
+    @classmethod
+    def parse(cls, text: Any, key: str, source: str | None = None) -> "VariableRef":
+        """Parse ``"component.variable"``; a malformed value raises ScenarioError naming ``key``."""
+        if not isinstance(text, str):
+            raise ScenarioError(key, text, 'a string "component.variable"', source)
+        comp, dot, var = text.partition(".")
+        if not dot or not comp or not var or not _NAME_RE.match(comp):
+            raise ScenarioError(key, text, 'a string "component.variable"', source)
+        return cls(comp, var)
+
+    def __str__(self) -> str:
+        return f"{self.component}.{self.variable}"
+
+
+@dataclass(frozen=True)
+class Component:
+    """One FMU instance of the system.
+
+    Parameters
+    ----------
+    name : str
+        Instance name (letters, digits, ``_``, ``-``; no dots).
+    fmu : pathlib.Path
+        FMU file as written in the scenario (may be relative, see
+        :meth:`Scenario.fmu_candidates`).
+    parameters : mapping of str -> float, int, bool or str
+        Start values of parameters (or unconnected inputs) by FMU variable name.
+    """
+
+    name: str
+    fmu: Path
+    parameters: Mapping[str, ParameterValue] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not _NAME_RE.match(self.name):
+            raise ScenarioError("components", self.name, "a component name of letters, digits, '_' or '-' (no dots)")
+        object.__setattr__(self, "fmu", Path(self.fmu))
+        params = dict(self.parameters)
+        for pname, value in params.items():
+            if not isinstance(value, (int, float, bool, str)):
+                raise ScenarioError(f"components.{self.name}.parameters.{pname}", value, "a number, boolean or string")
+        object.__setattr__(self, "parameters", FrozenMap(params))
+
+
+@dataclass(frozen=True)
+class Connection:
+    """Output ``source`` drives input ``target`` at every communication step."""
+
+    source: VariableRef
+    target: VariableRef
+
+    def __str__(self) -> str:
+        return f"{self.source} -> {self.target}"
+
+
+@dataclass(frozen=True)
+class InitialBinding:
+    """Parameter (or input) ``target`` is set from output ``source`` during initialisation.
+
+    Example: the generator's initial speed from the gearbox's output speed, which
+    itself follows from the rotor speed at t = start.
+    """
+
+    source: VariableRef
+    target: VariableRef
+
+    def __str__(self) -> str:
+        return f"{self.source} => {self.target}"
+
+
+@dataclass(frozen=True)
+class SimulationSettings:
+    """Time grid and master algorithm.
+
+    Parameters
+    ----------
+    stop_s : float
+        Stop time [s] (> start, a whole number of steps after it).
+    step_s : float
+        Communication step H [s] (> 0).
+    start_s : float
+        Start time [s].
+    output_interval_s : float, optional
+        Sampling interval of the recorded variables [s], a whole multiple of the
+        step; default: the step.
+    window_s : (float, float), optional
+        Analysis window of the statistics [s]; default ``(start, stop)``.
+    algorithm : {"gauss-seidel", "jacobi"}
+        Master algorithm.
+    extrapolation : {"hold", "linear"}
+        How coupled inputs are formed from the sources' samples (see
+        :mod:`orchestrator.cosim.master`).
+    order : tuple of str, optional
+        Stepping order of the components; default from the connection graph.
+    """
+
+    stop_s: float
+    step_s: float
+    start_s: float = 0.0
+    output_interval_s: float | None = None
+    window_s: tuple[float, float] | None = None
+    algorithm: str = "gauss-seidel"
+    extrapolation: str = "hold"
+    order: tuple[str, ...] | None = None
+
+    def __post_init__(self) -> None:
+        for key, value in (("simulation.start", self.start_s), ("simulation.stop", self.stop_s), ("simulation.step", self.step_s)):
+            if not is_number(value) or not math.isfinite(value):
+                raise ScenarioError(key, value, "a finite number [s]")
+        start, stop, step = float(self.start_s), float(self.stop_s), float(self.step_s)
+        if not step > 0.0:
+            raise ScenarioError("simulation.step", self.step_s, "> 0 s")
+        if not stop > start:
+            raise ScenarioError("simulation.stop", self.stop_s, f"> simulation.start = {start:g} s")
+        if steps_between(stop - start, step) is None:
+            raise ScenarioError("simulation.step", self.step_s, f"a step that divides stop - start = {stop - start:g} s into whole steps")
+        out = step if self.output_interval_s is None else self.output_interval_s
+        if not is_number(out) or not math.isfinite(out) or not out > 0:
+            raise ScenarioError("simulation.output_interval", self.output_interval_s, "a number > 0 [s]")
+        if steps_between(float(out), step) in (None, 0):
+            raise ScenarioError("simulation.output_interval", self.output_interval_s, f"a whole multiple of the step {step:g} s")
+        window = (start, stop) if self.window_s is None else self.window_s
+        if (not isinstance(window, (tuple, list)) or len(window) != 2 or not all(is_number(w) for w in window)):
+            raise ScenarioError("simulation.window", self.window_s, "[begin, end] in seconds")
+        w0, w1 = float(window[0]), float(window[1])
+        if not (start <= w0 < w1 <= stop):
+            raise ScenarioError("simulation.window", list(window), f"start <= begin < end <= stop, i.e. within [{start:g}, {stop:g}] s")
+        if self.algorithm not in ALGORITHMS:
+            raise ScenarioError("simulation.algorithm", self.algorithm, "one of " + ", ".join(ALGORITHMS))
+        if self.extrapolation not in EXTRAPOLATIONS:
+            raise ScenarioError("simulation.extrapolation", self.extrapolation, "one of " + ", ".join(EXTRAPOLATIONS))
+        order = None if self.order is None else tuple(self.order)
+        if order is not None and not all(isinstance(o, str) for o in order):
+            raise ScenarioError("simulation.order", self.order, "a list of component names")
+        object.__setattr__(self, "start_s", start)
+        object.__setattr__(self, "stop_s", stop)
+        object.__setattr__(self, "step_s", step)
+        object.__setattr__(self, "output_interval_s", float(out))
+        object.__setattr__(self, "window_s", (w0, w1))
+        object.__setattr__(self, "order", order)
+
+    @property
+    def n_steps(self) -> int:
+        """Number of communication steps from start to stop."""
+        return steps_between(self.stop_s - self.start_s, self.step_s)
+
+    @property
+    def output_stride(self) -> int:
+        """Communication steps per recorded sample."""
+        return steps_between(self.output_interval_s, self.step_s)
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A complete, structurally valid co-simulation scenario.
+
+    Parameters
+    ----------
+    name : str
+        Scenario name (names the results directory).
+    components : tuple of Component
+        FMU instances, in declaration order.
+    connections : tuple of Connection
+        Output -> input couplings.
+    simulation : SimulationSettings
+        Time grid and master options.
+    initial : tuple of InitialBinding
+        Output -> parameter assignments made during initialisation.
+    record : tuple of str
+        Recorded variables: ``"component.name"`` or ``"component.pattern"`` with
+        ``*``/``?`` wildcards; empty means every output of every component.
+    description : str
+        Free text.
+    base_dir : pathlib.Path, optional
+        Directory relative FMU paths are resolved against first (the scenario
+        file's directory).
+    source : str, optional
+        File the scenario was read from (used in error messages).
+    events : tuple of ScenarioEvent
+        Generator load events (``[[events]]``); each must start inside the run.
+    analysis : AnalysisSettings
+        Settings of the result analyses (``[analysis]``).
+    """
+
+    name: str
+    components: tuple[Component, ...]
+    connections: tuple[Connection, ...]
+    simulation: SimulationSettings
+    initial: tuple[InitialBinding, ...] = ()
+    record: tuple[str, ...] = ()
+    description: str = ""
+    base_dir: Path | None = None
+    source: str | None = None
+    events: tuple[ScenarioEvent, ...] = ()
+    analysis: AnalysisSettings = field(default_factory=AnalysisSettings)
+
+    def __post_init__(self) -> None:
+        src = self.source
+        if not isinstance(self.name, str) or not _NAME_RE.match(self.name):
+            raise ScenarioError("name", self.name, "a name of letters, digits, '_' or '-'", src)
+        object.__setattr__(self, "components", tuple(self.components))
+        object.__setattr__(self, "connections", tuple(self.connections))
+        object.__setattr__(self, "initial", tuple(self.initial))
+        object.__setattr__(self, "record", tuple(self.record))
+        if not self.components:
+            raise ScenarioError("components", {}, "at least one component", src)
+        names = [c.name for c in self.components]
+        dup = sorted({n for n in names if names.count(n) > 1})
+        if dup:
+            raise ScenarioError(f"components.{dup[0]}", dup[0], "unique component names", src)
+        known = set(names)
+        driven: dict[str, str] = {}
+        for i, con in enumerate(self.connections):
+            for end, ref in (("from", con.source), ("to", con.target)):
+                if ref.component not in known:
+                    raise ScenarioError(f"connections[{i}].{end}", str(ref), "a variable of a declared component: " + ", ".join(names), src)
+            if con.source.component == con.target.component:
+                raise ScenarioError(f"connections[{i}].to", str(con.target), f"a variable of another component than {con.source.component!r}", src)
+            tgt = str(con.target)
+            if tgt in driven:
+                raise ScenarioError(f"connections[{i}].to", tgt, f"an input connected once (already driven by {driven[tgt]})", src)
+            driven[tgt] = str(con.source)
+        set_initially: dict[str, int] = {}
+        for i, b in enumerate(self.initial):
+            for end, ref in (("from", b.source), ("to", b.target)):
+                if ref.component not in known:
+                    raise ScenarioError(f"initial[{i}].{end}", str(ref), "a variable of a declared component: " + ", ".join(names), src)
+            tgt = str(b.target)
+            if tgt in driven:
+                raise ScenarioError(f"initial[{i}].to", tgt, f"a variable not also driven by a connection (from {driven[tgt]})", src)
+            if tgt in set_initially:
+                raise ScenarioError(f"initial[{i}].to", tgt, f"a variable set once (already by initial[{set_initially[tgt]}])", src)
+            comp = next(c for c in self.components if c.name == b.target.component)
+            if b.target.variable in comp.parameters:
+                raise ScenarioError(f"initial[{i}].to", tgt, f"a variable without a value in components.{comp.name}.parameters", src)
+            set_initially[tgt] = i
+        for i, pattern in enumerate(self.record):
+            ref = VariableRef.parse(pattern, f"record.variables[{i}]", src)
+            if ref.component not in known and not any(ch in ref.component for ch in "*?"):
+                raise ScenarioError(f"record.variables[{i}]", pattern, "a variable of a declared component: " + ", ".join(names), src)
+        order = self.simulation.order
+        if order is not None and sorted(order) != sorted(names):
+            raise ScenarioError("simulation.order", list(order), "each component exactly once: " + ", ".join(names), src)
+        object.__setattr__(self, "events", tuple(self.events))
+        for i, ev in enumerate(self.events):
+            if not isinstance(ev, ScenarioEvent):
+                raise ScenarioError(f"events[{i}]", ev, "a ScenarioEvent", src)
+        check_events_in_run(self.events, self.simulation.start_s, self.simulation.stop_s, names, src)
+        if not isinstance(self.analysis, AnalysisSettings):
+            raise ScenarioError("analysis", self.analysis, "an AnalysisSettings", src)
+
+    # ------------------------------------------------------------------ access
+    def component(self, name: str) -> Component:
+        """The component called ``name``."""
+        for c in self.components:
+            if c.name == name:
+                return c
+        raise KeyError(name)
+
+    @property
+    def component_names(self) -> list[str]:
+        """Component names in declaration order."""
+        return [c.name for c in self.components]
+
+    def with_simulation(self, **changes) -> "Scenario":
+        """Copy with some :class:`SimulationSettings` fields replaced (validated again)."""
+        return replace(self, simulation=replace(self.simulation, **changes))
+
+    def with_parameters(self, component: str, **values: ParameterValue) -> "Scenario":
+        """Copy with parameter values of one component added or replaced."""
+        comps = tuple(
+            replace(c, parameters={**c.parameters, **values}) if c.name == component else c for c in self.components
+        )
+        if component not in self.component_names:
+            raise ScenarioError("components", component, "a declared component: " + ", ".join(self.component_names), self.source)
+        return replace(self, components=comps)
+
+    def fmu_candidates(self, component: Component, fmu_dir: Path | None) -> list[Path]:
+        """Where the component's FMU is looked for, in order.
+
+        An absolute path is used as is; a relative one is tried against the
+        scenario's directory, then the FMU directory.
+        """
+        if component.fmu.is_absolute():
+            return [component.fmu]
+        out = []
+        if self.base_dir is not None:
+            out.append(self.base_dir / component.fmu)
+        if fmu_dir is not None:
+            out.append(Path(fmu_dir) / component.fmu)
+        if not out:
+            out.append(Path.cwd() / component.fmu)
+        return out
+
+
+# ---------------------------------------------------------------------- TOML
+_TOP_KEYS = {"name", "description", "simulation", "components", "connections", "initial", "record", "events", "analysis"}
+_SIM_KEYS = {
+    "start": "start_s",
+    "stop": "stop_s",
+    "step": "step_s",
+    "output_interval": "output_interval_s",
+    "window": "window_s",
+    "algorithm": "algorithm",
+    "extrapolation": "extrapolation",
+    "order": "order",
+}
+_COMPONENT_KEYS = {"fmu", "parameters"}
+_LINK_KEYS = {"from", "to"}
+_RECORD_KEYS = {"variables"}
+
+
+def _check_keys(table: Mapping[str, Any], allowed: set[str], prefix: str, source: str | None) -> None:
+    for key in table:
+        if key not in allowed:
+            where = f"{prefix}.{key}" if prefix else key
+            raise ScenarioError(where, table[key], "a known key here: " + ", ".join(sorted(allowed)), source)
+
+
+def _require(table: Mapping[str, Any], key: str, kind: type | tuple, what: str, path: str, source: str | None):
+    if key not in table:
+        raise ScenarioError(path, None, f"{what} (missing)", source)
+    value = table[key]
+    if not isinstance(value, kind) or (isinstance(value, bool) and bool not in (kind if isinstance(kind, tuple) else (kind,))):
+        raise ScenarioError(path, value, what, source)
+    return value
+
+
+def _flatten_parameters(table: Mapping[str, Any], prefix: str, path: str, source: str | None) -> dict[str, ParameterValue]:
+    """Nested TOML tables -> dotted parameter names (``stage1 = {k0 = 1}`` -> ``stage1.k0``)."""
+    out: dict[str, ParameterValue] = {}
+    for key, value in table.items():
+        name = f"{prefix}.{key}" if prefix else key
+        if isinstance(value, dict):
+            out.update(_flatten_parameters(value, name, path, source))
+        elif isinstance(value, (bool, int, float, str)):
+            out[name] = value
+        else:
+            raise ScenarioError(f"{path}.{name}", value, "a number, boolean or string", source)
+    return out
+
+
+def scenario_from_dict(data: Mapping[str, Any], name: str | None = None, base_dir: Path | None = None,
+                       source: str | None = None) -> Scenario:
+    """Build a :class:`Scenario` from parsed TOML (or an equivalent dict).
+
+    Parameters
+    ----------
+    data : mapping
+        The document (see the module docstring for the keys).
+    name : str, optional
+        Name used when the document has none.
+    base_dir : pathlib.Path, optional
+        Directory relative FMU paths are resolved against.
+    source : str, optional
+        File name for error messages.
+
+    Raises
+    ------
+    ScenarioError
+        Naming the first offending key.
+    """
+    if not isinstance(data, Mapping):
+        raise ScenarioError("(document)", data, "a table", source)
+    _check_keys(data, _TOP_KEYS, "", source)
+    sc_name = data.get("name", name)
+    if sc_name is None:
+        raise ScenarioError("name", None, "a scenario name (missing)", source)
+    if not isinstance(sc_name, str):
+        raise ScenarioError("name", sc_name, "a string", source)
+    description = data.get("description", "")
+    if not isinstance(description, str):
+        raise ScenarioError("description", description, "a string", source)
+
+    sim = _require(data, "simulation", dict, "a [simulation] table", "simulation", source)
+    _check_keys(sim, set(_SIM_KEYS), "simulation", source)
+    for key in ("stop", "step"):
+        _require(sim, key, (int, float), "a number [s]", f"simulation.{key}", source)
+    kwargs: dict[str, Any] = {}
+    for key, attr in _SIM_KEYS.items():
+        if key not in sim:
+            continue
+        value = sim[key]
+        path = f"simulation.{key}"
+        if key in ("start", "stop", "step", "output_interval"):
+            if not is_number(value):
+                raise ScenarioError(path, value, "a number [s]", source)
+        elif key == "window":
+            if not isinstance(value, list) or len(value) != 2 or not all(is_number(v) for v in value):
+                raise ScenarioError(path, value, "[begin, end] in seconds", source)
+            value = (float(value[0]), float(value[1]))
+        elif key in ("algorithm", "extrapolation"):
+            if not isinstance(value, str):
+                raise ScenarioError(path, value, "a string", source)
+        elif key == "order":
+            if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
+                raise ScenarioError(path, value, "a list of component names", source)
+            value = tuple(value)
+        kwargs[attr] = value
+    try:
+        settings = SimulationSettings(**kwargs)
+    except ScenarioError as exc:
+        raise ScenarioError(exc.key, exc.value, exc.expected, source) from None
+
+    comps_table = _require(data, "components", dict, "a [components.<name>] table per FMU", "components", source)
+    components = []
+    for cname, ctab in comps_table.items():
+        path = f"components.{cname}"
+        if not isinstance(ctab, dict):
+            raise ScenarioError(path, ctab, "a table with fmu = ... and optional parameters", source)
+        _check_keys(ctab, _COMPONENT_KEYS, path, source)
+        fmu = _require(ctab, "fmu", str, "an FMU file name (string)", f"{path}.fmu", source)
+        params = ctab.get("parameters", {})
+        if not isinstance(params, dict):
+            raise ScenarioError(f"{path}.parameters", params, "a table of parameter values", source)
+        try:
+            components.append(Component(cname, Path(fmu), _flatten_parameters(params, "", f"{path}.parameters", source)))
+        except ScenarioError as exc:
+            key = path if exc.key == "components" else exc.key
+            raise ScenarioError(key, exc.value, exc.expected, source) from None
+
+    def links(key: str, cls):
+        items = data.get(key, [])
+        if not isinstance(items, list):
+            raise ScenarioError(key, items, f"an array of tables [[{key}]] with from/to", source)
+        out = []
+        for i, item in enumerate(items):
+            path = f"{key}[{i}]"
+            if not isinstance(item, dict):
+                raise ScenarioError(path, item, "a table with from = ... and to = ...", source)
+            _check_keys(item, _LINK_KEYS, path, source)
+            src = VariableRef.parse(_require(item, "from", str, '"component.variable"', f"{path}.from", source), f"{path}.from", source)
+            dst = VariableRef.parse(_require(item, "to", str, '"component.variable"', f"{path}.to", source), f"{path}.to", source)
+            out.append(cls(src, dst))
+        return tuple(out)
+
+    connections = links("connections", Connection)
+    initial = links("initial", InitialBinding)
+
+    record: tuple[str, ...] = ()
+    if "record" in data:
+        rec = data["record"]
+        if not isinstance(rec, dict):
+            raise ScenarioError("record", rec, "a [record] table with variables = [...]", source)
+        _check_keys(rec, _RECORD_KEYS, "record", source)
+        variables = rec.get("variables", [])
+        if not isinstance(variables, list) or not all(isinstance(v, str) for v in variables):
+            raise ScenarioError("record.variables", variables, 'a list of "component.variable" strings', source)
+        record = tuple(variables)
+
+    events = events_from_toml(data["events"], source) if "events" in data else ()
+    analysis = AnalysisSettings.from_toml(data["analysis"], source) if "analysis" in data else AnalysisSettings()
+
+    return Scenario(
+        name=sc_name,
+        description=description,
+        components=tuple(components),
+        connections=connections,
+        initial=initial,
+        simulation=settings,
+        record=record,
+        events=events,
+        analysis=analysis,
+        base_dir=base_dir,
+        source=source,
+    )
+
+
+def load_scenario(path: str | Path) -> Scenario:
+    """Read and validate a scenario TOML file.
+
+    Relative FMU paths are resolved against the file's directory first (see
+    :meth:`Scenario.fmu_candidates`).
+
+    Raises
+    ------
+    ScenarioError
+        On a missing/unreadable file, a TOML syntax error, or any invalid entry.
+    """
+    path = Path(path)
+    data = read_toml(path, ScenarioError)
+    return scenario_from_dict(data, name=path.stem, base_dir=path.resolve().parent, source=str(path))
+
+
+def packaged_scenarios() -> dict[str, Path]:
+    """Scenario files shipped with dtcosim, by name (e.g. ``"paper-60s"``)."""
+    return packaged_files("scenarios")
+
+
+def find_scenario(spec: str | Path | None) -> Path:
+    """A scenario file from a path or the name of a packaged scenario (default ``paper-60s``)."""
+    return find_input_file("paper-60s" if spec is None else spec, "scenarios", ScenarioError,
+                           suffixes=(".toml", ".ssp", ".ssd"), directories=True)

@@ -1,0 +1,100 @@
+"""Plot helpers shared by every PNG dtcosim writes (matplotlib Agg canvas, no pyplot global state).
+
+Figures, envelopes of long curves (every extreme kept), backlash shading and the
+names of contact-force kinds; the plots themselves live with their owners
+(:mod:`orchestrator.run.plots`, :mod:`orchestrator.run.analysis_plots`,
+:mod:`orchestrator.reports`, :mod:`orchestrator.study.plots`).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+
+RPM_PER_RAD_S = 60.0 / (2.0 * math.pi)
+
+
+#: above this many samples a curve is drawn as its min/max envelope over this many bins
+ENVELOPE_BINS = 2000
+
+
+FORCE_KIND_LABELS = {"sp": "sun-planet", "rp": "ring-planet", "mesh": "mesh"}
+
+
+#: contact-force variable names: stage, kind (sp, rp, mesh), planet
+FORCE_NAME_RE = re.compile(r"^(stage\d+)\.F_(sp|rp|mesh)(?:\[(\d+)\])?$")
+
+
+def envelope(t: np.ndarray, y: np.ndarray, bins: int = ENVELOPE_BINS) -> tuple[np.ndarray, np.ndarray]:
+    """A curve reduced to the minimum and maximum of each of ``bins`` time bins, in time order.
+
+    Drawing 2 x ``bins`` points instead of every sample is much faster and looks the
+    same at screen resolution: every extreme is kept. Curves with fewer than
+    4 x ``bins`` samples are returned unchanged.
+    """
+    n = t.size
+    if n < 4 * bins:
+        return t, y
+    per = n // bins
+    m = per * bins
+    tb = t[:m].reshape(bins, per)
+    yb = y[:m].reshape(bins, per)
+    i_min = np.argmin(yb, axis=1)
+    i_max = np.argmax(yb, axis=1)
+    first = np.minimum(i_min, i_max)
+    second = np.maximum(i_min, i_max)
+    rows = np.arange(bins)
+    tt = np.column_stack([tb[rows, first], tb[rows, second]]).ravel()
+    yy = np.column_stack([yb[rows, first], yb[rows, second]]).ravel()
+    if m < n:
+        tt = np.append(tt, t[m:])
+        yy = np.append(yy, y[m:])
+    return tt, yy
+
+
+def plot_envelope(ax, t, y, **kwargs) -> None:
+    """``ax.plot`` of a long curve as its :func:`envelope` (every extreme kept)."""
+    ax.plot(*envelope(t, y), **kwargs)
+
+
+def shade_inside_backlash(ax, t: np.ndarray, force: np.ndarray, threshold_n: float, label: str | None = None) -> None:
+    """Shade the full height of ``ax`` wherever ``|force| < threshold_n`` (teeth inside the backlash).
+
+    ``t`` [s] and ``force`` [N] at full resolution; ``label`` (default ``inside the
+    backlash (|F| < ... N)``) goes into the legend only if something is shaded.
+    """
+    inside = np.abs(force) < threshold_n
+    if inside.any():
+        ax.fill_between(t, 0, 1, where=inside, transform=ax.get_xaxis_transform(), color="tab:red", alpha=0.35,
+                        lw=0, label=label or f"inside the backlash (|F| < {threshold_n:g} N)")
+
+
+def new_figure(rows: int = 1, height: float = 4.0, sharex: bool = True, width: float = 10.0):
+    """A headless figure of ``rows`` stacked axes, ``width`` x ``height`` inches: (figure, axes array)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(width, height), dpi=110, layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(rows, 1, sharex=sharex, squeeze=False)[:, 0]
+    return fig, axes
+
+
+def save_figure(fig, path: Path) -> Path:
+    """Write the figure as PNG; returns ``path``."""
+    fig.savefig(path)
+    return path
+
+
+def close_figure(fig, path: str | Path) -> Path:
+    """Write a pyplot figure as PNG (tight bounding box, 120 dpi), close it and return ``path``."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=120, bbox_inches="tight")
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
+    return path

@@ -1,0 +1,155 @@
+"""PNG plots of a run's analyses: contact-force spectra, load duration distributions, load events.
+
+matplotlib with the Agg backend (no display needed). Every function takes the
+plain result objects of :mod:`components.analysis.fatigue` and
+:mod:`components.analysis.spectrum` (or arrays) and a path, writes one PNG and returns the path.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Mapping, Sequence
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from components.analysis.fatigue import LoadDurationDistribution  # noqa: E402
+from components.analysis.spectrum import amplitude_spectrum  # noqa: E402
+
+from ..plotting import close_figure, shade_inside_backlash  # noqa: E402
+
+
+def plot_force_spectra(
+    time_s: np.ndarray,
+    series: Mapping[str, np.ndarray],
+    path: str | Path,
+    mesh_frequencies_hz: Mapping[str, float] | None = None,
+    window: tuple[float, float] | None = None,
+    max_frequency_hz: float | None = None,
+) -> Path:
+    """Amplitude spectra (Hann window) of contact forces, with the mesh frequencies marked.
+
+    Parameters
+    ----------
+    time_s : ndarray, shape (N,)
+        Uniform sample times [s].
+    series : mapping name -> ndarray, shape (N,)
+        Contact forces [N] (one panel each).
+    path : str or Path
+    mesh_frequencies_hz : mapping label -> float, optional
+        Vertical markers, e.g. ``{"stage3 mesh": 426.7}``.
+    window : (float, float), optional
+        Analysed window [s].
+    max_frequency_hz : float, optional
+        Upper frequency limit of the plot.
+    """
+    t = np.asarray(time_s, dtype=float)
+    sel = np.ones(t.size, bool) if window is None else (t >= window[0]) & (t <= window[1])
+    dt = float(np.median(np.diff(t[sel])))
+    fig, axes = plt.subplots(len(series), 1, figsize=(10, 2.6 * len(series)), squeeze=False)
+    cmap = plt.get_cmap("tab10")
+    for ax, (name, x) in zip(axes[:, 0], series.items()):
+        f, amp = amplitude_spectrum(np.asarray(x)[sel], dt)
+        ax.semilogy(f[1:], np.maximum(amp[1:], 1e-12), lw=0.8, color="black")
+        for k, (label, fm) in enumerate((mesh_frequencies_hz or {}).items()):
+            ax.axvline(fm, ls="--", lw=1.0, color=cmap(k % 10), label=f"{label} {fm:.4g} Hz")
+        ax.set_ylabel(f"|{name}| [N]")
+        ax.set_xlim(0.0, max_frequency_hz or f[-1])
+        ax.grid(True, which="both", alpha=0.25)
+        if mesh_frequencies_hz:
+            ax.legend(fontsize=7, loc="upper right")
+    axes[-1, 0].set_xlabel("frequency [Hz]")
+    fig.suptitle(f"Contact-force amplitude spectra (Hann window, {t[sel][-1] - t[sel][0]:.3g} s, "
+                 f"resolution {1.0 / (t[sel][-1] - t[sel][0]):.3g} Hz)", fontsize=10)
+    fig.tight_layout()
+    return close_figure(fig, path)
+
+
+def plot_load_duration(ldds: Sequence[LoadDurationDistribution], path: str | Path) -> Path:
+    """Load duration distributions (time per load bin, log scale), one panel per signal.
+
+    Torques are drawn in kN m (forces in kN); the log time axis shows the rare extreme
+    loads (e.g. of a load event) next to the hours-equivalent of normal operation.
+    """
+    fig, axes = plt.subplots(len(ldds), 1, figsize=(9, 2.5 * len(ldds)), squeeze=False)
+    for ax, ld in zip(axes[:, 0], ldds):
+        scale, unit = (1e-3, "kN m") if ld.unit in ("N.m", "N m") else (1e-3, "kN") if ld.unit == "N" else (1.0, ld.unit)
+        edges = ld.edges * scale
+        centres = 0.5 * (edges[1:] + edges[:-1])
+        keep = ld.time_s > 0.0
+        ax.bar(centres[keep], ld.time_s[keep], width=np.diff(edges)[keep], color="tab:blue", edgecolor="none")
+        ax.set_yscale("log")
+        ax.set_xlim(edges[0], edges[-1])
+        ax.set_xlabel(f"{ld.name} [{unit}]")
+        ax.set_ylabel("time in bin [s]")
+        extra = f", {ld.time_outside_s:.3g} s outside the bins" if ld.time_outside_s > 0 else ""
+        ax.set_title(f"{ld.name}: load duration distribution ({ld.analysed_time_s:.4g} s analysed, "
+                     f"{edges.size - 1} bins of {np.diff(edges).mean():.3g} {unit}{extra})", fontsize=9)
+        ax.grid(True, which="both", alpha=0.25)
+    fig.tight_layout()
+    return close_figure(fig, path)
+
+
+def plot_event_response(
+    time_s: np.ndarray,
+    torques: Mapping[str, np.ndarray],
+    forces: Mapping[str, np.ndarray],
+    events: Sequence[tuple[str, float, float]],
+    path: str | Path,
+    threshold_n: float = 1.0,
+    span: tuple[float, float] | None = None,
+) -> Path:
+    """Drivetrain response to generator load events: torques on top, one contact force per panel below.
+
+    Parameters
+    ----------
+    time_s : ndarray, shape (N,)
+        Sample times [s].
+    torques : mapping name -> ndarray, shape (N,)
+        Torques [N m] drawn in the top panel (e.g. generator counter torque, shaft-3 torque).
+    forces : mapping name -> ndarray, shape (N,)
+        Contact forces [N], one panel each; the time inside the backlash
+        (``|F| < threshold_n``) is shaded red.
+    events : sequence of (label, start [s], end [s])
+        Shaded in every panel (end may be inf).
+    path : str or Path
+    threshold_n : float
+        Contact-loss threshold [N].
+    span : (float, float), optional
+        Time range shown [s]; default from 0.5 s before the first event to 2.5 s after the last end.
+    """
+    t = np.asarray(time_s, dtype=float)
+    if span is None:
+        first = min(e[1] for e in events)
+        last = max(min(e[2], e[1] + 3.0) for e in events)
+        span = (max(t[0], first - 0.5), min(t[-1], last + 2.5))
+    sel = (t >= span[0]) & (t <= span[1])
+    ts = t[sel]
+    n = 1 + len(forces)
+    fig, axes = plt.subplots(n, 1, figsize=(10, 2.3 * n + 0.6), sharex=True, squeeze=False)
+    axes = axes[:, 0]
+    for ax in axes:
+        for k, (label, a, b) in enumerate(events):
+            ax.axvspan(a, min(b, span[1]), color="gold", alpha=0.25, lw=0, label=label if ax is axes[0] else None)
+        ax.grid(True, alpha=0.3)
+    cmap = plt.get_cmap("tab10")
+    for k, (name, y) in enumerate(torques.items()):
+        axes[0].plot(ts, np.asarray(y)[sel] * 1e-3, lw=1.2, color=cmap(k), label=name)
+    axes[0].axhline(0.0, color="black", lw=0.6)
+    axes[0].set_ylabel("torque [kN m]")
+    axes[0].legend(fontsize=7.5, loc="upper right", ncol=2)
+    for ax, (name, y) in zip(axes[1:], forces.items()):
+        f = np.asarray(y)[sel]
+        ax.plot(ts, f * 1e-3, lw=1.0, color="black", label=name)
+        ax.axhline(0.0, color="black", lw=0.6)
+        shade_inside_backlash(ax, ts, f, threshold_n)
+        ax.set_ylabel("force [kN]")
+        ax.legend(fontsize=7.5, loc="upper right")
+    axes[-1].set_xlabel("time [s]")
+    axes[-1].set_xlim(*span)
+    fig.suptitle("Response to generator load events (torques and one contact force per stage)", fontsize=10)
+    fig.tight_layout()
+    return close_figure(fig, path)

@@ -1,0 +1,149 @@
+"""PNG plots of a drivetrain run (matplotlib, Agg canvas; no pyplot global state).
+
+* ``rotor_speed.png`` - rotor speed over time, the wind description (paper Fig. 15);
+* ``generator_speed.png`` - generator speed against the ideal gearbox, ratio x rotor
+  speed, with their relative difference below (Fig. 16);
+* ``contact_forces.png`` - every contact force, one panel per stage (Fig. 17).
+
+A plot is skipped when its variables were not recorded. The analysis window is
+shaded.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..cosim.master import RunOutcome
+from ..cosim.system import ResolvedSystem
+from ..plotting import (
+    FORCE_KIND_LABELS,
+    FORCE_NAME_RE,
+    RPM_PER_RAD_S,
+    new_figure,
+    plot_envelope,
+    save_figure,
+)
+from .derived import GEARBOX, GENERATOR, WIND, generator_vs_ideal, roles
+
+
+def _shade_window(ax, window) -> None:
+    ax.axvspan(window[0], window[1], color="0.93", zorder=0, label=f"analysis window {window[0]:g}-{window[1]:g} s")
+
+
+def plot_rotor_speed(outcome: RunOutcome, column: str, window, path: Path, title_suffix: str = "") -> Path:
+    """Rotor speed [rpm] over time (Fig. 15)."""
+    t = outcome.time_s
+    w = outcome.column(column) * RPM_PER_RAD_S
+    fig, (ax,) = new_figure()
+    _shade_window(ax, window)
+    plot_envelope(ax, t, w, lw=0.8, color="C0", label=f"rotor speed {column}")
+    sel = (t >= window[0]) & (t <= window[1])
+    if sel.any():
+        ax.axhline(w[sel].mean(), color="C3", lw=1.0, ls="--", label=f"mean over window: {w[sel].mean():.4g} rpm")
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("rotor speed [rpm]")
+    ax.set_title("Rotor speed: stochastic wind description, eq. 13-14 (paper Fig. 15)" + title_suffix)
+    ax.grid(True, lw=0.3)
+    ax.legend(loc="best", fontsize=8)
+    ax.set_xlim(t[0], t[-1])
+    return save_figure(fig, path)
+
+
+def plot_generator_speed(outcome: RunOutcome, rotor_column: str, gen_column: str, ratio: float, window,
+                         path: Path, title_suffix: str = "") -> Path:
+    """Generator speed against ratio x rotor speed, and their relative difference (Fig. 16)."""
+    t = outcome.time_s
+    gen = outcome.column(gen_column) * RPM_PER_RAD_S
+    ideal = ratio * outcome.column(rotor_column) * RPM_PER_RAD_S
+    fig, (ax, ax2) = new_figure(2, height=6.0)
+    _shade_window(ax, window)
+    plot_envelope(ax, t, ideal, lw=1.6, color="C1", label=f"ideal gearbox: {ratio:.6g} x rotor speed")
+    plot_envelope(ax, t, gen, lw=0.8, color="C0", label=f"simulated generator speed {gen_column}")
+    ax.set_ylabel("speed [rpm]")
+    ax.set_title("Generator speed vs ideal gearbox (paper Fig. 16)" + title_suffix)
+    ax.grid(True, lw=0.3)
+    ax.legend(loc="best", fontsize=8)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        dev = 100.0 * (gen / ideal - 1.0)
+    _shade_window(ax2, window)
+    plot_envelope(ax2, t, dev, lw=0.7, color="C2", label="generator / ideal - 1")
+    ax2.axhline(0.0, color="0.3", lw=0.6)
+    ax2.set_xlabel("time [s]")
+    ax2.set_ylabel("difference [%]")
+    ax2.grid(True, lw=0.3)
+    ax2.legend(loc="best", fontsize=8)
+    ax2.set_xlim(t[0], t[-1])
+    # scale both panels to the analysis window; a larger start-up transient is clipped
+    sel = (t >= window[0]) & (t <= window[1]) & np.isfinite(dev)
+    if sel.any():
+        for axis, curves in ((ax, (gen, ideal)), (ax2, (dev,))):
+            lo = min(float(np.min(c[sel])) for c in curves)
+            hi = max(float(np.max(c[sel])) for c in curves)
+            pad = 0.15 * (hi - lo) if hi > lo else max(abs(hi), 1e-9) * 0.01
+            full_lo = min(float(np.nanmin(c)) for c in curves)
+            full_hi = max(float(np.nanmax(c)) for c in curves)
+            if full_lo < lo - pad or full_hi > hi + pad:
+                axis.set_ylim(lo - pad, hi + pad)
+                axis.text(0.005, 0.02, "scaled to the analysis window (start-up transient clipped)",
+                          transform=axis.transAxes, fontsize=7, color="0.35")
+    return save_figure(fig, path)
+
+
+def plot_contact_forces(outcome: RunOutcome, gearbox: str, window, path: Path, title_suffix: str = "") -> Path | None:
+    """Every recorded contact force of the gearbox [kN], one panel per stage (Fig. 17)."""
+    prefix = f"{gearbox}."
+    stages: dict[str, list[tuple[str, str, int]]] = {}
+    for i, c in enumerate(outcome.columns):
+        if c.component != gearbox:
+            continue
+        m = FORCE_NAME_RE.match(c.variable)
+        if m:
+            stages.setdefault(m.group(1), []).append((c.variable, m.group(2), i))
+    if not stages:
+        return None
+    names = sorted(stages, key=lambda s: int(s[5:]))
+    fig, axes = new_figure(len(names), height=2.6 * len(names) + 0.8, width=12.5)
+    t = outcome.time_s
+    styles = {"sp": "-", "rp": "--", "mesh": "-"}
+    for ax, stage in zip(axes, names):
+        _shade_window(ax, window)
+        for k, (var, kind, i) in enumerate(stages[stage]):
+            plot_envelope(ax, t, outcome.values[:, i] / 1e3, lw=0.7, ls=styles[kind], color=f"C{k % 10}",
+                  label=f"{var} ({FORCE_KIND_LABELS[kind]})")
+        ax.set_ylabel("force [kN]")
+        ax.set_title(f"{prefix}{stage}", fontsize=10, loc="left")
+        ax.grid(True, lw=0.3)
+        # outside the axes: inside, it hid the peaks of load events and start-up swings
+        ax.legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), fontsize=7, ncol=1, borderaxespad=0.0)
+    axes[-1].set_xlabel("time [s]")
+    axes[-1].set_xlim(t[0], t[-1])
+    fig.suptitle("Gear contact forces of all stages (paper Fig. 17)" + title_suffix)
+    return save_figure(fig, path)
+
+
+def plot_run(system: ResolvedSystem, outcome: RunOutcome, out_dir: str | Path) -> list[Path]:
+    """Write the plots that the recorded variables allow; returns the files written."""
+    out_dir = Path(out_dir)
+    r = roles(system)
+    window = system.scenario.simulation.window_s
+    suffix = "" if outcome.complete else f" - INCOMPLETE, stopped at {outcome.stopped_at_s:g} s"
+    written: list[Path] = []
+    if outcome.time_s.size < 2:
+        return written
+    names = set(outcome.names)
+    rotor = f"{r[WIND]}.omega" if WIND in r else None
+    if rotor in names:
+        written.append(plot_rotor_speed(outcome, rotor, window, out_dir / "rotor_speed.png", suffix))
+    gen = f"{r[GENERATOR]}.omega" if GENERATOR in r else None
+    if rotor in names and gen in names:
+        fig16 = generator_vs_ideal(system, outcome)
+        if fig16 is not None:
+            written.append(plot_generator_speed(outcome, rotor, gen, fig16["ratio"], window,
+                                                out_dir / "generator_speed.png", suffix))
+    if GEARBOX in r:
+        p = plot_contact_forces(outcome, r[GEARBOX], window, out_dir / "contact_forces.png", suffix)
+        if p is not None:
+            written.append(p)
+    return written

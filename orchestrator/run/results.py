@@ -1,0 +1,110 @@
+"""Results of a run on disk: ``timeseries.csv`` and ``summary.json``.
+
+``timeseries.csv``
+    One row per sample: ``time [s]`` and every recorded variable, header
+    ``component.variable [unit]`` with the unit the FMU declares (``[-]`` when it
+    declares none), e.g. ``gearbox.stage1.F_sp[1] [N]``. Written also for an
+    incomplete run (the samples up to where it stopped).
+
+``summary.json``
+    ``scenario``, ``complete``, ``statistics`` (``{"component.variable": {"mean",
+    "std", "min", "max"}}`` over the analysis window), ``window_s``,
+    ``wall_time_s``, ``steps``, the time grid and master options, the generator
+    speed against the ideal gearbox (``generator_vs_ideal``), ``versions``
+    (dtcosim, python, numpy, scipy, fmpy, pythonfmu), ``fmus`` (file, SHA-256,
+    model name, GUID per component), ``stopped_at`` and ``error`` for an
+    incomplete run, ``comparison`` with ``--compare-reference``. Non-finite
+    numbers are written as ``null``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Mapping
+
+from components.reference.results import window_statistics
+
+from ..cosim.master import RunOutcome
+from ..cosim.system import ResolvedSystem
+from ..result_files import jsonable, versions, write_series_csv
+
+TIMESERIES_FILE = "timeseries.csv"
+SUMMARY_FILE = "summary.json"
+
+
+def column_header(component: str, variable: str, unit: str) -> str:
+    """CSV header of a column: ``component.variable [unit]``."""
+    return f"{component}.{variable} [{unit or '-'}]"
+
+
+def write_timeseries(path: str | Path, outcome: RunOutcome) -> Path:
+    """Write the sampled time series as CSV (full double precision, 17 significant digits)."""
+    header = ["time [s]"] + [column_header(c.component, c.variable, c.unit) for c in outcome.columns]
+    return write_series_csv(path, header, outcome.time_s, outcome.values)
+
+
+def statistics(outcome: RunOutcome, window: tuple[float, float]) -> dict[str, dict[str, float]]:
+    """Mean, std, min, max of every recorded variable over ``window`` [s]."""
+    return {c.column: window_statistics(outcome.time_s, outcome.values[:, i], window) for i, c in enumerate(outcome.columns)}
+
+
+def build_summary(system: ResolvedSystem, outcome: RunOutcome, *, wall_time_s: float,
+                  derived: Mapping[str, Any] | None = None, comparison: Mapping[str, Any] | None = None,
+                  files: Mapping[str, str] | None = None) -> dict[str, Any]:
+    """The ``summary.json`` content of a run (see the module docstring)."""
+    sc = system.scenario
+    sim = sc.simulation
+    summary: dict[str, Any] = {
+        "scenario": sc.name,
+        "description": sc.description,
+        "scenario_file": sc.source,
+        "complete": bool(outcome.complete),
+    }
+    if not outcome.complete:
+        summary["stopped_at"] = outcome.stopped_at_s
+        summary["error"] = outcome.error
+        summary["interrupted"] = outcome.interrupted
+    summary.update({
+        "window_s": list(sim.window_s),
+        "statistics": statistics(outcome, sim.window_s),
+        "wall_time_s": wall_time_s,
+        "cosimulation_wall_time_s": outcome.wall_time_s,
+        "loop_time_s": outcome.loop_time_s,
+        "steps": outcome.steps,
+        "step_s": sim.step_s,
+        "start_s": sim.start_s,
+        "stop_s": sim.stop_s,
+        "output_interval_s": sim.output_interval_s,
+        "algorithm": sim.algorithm,
+        "extrapolation": sim.extrapolation,
+        "order": list(system.order),
+        "initial_values": dict(outcome.initial_values),
+    })
+    if derived:
+        summary.update(derived)
+    summary["versions"] = versions()
+    summary["fmus"] = {
+        name: {
+            "file": str(system.fmu_paths[name]),
+            "sha256": iface.sha256,
+            "model_name": iface.model_name,
+            "guid": iface.guid,
+            "generation_tool": iface.generation_tool,
+            "parameters": dict(sc.component(name).parameters),
+        }
+        for name, iface in system.interfaces.items()
+    }
+    if outcome.profile is not None:
+        summary["profile"] = {"seconds_per_fmi_function": outcome.profile, "loop_time_s": outcome.loop_time_s}
+    if files:
+        summary["files"] = dict(files)
+    if comparison is not None:
+        summary["comparison"] = comparison
+    warnings = {name: [m for m in log if m.startswith(("[warning]", "[discard]", "[error]", "[fatal]"))]
+                for name, log in outcome.fmu_log.items()}
+    warnings = {k: v for k, v in warnings.items() if v}
+    if warnings:
+        summary["fmu_messages"] = warnings
+    return jsonable(summary)
+
+

@@ -1,0 +1,132 @@
+"""One scenario run from start to files: co-simulation, results, plots, optional reference.
+
+Used by ``dtcosim run`` and by the tests; everything a run writes goes into one
+output directory (default ``results/<scenario name>/``).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+from ..cosim.master import CoSimulation, RunOutcome
+from ..cosim.system import ResolvedSystem
+from ..inputs.scenario import Scenario, load_scenario
+from ..result_files import write_summary
+from .analyses import analyse_run
+from .comparison import (
+    ReferenceError,
+    compare,
+    format_comparison,
+    monolithic_setup,
+    run_reference,
+)
+from .derived import generator_vs_ideal
+from .plots import plot_run
+from .results import SUMMARY_FILE, TIMESERIES_FILE, build_summary, write_timeseries
+
+
+def load_any(path: str | Path) -> Scenario:
+    """A scenario from a TOML file or an SSP (``.ssp`` archive, ``.ssd`` file or SSP directory)."""
+    p = Path(path)
+    if p.suffix in (".ssp", ".ssd") or (p.is_dir() and (p / "SystemStructure.ssd").is_file()):
+        from ..interop.ssp import import_ssp
+
+        return import_ssp(p)
+    return load_scenario(p)
+
+
+@dataclass
+class RunReport:
+    """What :func:`run_scenario` did.
+
+    Attributes
+    ----------
+    outcome : RunOutcome
+    summary : dict
+        The content of ``summary.json``.
+    files : dict of str -> pathlib.Path
+        Written files by role (``timeseries``, ``summary``, ``plot:<name>``).
+    comparison_text : str
+        The co-simulation vs monolithic table ("" without ``compare_reference``).
+    """
+
+    outcome: RunOutcome
+    summary: dict[str, Any]
+    files: dict[str, Path] = field(default_factory=dict)
+    comparison_text: str = ""
+
+
+def run_scenario(system: ResolvedSystem, out_dir: str | Path, *, compare_reference: bool = False, plots: bool = True,
+                 progress: Callable[[int, int], None] | None = None, handle_sigint: bool = True,
+                 profile: bool = False) -> RunReport:
+    """Run a checked scenario and write ``timeseries.csv``, ``summary.json``, the analyses and the plots.
+
+    The analyses (:func:`orchestrator.run.analyses.analyse_run`: contact loss, fatigue
+    loads, contact-force spectra) add ``contact_loss.csv``, ``fatigue_del.csv``,
+    ``fatigue_ldd.csv`` and their plots.
+
+    Parameters
+    ----------
+    system : ResolvedSystem
+    out_dir : path
+        Created if missing; existing result files are overwritten.
+    compare_reference : bool
+        Also run the monolithic reference on the same scenario and report every
+        statistic of both (``summary.json`` key ``comparison``).
+    plots : bool
+        Write the PNG plots.
+    progress : callable(done, total), optional
+        Progress callback (communication steps).
+    handle_sigint : bool
+        Stop cleanly on Ctrl-C (partial results, ``complete: false``).
+    profile : bool
+        Time every FMI call per FMU (``summary.json`` key ``profile``).
+
+    Returns
+    -------
+    RunReport
+        Results are written also when the run stops early; ``outcome.complete`` tells.
+    """
+    wall0 = time.perf_counter()
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    outcome = CoSimulation(system, profile=profile).run(progress=progress, handle_sigint=handle_sigint)
+    files: dict[str, Path] = {"timeseries": write_timeseries(out / TIMESERIES_FILE, outcome)}
+    derived: dict[str, Any] = {}
+    fig16 = generator_vs_ideal(system, outcome)
+    if fig16 is not None:
+        derived["generator_vs_ideal"] = fig16
+    if system.events:
+        derived["events"] = [a.as_dict() for a in system.events]
+    derived["analysis_settings"] = system.scenario.analysis.as_dict()
+    analyses = analyse_run(system, outcome, out, plots=plots)
+    derived.update(analyses.summary)
+    if analyses.notes:
+        derived["analysis_notes"] = analyses.notes
+    files.update(analyses.files)
+    comparison = None
+    comparison_text = ""
+    if compare_reference:
+        if not outcome.complete:
+            comparison = {"skipped": "the co-simulation did not complete"}
+        else:
+            try:
+                setup = monolithic_setup(system)
+                reference = run_reference(system, setup)
+                comparison = compare(outcome, reference, system, setup)
+                comparison_text = format_comparison(comparison)
+            except ReferenceError as exc:
+                comparison = {"skipped": str(exc)}
+                comparison_text = f"no monolithic comparison: {exc}"
+    if plots:
+        for p in plot_run(system, outcome, out):
+            files[f"plot:{p.stem}"] = p
+    summary = build_summary(
+        system, outcome, wall_time_s=time.perf_counter() - wall0, derived=derived, comparison=comparison,
+        files={k: p.name for k, p in files.items()} | {"summary": SUMMARY_FILE},
+    )
+    files["summary"] = write_summary(out / SUMMARY_FILE, summary)
+    return RunReport(outcome, summary, files, comparison_text)

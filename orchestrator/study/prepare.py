@@ -1,0 +1,394 @@
+"""A study checked against its base, ready to run: the workers' payload and the point keys.
+
+:func:`prepare_study` checks a :class:`~orchestrator.inputs.study.Study` against its
+base (a scenario and its FMUs, or a built-in model) and builds everything the
+workers need (:class:`~orchestrator.study.engine.StudyPayload`); every mistake is
+a :class:`~orchestrator.inputs.study.StudyError` naming the study key, raised before
+anything runs. Checked: every varied or fixed parameter exists (with
+suggestions), is settable and has its FMI type; a built-in model accepts the
+base's values; the time grid; the variables of statistic measures exist (and,
+for the monolithic engine, have a counterpart in the monolithic model); the
+engine computes each measure.
+
+Point identity
+--------------
+A point's key is the SHA-256 of its parameter values, the engine, the base
+(scenario file content and FMU hashes, or the model name), the study's fixed
+parameters, simulation and solver overrides, the measures and the code version
+(the dtcosim version and the Python sources of ``components`` and
+``orchestrator``, without the CLI and the modules that only present results).
+:mod:`orchestrator.study.sweep` skips points whose key the journal already holds.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any, Mapping
+
+from ..errors import ScenarioError, suggestion
+from ..inputs.study import Point, Study, StudyError, split_parameter
+from .engine import StudyPayload
+
+#: modules left out of the code version: they present results, they do not change a point's numbers
+_PRESENTATION_MODULES = ("plots.py", "analysis_plots.py", "study_plots.py", "study_report.py", "modal_report.py",
+                         "journal.py")
+
+
+# ------------------------------------------------------------------ identity
+def code_version() -> str:
+    """SHA-256 (16 hex digits) of the dtcosim version and the ``components`` and ``orchestrator`` sources.
+
+    The CLI commands and the modules that only present results (plots, the
+    table, the journal) are left out: they do not change a point's numbers.
+    """
+    from importlib import metadata
+
+    import components
+
+    h = hashlib.sha256()
+    try:
+        h.update(metadata.version("dtcosim").encode())
+    except metadata.PackageNotFoundError:
+        h.update(b"unknown")
+    for pkg in (Path(components.__file__).parent, Path(__file__).parent):
+        for path in sorted(pkg.glob("*.py")):
+            if path.name in _PRESENTATION_MODULES:
+                continue
+            h.update(f"{pkg.name}/{path.name}\0".encode())
+            h.update(path.read_bytes())
+    return h.hexdigest()[:16]
+
+
+def _canonical(value: Any) -> Any:
+    if isinstance(value, float):
+        return repr(value)
+    if isinstance(value, Mapping):
+        return {str(k): _canonical(v) for k, v in sorted(value.items())}
+    if isinstance(value, (list, tuple)):
+        return [_canonical(v) for v in value]
+    return value
+
+
+def point_key(identity: Mapping[str, Any], point: Point) -> str:
+    """The point's key: SHA-256 (20 hex digits) of the sweep identity and its parameter values."""
+    doc = {"sweep": _canonical(identity), "parameters": _canonical(dict(point.parameters))}
+    return hashlib.sha256(json.dumps(doc, sort_keys=True).encode()).hexdigest()[:20]
+
+
+# --------------------------------------------------------------- preparation
+@dataclass(frozen=True)
+class PreparedStudy:
+    """A study checked against its base, ready to run.
+
+    Attributes
+    ----------
+    study : Study
+    points : tuple of Point
+    keys : tuple of str
+        Key of each point (same order).
+    payload : StudyPayload
+        What the workers share.
+    identity : mapping
+        Everything the keys depend on besides the point's own parameters.
+    fmu_paths : mapping of str -> pathlib.Path
+        The base scenario's FMU files (empty for a built-in model).
+    """
+
+    study: Study
+    points: tuple[Point, ...]
+    keys: tuple[str, ...]
+    payload: StudyPayload
+    identity: Mapping[str, Any]
+    fmu_paths: Mapping[str, Path] = field(default_factory=dict)
+
+
+def _origins(study: Study) -> list[tuple[str, str, list]]:
+    """(study key, parameter, values) of every varied parameter, for error messages."""
+    out = []
+    for i, axis in enumerate(study.axes):
+        for j, p in enumerate(axis.parameters):
+            key = f"axes[{i}].parameter" if len(axis.parameters) == 1 else f"axes[{i}].parameters[{j}]"
+            out.append((key, p, list(axis.values)))
+    for i, pt in enumerate(study.points):
+        for p, v in pt.items():
+            out.append((f"points[{i}].{p}", p, [v]))
+    if study.seeds:
+        out.append(("seeds", study.seed_parameter, list(study.seeds)))
+    return out
+
+
+def _study_key_of(exc: ScenarioError) -> str:
+    """``components.gearbox.parameters.stage1.k0`` -> ``base.parameters.gearbox.stage1.k0``."""
+    parts = exc.key.split(".", 3)
+    if len(parts) == 4 and parts[0] == "components" and parts[2] == "parameters":
+        return f"base.parameters.{parts[1]}.{parts[3]}"
+    return f"base.scenario ({exc.key})"
+
+
+def _simulation_changes(scenario, overrides: Mapping[str, Any]) -> dict[str, Any]:
+    sim = scenario.simulation
+    names = {"start": "start_s", "stop": "stop_s", "step": "step_s", "output_interval": "output_interval_s",
+             "algorithm": "algorithm", "extrapolation": "extrapolation"}
+    changes = {names[k]: v for k, v in overrides.items() if k in names}
+    if "window" in overrides:
+        changes["window_s"] = tuple(float(v) for v in overrides["window"])
+    else:  # clip the base window to a changed time range, as `dtcosim run --stop` does
+        start = changes.get("start_s", sim.start_s)
+        stop = changes.get("stop_s", sim.stop_s)
+        w0, w1 = sim.window_s
+        if not (start <= w0 < w1 <= stop):
+            end = min(w1, stop)
+            changes["window_s"] = (w0 if start <= w0 < end else start, end)
+    if "step" in overrides and "output_interval" not in overrides and sim.output_interval_s < overrides["step"]:
+        changes["output_interval_s"] = overrides["step"]
+    return changes
+
+
+def _check_value(system, name: str, value: Any, key: str, source: str | None) -> None:
+    """A varied scenario parameter exists, is settable, not connected, and the value has its type."""
+    from ..cosim.system import _value_matches, parameter_problem
+
+    comp, param = split_parameter(name)
+    if comp not in system.interfaces:
+        raise StudyError(key, name, "a parameter of a component of the base scenario: " + ", ".join(system.interfaces), source)
+    iface = system.interfaces[comp]
+    problem = parameter_problem(iface, param)
+    if problem is not None:
+        raise StudyError(key, name, problem, source)
+    var = iface.variables[param]
+    if any(str(c.target) == name for c in system.scenario.connections):
+        raise StudyError(key, name, "a parameter, not an input a connection drives", source)
+    if any(str(b.target) == name for b in system.scenario.initial):
+        raise StudyError(key, name, "a parameter the scenario does not set at initialisation (an [[initial]] binding)", source)
+    if not _value_matches(var, value):
+        raise StudyError(key, value, f"a {var.type} value for {name}", source)
+
+
+def _solver_settings(study: Study):
+    from components.errors import ParameterError
+    from components.reference.solver import SolverSettings
+
+    try:
+        return SolverSettings(**study.solver)
+    except ParameterError as exc:
+        raise StudyError(f"solver ({exc.name})", exc.value, exc.expected, study.source) from None
+
+
+def _micro_run_series(drivetrain, driver, start: float) -> list[str]:
+    """Names of the series the monolithic solver records for this model (a 2-sample run)."""
+    from components.reference.solver import simulate_monolithic
+
+    return list(simulate_monolithic(drivetrain, driver, start + 1e-7, output_interval_s=1e-7, t_start_s=start).series)
+
+
+def _check_measure_engines(study: Study) -> None:
+    for i, m in enumerate(study.measures):
+        if study.engine not in m.engines:
+            raise StudyError(f"measures[{i}]", m.name, f"a measure the {study.engine} engine computes "
+                             f"({m.name} needs the {' or '.join(m.engines)} engine)", study.source)
+
+
+def _prepare_model(study: Study) -> tuple[StudyPayload, dict[str, Any]]:
+    from components.errors import ParameterError
+
+    from .models import MODEL_COMPONENT, MODELS
+
+    src = study.source
+    model = MODELS[study.base.name]
+    defaults = model.defaults()
+    checks = [(f"base.parameters.{p}", p, [v]) for p, v in study.base.parameters.items()] + _origins(study)
+    for key, name, values in checks:
+        if name not in defaults:
+            raise StudyError(key, name, f"a parameter of the built-in model {model.name}{suggestion(name, defaults)}", src)
+        for v in values:
+            if isinstance(v, bool) or not isinstance(v, (int, float)):
+                raise StudyError(key, v, f"a number for {name}", src)
+    try:
+        drivetrain, driver = model.build(dict(study.base.parameters))
+    except ParameterError as exc:
+        raise StudyError(f"base.parameters ({exc.name})", exc.value, exc.expected, src) from None
+    sim = study.simulation
+    start = float(sim.get("start", 0.0))
+    stop = float(sim["stop"])
+    interval = float(sim.get("output_interval", 1e-3))
+    if not stop > start:
+        raise StudyError("simulation.stop", sim["stop"], f"> simulation.start = {start:g} s", src)
+    if not 0 < interval <= stop - start:
+        raise StudyError("simulation.output_interval", interval, f"> 0 and <= stop - start = {stop - start:g} s", src)
+    window = tuple(float(w) for w in sim.get("window", (start, stop)))
+    if not start <= window[0] < window[1] <= stop:
+        raise StudyError("simulation.window", list(window), f"start <= begin < end <= stop, within [{start:g}, {stop:g}] s", src)
+    settings = _solver_settings(study)
+    _check_measure_engines(study)
+    series_names = {}
+    stats = [m for m in study.measures if not m.builtin]
+    if stats:
+        names = _micro_run_series(drivetrain, driver, start)
+        for i, m in enumerate(study.measures):
+            if m.builtin:
+                continue
+            comp, var = split_parameter(m.variable)
+            if comp != MODEL_COMPONENT or var not in names:
+                raise StudyError(f"measures[{i}]", m.name, f"a variable {MODEL_COMPONENT}.<series> of the monolithic "
+                                 f"result{suggestion(var, names)}", src)
+            series_names[m.variable] = var
+    payload = StudyPayload(
+        study=study.name, engine="monolithic", measures=study.measures, model=model.name,
+        model_parameters=dict(study.base.parameters), time_grid=(start, stop, interval), window_s=window,
+        solver={k: getattr(settings, k) for k in ("rtol", "atol_angle_rad", "atol_speed_rad_s", "max_step_s", "max_steps")},
+        series_names=series_names,
+    )
+    return payload, {"model": model.name}
+
+
+def _prepare_scenario(study: Study, fmu_dir, build: bool) -> tuple[StudyPayload, dict[str, Any], dict[str, Path]]:
+    from ..cosim.fmu_store import ensure_fmus
+    from ..cosim.system import resolve_system
+    from ..run.runner import load_any
+
+    src = study.source
+    try:
+        scenario = load_any(study.base.path)
+    except ScenarioError as exc:
+        raise StudyError("base.scenario", study.base.name, f"a valid scenario ({exc})", src) from None
+    try:
+        scenario = scenario.with_simulation(**_simulation_changes(scenario, study.simulation))
+    except ScenarioError as exc:
+        key = exc.key if exc.key.startswith("simulation.") else "simulation"
+        raise StudyError(key, exc.value, exc.expected, src) from None
+    try:
+        paths = ensure_fmus(scenario, fmu_dir, build=build)
+    except ScenarioError as exc:
+        raise StudyError("base.scenario", study.base.name, f"FMUs that exist or can be built ({exc})", src) from None
+    by_comp: dict[str, dict[str, Any]] = {}
+    for name, value in study.base.parameters.items():
+        comp, param = split_parameter(name)
+        by_comp.setdefault(comp, {})[param] = value
+    try:
+        for comp, values in by_comp.items():
+            scenario = scenario.with_parameters(comp, **values)
+        system = resolve_system(scenario, fmu_paths=paths)
+    except ScenarioError as exc:
+        raise StudyError(_study_key_of(exc), exc.value, exc.expected, src) from None
+    for key, name, values in _origins(study):
+        for value in values:
+            _check_value(system, name, value, key, src)
+    _check_measure_engines(study)
+
+    series_names: dict[str, str] = {}
+    gearbox = [n for n, i in system.interfaces.items() if i.model_name == "Gearbox"]
+    if study.engine == "cosim":
+        extra = []
+        for i, m in enumerate(study.measures):
+            if m.builtin and m.name != "I_max_acc":
+                continue
+            if m.name == "I_max_acc":
+                if len(gearbox) != 1:
+                    raise StudyError(f"measures[{i}]", m.name, "a base scenario with exactly one Gearbox FMU "
+                                     f"(its omega_out); found {len(gearbox)}", src)
+                # the FMU's running peak over its internal steps (eq. 11 exactly) where it has one;
+                # FMUs built before it existed: finite differences of omega_out (a lower bound)
+                peak = "alpha_out_max" in system.interfaces[gearbox[0]].variables
+                variable = f"{gearbox[0]}.{'alpha_out_max' if peak else 'omega_out'}"
+                series_names["I_max_acc"] = variable
+            else:
+                variable = m.variable
+                comp, var = split_parameter(variable)
+                iface = system.interfaces.get(comp)
+                fv = iface.variables.get(var) if iface is not None else None
+                if fv is None or fv.type != "Real":
+                    choices = [f"{c}.{n}" for c, f in system.interfaces.items() for n, v in f.variables.items() if v.type == "Real"]
+                    raise StudyError(f"measures[{i}]", m.name, f"a Real variable of the base scenario's FMUs{suggestion(variable, choices)}", src)
+            if scenario.record and variable not in {r.column for r in system.recorded}:
+                extra.append(variable)
+        if extra:
+            scenario = replace(scenario, record=scenario.record + tuple(dict.fromkeys(extra)))
+            system = resolve_system(scenario, fmu_paths=paths)
+        blobs = {}
+        for comp, path in system.fmu_paths.items():
+            blobs[system.interfaces[comp].sha256] = Path(path).read_bytes()
+        payload = StudyPayload(study=study.name, engine="cosim", measures=study.measures, system=system,
+                               window_s=scenario.simulation.window_s, series_names=series_names, fmu_blobs=blobs)
+        settings = None
+    else:
+        from components.model.wind import RotorSpeedProcess
+
+        from ..run.comparison import ReferenceError, monolithic_setup, reference_name
+
+        try:
+            setup = monolithic_setup(system)
+        except ReferenceError as exc:
+            raise StudyError("engine", "monolithic", f"a base scenario the monolithic model represents ({exc})", src) from None
+        settings = _solver_settings(study)
+        stats = [m for m in study.measures if not m.builtin]
+        if stats:
+            series = dict.fromkeys(_micro_run_series(setup.drivetrain, RotorSpeedProcess(setup.wind), scenario.simulation.start_s))
+            last_shaft = setup.drivetrain.output_shaft.name if setup.drivetrain.output_shaft is not None else "shaft3"
+            for i, m in enumerate(study.measures):
+                if m.builtin:
+                    continue
+                name = reference_name(m.variable, setup.roles, series, last_shaft)
+                if name is None:
+                    raise StudyError(f"measures[{i}]", m.name, "a variable of the scenario with a counterpart in the "
+                                     "monolithic model (e.g. gearbox.stage1.F_sp[1], generator.omega, wind.omega)", src)
+                series_names[m.variable] = name
+        payload = StudyPayload(
+            study=study.name, engine="monolithic", measures=study.measures, system=system,
+            window_s=scenario.simulation.window_s, series_names=series_names,
+            solver={k: getattr(settings, k) for k in ("rtol", "atol_angle_rad", "atol_speed_rad_s", "max_step_s", "max_steps")},
+        )
+    identity = {
+        "scenario_sha256": _content_sha256(Path(study.base.path)),
+        "fmus": {c: i.sha256 for c, i in system.interfaces.items()},
+    }
+    return payload, identity, dict(system.fmu_paths)
+
+
+def _content_sha256(path: Path) -> str:
+    """SHA-256 of a file's content, or of every file under a directory (an SSP directory) with its name."""
+    if path.is_file():
+        return hashlib.sha256(path.read_bytes()).hexdigest()
+    h = hashlib.sha256()
+    for f in sorted(p for p in path.rglob("*") if p.is_file()):
+        h.update(str(f.relative_to(path)).encode() + b"\0" + f.read_bytes())
+    return h.hexdigest()
+
+
+def prepare_study(study: Study, fmu_dir: str | Path | None = None, build: bool = True) -> PreparedStudy:
+    """Check a study against its base and build the workers' payload (nothing runs).
+
+    Parameters
+    ----------
+    study : Study
+    fmu_dir : path, optional
+        Where the base scenario's FMUs are looked for (and missing project FMUs
+        built); default :func:`orchestrator.cosim.system.default_fmu_dir`.
+    build : bool
+        Build missing project FMUs.
+
+    Raises
+    ------
+    StudyError
+        Naming the study key of the first problem.
+    """
+    if study.base.kind == "model":
+        payload, base_identity = _prepare_model(study)
+        fmu_paths: dict[str, Path] = {}
+    else:
+        payload, base_identity, fmu_paths = _prepare_scenario(study, fmu_dir, build)
+    identity = {
+        "engine": study.engine,
+        "base": {"kind": study.base.kind, **base_identity},
+        "base_parameters": dict(study.base.parameters),
+        "simulation": dict(study.simulation),
+        "solver": dict(study.solver),
+        "measures": [m.name for m in study.measures],
+        "code": code_version(),
+    }
+    payload = replace(payload, timeout_s=study.timeout_s)  # not in the identity: it changes no result
+    points = tuple(study.expand())
+    keys = tuple(point_key(identity, p) for p in points)
+    return PreparedStudy(study, points, keys, payload, identity, fmu_paths)

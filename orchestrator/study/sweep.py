@@ -1,0 +1,312 @@
+"""Running a prepared study on Dask: the sweep loop, re-runs, interruptions.
+
+:func:`run_sweep` runs the points of a :class:`~orchestrator.study.prepare.PreparedStudy`
+that the output directory's journal does not already hold, on Dask workers: a
+``distributed.LocalCluster`` (processes, one thread each) by default, or an
+existing cluster given its scheduler address. What all points share (base
+system, measures, FMU bytes) is scattered once; each task carries one point
+(:func:`orchestrator.study.engine.run_point`).
+
+Results are journaled by the client as futures complete (:mod:`orchestrator.study.journal`);
+the CSV table and plots are regenerated from the journal when the sweep ends,
+also after Ctrl-C.
+
+Re-runs
+-------
+Running a study again skips every point whose key (see
+:mod:`orchestrator.study.prepare`) has an ``ok`` record, and every ``failed``
+one: a failure of the point itself (the model rejected a parameter, the solver
+or an FMU failed) is deterministic for the same key, so it is not re-tried
+unless ``retry_failed`` is set. Records with status ``error`` (a lost worker, an
+unexpected exception) are re-tried on the next run.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import datetime as _dt
+import logging
+import math
+import os
+import signal
+import threading
+import time
+import uuid
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+from ..inputs.study import StudyError
+from .engine import FAILED, OK, PointTask, run_point
+from .journal import JOURNAL_FILE, Journal, latest_by_key, read_journal
+from .prepare import PreparedStudy
+
+ERROR = "error"
+#: how long a sweep waits for the first worker of an existing cluster [s]
+WAIT_FOR_WORKERS_S = 60.0
+
+
+# --------------------------------------------------------------------- sweep
+@dataclass
+class SweepReport:
+    """What :func:`run_sweep` did.
+
+    Attributes
+    ----------
+    total : int
+        Points of the study.
+    skipped : int
+        Points the journal already held (not run again).
+    submitted : int
+        Points run in this sweep.
+    ok, failed, errors : int
+        Outcomes of the submitted points that finished (``failed``: the point
+        itself failed; ``errors``: infrastructure or unexpected errors).
+    interrupted : bool
+        Stopped by Ctrl-C (finished points are journaled).
+    wall_time_s : float
+        The whole call [s] (cluster start-up and output files included).
+    compute_time_s : float
+        First submission to last result [s].
+    workers : int
+        Workers of the cluster when the sweep started (0 if none ran).
+    out_dir : pathlib.Path
+    files : dict of str -> pathlib.Path
+        Written files by role (``journal``, ``table``, ``summary``, ``plot:<name>``).
+    """
+
+    total: int
+    skipped: int = 0
+    submitted: int = 0
+    ok: int = 0
+    failed: int = 0
+    errors: int = 0
+    interrupted: bool = False
+    wall_time_s: float = 0.0
+    compute_time_s: float = 0.0
+    workers: int = 0
+    out_dir: Path = Path(".")
+    files: dict[str, Path] = field(default_factory=dict)
+
+
+def pending_points(prepared: PreparedStudy, records: list[dict], retry_failed: bool = False) -> list[int]:
+    """Indices of the points a sweep still has to run, given the journal's records."""
+    latest = latest_by_key(records)
+    out = []
+    for i, key in enumerate(prepared.keys):
+        rec = latest.get(key)
+        if rec is None or rec.get("status") == ERROR or (rec.get("status") == FAILED and retry_failed):
+            out.append(i)
+    return out
+
+
+class _Interrupts:
+    """SIGINT handling that never splits a journal write: Ctrl-C during a write is raised after it."""
+
+    def __init__(self) -> None:
+        self.critical = False
+        self.pending = False
+        self.previous = None
+
+    def __enter__(self) -> "_Interrupts":
+        if threading.current_thread() is threading.main_thread():
+            self.previous = signal.signal(signal.SIGINT, self._handler)
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self.previous is not None:
+            signal.signal(signal.SIGINT, self.previous)
+
+    def _handler(self, signum, frame) -> None:
+        if self.critical:
+            self.pending = True
+        else:
+            raise KeyboardInterrupt
+
+    @contextlib.contextmanager
+    def critical_section(self):
+        self.critical = True
+        try:
+            yield
+        finally:
+            self.critical = False
+            if self.pending:
+                self.pending = False
+                raise KeyboardInterrupt
+
+
+def _now() -> str:
+    return _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+
+
+def _json_value(value: Any) -> Any:
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+def _open_client(workers: int | None, scheduler: str | None):
+    """(client, cluster or None): a new LocalCluster, or a client of an existing scheduler."""
+    from distributed import Client, LocalCluster
+
+    if scheduler:
+        try:
+            return Client(scheduler, timeout="20s"), None
+        except OSError as exc:
+            raise StudyError("--scheduler", scheduler, f"the address of a running Dask scheduler ({exc})") from None
+    n = workers if workers else (os.cpu_count() or 1)
+    # Ctrl-C on a terminal signals the whole process group: the worker processes start with SIGINT ignored
+    # (an ignored signal stays ignored across exec), so only this process acts on it and closes the cluster
+    previous = None
+    if threading.current_thread() is threading.main_thread():
+        previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                               silence_logs=logging.ERROR)
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGINT, previous)
+    return Client(cluster), cluster
+
+
+def _worker_count(client) -> int:
+    """Workers connected to the scheduler now."""
+    try:
+        info = client.scheduler_info(n_workers=-1)  # newer distributed lists only a few workers by default
+    except TypeError:
+        info = client.scheduler_info()
+    return len(info.get("workers", {}))
+
+
+def _close(client, cluster) -> None:
+    """Close the client, then the cluster we started (never an external one)."""
+    with contextlib.suppress(Exception):
+        client.close(timeout=10)
+    if cluster is not None:
+        with contextlib.suppress(Exception):
+            cluster.close(timeout=20)
+
+
+def run_sweep(
+    prepared: PreparedStudy,
+    out_dir: str | Path,
+    *,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    retry_failed: bool = False,
+    progress: Callable[[dict[str, Any]], None] | None = None,
+    on_start: Callable[[int, int], None] | None = None,
+    plots: bool = True,
+) -> SweepReport:
+    """Run the study's pending points on Dask and write the journal, the table and the plots.
+
+    Parameters
+    ----------
+    prepared : PreparedStudy
+    out_dir : path
+        Output directory (created): ``journal.jsonl``, ``results.csv``,
+        ``study.json``, PNG plots.
+    workers : int, optional
+        Workers of the LocalCluster (processes with one thread each; default: CPU count).
+    scheduler : str, optional
+        Address of an existing Dask scheduler (e.g. ``tcp://10.0.0.5:8786``); then
+        ``workers`` is ignored and the cluster is left running.
+    retry_failed : bool
+        Run points whose journal record says ``failed`` again.
+    progress : callable(record), optional
+        Called with each point's journal record as it is written.
+    on_start : callable(pending, skipped), optional
+        Called once before the cluster starts.
+    plots : bool
+        Write the PNG plots.
+
+    Returns
+    -------
+    SweepReport
+        Also after Ctrl-C (``interrupted``); the journal holds every finished point.
+    """
+    from .report import write_outputs
+
+    wall0 = time.perf_counter()
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    report = SweepReport(total=len(prepared.points), out_dir=out)
+    journal_path = out / JOURNAL_FILE
+    with Journal(journal_path) as journal:
+        todo = pending_points(prepared, read_journal(journal_path), retry_failed)
+        report.skipped = report.total - len(todo)
+        if on_start is not None:
+            on_start(len(todo), report.skipped)
+        if todo:
+            _execute(prepared, todo, journal, report, workers, scheduler, progress)
+    report.files = write_outputs(prepared, out, report, plots=plots)
+    report.wall_time_s = time.perf_counter() - wall0
+    return report
+
+
+def _execute(prepared: PreparedStudy, todo: list[int], journal: Journal, report: SweepReport,
+             workers: int | None, scheduler: str | None, progress) -> None:
+    from distributed import as_completed
+
+    study = prepared.study
+    code = prepared.identity["code"]
+    futures: dict = {}
+    t0 = None
+    with _Interrupts() as interrupts:
+        client = cluster = None
+        try:
+            client, cluster = _open_client(workers, scheduler)
+            report.workers = _worker_count(client)
+            if report.workers == 0:  # an existing cluster whose workers have not connected (yet)
+                try:
+                    client.wait_for_workers(1, timeout=WAIT_FOR_WORKERS_S)
+                except TimeoutError:
+                    raise StudyError("--scheduler", scheduler, f"a cluster with at least one worker (none connected "
+                                     f"within {WAIT_FOR_WORKERS_S:g} s)") from None
+                report.workers = _worker_count(client)
+            payload = client.scatter([prepared.payload], hash=False)[0]
+            t0 = time.perf_counter()
+            run_id = uuid.uuid4().hex[:8]
+            for i in todo:
+                point = prepared.points[i]
+                task = PointTask(prepared.keys[i], point.index, dict(point.parameters))
+                fut = client.submit(run_point, payload, task, key=f"{study.name}-{point.index}-{run_id}", pure=False)
+                futures[fut] = i
+            report.submitted = len(futures)
+            for fut in as_completed(list(futures)):
+                i = futures.pop(fut)
+                point = prepared.points[i]
+                try:
+                    result = fut.result()
+                except Exception as exc:  # a lost worker, KilledWorker, a bug: re-tried next time
+                    result = {"key": prepared.keys[i], "index": point.index, "status": ERROR, "measures": {},
+                              "error": f"{type(exc).__name__}: {exc}", "error_type": type(exc).__name__}
+                fut.release()
+                record = {
+                    "key": prepared.keys[i], "index": point.index, "study": study.name, "engine": study.engine,
+                    "status": result["status"],
+                    "parameters": {k: _json_value(v) for k, v in point.parameters.items()},
+                    "measures": result.get("measures", {}), "error": result.get("error"),
+                    "error_type": result.get("error_type"), "worker": result.get("worker"),
+                    "task_wall_time_s": result.get("task_wall_time_s"), "code_version": code, "finished_at": _now(),
+                }
+                with interrupts.critical_section():
+                    journal.append(record)
+                if record["status"] == OK:
+                    report.ok += 1
+                elif record["status"] == FAILED:
+                    report.failed += 1
+                else:
+                    report.errors += 1
+                if progress is not None:
+                    progress(record)
+        except KeyboardInterrupt:
+            report.interrupted = True
+            if client is not None:
+                with contextlib.suppress(Exception):
+                    client.cancel(list(futures))
+        finally:
+            if t0 is not None:
+                report.compute_time_s = time.perf_counter() - t0
+            if client is not None:
+                _close(client, cluster)
