@@ -1,0 +1,191 @@
+"""Building the FMUs: validity, interface, units, self-containment, CLI."""
+
+from __future__ import annotations
+
+import math
+import zipfile
+from xml.etree import ElementTree as ET
+
+import pytest
+from fmpy import read_model_description
+from fmpy.validation import validate_fmu
+from tests.helpers.fmu_hosts import load_driver, run_python
+
+from components.model.presets import cosim_preset
+from fmus import build as fmu_build
+from fmus.build import BuildError, code_hash, rewrite_slave_imports
+from fmus.model_description import read_member, rewrite_archive
+from fmus.validation import check_fmu
+from orchestrator.commands.cli import main as dtcosim
+
+FMU_NAMES = ("WindSource", "Gearbox", "GeneratorRotor")
+
+
+def variables(path):
+    return {v.name: v for v in read_model_description(str(path)).modelVariables}
+
+
+@pytest.mark.parametrize("name", FMU_NAMES)
+def test_fmpy_validation_reports_no_problem(fmu_path, name):
+    assert validate_fmu(str(fmu_path(name))) == []
+    assert check_fmu(fmu_path(name)) == []
+
+
+@pytest.mark.parametrize("name, causality, expected", [
+    ("WindSource", "output", {"omega": "rad/s", "phi": "rad"}),
+    ("WindSource", "parameter", {"omega0": "rad/s", "a": "rad/s", "sigma": "rad/s", "n_harmonics": None,
+                                 "f_min": "rad/s", "f_max": "rad/s", "seed": None, "amplitude": None}),
+    ("Gearbox", "input", {"omega_rotor": "rad/s", "phi_rotor": "rad", "omega_gen": "rad/s", "phi_gen": "rad"}),
+    ("Gearbox", "output", {"shaft_torque": "N.m", "shaft_torque_end": "N.m", "shaft_torque_avg": "N.m",
+                           "omega_out": "rad/s", "torque_rotor": "N.m", "stage1.F_sp[3]": "N", "stage2.F_rp[1]": "N",
+                           "stage3.F_mesh": "N", "shaft1.torque": "N.m", "shaft3.torque": "N.m",
+                           "stage1.planet[2].omega": "rad/s", "stage3.driven.omega": "rad/s"}),
+    ("Gearbox", "parameter", {"stage1.k0": "N/m^e", "stage1.c0": "N.s/m2",
+                              "stage2.lambda": "1/m", "stage3.contact_law": None, "stage2.planet_inertia": "kg.m2",
+                              "shaft3.stiffness": "N.m/rad", "shaft2.damping": "N.m.s/rad", "solver.rtol": "1",
+                              "solver.max_steps": None, "shaft_torque_mode": None, "extrapolate_inputs": None}),
+    ("GeneratorRotor", "input", {"shaft_torque": "N.m"}),
+    ("GeneratorRotor", "output", {"omega": "rad/s", "phi": "rad", "generator_torque": "N.m"}),
+    ("GeneratorRotor", "parameter", {"inertia": "kg.m2", "counter_torque": "N.m", "initial_speed": "rad/s",
+                                     "initial_angle": "rad", "event1.kind": None, "event4.start": "s",
+                                     "event4.duration": "s", "event4.factor": "1"}),
+])
+def test_interface_names_causality_and_units(fmu_path, name, causality, expected):
+    found = variables(fmu_path(name))
+    for var_name, unit in expected.items():
+        assert var_name in found, f"{name} lacks {var_name}"
+        v = found[var_name]
+        assert v.causality == causality
+        assert v.unit == unit
+        assert v.description.endswith(f"[{unit or '-'}]")
+
+
+def test_gearbox_exposes_every_mesh_shaft_and_body_of_the_preset(fmu_path):
+    found = variables(fmu_path("Gearbox"))
+    outputs = {n for n, v in found.items() if v.causality == "output"}
+    forces = {f"stage{k}.F_{m}[{i}]" for k in (1, 2) for m in ("sp", "rp") for i in (1, 2, 3)} | {"stage3.F_mesh"}
+    speeds = {f"stage1.{b}.omega" for b in ("sun", "planet[1]", "planet[2]", "planet[3]")}
+    speeds |= {f"stage2.{b}.omega" for b in ("carrier", "sun", "planet[1]", "planet[2]", "planet[3]")}
+    speeds |= {"stage3.drive.omega", "stage3.driven.omega"}
+    main = {"shaft_torque", "shaft_torque_end", "shaft_torque_avg", "omega_out", "torque_rotor", "alpha_out", "alpha_out_max"}
+    assert outputs == main | forces | speeds | {"shaft1.torque", "shaft2.torque", "shaft3.torque"}
+
+
+def test_parameter_defaults_are_the_papers_in_si(fmu_path):
+    gearbox = variables(fmu_path("Gearbox"))
+    assert float(gearbox["stage1.k0"].start) == pytest.approx(5.0e5 * 1000.0 ** 1.5)  # 5e5 N/mm^1.5
+    assert float(gearbox["stage2.c0"].start) == pytest.approx(5.0e4 * 1.0e6)  # 5e4 N s/mm^2
+    assert float(gearbox["stage3.lambda"].start) == pytest.approx(600.0e3)  # 600 / mm
+    assert float(gearbox["stage1.planet_inertia"].start) == pytest.approx(15.6)  # 1.56e7 kg mm^2
+    assert float(gearbox["shaft3.stiffness"].start) == pytest.approx(1.0e5 * 1e-3 * 180.0 / math.pi)
+    assert int(gearbox["shaft_torque_mode"].start) == 0  # step average
+    generator = variables(fmu_path("GeneratorRotor"))
+    assert float(generator["inertia"].start) == pytest.approx(151.0)
+    assert float(generator["counter_torque"].start) == pytest.approx(25.4e3)
+    wind = variables(fmu_path("WindSource"))
+    assert float(wind["omega0"].start) == 16.0 * 2.0 * math.pi / 60.0  # exact: start written with repr
+    assert int(wind["amplitude"].start) == 0  # variance-preserving
+
+
+@pytest.mark.parametrize("name", FMU_NAMES)
+def test_model_structure_units_and_capabilities(fmu_path, name):
+    root = ET.fromstring(read_member(fmu_path(name)))
+    units = {u.get("name"): u for u in root.find("UnitDefinitions")}
+    md = read_model_description(str(fmu_path(name)))
+    for v in md.modelVariables:
+        if v.type == "Real":
+            assert v.unit in units
+        if v.causality == "output":
+            assert v.initial == "calculated" and v.start is None
+    assert all(u.dependencies == [] for u in md.outputs)  # no direct feedthrough
+    assert {u.variable.name for u in md.initialUnknowns} == {u.variable.name for u in md.outputs}
+    assert md.coSimulation.canGetAndSetFMUstate and md.coSimulation.canSerializeFMUstate
+    assert md.defaultExperiment.stepSize == "0.001"
+    if "N.m" in units:
+        assert units["N.m"].find("BaseUnit").attrib == {"kg": "1", "m": "2", "s": "-2"}
+    if "N/m^e" in units:
+        assert units["N/m^e"].find("BaseUnit") is None  # no integer SI exponents
+
+
+@pytest.mark.parametrize("name", FMU_NAMES)
+def test_archive_carries_its_code_under_private_names(built_fmus, name):
+    built = built_fmus[name]
+    assert built.package == f"_dtcosim_{name.lower()}_{built.build_id}"
+    with zipfile.ZipFile(built.path) as archive:
+        files = archive.namelist()
+        assert archive.read("resources/slavemodule.txt").decode().strip() == built.slave_module
+        slave_sources = [archive.read(f).decode() for f in files if f.startswith(f"resources/{built.package}/slaves/")]
+    assert f"resources/{built.package}/components/model/wind.py" in files
+    assert (f"resources/{built.package}/components/model/gearbox_model.py" in files) == (name == "Gearbox")
+    assert f"resources/{built.slave_module}.py" in files
+    assert not any(f.startswith(("resources/components/", "resources/fmus/")) for f in files)
+    assert slave_sources and not any("\nfrom components" in code for code in slave_sources)
+
+
+def test_code_hash_is_deterministic_and_names_the_configuration():
+    assert code_hash("Gearbox", "table6") == code_hash("Gearbox", "table6")
+    assert len({code_hash("Gearbox", "table6"), code_hash("Gearbox", "table5"), code_hash("WindSource", "table6")}) == 3
+
+
+def test_slave_imports_are_rewritten_to_the_embedding_package():
+    code = "from components.model.wind import X\n    from components import y\nfrom .base import Z\n"
+    assert rewrite_slave_imports(code, "m.py") == (
+        "from ..components.model.wind import X\n    from ..components import y\nfrom .base import Z\n")
+    with pytest.raises(BuildError, match="would not resolve inside an FMU"):
+        rewrite_slave_imports("import fmus.build\n", "m.py")
+
+
+def test_unknown_fmu_or_preset_is_refused(tmp_path):
+    with pytest.raises(BuildError, match="unknown FMU 'Gear'"):
+        fmu_build.build_fmu("Gear", tmp_path)
+    with pytest.raises(BuildError, match="unknown preset 'table9'"):
+        fmu_build.build_fmu("Gearbox", tmp_path, preset="table9")
+
+
+@pytest.mark.slow
+def test_cli_build_and_validate(tmp_path, capsys):
+    assert dtcosim(["build", "--out", str(tmp_path), "--fmu", "WindSource", "--fmu", "GeneratorRotor"]) == 0
+    assert sorted(p.name for p in tmp_path.glob("*.fmu")) == ["GeneratorRotor.fmu", "WindSource.fmu"]
+    assert dtcosim(["validate", str(tmp_path)]) == 0
+    assert "WindSource.fmu: ok" in capsys.readouterr().out
+    # an FMU whose modelDescription lost a unit definition is reported, exit code 1
+    broken = tmp_path / "WindSource.fmu"
+    xml = read_member(broken).replace(b'<Unit name="rad">', b'<Unit name="radian">')
+    rewrite_archive(broken, {"modelDescription.xml": xml})
+    assert dtcosim(["validate", str(broken)]) == 1
+    assert 'The unit "rad" of variable "phi"' in capsys.readouterr().out
+    assert dtcosim(["validate", str(tmp_path / "missing")]) == 1
+
+
+@pytest.mark.slow
+def test_build_script(tmp_path, this_python):
+    script = fmu_build.SourceTree.installed().components_dir.parent / "build_fmus.py"
+    result = run_python(this_python, str(script), "--out", str(tmp_path), "--fmu", "GeneratorRotor")
+    assert result.returncode == 0, result.stderr
+    assert (tmp_path / "GeneratorRotor.fmu").is_file()
+    assert check_fmu(tmp_path / "GeneratorRotor.fmu") == []
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("preset", ["table5", "table3"])
+def test_single_stage_presets_build_and_run(tmp_path, preset):
+    fmu_build.build_all(tmp_path, preset)
+    result = load_driver("fmu_loop").run(tmp_path, 0.2, 1.0e-3)
+    ratio = cosim_preset(preset).ratio
+    omega0 = 16.0 * math.pi / 30.0
+    # kinematic start at the preset's ratio; the run completes (the Table 6 generator load is
+    # heavy for a single stage, so the speeds themselves are not checked)
+    assert result["Gearbox.omega_out"][0] == pytest.approx(ratio * result["WindSource.omega"][0], rel=1e-12)
+    assert result["initial_generator_speed"] == pytest.approx(ratio * omega0, rel=0.05)
+    assert all(math.isfinite(x) for x in result["Gearbox.shaft_torque"])
+
+
+def test_documented_variable_tables_match_the_code():
+    from fmus.docs import update
+
+    doc = fmu_build.SourceTree.installed().components_dir.parent / "docs" / "fmus.md"
+    if not doc.is_file():
+        pytest.skip("docs/fmus.md is not next to the installed package")
+    text = doc.read_text(encoding="utf-8")
+    assert "<!-- BEGIN GENERATED Gearbox -->" in text
+    assert update(text) == text, "run: python -m fmus.docs --update docs/fmus.md"

@@ -1,0 +1,172 @@
+"""The FMUs in other hosts and environments: a plain fmpy loop (also without dtcosim installed),
+libcosim through libcosimpy, and two differently built FMUs in one process."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+import zipfile
+
+import numpy as np
+import pytest
+from fmpy import read_model_description
+from tests.helpers.fmu_hosts import Instance, load_driver, run_python
+
+from components.model.gearbox_model import GearboxModel
+from components.model.generator import GeneratorRotor
+from components.model.presets import cosim_preset
+from components.model.wind import RotorSpeedProcess, WindParameters
+from fmus.build import SourceTree, build_fmu
+
+H = 1.0e-3
+
+
+@pytest.fixture(scope="module")
+def loop_10s(fmu_dir):
+    """The plain fmpy loop over 10 s in this process."""
+    return load_driver("fmu_loop").run(fmu_dir, 10.0, H)
+
+
+def reference_loop(t_end: float) -> dict[str, np.ndarray]:
+    """The same Gauss-Seidel loop with the components called directly (as the FMUs compute it)."""
+    drivetrain = cosim_preset("table6")
+    gearbox = GearboxModel(drivetrain)
+    wind = RotorSpeedProcess(WindParameters())
+    w0, p0 = wind.speed(0.0), wind.angle(0.0)
+    gearbox.initialize(0.0, w0, p0, gearbox.ratio * w0, gearbox.ratio * p0)  # initialisation-mode outputs
+    w_out = gearbox.output_speed_rad_s
+    ratio = w_out / w0
+    gearbox.initialize(0.0, w0, p0, w_out, ratio * p0)
+    generator = GeneratorRotor(drivetrain.generator, w_out, ratio * p0)
+    speed, torque = [generator.speed_rad_s], [gearbox.shaft_torque_nm]
+    t_wind = 0.0  # the WindSource's time after a step is t + h, as computed in the FMU
+    for n in range(int(round(t_end / H))):
+        t = n * H
+        gearbox.step(t, H, wind.speed(t_wind), wind.angle(t_wind), generator.speed_rad_s, generator.angle_rad)
+        generator.step(t, H, gearbox.shaft_torque_nm)
+        t_wind = t + H
+        speed.append(generator.speed_rad_s)
+        torque.append(gearbox.shaft_torque_nm)
+    return {"GeneratorRotor.omega": np.array(speed), "Gearbox.shaft_torque": np.array(torque)}
+
+
+@pytest.mark.slow
+def test_fmpy_loop_reproduces_the_components_bit_for_bit(fmu_dir):
+    loop = load_driver("fmu_loop").run(fmu_dir, 1.0, H)
+    reference = reference_loop(1.0)
+    for key, values in reference.items():
+        np.testing.assert_array_equal(loop[key], values, err_msg=key)
+
+
+@pytest.mark.slow
+def test_loop_runs_in_a_fresh_venv_without_dtcosim(fmu_dir, bare_python, tmp_path):
+    assert run_python(bare_python, "-c", "import components").returncode != 0
+    assert run_python(bare_python, "-c", "import fmus").returncode != 0
+    out = tmp_path / "bare.npz"
+    driver = load_driver("fmu_loop").__file__
+    result = run_python(bare_python, driver, str(fmu_dir), "1.0", str(H), str(out))
+    assert result.returncode == 0, result.stderr[-3000:]
+    bare = np.load(out)
+    modules = list(bare["modules"])
+    assert modules and all(m.startswith("_dtcosim_") for m in modules), modules  # only the FMUs' private copies
+    in_process = load_driver("fmu_loop").run(fmu_dir, 1.0, H)
+    for key in ("GeneratorRotor.omega", "Gearbox.shaft_torque", "Gearbox.stage1.F_sp[1]", "WindSource.omega"):
+        np.testing.assert_allclose(bare[key], in_process[key], rtol=1e-9, atol=1e-6, err_msg=key)
+
+
+@pytest.mark.slow
+def test_libcosim_agrees_with_the_fmpy_loop(fmu_dir, loop_10s, libpython, tmp_path, this_python):
+    pytest.importorskip("libcosimpy")
+    out = tmp_path / "libcosim.npz"
+    driver = load_driver("libcosim_run").__file__
+    speed0 = float(loop_10s["initial_generator_speed"])
+    result = run_python(this_python, driver, str(fmu_dir), "10.0", str(H), repr(speed0), str(out),
+                        env={"LD_PRELOAD": str(libpython)})
+    assert result.returncode == 0, result.stderr[-3000:]
+    cosim = np.load(out)
+    assert cosim["time"][-1] == pytest.approx(10.0 - H)
+    fmpy_speed = np.interp(cosim["time"], loop_10s["time"], loop_10s["GeneratorRotor.omega"])
+    relative = np.abs(cosim["GeneratorRotor.omega"] - fmpy_speed) / np.abs(fmpy_speed)
+    assert relative.max() < 1.0e-3  # Jacobi (libcosim) vs Gauss-Seidel (fmpy loop) exchange
+    assert relative.max() > 0.0  # libcosim really ran its own master algorithm
+    np.testing.assert_allclose(cosim["WindSource.omega"], np.interp(cosim["time"], loop_10s["time"],
+                                                                    loop_10s["WindSource.omega"]), rtol=1e-12)
+
+
+MARKER = 12345.0
+PATCH = f'''
+
+# --- test patch: this copy of the code reports a marker rotor torque ---
+GearboxModel.output_vector = lambda self: __import__('numpy').full(len(self.output_names), {MARKER!r})
+'''
+
+
+@pytest.mark.slow
+def test_two_differently_built_fmus_each_run_their_own_code(built_fmus, tmp_path):
+    installed = SourceTree.installed()
+    patched_root = tmp_path / "patched"
+    shutil.copytree(installed.components_dir, patched_root / "components", ignore=shutil.ignore_patterns("__pycache__"))
+    shutil.copytree(installed.slaves_dir, patched_root / "fmus" / "slaves", ignore=shutil.ignore_patterns("__pycache__"))
+    with open(patched_root / "components" / "model" / "gearbox_model.py", "a") as f:
+        f.write(PATCH)
+    patched = build_fmu("Gearbox", tmp_path / "out", source=SourceTree.at(patched_root))
+    original = built_fmus["Gearbox"]
+    assert patched.package != original.package and patched.slave_module != original.slave_module
+
+    def run_one_step(path, name):
+        inst = Instance(path, name)
+        inst.initialize()
+        inst.step(0.0, H)
+        torque = inst.get("torque_rotor")[0]
+        inst.free()
+        return torque
+
+    # both in this process, in both orders
+    first_patched = run_one_step(patched.path, "p1")
+    first_original = run_one_step(original.path, "o1")
+    assert first_patched == MARKER
+    assert first_original != MARKER
+    assert run_one_step(patched.path, "p2") == MARKER
+    assert run_one_step(original.path, "o2") == first_original
+    # each FMU imported its own copy; this process's components are untouched
+    assert sys.modules[f"{patched.package}.components.model.gearbox_model"].__file__ != \
+        sys.modules[f"{original.package}.components.model.gearbox_model"].__file__
+    assert not isinstance(GearboxModel.rotor_torque_nm, float)
+
+
+@pytest.mark.slow
+def test_c_host_runs_the_gearbox_with_libpython_preloaded(fmu_path, libpython, tmp_path, bare_python):
+    """A plain C host (dlopen + FMI calls, drivers/c_host.c) needs libpython preloaded; results equal fmpy's."""
+    compiler = shutil.which("cc") or shutil.which("gcc")
+    if compiler is None:
+        pytest.skip("no C compiler")
+    host = tmp_path / "c_host"
+    source = load_driver("fmu_loop").__file__.replace("fmu_loop.py", "c_host.c")
+    subprocess.run([compiler, "-O1", "-o", str(host), source, "-ldl"], check=True, capture_output=True)
+    unzipped = tmp_path / "Gearbox"
+    with zipfile.ZipFile(fmu_path("Gearbox")) as archive:
+        archive.extractall(unzipped)
+    md = read_model_description(str(fmu_path("Gearbox")))
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    args = [str(host), str(unzipped / "binaries" / "linux64" / "Gearbox.so"), (unzipped / "resources").as_uri(),
+            md.guid, "200"] + [str(vr[n]) for n in ("omega_rotor", "phi_rotor", "omega_gen", "phi_gen", "shaft_torque")]
+    site = next((bare_python.parent.parent / "lib").glob("python3*/site-packages"))
+    without = subprocess.run(args, capture_output=True, text=True, timeout=120)
+    assert without.returncode != 0 and "undefined symbol" in without.stderr  # the FMU needs libpython's symbols
+    env = {**os.environ, "LD_PRELOAD": str(libpython), "PYTHONPATH": str(site)}
+    result = subprocess.run(args, capture_output=True, text=True, timeout=300, env=env)
+    assert result.returncode == 0, result.stderr[-3000:]
+    torque_c = float(result.stdout.split()[-1])
+    # the same run through fmpy in this process
+    inst = Instance(fmu_path("Gearbox"), "same-as-c")
+    omega_rotor = 1.6755160819145563
+    omega_gen = 0.99 * 100.0 * omega_rotor
+    inst.initialize(omega_rotor=omega_rotor, phi_rotor=0.0, omega_gen=omega_gen, phi_gen=0.0)
+    for n in range(200):
+        t = n * H
+        inst.set(omega_rotor=omega_rotor, phi_rotor=omega_rotor * t, omega_gen=omega_gen, phi_gen=omega_gen * t)
+        inst.step(t, H)
+    assert torque_c == inst.get("shaft_torque")[0]
+    inst.free()

@@ -1,0 +1,73 @@
+"""Runs that stop early: an FMU failing mid-run and Ctrl-C leave partial results with complete = false."""
+
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from tests.helpers.scenarios import TOY_SCENARIO, dtcosim
+
+from orchestrator.result_files import read_timeseries
+
+pytestmark = pytest.mark.slow
+
+# Tolerances so loose that the gearbox's integrator accepts wrong steps until it diverges
+# (about 0.65 s into the run with the Table 6 defaults).
+DIVERGING_GEARBOX = ["--set", "gearbox.solver.rtol=100.0", "--set", "gearbox.solver.atol_q=1.0",
+                     "--set", "gearbox.solver.atol_v=1.0"]
+
+
+def test_gearbox_diverging_mid_run_leaves_partial_results(fmu_dir, tmp_path):
+    out = tmp_path / "diverged"
+    proc = dtcosim("run", "--stop", "3", "--fmu-dir", str(fmu_dir), "--out", str(out), *DIVERGING_GEARBOX,
+                   cwd=tmp_path)
+    assert proc.returncode == 1, proc.stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["complete"] is False
+    t_stop = summary["stopped_at"]
+    assert 0.1 < t_stop < 3.0
+    error = summary["error"]
+    assert "FMU 'gearbox'" in error and "fmi2DoStep" in error and "discard" in error and f"t = {t_stop:g} s" in error
+    assert "failed" in error  # the FMU's own message is included
+    header, data = read_timeseries(out / "timeseries.csv")
+    assert data.shape[0] == round(t_stop / 1e-3) + 1
+    assert data[-1, 0] == pytest.approx(t_stop) and np.all(np.isfinite(data))
+    assert (out / "contact_forces.png").exists()
+    assert "partial results written" in proc.stderr
+
+
+def test_fmu_exception_is_reported_with_its_message(toy_scenario, tmp_path):
+    text = TOY_SCENARIO.replace("mode = 0", "mode = 1\nfail_at = 0.05")
+    path = toy_scenario(text)
+    proc = dtcosim("run", str(path), "--out", str(tmp_path / "out"), "-q", cwd=tmp_path)
+    assert proc.returncode == 1
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["complete"] is False and summary["stopped_at"] == pytest.approx(0.05)
+    assert "FMU 'fail'" in summary["error"] and "fatal" in summary["error"]
+    assert "toy failure at t=0.05" in summary["error"]
+    header, data = read_timeseries(tmp_path / "out" / "timeseries.csv")
+    assert data.shape[0] == 6
+
+
+def test_ctrl_c_stops_the_run_and_writes_partial_results(fmu_dir, tmp_path):
+    out = tmp_path / "interrupted"
+    exe = Path(sys.executable).parent / "dtcosim"
+    proc = subprocess.Popen([str(exe), "run", "--fmu-dir", str(fmu_dir), "--out", str(out), "--no-plots"],
+                            cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(5.0)  # past loading and initialisation, well before 60 s of simulated time
+    proc.send_signal(signal.SIGINT)
+    stdout, stderr = proc.communicate(timeout=120)
+    assert proc.returncode == 130, stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["complete"] is False and summary["interrupted"] is True
+    assert 0.0 < summary["stopped_at"] < 60.0
+    assert "interrupted" in summary["error"]
+    header, data = read_timeseries(out / "timeseries.csv")
+    assert data.shape[0] == round(summary["stopped_at"] / 1e-3) + 1
+    assert np.all(np.isfinite(data))

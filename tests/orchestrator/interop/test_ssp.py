@@ -1,0 +1,126 @@
+"""SSP 1.0 export/import: round trip, identical re-run, and the same system in libcosim."""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+import zipfile
+
+import numpy as np
+import pytest
+from tests.helpers.scenarios import dtcosim
+
+from orchestrator.cosim.master import CoSimulation
+from orchestrator.cosim.system import resolve_system
+from orchestrator.inputs.scenario import find_scenario, load_scenario
+from orchestrator.interop.ssp import NS, export_ssp, import_ssp
+from orchestrator.run.runner import load_any
+
+TOY = """
+name = "toy-ssp"
+description = "sine into integrator"
+[simulation]
+start = 0.1
+stop = 1.1
+step = 0.01
+output_interval = 0.02
+window = [0.5, 1.1]
+algorithm = "jacobi"
+extrapolation = "linear"
+[components.gain]
+fmu = "ToyGain.fmu"
+[components.gain.parameters]
+u = 3.0
+[components.src]
+fmu = "ToySine.fmu"
+[components.src.parameters]
+amplitude = 2.5
+[components.int]
+fmu = "ToyIntegrator.fmu"
+[components.fail]
+fmu = "ToyFailer.fmu"
+[components.fail.parameters]
+mode = 0
+[[connections]]
+from = "src.y"
+to = "int.u"
+[[initial]]
+from = "gain.y"
+to = "int.x0"
+[record]
+variables = ["src.y", "int.*"]
+"""
+
+
+def test_export_import_round_trip_and_identical_run(toy_scenario, tmp_path):
+    original = load_scenario(toy_scenario(TOY))
+    system = resolve_system(original)
+    ssp = export_ssp(system, tmp_path / "toy.ssp", CoSimulation(system).initial_values())
+    with zipfile.ZipFile(ssp) as zf:
+        names = set(zf.namelist())
+        root = ET.fromstring(zf.read("SystemStructure.ssd"))
+    assert names == {"SystemStructure.ssd", "resources/ToyGain.fmu", "resources/ToySine.fmu",
+                     "resources/ToyIntegrator.fmu", "resources/ToyFailer.fmu"}
+    # libcosim needs typed connectors for connected variables and the fixed-step algorithm
+    int_connectors = {c.get("name"): c for c in root.findall(".//ssd:Component[@name='int']/ssd:Connectors/ssd:Connector", NS)}
+    assert int_connectors["u"].get("kind") == "input" and int_connectors["u"].find("ssc:Real", NS) is not None
+    fsa = root.find("ssd:DefaultExperiment/ssd:Annotations/ssc:Annotation/osp:Algorithm/osp:FixedStepAlgorithm", NS)
+    assert float(fsa.get("baseStepSize")) == 0.01
+    # the initial binding's value is in the parameter set for other hosts
+    x0 = root.find(".//ssd:Component[@name='int']//ssv:Parameter[@name='x0']/ssv:Real", NS)
+    assert float(x0.get("value")) == 6.0
+
+    # valid against the SSP 1.0 schema (fmpy validates while reading)
+    from fmpy.ssp.ssd import read_ssd
+
+    ssd = read_ssd(str(ssp))
+    assert [c.name for c in ssd.system.elements] == ["gain", "src", "int", "fail"]
+
+    back = import_ssp(ssp)
+    assert back.name == original.name and back.description == original.description
+    assert back.simulation == original.simulation
+    assert back.connections == original.connections and back.initial == original.initial
+    assert back.record == original.record
+    assert [(c.name, dict(c.parameters)) for c in back.components] == [(c.name, dict(c.parameters)) for c in original.components]
+    run_a = CoSimulation(system).run(handle_sigint=False)
+    run_b = CoSimulation(resolve_system(back)).run(handle_sigint=False)
+    assert run_a.names == run_b.names
+    np.testing.assert_array_equal(run_a.time_s, run_b.time_s)
+    np.testing.assert_array_equal(run_a.values, run_b.values)
+
+
+@pytest.fixture(scope="module")
+def paper_ssp(fmu_dir, tmp_path_factory):
+    """The paper scenario exported with `dtcosim export-ssp`."""
+    work = tmp_path_factory.mktemp("ssp")
+    proc = dtcosim("export-ssp", "--out", str(work / "paper.ssp"), "--fmu-dir", str(fmu_dir), cwd=work)
+    assert proc.returncode == 0, proc.stderr
+    assert "generator.initial_speed" in proc.stdout
+    return work / "paper.ssp"
+
+
+@pytest.mark.slow
+def test_reimported_paper_ssp_runs_identically(paper_ssp, fmu_dir):
+    stop = dict(stop_s=3.0, window_s=(1.0, 3.0))
+    from_toml = resolve_system(load_scenario(find_scenario(None)).with_simulation(**stop), fmu_dir=fmu_dir)
+    from_ssp = resolve_system(load_any(paper_ssp).with_simulation(**stop))
+    assert from_ssp.order == from_toml.order
+    a = CoSimulation(from_toml).run(handle_sigint=False)
+    b = CoSimulation(from_ssp).run(handle_sigint=False)
+    assert a.names == b.names
+    np.testing.assert_array_equal(a.values, b.values)
+
+
+@pytest.mark.slow
+def test_exported_ssp_runs_in_libcosim_like_dtcosim(paper_ssp):
+    from orchestrator.interop.libcosim import run_ssp_in_libcosim
+
+    stop = 10.0
+    lib = run_ssp_in_libcosim(paper_ssp, stop, ["generator.omega", "wind.omega"])
+    ours = CoSimulation(resolve_system(load_any(paper_ssp).with_simulation(stop_s=stop, window_s=(0.0, stop)))).run(
+        handle_sigint=False)
+    assert lib.time_s.size == ours.time_s.size == 10001
+    np.testing.assert_allclose(lib.time_s, ours.time_s, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(lib.values["wind.omega"], ours.column("wind.omega"), rtol=1e-12)
+    deviation = np.max(np.abs(lib.values["generator.omega"] / ours.column("generator.omega") - 1.0))
+    print(f"libcosim vs dtcosim generator speed, max relative deviation over [0, {stop:g}] s: {deviation:.2e}")
+    assert deviation < 1e-3

@@ -1,0 +1,65 @@
+"""Study measures: parsing and the window statistics, damage-equivalent loads included."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from components.analysis.fatigue import FatigueSettings, fatigue_loads
+from orchestrator.inputs.measures import MeasureError, parse_measure
+from orchestrator.study.measure_values import window_statistic
+
+
+@pytest.mark.parametrize("text, statistic, unit", [
+    ("gearbox.shaft1.torque:del4", "del4", "N.m"),
+    ("gearbox.stage3.F_mesh:del10", "del10", "N"),
+    ("gearbox.stage1.F_sp[1]:del3.5", "del3.5", "N"),
+    ("generator.omega:rms", "rms", "rad/s"),
+])
+def test_statistic_measures_parse(text, statistic, unit):
+    m = parse_measure(text)
+    assert (m.statistic, m.unit, m.builtin) == (statistic, unit, False)
+
+
+@pytest.mark.parametrize("text", ["gearbox.shaft1.torque:del0", "gearbox.shaft1.torque:del", "x.y:delm", "x.y:del-3"])
+def test_bad_del_measures_name_what_is_expected(text):
+    with pytest.raises(MeasureError, match=r"del<m> \(damage-equivalent load, e\.g\. del4\)"):
+        parse_measure(text)
+
+
+def test_del_of_a_sine_is_its_range_times_the_frequency_ratio():
+    """f T cycles of range 2A (from peak to peak: no residue), N_ref = 1 Hz x T: DEL_m = 2A f^(1/m)."""
+    t = np.linspace(0.0, 10.0, 20001)
+    f_hz, amplitude = 2.0, 3.0
+    load = 100.0 + amplitude * np.cos(2 * np.pi * f_hz * t)
+    for m in (3.0, 4.0, 10.0):
+        assert window_statistic(t, load, (0.0, 10.0), f"del{m:g}") == pytest.approx(2 * amplitude * f_hz ** (1 / m), rel=1e-6)
+
+
+def test_del_over_a_window_is_what_the_run_analysis_computes():
+    rng = np.random.default_rng(7)
+    t = np.arange(0.0, 60.0, 1e-2)
+    load = np.cumsum(rng.normal(size=t.size))
+    window = (5.0, 60.0)
+    expected = fatigue_loads(t, load, FatigueSettings(wohler_exponents=(4.0,)), window=window).del_by_exponent[4.0]
+    assert window_statistic(t, load, window, "del4") == pytest.approx(expected, rel=1e-12)
+    assert np.isnan(window_statistic(t, load, (100.0, 200.0), "del4"))
+    assert window_statistic(t, load, window, "max") == pytest.approx(load[t >= 5.0 - 1e-12].max())
+
+
+def test_cells_combine_dels_by_damage_and_other_measures_arithmetically(fmu_dir):
+    """Six seeds per cell of shaft3-seeds: a DEL cell is (mean DEL^m)^(1/m), a std cell the plain mean."""
+    from orchestrator.inputs.study import find_study, load_study
+    from orchestrator.study.plots import grid
+    from orchestrator.study.prepare import prepare_study
+
+    prepared = prepare_study(load_study(find_study("shaft3-seeds")), fmu_dir=fmu_dir, build=False)
+    values = np.array([500.0, 520.0, 610.0, 640.0, 660.0, 700.0])  # the six seeds of every cell
+    recs = [{"status": "ok", "measures": {"gearbox.shaft3.torque:del4": values[p.coords[-1]],
+                                          "generator.omega:std": values[p.coords[-1]]}} for p in prepared.points]
+    recs[0] = {"status": "failed", "measures": {}}  # seed 1 of the first stiffness
+    dels, count, failed = grid(prepared, recs, "gearbox.shaft3.torque:del4", 0, None)
+    assert count.tolist() == [[5, 6, 6]] and failed.tolist() == [[1, 0, 0]]
+    np.testing.assert_allclose(dels[0], [np.mean(values[1:] ** 4) ** 0.25] + [np.mean(values**4) ** 0.25] * 2)
+    stds, _, _ = grid(prepared, recs, "generator.omega:std", 0, None)
+    np.testing.assert_allclose(stds[0], [values[1:].mean(), values.mean(), values.mean()])
