@@ -34,11 +34,12 @@ def main() -> None:
 
     from orchestrator.cosim.fmu_store import ensure_fmus
     from orchestrator.cosim.master import CoSimulation
+    from orchestrator.cosim.physics_view import physics_view
     from orchestrator.cosim.system import resolve_system
     from orchestrator.inputs.scenario import find_scenario, load_scenario
     from orchestrator.interop.libcosim import run_ssp_in_libcosim
     from orchestrator.interop.ssp import export_ssp
-    from orchestrator.run.comparison import monolithic_setup, run_reference
+    from orchestrator.run.comparison import run_reference
 
     scenario = load_scenario(find_scenario("paper-60s"))
     if args.stop != scenario.simulation.stop_s:
@@ -54,7 +55,7 @@ def main() -> None:
     print(f"  dtcosim co-simulation      {t_cosim:7.2f} s   (stepping loop {outcome.loop_time_s:.2f} s, "
           f"{1e6 * outcome.loop_time_s / outcome.steps:.1f} us per communication step)")
 
-    setup = monolithic_setup(system)
+    setup = physics_view(system)
     t0 = time.perf_counter()
     reference = run_reference(system, setup)
     t_mono = time.perf_counter() - t0

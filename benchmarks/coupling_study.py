@@ -42,9 +42,10 @@ def main() -> None:
 
     from orchestrator.cosim.fmu_store import ensure_fmus
     from orchestrator.cosim.master import CoSimulation
+    from orchestrator.cosim.physics_view import physics_view
     from orchestrator.cosim.system import resolve_system
     from orchestrator.inputs.scenario import find_scenario, load_scenario
-    from orchestrator.run.comparison import compare, monolithic_setup, run_reference
+    from orchestrator.run.comparison import compare, run_reference
 
     steps = [float(h) * 1e-3 for h in args.steps.split(",")]
     window = (min(5.0, args.stop / 2), args.stop)
@@ -52,7 +53,7 @@ def main() -> None:
                                                                        output_interval_s=0.01)
     paths = ensure_fmus(base, args.fmu_dir)
     system = resolve_system(base, fmu_paths=paths)
-    setup = monolithic_setup(system)
+    setup = physics_view(system)
     reference = run_reference(system, setup)
     print(f"paper scenario, 0-{args.stop:g} s, window [{window[0]:g}, {window[1]:g}] s; monolithic reference "
           f"({reference.wall_time_s:.2f} s LSODA)\n")

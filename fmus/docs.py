@@ -14,7 +14,8 @@ import sys
 from pathlib import Path
 from typing import Sequence
 
-from .build import FMU_NAMES, FMU_SLAVES
+from .build import FMU_NAMES, FMU_SLAVES, drivetrain_of_preset
+from .records import model_of
 from .slaves.interface import REAL, Variable
 
 _CAUSALITY_ORDER = {"input": 0, "output": 1, "parameter": 2}
@@ -23,8 +24,8 @@ _CAUSALITY_ORDER = {"input": 0, "output": 1, "parameter": 2}
 def interface(name: str, preset: str = "table6") -> tuple[Variable, ...]:
     """Variables of FMU ``name`` built for ``preset``, in value-reference order."""
     module, _ = FMU_SLAVES[name]
-    base = getattr(importlib.import_module(f"fmus.slaves.{module}"), name)
-    return tuple(base.build_interface.__func__(type(name, (base,), {"preset": preset})))
+    slave = getattr(importlib.import_module(f"fmus.slaves.{module}"), name)
+    return tuple(slave.build_interface(model_of(name, drivetrain_of_preset(preset))))
 
 
 def _start(var: Variable) -> str:

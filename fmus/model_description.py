@@ -9,7 +9,9 @@ pythonfmu emits neither units nor ``InitialUnknowns``; this module adds
   ``initial="calculated"``: computed from parameters and inputs in
   initialisation mode) and ``dependencies=""`` on every output (no direct
   feedthrough: outputs change only in ``doStep``);
-* a deterministic GUID derived from the build hash and the generation tool.
+* a deterministic GUID derived from the build hash and the generation tool;
+* ``VendorAnnotations`` with the dtcosim tool entry: the component's declared
+  role and where its record is (``resources/dtcosim.json``).
 """
 
 from __future__ import annotations
@@ -58,8 +60,9 @@ def unit_definitions(unit_names: Iterable[str]) -> ET.Element:
     return root
 
 
-def finalize(xml: bytes, variables: tuple[Variable, ...], build_id: str, generation_tool: str) -> bytes:
-    """Add units, InitialUnknowns, output dependencies and a deterministic GUID.
+def finalize(xml: bytes, variables: tuple[Variable, ...], build_id: str, generation_tool: str,
+             role: str = "", record_file: str = "") -> bytes:
+    """Add units, InitialUnknowns, output dependencies, a deterministic GUID and the vendor annotation.
 
     Parameters
     ----------
@@ -71,6 +74,10 @@ def finalize(xml: bytes, variables: tuple[Variable, ...], build_id: str, generat
         Hash of the code and configuration the FMU was built from.
     generation_tool : str
         Value of the ``generationTool`` attribute.
+    role, record_file : str
+        The component's role and its record's path in the archive, written as
+        ``<VendorAnnotations><Tool name="dtcosim"><Component role=... record=.../></Tool>``
+        (omitted when empty).
 
     Returns
     -------
@@ -97,6 +104,14 @@ def finalize(xml: bytes, variables: tuple[Variable, ...], build_id: str, generat
     co_simulation = root.find("CoSimulation")
     position = list(root).index(co_simulation) + 1
     root.insert(position, unit_definitions(v.unit for v in variables if v.type == REAL))
+    if role:
+        annotations = ET.Element("VendorAnnotations")
+        tool = ET.SubElement(annotations, "Tool", name="dtcosim")
+        ET.SubElement(tool, "Component", role=role, record=record_file)
+        before = next((i for i, child in enumerate(root) if child.tag in ("ModelVariables",)), len(root))
+        for existing in root.findall("VendorAnnotations"):
+            root.remove(existing)
+        root.insert(before, annotations)
 
     structure = root.find("ModelStructure")
     for child in list(structure):

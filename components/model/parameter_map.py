@@ -26,6 +26,15 @@ the planets' orbital inertia). Per parallel stage: ``drive_radius``,
 ``stiffness_variation`` [-]. Per shaft ``shaftK``: ``stiffness`` [N m/rad],
 ``damping`` [N m s/rad]. Generator: ``generator.inertia`` [kg m^2],
 ``generator.counter_torque`` [N m]. Without a generator: ``output_torque`` [N m].
+
+The WindSource and GeneratorRotor FMUs' parameters have flat names of their own
+(:func:`wind_values` / :func:`wind_from_values`: ``omega0``, ``a``, ``sigma``,
+``n_harmonics``, ``f_min``, ``f_max``, ``seed``, ``amplitude``;
+:func:`generator_values` / :func:`generator_from_values`: ``inertia``,
+``counter_torque`` and the load-event slots ``event{i}.kind`` (0 none, then
+:data:`~components.model.generator.EVENT_KINDS` from 1), ``event{i}.start``,
+``event{i}.duration``, ``event{i}.factor``). The FMUs and the physics view of a
+scenario both use these functions, so they cannot disagree.
 """
 
 from __future__ import annotations
@@ -37,7 +46,23 @@ from typing import Mapping
 from ..errors import ParameterError
 from .contact import CONTACT_LAWS, MeshContact
 from .drivetrain import Drivetrain
+from .generator import EVENT_KINDS, GeneratorParameters, LoadEvent
 from .stages import PlanetaryStage, Shaft
+from .wind import AMPLITUDE_CONVENTIONS, WindParameters
+
+#: WindSource FMU parameter -> WindParameters field
+WIND_FIELDS = {
+    "omega0": "mean_speed_rad_s", "a": "spectrum_level", "sigma": "sigma_rad_s", "n_harmonics": "n_harmonics",
+    "f_min": "f_min_rad_s", "f_max": "f_max_rad_s", "seed": "seed",
+}
+#: GeneratorRotor FMU parameter -> GeneratorParameters field
+GENERATOR_FIELDS = {"inertia": "inertia_kgm2", "counter_torque": "counter_torque_nm"}
+#: load-event slots of the GeneratorRotor FMU
+N_EVENT_SLOTS = 4
+#: ``event{i}.kind`` codes: 0 = no event, then the event kinds
+EVENT_KIND_CODES = ("none",) + EVENT_KINDS
+#: slot parameter -> LoadEvent field
+_SLOT_FIELDS = {"start": "start_s", "duration": "duration_s", "factor": "factor"}
 
 UNITS: dict[str, str] = {
     "sun_radius": "m", "ring_radius": "m", "drive_radius": "m", "driven_radius": "m", "module": "m", "width": "m",
@@ -195,3 +220,92 @@ def unflatten(template: Drivetrain, values: Mapping[str, float]) -> Drivetrain:
         )
         return replace(template, stages=tuple(stages), shafts=shafts, generator=generator, output_shaft=shaft(template.output_shaft))
     return replace(template, stages=tuple(stages), shafts=shafts, output_torque_nm=values.get("output_torque", template.output_torque_nm))
+
+
+def _integer_code(name: str, value, choices: tuple[str, ...]) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not float(value).is_integer() \
+            or not 0 <= int(value) < len(choices):
+        raise ParameterError(name, value, ", ".join(f"{i} = {c}" for i, c in enumerate(choices)))
+    return int(value)
+
+
+def wind_values(params: WindParameters) -> dict[str, float | int]:
+    """The WindSource FMU's parameter values of ``params`` by flat name (``amplitude`` as its code)."""
+    out: dict[str, float | int] = {k: getattr(params, f) for k, f in WIND_FIELDS.items()}
+    out["amplitude"] = AMPLITUDE_CONVENTIONS.index(params.amplitude)
+    return out
+
+
+def wind_from_values(values: Mapping[str, float | int], template: WindParameters | None = None) -> WindParameters:
+    """WindParameters from WindSource FMU parameter values (missing ones from ``template``).
+
+    Raises
+    ------
+    ParameterError
+        Naming the flat parameter (``seed``, ``amplitude``, ...).
+    """
+    template = template or WindParameters()
+    changes = {f: values[k] for k, f in WIND_FIELDS.items() if k in values}
+    if "amplitude" in values:
+        changes["amplitude"] = AMPLITUDE_CONVENTIONS[_integer_code("amplitude", values["amplitude"], AMPLITUDE_CONVENTIONS)]
+    try:
+        return replace(template, **changes)
+    except ParameterError as exc:  # WindParameters names them wind.<flat name>
+        raise ParameterError(exc.name.removeprefix("wind."), exc.value, exc.expected) from None
+
+
+def generator_values(params: GeneratorParameters, n_slots: int = N_EVENT_SLOTS) -> dict[str, float | int]:
+    """The GeneratorRotor FMU's parameter values of ``params`` by flat name, events in the first slots."""
+    if len(params.events) > n_slots:
+        raise ParameterError("generator.events", len(params.events), f"at most {n_slots} load events")
+    out: dict[str, float | int] = {k: getattr(params, f) for k, f in GENERATOR_FIELDS.items()}
+    for i in range(1, n_slots + 1):
+        ev = params.events[i - 1] if i <= len(params.events) else None
+        out[f"event{i}.kind"] = 0 if ev is None else EVENT_KIND_CODES.index(ev.kind)
+        out[f"event{i}.start"] = 0.0 if ev is None else ev.start_s
+        out[f"event{i}.duration"] = 1.0 if ev is None else ev.duration_s
+        out[f"event{i}.factor"] = 1.0 if ev is None else ev.factor
+    return out
+
+
+def events_from_slots(values: Mapping[str, float | int], n_slots: int = N_EVENT_SLOTS) -> tuple[LoadEvent, ...]:
+    """The load events of the slot parameters ``event{i}.*`` (kind 0: empty slot), in slot order.
+
+    Raises
+    ------
+    ParameterError
+        Naming the slot parameter (``event2.duration``, ...).
+    """
+    events = []
+    for i in range(1, n_slots + 1):
+        code = _integer_code(f"event{i}.kind", values.get(f"event{i}.kind", 0), EVENT_KIND_CODES)
+        if code == 0:
+            continue
+        fields = {f: values[f"event{i}.{k}"] for k, f in _SLOT_FIELDS.items() if f"event{i}.{k}" in values}
+        if "start_s" not in fields:
+            raise ParameterError(f"event{i}.start", None, f"a start time [s] for the event of event{i}.kind = {code}")
+        try:
+            events.append(LoadEvent(kind=EVENT_KIND_CODES[code], **fields))
+        except ParameterError as exc:  # LoadEvent names them event.<field>
+            local = exc.name.removeprefix("event.")
+            flat = next((k for k, f in _SLOT_FIELDS.items() if f == local), local)
+            raise ParameterError(f"event{i}.{flat}", exc.value, exc.expected) from None
+    return tuple(events)
+
+
+def generator_from_values(values: Mapping[str, float | int], template: GeneratorParameters | None = None,
+                          n_slots: int = N_EVENT_SLOTS) -> GeneratorParameters:
+    """GeneratorParameters from GeneratorRotor FMU parameter values (missing ones from ``template``).
+
+    The events are those of the slots when any slot parameter is given, else the template's.
+    """
+    template = template or GeneratorParameters()
+    changes: dict = {f: values[k] for k, f in GENERATOR_FIELDS.items() if k in values}
+    if any(k.startswith("event") for k in values):
+        changes["events"] = events_from_slots(values, n_slots)
+    try:
+        return replace(template, **changes)
+    except ParameterError as exc:  # GeneratorParameters names them generator.<field>
+        local = exc.name.removeprefix("generator.")
+        flat = next((k for k, f in GENERATOR_FIELDS.items() if f == local), local)
+        raise ParameterError(flat, exc.value, exc.expected) from None

@@ -1,7 +1,8 @@
 """Base class of the dtcosim FMU slaves: FMI variables <-> component, errors, state.
 
-A slave subclass declares its variables (:meth:`DtcosimSlave.interface`) and
-implements five small hooks that talk to a ``components`` object:
+A slave subclass declares its variables (:meth:`DtcosimSlave.build_interface`)
+from the model its FMU records (``resources/dtcosim.json``, :mod:`.record`: the
+parameter set the build was made from, read at instantiation) and implements five small hooks that talk to a ``components`` object:
 ``_configure`` (build it from the parameter values), ``_initialize`` (initial
 state from inputs at the start time), ``_step``, ``_refresh`` (write one group
 of outputs) and ``_component_state`` / ``_restore_component_state``.
@@ -36,6 +37,7 @@ How errors reach the host (pythonfmu 0.7 C wrapper)
 from __future__ import annotations
 
 import ctypes
+import json
 import sys
 from abc import abstractmethod
 from contextlib import contextmanager
@@ -58,6 +60,7 @@ from components import __version__ as COMPONENTS_VERSION
 from components.errors import DtcosimError, ParameterError
 
 from .interface import BOOLEAN, INPUT, INTEGER, OUTPUT, PARAMETER, REAL, Value, Variable
+from .record import read_record
 
 #: Life-cycle phases of an instance.
 INSTANTIATED, INITIALIZATION, STEPPING, TERMINATED = "instantiated", "initialization", "stepping", "terminated"
@@ -111,8 +114,8 @@ class DtcosimSlave(Fmi2Slave):
 
     Class attributes
     ----------------
-    preset : str
-        Drivetrain preset the FMU is built for (build-time structure, defaults).
+    role : str
+        What the component is in a drivetrain (:data:`.record.ROLES`), declared in the record.
     build_id : str
         Hash of the code the FMU was built from (set by the build).
     echo_errors_to_stderr : bool
@@ -128,7 +131,7 @@ class DtcosimSlave(Fmi2Slave):
     copyright = "dtcosim contributors, MIT licence"
     version = COMPONENTS_VERSION
     default_experiment = DefaultExperiment(start_time=0.0, stop_time=60.0, step_size=1.0e-3)
-    preset = "table6"
+    role = ""
     build_id = "source"
     echo_errors_to_stderr = True
     eager_output_groups: frozenset = frozenset()
@@ -137,7 +140,9 @@ class DtcosimSlave(Fmi2Slave):
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__(**kwargs)
-        variables = self.interface()
+        #: the parameter set of this FMU's record (structure and defaults)
+        self.model: dict[str, Any] = read_record(self.resources)["model"]
+        variables = self.interface(self.model)
         self.variables: tuple[Variable, ...] = variables
         self.vr: dict[str, int] = {v.name: i for i, v in enumerate(variables)}
         self._values: list[Value] = [0.0 if v.start is None else v.start for v in variables]
@@ -166,17 +171,17 @@ class DtcosimSlave(Fmi2Slave):
 
     # ------------------------------------------------------------------ interface
     @classmethod
-    def interface(cls) -> tuple[Variable, ...]:
-        """The FMU's variables in value-reference order (cached per class and preset)."""
-        key = (cls, cls.preset)
+    def interface(cls, model: Mapping[str, Any]) -> tuple[Variable, ...]:
+        """The FMU's variables in value-reference order for the record's ``model`` (cached)."""
+        key = (cls, json.dumps(model, sort_keys=True))
         if key not in DtcosimSlave._interface_cache:
-            DtcosimSlave._interface_cache[key] = tuple(cls.build_interface())
+            DtcosimSlave._interface_cache[key] = tuple(cls.build_interface(model))
         return DtcosimSlave._interface_cache[key]
 
     @classmethod
     @abstractmethod
-    def build_interface(cls) -> Iterable[Variable]:
-        """Declare the variables (called once per class and preset)."""
+    def build_interface(cls, model: Mapping[str, Any]) -> Iterable[Variable]:
+        """Declare the variables of the record's ``model`` (called once per class and model)."""
 
     def output_group(self, name: str) -> Hashable:
         """Group key of an output: outputs of one group are refreshed together."""
@@ -445,8 +450,6 @@ class DtcosimSlave(Fmi2Slave):
     @staticmethod
     def _fmu_state_from_bytes(state: bytes) -> Any:
         """Deserialise; never raises (a bad buffer is reported by ``setFMUstate``, which knows the instance)."""
-        import json
-
         try:
             return json.loads(state.decode("utf-8"))
         except Exception as exc:  # noqa: BLE001

@@ -11,8 +11,8 @@ output member's acceleration ``alpha_out`` (averaged over the last step) and
 its running peak magnitude ``alpha_out_max`` (eq. 11, over every internal
 solver step).
 
-The structure (stages, planets, shafts) is fixed at build time by the preset;
-every number is a parameter (see :mod:`fmus.slaves.gearbox_parameters`).
+The structure (stages, planets, shafts) is the drivetrain of the FMU's record
+(``resources/dtcosim.json``, fixed at build time); every number is a parameter (see :mod:`fmus.slaves.gearbox_parameters`).
 Before the first step (initialisation mode) the outputs describe the
 kinematically consistent, undeflected initial state at the current inputs,
 e.g. ``omega_out = ratio * omega_rotor``.
@@ -20,14 +20,14 @@ e.g. ``omega_out = ratio * omega_rotor``.
 
 from __future__ import annotations
 
-from typing import Hashable, Iterable
+from typing import Any, Hashable, Iterable, Mapping
 
 from components.errors import ParameterError
 from components.model.assembly import Assembly
+from components.model.description import build
+from components.model.drivetrain import Drivetrain
 from components.model.gearbox_model import SHAFT_TORQUE_MODES, GearboxModel
 from components.model.integrators import StepControl
-from components.model.presets import cosim_preset
-from components.model.wind import WindParameters
 
 from .base import DtcosimSlave
 from .gearbox_parameters import (
@@ -44,6 +44,7 @@ from .interface import (
     real_input,
     real_output,
 )
+from .record import GEARBOX
 
 _MESH_KINDS = {"sun_planet": "sun-planet mesh", "ring_planet": "ring-planet mesh", "parallel": "parallel-stage mesh"}
 
@@ -52,8 +53,15 @@ _MESH_KINDS = {"sun_planet": "sun-planet mesh", "ring_planet": "ring-planet mesh
 _OUTPUTS = "outputs"
 
 
-def _assembly(preset: str) -> Assembly:
-    return Assembly(cosim_preset(preset), cut_at_generator=True)
+def _planet_of(force_name: str) -> dict[str, str]:
+    """``{"planet": "2"}`` for a planet mesh force ``stage1.F_sp[2]``, ``{}`` for a parallel mesh."""
+    inside = force_name.rpartition("[")[2].rstrip("]") if force_name.endswith("]") else ""
+    return {"planet": inside} if inside else {}
+
+
+def template_of(model: Mapping[str, Any]) -> Drivetrain:
+    """The drivetrain of a Gearbox record's model (structure and default values)."""
+    return build(model["drivetrain"], "model.drivetrain")
 
 
 class Gearbox(DtcosimSlave):
@@ -61,13 +69,14 @@ class Gearbox(DtcosimSlave):
 
     description = ("dtcosim Gearbox: multi-stage planetary/parallel gearbox with CFS (or impact) gear contact "
                    "and shaft 3, driven by the rotor motion and cut at the generator (SI units)")
+    role = GEARBOX
     eager_output_groups = frozenset({_OUTPUTS})  # shaft_torque is read every step
 
     @classmethod
-    def build_interface(cls) -> Iterable[Variable]:
-        template = cosim_preset(cls.preset)
-        assembly = _assembly(cls.preset)
-        omega0 = WindParameters().mean_speed_rad_s
+    def build_interface(cls, model: Mapping[str, Any]) -> Iterable[Variable]:
+        template = template_of(model)
+        assembly = Assembly(template, cut_at_generator=True)
+        omega0 = float(model["rotor_speed_rad_s"])
         ratio = float(assembly.port_ratio[0])
         variables = drivetrain_variables(template)
         variables += solver_variables(StepControl())
@@ -83,32 +92,41 @@ class Gearbox(DtcosimSlave):
             real_input("omega_gen", ratio * omega0, "rad/s", "generator speed (far end of shaft 3)"),
             real_input("phi_gen", 0.0, "rad", "generator angle (far end of shaft 3)"),
             real_output("shaft_torque", "N.m",
-                        "torque of shaft 3 on the generator, per shaft_torque_mode (default: step average)"),
-            real_output("shaft_torque_end", "N.m", "torque of shaft 3 on the generator at the end of the last step"),
-            real_output("shaft_torque_avg", "N.m", "torque of shaft 3 on the generator averaged over the last step"),
-            real_output("omega_out", "rad/s", f"speed of the output member {assembly.stage_members[template.stages[-1].name]['output']}"),
-            real_output("torque_rotor", "N.m", "torque the rotor applies to the gearbox (for the power balance)"),
+                        "torque of shaft 3 on the generator, per shaft_torque_mode (default: step average)",
+                        "generator_shaft_torque"),
+            real_output("shaft_torque_end", "N.m", "torque of shaft 3 on the generator at the end of the last step",
+                        "generator_shaft_torque"),
+            real_output("shaft_torque_avg", "N.m", "torque of shaft 3 on the generator averaged over the last step",
+                        "generator_shaft_torque"),
+            real_output("omega_out", "rad/s", f"speed of the output member {assembly.stage_members[template.stages[-1].name]['output']}",
+                        "output_speed"),
+            real_output("torque_rotor", "N.m", "torque the rotor applies to the gearbox (for the power balance)",
+                        "rotor_torque"),
         ]
         for mesh in assembly.meshes:
-            variables.append(real_output(mesh.name, "N", f"contact force of the {mesh.stage} {_MESH_KINDS[mesh.kind]} {mesh.name}"))
+            variables.append(real_output(mesh.name, "N", f"contact force of the {mesh.stage} {_MESH_KINDS[mesh.kind]} {mesh.name}",
+                                         "contact_force", stage=mesh.stage, mesh=mesh.kind, **_planet_of(mesh.name)))
         for shaft in assembly.shafts:
             variables.append(real_output(f"{shaft.name}.torque", "N.m",
-                                         f"torque of {shaft.name} ({shaft.upstream} -> {shaft.downstream})"))
+                                         f"torque of {shaft.name} ({shaft.upstream} -> {shaft.downstream})",
+                                         "shaft_torque", shaft=shaft.name, upstream=shaft.upstream,
+                                         downstream=shaft.downstream))
         for body in assembly.dof_names:
-            variables.append(real_output(f"{body}.omega", "rad/s", f"absolute speed of {body}"))
+            variables.append(real_output(f"{body}.omega", "rad/s", f"absolute speed of {body}", "body_speed", body=body))
         out_member = assembly.stage_members[template.stages[-1].name]["output"]
         variables += [  # after the body speeds: the same order as GearboxModel.output_names
             real_output("alpha_out", "rad/s2",
                         f"angular acceleration of the output member {out_member}, averaged over the last step"),
             real_output("alpha_out_max", "rad/s2",
                         "largest |d omega_out/dt| since initialisation over every internal solver step "
-                        "(paper eq. 11; resolves tooth impacts shorter than the communication step)"),
+                        "(paper eq. 11; resolves tooth impacts shorter than the communication step)",
+                        "output_acceleration_peak"),
         ]
         return variables
 
     def __init__(self, **kwargs) -> None:
         super().__init__(**kwargs)
-        self._template = cosim_preset(self.preset)
+        self._template = template_of(self.model)
         vr = self.vr
         self._vr_inputs = tuple(vr[n] for n in ("omega_rotor", "phi_rotor", "omega_gen", "phi_gen"))
         names = GearboxModel(self._template).output_names

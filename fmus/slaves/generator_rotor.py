@@ -10,13 +10,18 @@ the rotor is integrated exactly. Parameters: ``inertia``, ``counter_torque``,
 from __future__ import annotations
 
 import math
-from typing import Hashable, Iterable
+from typing import Any, Hashable, Iterable, Mapping
 
 from components.errors import ParameterError, SolverError
-from components.model.generator import EVENT_KINDS, GeneratorParameters, LoadEvent
+from components.model.description import build
 from components.model.generator import GeneratorRotor as RotorComponent
-from components.model.presets import cosim_preset
-from components.model.wind import WindParameters
+from components.model.parameter_map import (
+    EVENT_KIND_CODES,
+    GENERATOR_FIELDS,
+    N_EVENT_SLOTS,
+    generator_from_values,
+    generator_values,
+)
 
 from .base import DtcosimSlave, fmu_parameter_names
 from .interface import (
@@ -27,14 +32,9 @@ from .interface import (
     real_output,
     real_parameter,
 )
-
-#: number of load-event slots
-N_EVENT_SLOTS = 4
-EVENT_KIND_CODES = ("none",) + EVENT_KINDS
+from .record import GENERATOR
 
 _NAMES = {
-    "generator.inertia_kgm2": "inertia",
-    "generator.counter_torque_nm": "counter_torque",
     "generator.initial_speed": "initial_speed",
     "generator.initial_angle": "initial_angle",
 }
@@ -45,70 +45,50 @@ class GeneratorRotor(DtcosimSlave):
 
     description = ("dtcosim GeneratorRotor: generator inertia driven by the shaft-3 torque against a counter "
                    "torque with load events (SI units)")
+    role = GENERATOR
     eager_output_groups = frozenset({"motion"})
 
     @classmethod
-    def build_interface(cls) -> Iterable[Variable]:
-        gen = cosim_preset(cls.preset).generator
-        speed0 = cosim_preset(cls.preset).ratio * WindParameters().mean_speed_rad_s
+    def build_interface(cls, model: Mapping[str, Any]) -> Iterable[Variable]:
+        gen = build(model["generator"], "model.generator")
+        slots = generator_values(gen)
+        speed0 = float(model["initial_speed_rad_s"])
         kinds = enumeration_text(EVENT_KIND_CODES)
         variables = [
             real_parameter("inertia", gen.inertia_kgm2, "kg.m2", "generator rotor inertia (Table 6: 1.51e8 kg mm^2)"),
             real_parameter("counter_torque", gen.counter_torque_nm, "N.m",
                            "base counter torque of the generator (Sec. 4.2: 2.54e7 N mm)"),
             real_parameter("initial_speed", speed0, "rad/s",
-                           "generator speed at the start time (default: total ratio x 16 rpm)"),
+                           "generator speed at the start time (default: total ratio x the default rotor speed)"),
             real_parameter("initial_angle", 0.0, "rad", "generator angle at the start time"),
         ]
         for i in range(1, N_EVENT_SLOTS + 1):
             variables += [
-                integer_parameter(f"event{i}.kind", 0, f"load event {i}: {kinds}"),
-                real_parameter(f"event{i}.start", 0.0, "s", f"load event {i}: start time"),
-                real_parameter(f"event{i}.duration", 1.0, "s",
+                integer_parameter(f"event{i}.kind", slots[f"event{i}.kind"], f"load event {i}: {kinds}"),
+                real_parameter(f"event{i}.start", slots[f"event{i}.start"], "s", f"load event {i}: start time"),
+                real_parameter(f"event{i}.duration", slots[f"event{i}.duration"], "s",
                                f"load event {i}: duration (> 0; +inf allowed for a permanent torque_step)"),
-                real_parameter(f"event{i}.factor", 1.0, "1",
+                real_parameter(f"event{i}.factor", slots[f"event{i}.factor"], "1",
                                f"load event {i}: torque factor (torque_step: factor x base; emergency_stop: "
                                "-|factor| x base; unused by grid_fault)"),
             ]
         variables += [
             real_input("shaft_torque", 0.0, "N.m", "torque of shaft 3 driving the generator (Gearbox output)"),
-            real_output("omega", "rad/s", "generator speed"),
-            real_output("phi", "rad", "generator angle"),
-            real_output("generator_torque", "N.m", "counter torque applied at the current time (base torque and events)"),
+            real_output("omega", "rad/s", "generator speed", "generator_speed"),
+            real_output("phi", "rad", "generator angle", "generator_angle"),
+            real_output("generator_torque", "N.m", "counter torque applied at the current time (base torque and events)",
+                        "generator_torque"),
         ]
         return variables
 
     def output_group(self, name: str) -> Hashable:
         return "motion"
 
-    def _events(self) -> tuple[LoadEvent, ...]:
-        events = []
-        for i in range(1, N_EVENT_SLOTS + 1):
-            code = self.value(f"event{i}.kind")
-            if not 0 <= code < len(EVENT_KIND_CODES):
-                raise ParameterError(f"event{i}.kind", code, enumeration_text(EVENT_KIND_CODES))
-            if code == 0:
-                continue
-            names = {f"event.{f}": f"event{i}.{g}" for f, g in
-                     (("kind", "kind"), ("start_s", "start"), ("duration_s", "duration"), ("factor", "factor"))}
-            with fmu_parameter_names(names):
-                events.append(LoadEvent(
-                    kind=EVENT_KIND_CODES[code],
-                    start_s=self.value(f"event{i}.start"),
-                    duration_s=self.value(f"event{i}.duration"),
-                    factor=self.value(f"event{i}.factor"),
-                ))
-        return tuple(events)
-
     def _configure(self) -> None:
-        events = self._events()
-        with fmu_parameter_names(_NAMES):
-            self.params = GeneratorParameters(
-                inertia_kgm2=self.value("inertia"),
-                counter_torque_nm=self.value("counter_torque"),
-                events=events,
-            )
-            self._new_rotor()
+        names = (*GENERATOR_FIELDS, *(f"event{i}.{f}" for i in range(1, N_EVENT_SLOTS + 1)
+                                        for f in ("kind", "start", "duration", "factor")))
+        self.params = generator_from_values({n: self.value(n) for n in names}, build(self.model["generator"]))
+        self._new_rotor()
         self._vr_torque = self.vr["shaft_torque"]
         self._vr_out = (self.vr["omega"], self.vr["phi"], self.vr["generator_torque"])
 

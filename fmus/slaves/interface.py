@@ -83,6 +83,12 @@ class Variable:
         Unit name (a key of :data:`UNITS`); Real variables only, ``""`` otherwise.
     start : float, int, bool or None
         Start value of parameters and inputs; ``None`` for outputs (they are calculated).
+    signal : str
+        What an output is in the drivetrain (a kind of :data:`fmus.slaves.record.SIGNALS`,
+        e.g. ``"contact_force"``), declared in the FMU's record; ``""``: nothing the
+        analyses use.
+    info : tuple of (str, str)
+        Details of the signal (``("stage", "stage1"), ("mesh", "sun_planet"), ("planet", "1")``).
     """
 
     name: str
@@ -91,6 +97,8 @@ class Variable:
     description: str
     unit: str = ""
     start: Value | None = None
+    signal: str = ""
+    info: tuple[tuple[str, str], ...] = ()
 
     def __post_init__(self) -> None:
         if self.type not in (REAL, INTEGER, BOOLEAN):
@@ -138,9 +146,9 @@ def real_input(name: str, start: float, unit: str, description: str) -> Variable
     return Variable(name, REAL, INPUT, description, unit, float(start))
 
 
-def real_output(name: str, unit: str, description: str) -> Variable:
-    """A continuous Real output (initial = calculated)."""
-    return Variable(name, REAL, OUTPUT, description, unit, None)
+def real_output(name: str, unit: str, description: str, signal: str = "", **info: str) -> Variable:
+    """A continuous Real output (initial = calculated), optionally declared as a drivetrain ``signal``."""
+    return Variable(name, REAL, OUTPUT, description, unit, None, signal, tuple((k, str(v)) for k, v in info.items()))
 
 
 def enumeration_text(choices: tuple[str, ...]) -> str:

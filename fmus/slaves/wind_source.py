@@ -10,16 +10,14 @@ time, so the only state is the time itself.
 
 from __future__ import annotations
 
-from typing import Hashable, Iterable
+from typing import Any, Hashable, Iterable, Mapping
 
 from components.errors import ParameterError
-from components.model.wind import (
-    AMPLITUDE_CONVENTIONS,
-    RotorSpeedProcess,
-    WindParameters,
-)
+from components.model.description import build
+from components.model.parameter_map import WIND_FIELDS, wind_from_values
+from components.model.wind import AMPLITUDE_CONVENTIONS, RotorSpeedProcess
 
-from .base import DtcosimSlave, fmu_parameter_names
+from .base import DtcosimSlave
 from .interface import (
     Variable,
     enumeration_text,
@@ -27,20 +25,19 @@ from .interface import (
     real_output,
     real_parameter,
 )
-
-#: component parameter name -> FMU variable name
-_NAMES = {f"wind.{n}": n for n in ("omega0", "a", "sigma", "n_harmonics", "f_min", "f_max", "seed", "amplitude")}
+from .record import WIND_SOURCE
 
 
 class WindSource(DtcosimSlave):
     """Stochastic rotor speed (eq. 13-14) as an FMU with outputs ``omega`` and ``phi``."""
 
     description = "dtcosim WindSource: stochastic rotor speed omega(t) and angle phi(t) of eq. 13-14 (SI units)"
+    role = WIND_SOURCE
     eager_output_groups = frozenset({"motion"})
 
     @classmethod
-    def build_interface(cls) -> Iterable[Variable]:
-        d = WindParameters()
+    def build_interface(cls, model: Mapping[str, Any]) -> Iterable[Variable]:
+        d = build(model["wind"], "model.wind")
         amplitude = enumeration_text(AMPLITUDE_CONVENTIONS)
         return (
             real_parameter("omega0", d.mean_speed_rad_s, "rad/s", "mean rotor speed omega0 (eq. 13; paper: 16 rpm)"),
@@ -53,29 +50,16 @@ class WindSource(DtcosimSlave):
             integer_parameter("seed", d.seed, "seed of the random phases (numpy default_rng, >= 0)"),
             integer_parameter("amplitude", AMPLITUDE_CONVENTIONS.index(d.amplitude),
                               f"amplitude convention: {amplitude} (W_k = sqrt(2 S df) or the paper's S df)"),
-            real_output("omega", "rad/s", "rotor speed omega(t) (eq. 13)"),
-            real_output("phi", "rad", "rotor angle phi(t), the integral of omega from t = 0"),
+            real_output("omega", "rad/s", "rotor speed omega(t) (eq. 13)", "rotor_speed"),
+            real_output("phi", "rad", "rotor angle phi(t), the integral of omega from t = 0", "rotor_angle"),
         )
 
     def output_group(self, name: str) -> Hashable:
         return "motion"
 
     def _configure(self) -> None:
-        code = self.value("amplitude")
-        if not 0 <= code < len(AMPLITUDE_CONVENTIONS):
-            raise ParameterError("amplitude", code, enumeration_text(AMPLITUDE_CONVENTIONS))
-        with fmu_parameter_names(_NAMES):
-            params = WindParameters(
-                mean_speed_rad_s=self.value("omega0"),
-                spectrum_level=self.value("a"),
-                sigma_rad_s=self.value("sigma"),
-                n_harmonics=self.value("n_harmonics"),
-                f_min_rad_s=self.value("f_min"),
-                f_max_rad_s=self.value("f_max"),
-                seed=self.value("seed"),
-                amplitude=AMPLITUDE_CONVENTIONS[code],
-            )
-            self.process = RotorSpeedProcess(params)
+        values = {name: self.value(name) for name in (*WIND_FIELDS, "amplitude")}
+        self.process = RotorSpeedProcess(wind_from_values(values, build(self.model["wind"], "model.wind")))
         self._vr_omega = self.vr["omega"]
         self._vr_phi = self.vr["phi"]
 

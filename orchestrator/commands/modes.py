@@ -3,7 +3,7 @@
 With a scenario (packaged name, TOML or SSP file) the drivetrain is the one behind
 its FMUs - the Gearbox FMU's effective parameters and the generator's inertia and
 counter torque, rebuilt as for the monolithic reference
-(:func:`orchestrator.run.comparison.monolithic_setup`) - and the operating point is the
+(:func:`orchestrator.cosim.physics_view.physics_view`: the FMUs' records with the scenario's values) - and the operating point is the
 scenario's: the WindSource's mean rotor speed ``omega0`` and the generator's
 base counter torque (load events and the wind's fluctuation are not part of a
 linearisation). ``--rotor-speed-rpm`` and ``--torque-nm`` override either.
@@ -75,17 +75,17 @@ def scenario_drivetrain(spec: str, fmu_dir: Path | None = None):
     from components.model.generator import GeneratorParameters
 
     from ..cosim.fmu_store import ensure_fmus
+    from ..cosim.physics_view import PhysicsUnavailable, physics_view
     from ..cosim.system import resolve_system
     from ..errors import ScenarioError
     from ..inputs.scenario import find_scenario
-    from ..run.comparison import ReferenceError, monolithic_setup
     from ..run.runner import load_any
 
     scenario = load_any(find_scenario(spec))
     system = resolve_system(scenario, fmu_paths=ensure_fmus(scenario, fmu_dir, build=True))
     try:
-        setup = monolithic_setup(system)
-    except ReferenceError as exc:
+        setup = physics_view(system)
+    except PhysicsUnavailable as exc:
         raise ScenarioError("(scenario)", scenario.name, f"a scenario with a dtcosim drivetrain ({exc})") from None
     dt = setup.drivetrain
     if dt.generator is not None and dt.generator.events:

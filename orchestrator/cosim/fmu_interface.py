@@ -3,13 +3,18 @@
 :func:`read_fmu_interface` gives an :class:`FmuInterface`: the variables with
 value reference, type, causality, variability and unit, the direct-feedthrough
 dependencies of the outputs (ModelStructure), the co-simulation capabilities,
-and the file's SHA-256. Reading is cached per (path, size, mtime).
+the file's SHA-256 and, for an FMU dtcosim built, its record
+(``resources/dtcosim.json``: declared role, the parameter set it was built from,
+the signals of its outputs; :mod:`fmus.slaves.record`). Reading is cached per
+(path, size, mtime).
 """
 
 from __future__ import annotations
 
 import hashlib
+import json
 import os
+import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
@@ -73,6 +78,9 @@ class FmuInterface:
     unit_definitions : mapping of str -> mapping of str -> float
         FMI 2 UnitDefinitions: unit name -> SI base-unit exponents (``kg``, ``m``, ``s``,
         ``A``, ``K``, ``mol``, ``cd``, ``rad``) and ``factor``, ``offset`` (non-default entries only).
+    record : mapping or None
+        The dtcosim record of an FMU dtcosim built (``role``, ``source``, ``model``,
+        ``signals``); None for any other FMU.
     """
 
     path: Path
@@ -88,6 +96,7 @@ class FmuInterface:
     sha256: str
     default_step_s: float | None = None
     unit_definitions: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
+    record: Mapping[str, Any] | None = field(default=None, repr=False)
     _inputs: tuple[str, ...] = field(default=(), repr=False)
 
     def variable(self, name: str) -> FmuVariable:
@@ -127,6 +136,31 @@ def _typed_start(type_: str, start: Any) -> Any:
     except ValueError:
         return start
     return str(start)
+
+
+def read_record(path: Path, key: str) -> dict[str, Any] | None:
+    """The dtcosim record in an FMU archive, None if it has none.
+
+    Raises
+    ------
+    ScenarioError
+        A record that is there but unreadable or of another format (names the file).
+    """
+    from fmus.slaves.record import RECORD_FILE, RECORD_FORMAT, ROLES
+
+    member = f"resources/{RECORD_FILE}"
+    try:
+        with zipfile.ZipFile(path) as archive:
+            if member not in archive.namelist():
+                return None
+            record = json.loads(archive.read(member))
+    except (OSError, zipfile.BadZipFile, ValueError) as exc:
+        raise ScenarioError(key, str(path), f"an FMU with a readable {member} ({exc})") from None
+    if not isinstance(record, dict) or record.get("format") != RECORD_FORMAT or record.get("role") not in ROLES \
+            or not isinstance(record.get("model"), dict) or not isinstance(record.get("signals"), dict):
+        raise ScenarioError(key, str(path), f"an FMU whose {member} is a dtcosim record of format {RECORD_FORMAT} "
+                            f"with a role ({', '.join(ROLES)}), a model and signals")
+    return record
 
 
 def file_sha256(path: str | Path) -> str:
@@ -221,6 +255,7 @@ def read_fmu_interface(path: str | Path, key: str = "fmu") -> FmuInterface:
         sha256=file_sha256(p),
         default_step_s=default_step,
         unit_definitions=FrozenMap(units),
+        record=read_record(p, key),
         _inputs=inputs,
     )
     _CACHE[cache_key] = iface

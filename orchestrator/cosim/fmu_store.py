@@ -9,6 +9,7 @@ missing FMU is a scenario error naming the component.
 
 from __future__ import annotations
 
+import json
 import re
 import zipfile
 from pathlib import Path
@@ -81,30 +82,31 @@ _BUILD_ID = re.compile(r"^_dtcosim_[a-z]+_([0-9a-f]{12})_slave$")
 def stale_project_fmus(paths: Mapping[str, Path]) -> list[str]:
     """Warnings for project FMUs built from other code than the installed ``components``/``fmus``.
 
-    A project FMU carries the hash of the code it embeds in its pythonfmu entry
-    module name (``resources/slavemodule.txt``); it is stale when that hash matches
-    the current sources for no preset. Other FMUs are not checked.
+    A project FMU carries the hash of its code and of the model it was built from
+    in its pythonfmu entry module name (``resources/slavemodule.txt``) and that
+    model in its record (``resources/dtcosim.json``); it is stale when the
+    installed sources, built from the same model, would give another hash.
+    Other FMUs are not checked.
     """
     try:
-        from components.model.presets import PRESETS
         from fmus.build import FMU_NAMES, code_hash
+        from fmus.slaves.record import RECORD_FILE
     except ImportError:
         return []
-    current: dict[str, set[str]] = {}
     out = []
     for comp, path in paths.items():
         try:
             with zipfile.ZipFile(path) as zf:
                 module = zf.read("resources/slavemodule.txt").decode().strip()
-        except (KeyError, OSError, zipfile.BadZipFile):
+                record = json.loads(zf.read(f"resources/{RECORD_FILE}"))
+            model = record["model"]
+        except (KeyError, OSError, ValueError, TypeError, zipfile.BadZipFile):
             continue
         m = _BUILD_ID.match(module)
-        name = path.stem
+        name = record.get("fmu")
         if not m or name not in FMU_NAMES:
             continue
-        if name not in current:
-            current[name] = {code_hash(name, preset) for preset in PRESETS}
-        if m.group(1) not in current[name]:
+        if m.group(1) != code_hash(name, model):
             out.append(f"{path} ({comp}) was built from other code than the installed dtcosim (build {m.group(1)}); "
                        f"rebuild it with `dtcosim build --out {path.parent}`")
     return out

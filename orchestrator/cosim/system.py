@@ -14,17 +14,19 @@ from __future__ import annotations
 import importlib.util
 import os
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Mapping
 
 from components.validation import is_number
 
 from ..errors import AlgebraicLoopError, ScenarioError, suggestion
+from ..frozen_map import FrozenMap
 from ..inputs.scenario import Scenario, VariableRef
 from .event_slots import AssignedEvent, assign_events
 from .fmu_interface import FmuInterface, FmuVariable, read_fmu_interface
 from .graph import find_algebraic_loop, initialization_order, stepping_order
+from .roles import ComponentRole, declared_roles
 
 #: causalities a scenario may give a value to
 SETTABLE_CAUSALITIES = ("parameter", "input")
@@ -97,6 +99,8 @@ class ResolvedSystem:
         Recorded variables in the order of the record patterns.
     events : tuple of AssignedEvent
         The scenario's load events with the component and slot that apply them.
+    roles : mapping of str -> ComponentRole
+        Declared role of each component that has one (its FMU's record or the scenario).
     """
 
     scenario: Scenario
@@ -106,6 +110,11 @@ class ResolvedSystem:
     init_order: tuple[str, ...]
     recorded: tuple[RecordedVariable, ...]
     events: tuple[AssignedEvent, ...] = ()
+    roles: Mapping[str, ComponentRole] = field(default_factory=dict)
+
+    def with_role(self, role: str) -> list[ComponentRole]:
+        """The components declared with ``role``, in scenario order."""
+        return [r for r in self.roles.values() if r.role == role]
 
     def variable(self, ref: VariableRef) -> FmuVariable:
         """Model-description entry of a ``component.variable`` reference."""
@@ -261,6 +270,7 @@ def resolve_system(
         init_order=init_order,
         recorded=recorded,
         events=events,
+        roles=FrozenMap(declared_roles(scenario, interfaces)),
     )
 
 

@@ -123,13 +123,23 @@ class Component:
         :meth:`Scenario.fmu_candidates`).
     parameters : mapping of str -> float, int, bool or str
         Start values of parameters (or unconnected inputs) by FMU variable name.
+    role : str, optional
+        What a foreign FMU is in the drivetrain (``wind_source``, ``gearbox``,
+        ``generator``; :mod:`orchestrator.cosim.roles`). dtcosim FMUs declare their own.
+    signals : mapping of str -> tuple of str
+        With ``role``: signal kind -> the FMU outputs that are that signal
+        (``{"generator_speed": ("w",)}``).
     """
 
     name: str
     fmu: Path
     parameters: Mapping[str, ParameterValue] = field(default_factory=dict)
+    role: str | None = None
+    signals: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
+        from fmus.slaves.record import ROLES
+
         if not isinstance(self.name, str) or not _NAME_RE.match(self.name):
             raise ScenarioError("components", self.name, "a component name of letters, digits, '_' or '-' (no dots)")
         object.__setattr__(self, "fmu", Path(self.fmu))
@@ -138,6 +148,16 @@ class Component:
             if not isinstance(value, (int, float, bool, str)):
                 raise ScenarioError(f"components.{self.name}.parameters.{pname}", value, "a number, boolean or string")
         object.__setattr__(self, "parameters", FrozenMap(params))
+        if self.role is not None and self.role not in ROLES:
+            raise ScenarioError(f"components.{self.name}.role", self.role, "one of " + ", ".join(ROLES))
+        signals = {}
+        for kind, names in dict(self.signals).items():
+            names = (names,) if isinstance(names, str) else names
+            if not isinstance(names, (list, tuple)) or not names or not all(isinstance(n, str) for n in names):
+                raise ScenarioError(f"components.{self.name}.signals.{kind}", names,
+                                    "an output name or a list of output names")
+            signals[kind] = tuple(names)
+        object.__setattr__(self, "signals", FrozenMap(signals))
 
 
 @dataclass(frozen=True)
@@ -403,7 +423,7 @@ _SIM_KEYS = {
     "extrapolation": "extrapolation",
     "order": "order",
 }
-_COMPONENT_KEYS = {"fmu", "parameters"}
+_COMPONENT_KEYS = {"fmu", "parameters", "role", "signals"}
 _LINK_KEYS = {"from", "to"}
 _RECORD_KEYS = {"variables"}
 
@@ -511,8 +531,15 @@ def scenario_from_dict(data: Mapping[str, Any], name: str | None = None, base_di
         params = ctab.get("parameters", {})
         if not isinstance(params, dict):
             raise ScenarioError(f"{path}.parameters", params, "a table of parameter values", source)
+        role = ctab.get("role")
+        if role is not None and not isinstance(role, str):
+            raise ScenarioError(f"{path}.role", role, "a role name (string)", source)
+        signals = ctab.get("signals", {})
+        if not isinstance(signals, dict):
+            raise ScenarioError(f"{path}.signals", signals, "a table of signal kind = output name(s)", source)
         try:
-            components.append(Component(cname, Path(fmu), _flatten_parameters(params, "", f"{path}.parameters", source)))
+            components.append(Component(cname, Path(fmu), _flatten_parameters(params, "", f"{path}.parameters", source),
+                                        role, signals))
         except ScenarioError as exc:
             key = path if exc.key == "components" else exc.key
             raise ScenarioError(key, exc.value, exc.expected, source) from None

@@ -3,27 +3,30 @@
 :func:`analyse_run` runs on the recorded time series over the scenario's analysis
 window (``simulation.window``) with the scenario's ``[analysis]`` settings
 (:class:`~orchestrator.inputs.analysis_settings.AnalysisSettings`) and returns the
-``summary.json`` entries and the files it wrote:
+``summary.json`` entries and the files it wrote. Which series an analysis uses is
+decided by the signals the components declare (:mod:`orchestrator.cosim.roles`),
+never by a variable's name:
 
-* **contact loss** (:mod:`components.analysis.contact_loss`) of every recorded contact force
-  (``*.F_*``): separations, flank changes, time inside the backlash (``|F| <
-  contact_loss_threshold_n``) -> ``summary["contact_loss"]``, ``contact_loss.csv``;
-* **fatigue** (:mod:`components.analysis.fatigue`): rainflow counts and damage-equivalent
-  loads of every recorded contact force and shaft torque (``*shaftK.torque``) for the
-  Woehler exponents, and the load duration distribution of every shaft torque
-  (with the load revolution distribution where the shaft's speed is recorded)
-  -> ``summary["fatigue"]``, ``fatigue_del.csv``, ``fatigue_ldd.csv``,
-  ``load_duration.png``;
+* **contact loss** (:mod:`components.analysis.contact_loss`) of every recorded
+  ``contact_force`` of a gearbox: separations, flank changes, time inside the
+  backlash (``|F| < contact_loss_threshold_n``) -> ``summary["contact_loss"]``,
+  ``contact_loss.csv``;
+* **fatigue** (:mod:`components.analysis.fatigue`): rainflow counts and
+  damage-equivalent loads of every recorded contact force and ``shaft_torque``
+  for the Woehler exponents, and the load duration distribution of every shaft
+  torque (with the load revolution distribution where a speed of the shaft's
+  bodies is recorded) -> ``summary["fatigue"]``, ``fatigue_del.csv``,
+  ``fatigue_ldd.csv``, ``load_duration.png``;
 * **spectra** (:mod:`components.analysis.spectrum`) of one contact force per mesh kind and
   stage, with every stage's gear-mesh frequency at the mean rotor speed marked ->
   ``summary["spectrum"]``, ``contact_force_spectra.png``; written when a mesh
-  stiffness varies in time (``spectrum = "auto"``), always, or never.
+  stiffness varies in time (``spectrum = "auto"``), always, or never;
+* the **event response** plot with load events.
 
-Mesh frequencies, shaft speeds and the stiffness variation come from the
-drivetrain rebuilt from the Gearbox FMU's parameters
-(:func:`orchestrator.run.comparison.monolithic_setup`); a system without the three
-dtcosim FMUs still gets contact loss and fatigue loads of whatever it records
-under these names.
+Mesh frequencies, shaft speeds and the stiffness variation come from the Gearbox
+FMU's record (:func:`orchestrator.cosim.physics_view.gearbox_drivetrain`). An
+analysis that cannot run (no gearbox, nothing declared, nothing recorded, no
+record) is listed in :attr:`RunAnalyses.skipped` with the reason.
 """
 
 from __future__ import annotations
@@ -42,9 +45,10 @@ from components.analysis.contact_loss import (
 from components.analysis.fatigue import fatigue_report, write_del_csv, write_ldd_csv
 from components.analysis.spectrum import amplitude_spectrum
 from components.errors import DtcosimError
-from components.reference.results import is_contact_force, is_shaft_torque
 
 from ..cosim.master import RunOutcome
+from ..cosim.physics_view import PhysicsUnavailable, gearbox_drivetrain, wind_parameters
+from ..cosim.roles import GEARBOX, GENERATOR, WIND_SOURCE
 from ..cosim.system import ResolvedSystem
 
 CONTACT_LOSS_FILE = "contact_loss.csv"
@@ -67,57 +71,85 @@ class RunAnalyses:
         Written files by role (``contact_loss``, ``fatigue_del``, ``fatigue_ldd``,
         ``plot:load_duration``, ``plot:contact_force_spectra``, ``plot:event_response``).
     notes : list of str
-        Analyses skipped and why.
+        Limits of the analyses that ran (an incomplete run, ...).
+    skipped : list of dict
+        ``{"analysis": name, "reason": text}`` for each analysis that did not run.
     """
 
     summary: dict[str, Any] = field(default_factory=dict)
     files: dict[str, Path] = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
+    skipped: list[dict[str, str]] = field(default_factory=list)
+
+    def skip(self, analysis: str, reason: str) -> None:
+        """Record that ``analysis`` did not run and why."""
+        self.skipped.append({"analysis": analysis, "reason": reason})
 
 
-def _stage_of(column: str) -> str:
-    """Stage of a contact-force column: ``"gearbox.stage1.F_sp[1]"`` -> ``"stage1"``."""
-    parts = column.split(".")
-    return parts[-2] if len(parts) >= 2 else ""
+@dataclass(frozen=True)
+class _Signals:
+    """The declared drivetrain signals a run recorded."""
+
+    forces: list[str]  # contact-force columns of the gearboxes
+    torques: list[str]  # shaft-torque columns
+    stage: dict[str, str]  # contact-force column -> stage
+    mesh: dict[str, str]  # contact-force column -> mesh kind (sun_planet, ring_planet, parallel)
+    shaft_speed: dict[str, list[str]]  # shaft-torque column -> recorded speed columns of its bodies
+
+
+def _recorded_signals(system: ResolvedSystem, series: dict[str, np.ndarray]) -> _Signals:
+    forces, torques, stage, mesh, speeds = [], [], {}, {}, {}
+    generator_speed = [r.column("generator_speed") for r in system.with_role(GENERATOR)]
+    for role in system.with_role(GEARBOX):
+        body_speed = {s.info.get("body"): f"{role.component}.{s.variable}" for s in role.of_kind("body_speed")}
+        for s in role.of_kind("contact_force"):
+            col = f"{role.component}.{s.variable}"
+            if col in series:
+                forces.append(col)
+                stage[col] = s.info.get("stage", role.component)
+                mesh[col] = s.info.get("mesh", "mesh")
+        for s in role.of_kind("shaft_torque"):
+            col = f"{role.component}.{s.variable}"
+            if col not in series:
+                continue
+            torques.append(col)
+            cands = [body_speed.get(s.info.get("upstream")), body_speed.get(s.info.get("downstream"))]
+            if s.info.get("downstream") == "generator":
+                cands += generator_speed
+            speeds[col] = [c for c in cands if c is not None and c in series]
+    return _Signals(forces, torques, stage, mesh, speeds)
 
 
 @dataclass(frozen=True)
 class _Drivetrain:
-    """What the analyses need from the drivetrain behind the Gearbox FMU."""
+    """What the spectra need from the drivetrain of the Gearbox FMU's record."""
 
-    gearbox: str
-    wind: str
-    generator: str
     mesh_rate: dict[str, float]  # stage -> tooth pairs per rotor radian
     variation: dict[str, float]  # stage -> largest stiffness variation of its meshes
-    shaft_speed: dict[str, list[str]]  # shaft torque column -> candidate speed columns
-    omega0_rad_s: float
+    rotor_speed_column: str | None  # the declared, recorded rotor speed
+    omega0_rad_s: float | None  # the wind source's mean speed (its record), if known
 
 
-def _drivetrain_info(system: ResolvedSystem) -> _Drivetrain | None:
+def _drivetrain_info(system: ResolvedSystem, series: dict[str, np.ndarray]) -> _Drivetrain:
+    """Mesh rates and stiffness variation of the one dtcosim gearbox (PhysicsUnavailable otherwise)."""
     from components.model.assembly import Assembly
 
-    from .comparison import GEARBOX, GENERATOR, WIND, ReferenceError, monolithic_setup
-
-    try:
-        setup = monolithic_setup(system)
-    except ReferenceError:
-        return None
-    by_role = {role: name for name, role in setup.roles.items()}
-    g, gen = by_role[GEARBOX], by_role[GENERATOR]
-    a = Assembly(setup.drivetrain)
+    gearboxes = [r for r in system.with_role(GEARBOX) if r.record is not None]
+    if len(gearboxes) != 1:
+        raise PhysicsUnavailable(f"needs exactly one dtcosim Gearbox FMU (with a record of its drivetrain), "
+                                 f"the scenario has {len(gearboxes)}")
+    a = Assembly(gearbox_drivetrain(system, gearboxes[0].component))
     rate: dict[str, float] = {}
     variation: dict[str, float] = {}
     for m in a.meshes:
         rate.setdefault(m.stage, abs(m.teeth_per_driver_rad))
         variation[m.stage] = max(variation.get(m.stage, 0.0), m.contact.stiffness_variation)
-    speeds = {}
-    for sh in a.shafts:
-        cands = [f"{g}.{sh.upstream}.omega", f"{g}.{sh.downstream}.omega"]
-        if sh.downstream == "generator":
-            cands.append(f"{gen}.omega")
-        speeds[f"{g}.{sh.name}.torque"] = cands
-    return _Drivetrain(g, by_role[WIND], gen, rate, variation, speeds, setup.wind.mean_speed_rad_s)
+    winds = system.with_role(WIND_SOURCE)
+    column = winds[0].column("rotor_speed") if len(winds) == 1 else None
+    omega0 = None
+    if len(winds) == 1 and winds[0].record is not None:
+        omega0 = wind_parameters(system, winds[0].component).mean_speed_rad_s
+    return _Drivetrain(rate, variation, column if column in series else None, omega0)
 
 
 def _window_of(outcome: RunOutcome, window: tuple[float, float]) -> tuple[float, float] | None:
@@ -130,13 +162,16 @@ def _window_of(outcome: RunOutcome, window: tuple[float, float]) -> tuple[float,
     return (w0, w1) if w1 > w0 and inside >= 2 else None
 
 
+_NO_FORCES = "no contact force of a gearbox is declared and recorded (dtcosim Gearbox FMU, or role and signals)"
+
+
 def analyse_run(system: ResolvedSystem, outcome: RunOutcome, out_dir: str | Path, plots: bool = True) -> RunAnalyses:
     """Contact loss, fatigue loads and (optionally) force spectra of a run, with their files.
 
     Parameters
     ----------
     system : ResolvedSystem
-        The scenario that ran (window and ``[analysis]`` settings).
+        The scenario that ran (window, ``[analysis]`` settings, declared roles).
     outcome : RunOutcome
         Its recorded samples (an incomplete run is analysed up to where it stopped).
     out_dir : path
@@ -153,21 +188,28 @@ def analyse_run(system: ResolvedSystem, outcome: RunOutcome, out_dir: str | Path
     result = RunAnalyses()
     window = _window_of(outcome, system.scenario.simulation.window_s)
     if window is None:
-        result.notes.append("no analyses: fewer than 2 samples inside the analysis window")
+        for name in ("contact_loss", "fatigue", "spectrum"):
+            result.skip(name, "fewer than 2 samples inside the analysis window")
         return result
     if not outcome.complete:
         result.notes.append(f"run incomplete: analyses over [{window[0]:g}, {window[1]:g}] s only")
     t = outcome.time_s
     series = {c.column: outcome.values[:, i] for i, c in enumerate(outcome.columns)}
-    forces = [c for c in series if is_contact_force(c)]
-    torques = [c for c in series if is_shaft_torque(c)]
-    info = _drivetrain_info(system)
+    sig = _recorded_signals(system, series)
+    forces, torques = sig.forces, sig.torques
+    try:
+        info: _Drivetrain | None = _drivetrain_info(system, series)
+        no_info = ""
+    except PhysicsUnavailable as exc:
+        info, no_info = None, str(exc)
 
-    if forces:
+    if not forces:
+        result.skip("contact_loss", _NO_FORCES)
+    else:
         try:
             stats = contact_loss_summary(series, settings.contact_loss_threshold_n, window, forces, time_s=t)
         except DtcosimError as exc:
-            result.notes.append(f"no contact-loss count: {exc}")
+            result.skip("contact_loss", str(exc))
         else:
             meshes = {n: {k: v for k, v in s.as_dict().items() if k not in ("name", "threshold_n", "analysed_time_s")}
                       for n, s in stats.items()}
@@ -185,20 +227,18 @@ def analyse_run(system: ResolvedSystem, outcome: RunOutcome, out_dir: str | Path
             result.files["contact_loss"] = write_contact_loss_csv(out / CONTACT_LOSS_FILE, stats)
 
     loads = forces + torques
-    if loads:
-        speeds = {}
-        if info is not None:
-            for name in torques:
-                speed = next((c for c in info.shaft_speed.get(name, []) if c in series), None)
-                if speed is not None:
-                    speeds[name] = speed
+    if not loads:
+        result.skip("fatigue", "no contact force or shaft torque of a gearbox is declared and recorded")
+    else:
+        speeds = {name: cands[0] for name, cands in sig.shaft_speed.items() if cands}
         try:
             report = fatigue_report(series, settings.fatigue_settings(), window, loads, time_s=t, speeds=speeds)
         except DtcosimError as exc:
-            result.notes.append(f"no fatigue loads: {exc}")
+            result.skip("fatigue", str(exc))
         else:
             fat = report.as_dict()
             fat["revolution_speeds"] = speeds
+            fat["shaft_torques"] = list(torques)
             result.summary["fatigue"] = fat
             result.files["fatigue_del"] = write_del_csv(out / DEL_FILE, report)
             if report.ldd:
@@ -208,54 +248,62 @@ def analyse_run(system: ResolvedSystem, outcome: RunOutcome, out_dir: str | Path
 
                     result.files["plot:load_duration"] = plot_load_duration(list(report.ldd.values()), out / LDD_PLOT)
 
-    if plots and system.events and forces:
-        result.files["plot:event_response"] = _plot_events(system, outcome, series, forces, torques, info, out / EVENT_PLOT)
-
-    want = settings.spectrum == "always" or (
-        settings.spectrum == "auto" and info is not None and any(v > 0.0 for v in info.variation.values()))
-    if want and forces:
-        spectrum = _spectrum(series, t, window, forces, info)
-        if spectrum is not None:
-            summary, chosen, marks, fmax = spectrum
-            result.summary["spectrum"] = summary
-            if plots:
-                from .analysis_plots import plot_force_spectra
-
-                result.files["plot:contact_force_spectra"] = plot_force_spectra(
-                    t, {n: series[n] for n in chosen}, out / SPECTRUM_PLOT, marks, window, fmax)
-                summary["file"] = SPECTRUM_PLOT
+    if system.events and plots:
+        if forces:
+            result.files["plot:event_response"] = _plot_events(system, outcome, series, sig, out / EVENT_PLOT)
         else:
-            result.notes.append("no spectrum: the samples are not uniformly spaced")
+            result.skip("event_response", _NO_FORCES)
+
+    if settings.spectrum != "never":
+        if info is None:
+            if settings.spectrum == "always":
+                result.skip("spectrum", f"mesh frequencies unknown: {no_info}")
+        elif settings.spectrum == "always" or any(v > 0.0 for v in info.variation.values()):
+            if not forces:
+                result.skip("spectrum", _NO_FORCES)
+            else:
+                spectrum = _spectrum(series, t, window, sig, info)
+                if spectrum is None:
+                    result.skip("spectrum", "the samples are not uniformly spaced")
+                else:
+                    summary, chosen, marks, fmax = spectrum
+                    result.summary["spectrum"] = summary
+                    if plots:
+                        from .analysis_plots import plot_force_spectra
+
+                        result.files["plot:contact_force_spectra"] = plot_force_spectra(
+                            t, {n: series[n] for n in chosen}, out / SPECTRUM_PLOT, marks, window, fmax)
+                        summary["file"] = SPECTRUM_PLOT
     return result
 
 
-def _first_per_stage(forces: list[str]) -> list[str]:
-    """One force per stage: the first listed (``F_sp[1]`` of a planetary stage, ``F_mesh`` of a parallel one)."""
+def _first_per_stage(sig: _Signals) -> list[str]:
+    """One force per stage: the first declared (``F_sp[1]`` of a planetary stage, ``F_mesh`` of a parallel one)."""
     seen: set[str] = set()
     out = []
-    for n in forces:
-        stage = _stage_of(n)
-        if stage not in seen:
-            seen.add(stage)
+    for n in sig.forces:
+        if sig.stage[n] not in seen:
+            seen.add(sig.stage[n])
             out.append(n)
     return out
 
 
-def _plot_events(system: ResolvedSystem, outcome: RunOutcome, series, forces, torques, info: _Drivetrain | None,
-                 path: Path) -> Path:
+def _plot_events(system: ResolvedSystem, outcome: RunOutcome, series, sig: _Signals, path: Path) -> Path:
     from .analysis_plots import plot_event_response
 
     shown: dict[str, np.ndarray] = {}
-    if info is not None and f"{info.generator}.generator_torque" in series:
-        shown["generator counter torque"] = series[f"{info.generator}.generator_torque"]
-    if torques:
-        shown[torques[-1]] = series[torques[-1]]  # the output shaft (drives the generator)
+    for gen in system.with_role(GENERATOR):
+        col = gen.column("generator_torque")
+        if col in series:
+            shown["generator counter torque"] = series[col]
+    if sig.torques:
+        shown[sig.torques[-1]] = series[sig.torques[-1]]  # the output shaft (drives the generator)
     events = [(f"{a.event.kind} ({a.component})", a.event.start_s, a.event.end_s) for a in system.events]
-    return plot_event_response(outcome.time_s, shown, {n: series[n] for n in _first_per_stage(forces)}, events, path,
+    return plot_event_response(outcome.time_s, shown, {n: series[n] for n in _first_per_stage(sig)}, events, path,
                                system.scenario.analysis.contact_loss_threshold_n)
 
 
-def _spectrum(series, t, window, forces, info: _Drivetrain | None):
+def _spectrum(series, t, window, sig: _Signals, info: _Drivetrain):
     """Spectrum summary, the forces to plot, the mesh-frequency marks and the plot's upper frequency."""
     sel = (t >= window[0] - 1e-12) & (t <= window[1] + 1e-12)
     tw = t[sel]
@@ -267,23 +315,21 @@ def _spectrum(series, t, window, forces, info: _Drivetrain | None):
     # one force per stage and mesh kind: the first planet's sun and ring mesh, the parallel mesh
     chosen: list[str] = []
     kinds: set[tuple[str, str]] = set()
-    for n in forces:
-        stage = _stage_of(n)
-        kind = n.rsplit(".", 1)[-1].split("[", 1)[0]
+    for n in sig.forces:
+        stage, kind = sig.stage[n], sig.mesh[n]
         if (stage, kind) not in kinds:
             kinds.add((stage, kind))
             chosen.append(n)
     mesh_hz: dict[str, float] = {}
-    speed = None
-    if info is not None:
-        wind_col = f"{info.wind}.omega"
-        speed = float(np.mean(series[wind_col][sel])) if wind_col in series else info.omega0_rad_s
+    col = info.rotor_speed_column
+    speed = float(np.mean(series[col][sel])) if col is not None else info.omega0_rad_s
+    if speed is not None:
         mesh_hz = {stage: rate * abs(speed) / (2.0 * math.pi) for stage, rate in info.mesh_rate.items()}
     per_force = {}
     for n in chosen:
         f, amp = amplitude_spectrum(series[n][sel], h)
         df = f[1] - f[0]
-        stage = _stage_of(n)
+        stage = sig.stage[n]
         fm = mesh_hz.get(stage)
         if fm is None or fm >= nyquist:
             continue
@@ -307,7 +353,7 @@ def _spectrum(series, t, window, forces, info: _Drivetrain | None):
         "nyquist_hz": nyquist,
         "rotor_speed_rad_s": speed,
         "mesh_frequency_hz": mesh_hz,
-        "stiffness_variation": {} if info is None else dict(info.variation),
+        "stiffness_variation": dict(info.variation),
         "forces": per_force,
     }
     return summary, chosen, marks, fmax
@@ -338,7 +384,7 @@ def format_analyses(summary: dict[str, Any]) -> str:
     fat = summary.get("fatigue")
     if fat:
         exps = [f"m={m:g}" for m in fat["wohler_exponents"]]
-        shafts = {n: d for n, d in fat["del"].items() if is_shaft_torque(n)}
+        shafts = {n: d for n, d in fat["del"].items() if n in fat.get("shaft_torques", ())}
         if shafts:
             lines.append(f"damage-equivalent loads (N_ref = {fat['reference_frequency_hz'] or 0:g} Hz x T) [N m]: "
                          + ", ".join(exps))

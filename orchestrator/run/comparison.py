@@ -1,185 +1,76 @@
 """Monolithic reference of a co-simulation scenario and the co-simulation-vs-monolithic report.
 
 The reference is :func:`components.reference.solver.simulate_monolithic` (one stiff ODE,
-LSODA, analytic Jacobian) on the *same* system: the drivetrain is rebuilt from the
-scenario's effective Gearbox FMU parameter values with
-:func:`components.model.parameter_map.unflatten` (template: the
-:func:`~components.model.presets.cosim_preset` whose flat parameter names the FMU
-has), the rotor-speed process from the WindSource parameters (same seed, same
-harmonics), the generator from the GeneratorRotor parameters (inertia, counter
-torque, load events).
-
-Components are recognised by their FMU's model name (``WindSource``,
-``Gearbox``, ``GeneratorRotor``), not by their instance names.
+LSODA, analytic Jacobian) on the *same* system: the physics view of the scenario
+(:func:`orchestrator.cosim.physics_view.physics_view`), i.e. the drivetrain, wind
+and generator the FMUs' records describe, with the scenario's parameter values.
+Co-simulated columns are paired with the reference's series by the signals the
+FMUs declare (:mod:`orchestrator.cosim.roles`).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import Any, Mapping
 
 import numpy as np
 
-from components.errors import DtcosimError, ParameterError
 from components.reference.results import SimulationResult, window_statistics
 
 from ..cosim.master import RunOutcome
+from ..cosim.physics_view import PhysicsView, physics_view
+from ..cosim.roles import GEARBOX, GENERATOR, WIND_SOURCE
 from ..cosim.system import ResolvedSystem
 
-WIND, GEARBOX, GENERATOR = "WindSource", "Gearbox", "GeneratorRotor"
 STATISTICS = ("mean", "std", "min", "max")
 
+#: declared signal -> the monolithic result's series
+_REFERENCE_SERIES = {
+    (WIND_SOURCE, "rotor_speed"): "omega_rotor",
+    (WIND_SOURCE, "rotor_angle"): "phi_rotor",
+    (GENERATOR, "generator_speed"): "omega_gen",
+    (GENERATOR, "generator_angle"): "phi_gen",
+    (GENERATOR, "generator_torque"): "load_torque",
+}
 
-class ReferenceError(DtcosimError, ValueError):
-    """The scenario cannot be expressed as a monolithic reference (names the reason)."""
 
+def reference_name(column: str, system: ResolvedSystem, view: PhysicsView,
+                   series: Mapping[str, np.ndarray]) -> str | None:
+    """Name in the monolithic result of a co-simulation column ``component.variable`` (None: no counterpart).
 
-@dataclass(frozen=True)
-class MonolithicSetup:
-    """Inputs of the monolithic reference rebuilt from a scenario.
-
-    Attributes
-    ----------
-    drivetrain : components.model.drivetrain.Drivetrain
-    wind : components.model.wind.WindParameters
-    roles : dict of str -> str
-        Component name -> role (``WindSource``, ``Gearbox``, ``GeneratorRotor``).
-    preset : str
-        Template preset the gearbox parameters were mapped onto.
-    notes : list of str
-        Differences between the two set-ups that the reference cannot represent.
+    Wind source and generator outputs pair by their declared signal; the Gearbox's
+    outputs have the names of the monolithic series (both come from
+    :class:`components.model.gearbox_model.GearboxModel`), its generator-shaft
+    torque outputs pair with the last shaft's torque.
     """
-
-    drivetrain: Any
-    wind: Any
-    roles: dict[str, str]
-    preset: str
-    notes: list[str]
-
-
-def component_roles(system: ResolvedSystem) -> dict[str, str]:
-    """Component name -> role, from each FMU's model name; exactly one of each role is required."""
-    roles = {}
-    for name, iface in system.interfaces.items():
-        if iface.model_name in (WIND, GEARBOX, GENERATOR):
-            roles[name] = iface.model_name
-    for role in (WIND, GEARBOX, GENERATOR):
-        found = [n for n, r in roles.items() if r == role]
-        if len(found) != 1:
-            raise ReferenceError(
-                f"the monolithic reference needs exactly one {role} FMU in the scenario; found {len(found)}"
-                + (f" ({', '.join(found)})" if found else "")
-            )
-    return roles
-
-
-def monolithic_setup(system: ResolvedSystem) -> MonolithicSetup:
-    """Rebuild drivetrain and rotor-speed process from the scenario's effective FMU parameters.
-
-    Raises
-    ------
-    ReferenceError
-        If the scenario lacks one of the three FMUs or uses parameters the
-        monolithic model cannot represent.
-    """
-    from components.model.generator import EVENT_KINDS, GeneratorParameters, LoadEvent
-    from components.model.parameter_map import flatten, unflatten
-    from components.model.presets import PRESETS, cosim_preset
-    from components.model.wind import AMPLITUDE_CONVENTIONS, WindParameters
-
-    roles = component_roles(system)
-    by_role = {r: n for n, r in roles.items()}
-    notes: list[str] = []
-
-    w = system.parameter_values(by_role[WIND])
-    amp = w.get("amplitude", 0)
-    amplitude = AMPLITUDE_CONVENTIONS[int(amp)] if isinstance(amp, (int, float)) else str(amp)
-    try:
-        wind = WindParameters(
-            mean_speed_rad_s=float(w["omega0"]), spectrum_level=float(w["a"]), sigma_rad_s=float(w["sigma"]),
-            n_harmonics=int(w["n_harmonics"]), f_min_rad_s=float(w["f_min"]), f_max_rad_s=float(w["f_max"]),
-            seed=int(w["seed"]), amplitude=amplitude,
-        )
-    except KeyError as exc:
-        raise ReferenceError(f"WindSource FMU has no parameter {exc.args[0]!r}") from None
-
-    gear_values = system.parameter_values(by_role[GEARBOX])
-    gen_keys = ("generator.inertia", "generator.counter_torque")
-    template = None
-    preset_name = ""
-    # the FMU's drivetrain parameters (stageN.*, shaftN.*), not its solver options (solver.*, shaft_torque_mode, ...)
-    structural = {k for k in gear_values if "." in k and k.split(".")[0].startswith(("stage", "shaft"))}
-    for name in PRESETS:
-        candidate = cosim_preset(name)
-        if set(flatten(candidate)) - set(gen_keys) == structural:
-            template, preset_name = candidate, name
-            break
-    if template is None:
-        raise ReferenceError(
-            "the Gearbox FMU's parameters match no drivetrain preset of components.model.parameter_map "
-            f"(presets tried: {', '.join(PRESETS)})"
-        )
-    keys = set(flatten(template)) - set(gen_keys)
-    g = system.parameter_values(by_role[GENERATOR])
-    try:
-        events = []
-        i = 1
-        while f"event{i}.kind" in g:
-            code = int(g[f"event{i}.kind"])
-            if code:
-                events.append(LoadEvent(kind=EVENT_KINDS[code - 1], start_s=float(g[f"event{i}.start"]),
-                                        duration_s=float(g[f"event{i}.duration"]), factor=float(g[f"event{i}.factor"])))
-            i += 1
-        values = {k: gear_values[k] for k in keys}
-        values["generator.inertia"] = float(g["inertia"])
-        values["generator.counter_torque"] = float(g["counter_torque"])
-    except KeyError as exc:
-        raise ReferenceError(f"GeneratorRotor FMU has no parameter {exc.args[0]!r}") from None
-    except (ParameterError, IndexError) as exc:
-        raise ReferenceError(f"generator load events not representable in the reference model: {exc}") from None
-    try:
-        drivetrain = unflatten(template, values)
-    except ParameterError as exc:
-        raise ReferenceError(f"gearbox/generator parameters rejected by the reference model: {exc}") from None
-    if events:
-        from dataclasses import replace
-
-        drivetrain = replace(drivetrain, generator=GeneratorParameters(
-            inertia_kgm2=drivetrain.generator.inertia_kgm2,
-            counter_torque_nm=drivetrain.generator.counter_torque_nm,
-            events=tuple(events),
-        ))
-    bound = {str(b.target) for b in system.scenario.initial}
-    gen_name = by_role[GENERATOR]
-    if f"{gen_name}.initial_speed" not in bound:
-        notes.append("the generator's initial speed is not bound to the gearbox output speed; the reference starts "
-                     "kinematically consistent")
-    return MonolithicSetup(drivetrain, wind, roles, preset_name, notes)
-
-
-def reference_name(column: str, roles: Mapping[str, str], series: Mapping[str, np.ndarray],
-                   last_shaft: str) -> str | None:
-    """Name in the monolithic result of a co-simulation column ``component.variable`` (None: no counterpart)."""
     comp, _, var = column.partition(".")
-    role = roles.get(comp)
-    if role == WIND:
-        name = {"omega": "omega_rotor", "phi": "phi_rotor"}.get(var)
-    elif role == GENERATOR:
-        name = {"omega": "omega_gen", "phi": "phi_gen", "generator_torque": "load_torque"}.get(var)
-    elif role == GEARBOX:
-        name = f"{last_shaft}.torque" if var in ("shaft_torque", "shaft_torque_end", "shaft_torque_avg") else var
+    if comp not in view.components.values():
+        return None
+    role = system.roles[comp]
+    kinds = {s.variable: s.kind for s in role.signals}
+    if role.role == GEARBOX:
+        if kinds.get(var) == "generator_shaft_torque":
+            last = view.drivetrain.output_shaft
+            name = f"{last.name}.torque" if last is not None else None
+        else:
+            name = var
     else:
-        name = None
+        name = _REFERENCE_SERIES.get((role.role, kinds.get(var, "")))
     return name if name in series else None
 
 
-def run_reference(system: ResolvedSystem, setup: MonolithicSetup | None = None) -> SimulationResult:
-    """The monolithic solution on the scenario's time grid (start, stop, output interval)."""
+def run_reference(system: ResolvedSystem, view: PhysicsView | None = None) -> SimulationResult:
+    """The monolithic solution on the scenario's time grid (start, stop, output interval).
+
+    Raises
+    ------
+    PhysicsUnavailable
+        If the scenario's physics cannot be read from its FMUs' records.
+    """
     from components.model.wind import RotorSpeedProcess
     from components.reference.solver import simulate_monolithic
 
-    setup = setup or monolithic_setup(system)
+    setup = view or physics_view(system)
     sim = system.scenario.simulation
     return simulate_monolithic(
         setup.drivetrain, RotorSpeedProcess(setup.wind), sim.stop_s,
@@ -192,7 +83,7 @@ def _rel(a: float, b: float, scale: float) -> float:
 
 
 def compare(outcome: RunOutcome, reference: SimulationResult, system: ResolvedSystem,
-            setup: MonolithicSetup) -> dict[str, Any]:
+            setup: PhysicsView) -> dict[str, Any]:
     """Every statistic, co-simulation vs monolithic, over the scenario's analysis window.
 
     Returns
@@ -206,7 +97,6 @@ def compare(outcome: RunOutcome, reference: SimulationResult, system: ResolvedSy
         grid within the window.
     """
     window = system.scenario.simulation.window_s
-    last_shaft = setup.drivetrain.output_shaft.name if setup.drivetrain.output_shaft is not None else "shaft3"
     t_co = outcome.time_s
     t_ref = reference.time_s
     n = min(t_co.size, t_ref.size)
@@ -214,7 +104,7 @@ def compare(outcome: RunOutcome, reference: SimulationResult, system: ResolvedSy
     sel = (t_co[:n] >= window[0] - 1e-12) & (t_co[:n] <= window[1] + 1e-12)
     result: dict[str, Any] = {}
     for i, col in enumerate(outcome.columns):
-        ref_name = reference_name(col.column, setup.roles, reference.series, last_shaft)
+        ref_name = reference_name(col.column, system, setup, reference.series)
         if ref_name is None:
             continue
         co = outcome.values[:, i]
@@ -237,7 +127,7 @@ def compare(outcome: RunOutcome, reference: SimulationResult, system: ResolvedSy
         result[col.column] = entry
     return {
         "reference": "monolithic LSODA (components.reference.solver.simulate_monolithic)",
-        "preset": setup.preset,
+        "built_from": dict(setup.sources),
         "window_s": list(window),
         "reference_complete": bool(reference.complete),
         "reference_wall_time_s": float(reference.wall_time_s),

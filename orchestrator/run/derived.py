@@ -1,11 +1,10 @@
-"""Drivetrain quantities derived from a run: component roles, the ideal gearbox, Fig. 16.
+"""Drivetrain quantities derived from a run: the ideal gearbox and the generator against it (Fig. 16).
 
-Roles are recognised by the FMU model names ``WindSource``, ``Gearbox`` and
-``GeneratorRotor`` (instance names are free). The ideal gearbox ratio comes from
-the gearbox itself: the drivetrain rebuilt from the Gearbox FMU's parameters
-(:func:`orchestrator.run.comparison.monolithic_setup`), or, if that is not possible,
-the gearbox's kinematically consistent initial state,
-``omega_out(t0) / omega_rotor(t0)``.
+The components are found by their declared roles (:mod:`orchestrator.cosim.roles`),
+their outputs by their declared signals. The ideal gearbox ratio comes from the
+Gearbox FMU's record (:func:`orchestrator.cosim.physics_view.gearbox_drivetrain`);
+for a gearbox without a record, from its declared rotor and output speeds at the
+start, ``omega_out(t0) / omega_rotor(t0)`` (a kinematically consistent start).
 """
 
 from __future__ import annotations
@@ -17,65 +16,68 @@ import numpy as np
 from components.reference.results import window_statistics
 
 from ..cosim.master import RunOutcome
+from ..cosim.physics_view import PhysicsUnavailable, gearbox_drivetrain
+from ..cosim.roles import GEARBOX, GENERATOR, WIND_SOURCE, ComponentRole
 from ..cosim.system import ResolvedSystem
 
-WIND, GEARBOX, GENERATOR = "WindSource", "Gearbox", "GeneratorRotor"
+
+class Skipped(Exception):
+    """An analysis cannot run on this system; the message says why (goes into ``summary.json``)."""
 
 
-def roles(system: ResolvedSystem) -> dict[str, str]:
-    """Role -> component name for the roles present (first component of each model name)."""
-    out: dict[str, str] = {}
-    for name in system.scenario.component_names:
-        model = system.interfaces[name].model_name
-        if model in (WIND, GEARBOX, GENERATOR) and model not in out:
-            out[model] = name
-    return out
+def single_role(system: ResolvedSystem, role: str) -> ComponentRole:
+    """The one component declared with ``role`` (:class:`Skipped` naming the problem otherwise)."""
+    found = system.with_role(role)
+    if len(found) != 1:
+        names = f" ({', '.join(r.component for r in found)})" if found else ""
+        raise Skipped(f"needs exactly one component with the role {role}, the scenario has {len(found)}{names}")
+    return found[0]
 
 
-def _column(outcome: RunOutcome, name: str) -> np.ndarray | None:
+def recorded_signal(outcome: RunOutcome, role: ComponentRole, kind: str) -> np.ndarray:
+    """Samples of the component's one output declared as ``kind`` (:class:`Skipped` if absent or unrecorded)."""
+    column = role.column(kind)
+    if column is None:
+        raise Skipped(f"{role.component} ({role.role}) declares no {kind} output")
     try:
-        return outcome.column(name)
+        return outcome.column(column)
     except KeyError:
-        return None
+        raise Skipped(f"{column} ({kind}) was not recorded") from None
 
 
-def ideal_ratio(system: ResolvedSystem, outcome: RunOutcome) -> tuple[float | None, str]:
-    """Kinematic ratio generator / rotor speed of the gearbox and where it came from."""
-    from .comparison import ReferenceError, monolithic_setup
-
-    try:
-        return float(monolithic_setup(system).drivetrain.ratio), "gearbox parameters (components.model.parameter_map)"
-    except ReferenceError:  # a system the reference model cannot express
-        pass
-    r = roles(system)
-    if WIND in r and GEARBOX in r:
-        rotor = _column(outcome, f"{r[WIND]}.omega")
-        out = _column(outcome, f"{r[GEARBOX]}.omega_out")
-        if rotor is not None and out is not None and rotor.size and rotor[0] != 0:
-            return float(out[0] / rotor[0]), "gearbox initial state omega_out(t0) / omega_rotor(t0)"
-    return None, "unavailable"
+def ideal_ratio(system: ResolvedSystem, outcome: RunOutcome) -> tuple[float, str]:
+    """Kinematic ratio generator / rotor speed of the gearbox and where it came from (:class:`Skipped`)."""
+    gearbox = single_role(system, GEARBOX)
+    if gearbox.record is not None:
+        try:
+            return float(gearbox_drivetrain(system, gearbox.component).ratio), "the Gearbox FMU's record"
+        except PhysicsUnavailable as exc:
+            raise Skipped(str(exc)) from None
+    rotor = recorded_signal(outcome, single_role(system, WIND_SOURCE), "rotor_speed")
+    out = recorded_signal(outcome, gearbox, "output_speed")
+    if not rotor.size or rotor[0] == 0:
+        raise Skipped("the rotor speed at the start is zero: no ratio from the initial state")
+    return float(out[0] / rotor[0]), "gearbox initial state omega_out(t0) / omega_rotor(t0)"
 
 
-def generator_vs_ideal(system: ResolvedSystem, outcome: RunOutcome) -> dict[str, Any] | None:
+def generator_vs_ideal(system: ResolvedSystem, outcome: RunOutcome) -> dict[str, Any]:
     """Generator speed against ``ratio x rotor speed`` over the analysis window (paper Fig. 16).
 
     Returns
     -------
-    dict or None
+    dict
         ``{"ratio", "ratio_source", "relative_deviation": {"mean", "std", "min", "max", "max_abs"}}``
-        where the deviation is ``omega_gen / (ratio omega_rotor) - 1``; None if the
-        scenario has no wind source or generator, or they were not recorded.
+        where the deviation is ``omega_gen / (ratio omega_rotor) - 1``.
+
+    Raises
+    ------
+    Skipped
+        Without a wind source, a generator or a gearbox whose ratio is known, or
+        their speeds unrecorded.
     """
-    r = roles(system)
-    if WIND not in r or GENERATOR not in r:
-        return None
-    rotor = _column(outcome, f"{r[WIND]}.omega")
-    gen = _column(outcome, f"{r[GENERATOR]}.omega")
-    if rotor is None or gen is None:
-        return None
+    rotor = recorded_signal(outcome, single_role(system, WIND_SOURCE), "rotor_speed")
+    gen = recorded_signal(outcome, single_role(system, GENERATOR), "generator_speed")
     ratio, source = ideal_ratio(system, outcome)
-    if ratio is None:
-        return None
     with np.errstate(divide="ignore", invalid="ignore"):
         dev = gen / (ratio * rotor) - 1.0
     stats = window_statistics(outcome.time_s, dev, system.scenario.simulation.window_s)

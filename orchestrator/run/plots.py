@@ -5,8 +5,9 @@
   speed, with their relative difference below (Fig. 16);
 * ``contact_forces.png`` - every contact force, one panel per stage (Fig. 17).
 
-A plot is skipped when its variables were not recorded. The analysis window is
-shaded.
+The variables come from the components' declared roles and signals
+(:mod:`orchestrator.cosim.roles`); a plot whose signals are not declared or not
+recorded is skipped and :func:`plot_run` says why. The analysis window is shaded.
 """
 
 from __future__ import annotations
@@ -16,16 +17,13 @@ from pathlib import Path
 import numpy as np
 
 from ..cosim.master import RunOutcome
+from ..cosim.roles import GEARBOX, GENERATOR, WIND_SOURCE, ComponentRole
 from ..cosim.system import ResolvedSystem
-from ..plotting import (
-    FORCE_KIND_LABELS,
-    FORCE_NAME_RE,
-    RPM_PER_RAD_S,
-    new_figure,
-    plot_envelope,
-    save_figure,
-)
-from .derived import GEARBOX, GENERATOR, WIND, generator_vs_ideal, roles
+from ..plotting import RPM_PER_RAD_S, new_figure, plot_envelope, save_figure
+from .derived import Skipped, generator_vs_ideal, single_role
+
+#: mesh kind (declared signal info) -> label and line style
+_MESH_STYLE = {"sun_planet": ("sun-planet", "-"), "ring_planet": ("ring-planet", "--"), "parallel": ("mesh", "-")}
 
 
 def _shade_window(ax, window) -> None:
@@ -91,29 +89,28 @@ def plot_generator_speed(outcome: RunOutcome, rotor_column: str, gen_column: str
     return save_figure(fig, path)
 
 
-def plot_contact_forces(outcome: RunOutcome, gearbox: str, window, path: Path, title_suffix: str = "") -> Path | None:
-    """Every recorded contact force of the gearbox [kN], one panel per stage (Fig. 17)."""
-    prefix = f"{gearbox}."
+def plot_contact_forces(outcome: RunOutcome, gearbox: ComponentRole, window, path: Path,
+                        title_suffix: str = "") -> Path | None:
+    """Every recorded contact force the gearbox declares [kN], one panel per stage (Fig. 17)."""
+    recorded = {c.column: i for i, c in enumerate(outcome.columns)}
     stages: dict[str, list[tuple[str, str, int]]] = {}
-    for i, c in enumerate(outcome.columns):
-        if c.component != gearbox:
-            continue
-        m = FORCE_NAME_RE.match(c.variable)
-        if m:
-            stages.setdefault(m.group(1), []).append((c.variable, m.group(2), i))
+    for s in gearbox.of_kind("contact_force"):
+        i = recorded.get(f"{gearbox.component}.{s.variable}")
+        if i is not None:
+            stages.setdefault(s.info.get("stage", ""), []).append((s.variable, s.info.get("mesh", "parallel"), i))
     if not stages:
         return None
-    names = sorted(stages, key=lambda s: int(s[5:]))
+    names = list(stages)
     fig, axes = new_figure(len(names), height=2.6 * len(names) + 0.8, width=12.5)
     t = outcome.time_s
-    styles = {"sp": "-", "rp": "--", "mesh": "-"}
     for ax, stage in zip(axes, names):
         _shade_window(ax, window)
         for k, (var, kind, i) in enumerate(stages[stage]):
-            plot_envelope(ax, t, outcome.values[:, i] / 1e3, lw=0.7, ls=styles[kind], color=f"C{k % 10}",
-                  label=f"{var} ({FORCE_KIND_LABELS[kind]})")
+            label, style = _MESH_STYLE.get(kind, (kind, "-"))
+            plot_envelope(ax, t, outcome.values[:, i] / 1e3, lw=0.7, ls=style, color=f"C{k % 10}",
+                          label=f"{var} ({label})")
         ax.set_ylabel("force [kN]")
-        ax.set_title(f"{prefix}{stage}", fontsize=10, loc="left")
+        ax.set_title(f"{gearbox.component}.{stage}", fontsize=10, loc="left")
         ax.grid(True, lw=0.3)
         # outside the axes: inside, it hid the peaks of load events and start-up swings
         ax.legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), fontsize=7, ncol=1, borderaxespad=0.0)
@@ -123,27 +120,51 @@ def plot_contact_forces(outcome: RunOutcome, gearbox: str, window, path: Path, t
     return save_figure(fig, path)
 
 
-def plot_run(system: ResolvedSystem, outcome: RunOutcome, out_dir: str | Path) -> list[Path]:
-    """Write the plots that the recorded variables allow; returns the files written."""
+def plot_run(system: ResolvedSystem, outcome: RunOutcome, out_dir: str | Path,
+             skipped: list[dict[str, str]] | None = None) -> list[Path]:
+    """Write the plots that the declared and recorded signals allow; returns the files written.
+
+    Parameters
+    ----------
+    skipped : list, optional
+        Receives ``{"analysis": "plot:<name>", "reason": ...}`` for each plot not drawn.
+    """
     out_dir = Path(out_dir)
-    r = roles(system)
+    skipped = [] if skipped is None else skipped
     window = system.scenario.simulation.window_s
     suffix = "" if outcome.complete else f" - INCOMPLETE, stopped at {outcome.stopped_at_s:g} s"
     written: list[Path] = []
     if outcome.time_s.size < 2:
+        skipped.append({"analysis": "plots", "reason": "fewer than 2 samples"})
         return written
     names = set(outcome.names)
-    rotor = f"{r[WIND]}.omega" if WIND in r else None
-    if rotor in names:
+
+    def signal_column(role: str, kind: str) -> str:
+        col = single_role(system, role).column(kind)
+        if col is None:
+            raise Skipped(f"the {role} declares no {kind} output")
+        if col not in names:
+            raise Skipped(f"{col} ({kind}) was not recorded")
+        return col
+
+    try:
+        rotor = signal_column(WIND_SOURCE, "rotor_speed")
         written.append(plot_rotor_speed(outcome, rotor, window, out_dir / "rotor_speed.png", suffix))
-    gen = f"{r[GENERATOR]}.omega" if GENERATOR in r else None
-    if rotor in names and gen in names:
+    except Skipped as exc:
+        skipped.append({"analysis": "plot:rotor_speed", "reason": str(exc)})
+    try:
+        rotor = signal_column(WIND_SOURCE, "rotor_speed")
+        gen = signal_column(GENERATOR, "generator_speed")
         fig16 = generator_vs_ideal(system, outcome)
-        if fig16 is not None:
-            written.append(plot_generator_speed(outcome, rotor, gen, fig16["ratio"], window,
-                                                out_dir / "generator_speed.png", suffix))
-    if GEARBOX in r:
-        p = plot_contact_forces(outcome, r[GEARBOX], window, out_dir / "contact_forces.png", suffix)
-        if p is not None:
-            written.append(p)
+        written.append(plot_generator_speed(outcome, rotor, gen, fig16["ratio"], window,
+                                            out_dir / "generator_speed.png", suffix))
+    except Skipped as exc:
+        skipped.append({"analysis": "plot:generator_speed", "reason": str(exc)})
+    try:
+        p = plot_contact_forces(outcome, single_role(system, GEARBOX), window, out_dir / "contact_forces.png", suffix)
+        if p is None:
+            raise Skipped("no declared contact force was recorded")
+        written.append(p)
+    except Skipped as exc:
+        skipped.append({"analysis": "plot:contact_forces", "reason": str(exc)})
     return written

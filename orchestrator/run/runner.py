@@ -12,18 +12,13 @@ from pathlib import Path
 from typing import Any, Callable
 
 from ..cosim.master import CoSimulation, RunOutcome
+from ..cosim.physics_view import PhysicsUnavailable, physics_view
 from ..cosim.system import ResolvedSystem
 from ..inputs.scenario import Scenario, load_scenario
 from ..result_files import write_summary
 from .analyses import analyse_run
-from .comparison import (
-    ReferenceError,
-    compare,
-    format_comparison,
-    monolithic_setup,
-    run_reference,
-)
-from .derived import generator_vs_ideal
+from .comparison import compare, format_comparison, run_reference
+from .derived import Skipped, generator_vs_ideal
 from .plots import plot_run
 from .results import SUMMARY_FILE, TIMESERIES_FILE, build_summary, write_timeseries
 
@@ -96,9 +91,11 @@ def run_scenario(system: ResolvedSystem, out_dir: str | Path, *, compare_referen
     outcome = CoSimulation(system, profile=profile).run(progress=progress, handle_sigint=handle_sigint)
     files: dict[str, Path] = {"timeseries": write_timeseries(out / TIMESERIES_FILE, outcome)}
     derived: dict[str, Any] = {}
-    fig16 = generator_vs_ideal(system, outcome)
-    if fig16 is not None:
-        derived["generator_vs_ideal"] = fig16
+    skipped: list[dict[str, str]] = []
+    try:
+        derived["generator_vs_ideal"] = generator_vs_ideal(system, outcome)
+    except Skipped as exc:
+        skipped.append({"analysis": "generator_vs_ideal", "reason": str(exc)})
     if system.events:
         derived["events"] = [a.as_dict() for a in system.events]
     derived["analysis_settings"] = system.scenario.analysis.as_dict()
@@ -106,6 +103,7 @@ def run_scenario(system: ResolvedSystem, out_dir: str | Path, *, compare_referen
     derived.update(analyses.summary)
     if analyses.notes:
         derived["analysis_notes"] = analyses.notes
+    skipped += analyses.skipped
     files.update(analyses.files)
     comparison = None
     comparison_text = ""
@@ -114,16 +112,18 @@ def run_scenario(system: ResolvedSystem, out_dir: str | Path, *, compare_referen
             comparison = {"skipped": "the co-simulation did not complete"}
         else:
             try:
-                setup = monolithic_setup(system)
-                reference = run_reference(system, setup)
-                comparison = compare(outcome, reference, system, setup)
+                view = physics_view(system)
+                reference = run_reference(system, view)
+                comparison = compare(outcome, reference, system, view)
                 comparison_text = format_comparison(comparison)
-            except ReferenceError as exc:
-                comparison = {"skipped": str(exc)}
+            except PhysicsUnavailable as exc:
+                comparison = {"skipped": f"no monolithic reference: {exc}"}
                 comparison_text = f"no monolithic comparison: {exc}"
+                skipped.append({"analysis": "comparison", "reason": str(exc)})
     if plots:
-        for p in plot_run(system, outcome, out):
+        for p in plot_run(system, outcome, out, skipped):
             files[f"plot:{p.stem}"] = p
+    derived["analyses_skipped"] = skipped
     summary = build_summary(
         system, outcome, wall_time_s=time.perf_counter() - wall0, derived=derived, comparison=comparison,
         files={k: p.name for k, p in files.items()} | {"summary": SUMMARY_FILE},

@@ -12,7 +12,7 @@ Engines
 ``monolithic``
     :func:`components.reference.solver.simulate_monolithic` (LSODA with the analytic
     Jacobian) on the monolithic model: a scenario's (same drivetrain, wind seed and
-    generator, :func:`orchestrator.run.comparison.monolithic_setup`) or a built-in model
+    generator, :func:`orchestrator.cosim.physics_view.physics_view`) or a built-in model
     (:mod:`orchestrator.study.models`).
 ``cosim``
     The scenario's FMUs stepped by :class:`orchestrator.cosim.master.CoSimulation`.
@@ -190,11 +190,11 @@ def _monolithic(payload: StudyPayload, task: PointTask) -> dict[str, float]:
     else:
         from components.model.wind import RotorSpeedProcess
 
-        from ..run.comparison import monolithic_setup
+        from ..cosim.physics_view import physics_view
 
         system = _point_system(payload, task, local_files=False)
-        setup = monolithic_setup(system)
-        drivetrain, driver = setup.drivetrain, RotorSpeedProcess(setup.wind)
+        view = physics_view(system)
+        drivetrain, driver = view.drivetrain, RotorSpeedProcess(view.wind)
         sim = system.scenario.simulation
         start, stop, interval = sim.start_s, sim.stop_s, sim.output_interval_s
     result = simulate_monolithic(drivetrain, driver, stop, output_interval_s=interval, settings=settings,

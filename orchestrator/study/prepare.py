@@ -15,8 +15,8 @@ Point identity
 A point's key is the SHA-256 of its parameter values, the engine, the base
 (scenario file content and FMU hashes, or the model name), the study's fixed
 parameters, simulation and solver overrides, the measures and the code version
-(the dtcosim version and the Python sources of ``components`` and
-``orchestrator``, without the CLI and the modules that only present results).
+(:func:`code_version`: the dtcosim version and what the code a point runs
+computes, wherever that code lives).
 :mod:`orchestrator.study.sweep` skips points whose key the journal already holds.
 """
 
@@ -32,33 +32,46 @@ from ..errors import ScenarioError, suggestion
 from ..inputs.study import Point, Study, StudyError, split_parameter
 from .engine import StudyPayload
 
-#: modules left out of the code version: they present results, they do not change a point's numbers
-_PRESENTATION_MODULES = ("plots.py", "analysis_plots.py", "study_plots.py", "study_report.py", "modal_report.py",
-                         "journal.py")
+#: the module that computes a point (:func:`orchestrator.study.engine.run_point`): its import closure is the code
+#: a point's numbers depend on
+POINT_ENGINE = "orchestrator.study.engine"
 
 
 # ------------------------------------------------------------------ identity
-def code_version() -> str:
-    """SHA-256 (16 hex digits) of the dtcosim version and the ``components`` and ``orchestrator`` sources.
+def code_version(packages: Mapping[str, Path] | None = None) -> str:
+    """SHA-256 (16 hex digits) of the dtcosim version and of the code a point runs.
 
-    The CLI commands and the modules that only present results (plots, the
-    table, the journal) are left out: they do not change a point's numbers.
+    The code is the static import closure of :data:`POINT_ENGINE` within the
+    project's packages (:func:`fmus.source_closure.import_closure`: everything
+    the engine may import, lazily or not, the physics included); each module
+    counts by what it computes (:func:`fmus.source_closure.behaviour_digest`:
+    docstrings, comments and import lines left out), not by its file name, so
+    moving a module changes no point key, and plots, reports and the CLI, which
+    a point never imports, change none either. The FMUs a point runs are in its
+    key by their own SHA-256.
+
+    Parameters
+    ----------
+    packages : mapping of str -> pathlib.Path, optional
+        Top-level package -> folder (default: the installed ``components``,
+        ``orchestrator`` and ``fmus``).
     """
     from importlib import metadata
 
-    import components
+    from fmus.source_closure import behaviour_digest, import_closure
 
+    if packages is None:
+        import components
+        import fmus
+        import orchestrator
+
+        packages = {m.__name__: Path(m.__file__).parent for m in (components, orchestrator, fmus)}
     h = hashlib.sha256()
     try:
         h.update(metadata.version("dtcosim").encode())
     except metadata.PackageNotFoundError:
         h.update(b"unknown")
-    for pkg in (Path(components.__file__).parent, Path(__file__).parent):
-        for path in sorted(pkg.glob("*.py")):
-            if path.name in _PRESENTATION_MODULES:
-                continue
-            h.update(f"{pkg.name}/{path.name}\0".encode())
-            h.update(path.read_bytes())
+    h.update(behaviour_digest(import_closure([POINT_ENGINE], packages)).encode())
     return h.hexdigest()[:16]
 
 
@@ -197,6 +210,8 @@ def _prepare_model(study: Study) -> tuple[StudyPayload, dict[str, Any]]:
     from .models import MODEL_COMPONENT, MODELS
 
     src = study.source
+    if study.base.name not in MODELS:
+        raise StudyError("base.model", study.base.name, "one of the built-in models: " + ", ".join(MODELS), src)
     model = MODELS[study.base.name]
     defaults = model.defaults()
     checks = [(f"base.parameters.{p}", p, [v]) for p, v in study.base.parameters.items()] + _origins(study)
@@ -316,21 +331,21 @@ def _prepare_scenario(study: Study, fmu_dir, build: bool) -> tuple[StudyPayload,
     else:
         from components.model.wind import RotorSpeedProcess
 
-        from ..run.comparison import ReferenceError, monolithic_setup, reference_name
+        from ..cosim.physics_view import PhysicsUnavailable, physics_view
+        from ..run.comparison import reference_name
 
         try:
-            setup = monolithic_setup(system)
-        except ReferenceError as exc:
+            setup = physics_view(system)
+        except PhysicsUnavailable as exc:
             raise StudyError("engine", "monolithic", f"a base scenario the monolithic model represents ({exc})", src) from None
         settings = _solver_settings(study)
         stats = [m for m in study.measures if not m.builtin]
         if stats:
             series = dict.fromkeys(_micro_run_series(setup.drivetrain, RotorSpeedProcess(setup.wind), scenario.simulation.start_s))
-            last_shaft = setup.drivetrain.output_shaft.name if setup.drivetrain.output_shaft is not None else "shaft3"
             for i, m in enumerate(study.measures):
                 if m.builtin:
                     continue
-                name = reference_name(m.variable, setup.roles, series, last_shaft)
+                name = reference_name(m.variable, system, setup, series)
                 if name is None:
                     raise StudyError(f"measures[{i}]", m.name, "a variable of the scenario with a counterpart in the "
                                      "monolithic model (e.g. gearbox.stage1.F_sp[1], generator.omega, wind.omega)", src)

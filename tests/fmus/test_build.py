@@ -2,21 +2,32 @@
 
 from __future__ import annotations
 
+import json
 import math
+import shutil
 import zipfile
 from xml.etree import ElementTree as ET
 
 import pytest
 from fmpy import read_model_description
 from fmpy.validation import validate_fmu
-from tests.helpers.fmu_hosts import load_driver, run_python
 
+from components.model.description import build
 from components.model.presets import cosim_preset
 from fmus import build as fmu_build
-from fmus.build import BuildError, code_hash, rewrite_slave_imports
+from fmus.build import (
+    BuildError,
+    SourceTree,
+    code_hash,
+    drivetrain_of_preset,
+    embedded_modules,
+    rewrite_slave_imports,
+)
 from fmus.model_description import read_member, rewrite_archive
+from fmus.records import model_of
 from fmus.validation import check_fmu
 from orchestrator.commands.cli import main as dtcosim
+from tests.helpers.fmu_hosts import load_driver, run_python
 
 FMU_NAMES = ("WindSource", "Gearbox", "GeneratorRotor")
 
@@ -122,9 +133,14 @@ def test_archive_carries_its_code_under_private_names(built_fmus, name):
     assert slave_sources and not any("\nfrom components" in code for code in slave_sources)
 
 
+def _model(name, preset):
+    return model_of(name, drivetrain_of_preset(preset))
+
+
 def test_code_hash_is_deterministic_and_names_the_configuration():
-    assert code_hash("Gearbox", "table6") == code_hash("Gearbox", "table6")
-    assert len({code_hash("Gearbox", "table6"), code_hash("Gearbox", "table5"), code_hash("WindSource", "table6")}) == 3
+    assert code_hash("Gearbox", _model("Gearbox", "table6")) == code_hash("Gearbox", _model("Gearbox", "table6"))
+    assert len({code_hash("Gearbox", _model("Gearbox", "table6")), code_hash("Gearbox", _model("Gearbox", "table5")),
+                code_hash("WindSource", _model("WindSource", "table6"))}) == 3
 
 
 def test_slave_imports_are_rewritten_to_the_embedding_package():
@@ -189,3 +205,70 @@ def test_documented_variable_tables_match_the_code():
     text = doc.read_text(encoding="utf-8")
     assert "<!-- BEGIN GENERATED Gearbox -->" in text
     assert update(text) == text, "run: python -m fmus.docs --update docs/fmus.md"
+
+
+@pytest.fixture
+def source_copy(tmp_path):
+    """A copy of the installed ``components`` and ``fmus/slaves`` to edit: ``(root, SourceTree)``."""
+    installed = SourceTree.installed()
+    root = tmp_path / "src"
+    shutil.copytree(installed.components_dir, root / "components", ignore=shutil.ignore_patterns("__pycache__"))
+    shutil.copytree(installed.slaves_dir, root / "fmus" / "slaves", ignore=shutil.ignore_patterns("__pycache__"))
+    return root, SourceTree.at(root)
+
+
+def _build_ids(source):
+    return {name: code_hash(name, _model(name, "table6"), source) for name in FMU_NAMES}
+
+
+def test_analysis_code_does_not_change_a_build_id_the_contact_law_does(source_copy):
+    root, source = source_copy
+    before = _build_ids(source)
+    assert before == _build_ids(SourceTree.installed())
+    for rel in ("analysis/fatigue.py", "analysis/modes.py", "analysis/campbell.py", "reference/solver.py"):
+        with open(root / "components" / rel, "a") as f:
+            f.write("\n# an edit outside the model\nCHANGED = 1\n")
+    assert _build_ids(source) == before
+    with open(root / "components" / "model" / "contact.py", "a") as f:
+        f.write("\nCHANGED = 1\n")
+    after = _build_ids(source)
+    assert after["Gearbox"] != before["Gearbox"]
+    # the wind source's closure also holds contact.py (the parameter description types), so it changes too;
+    # what matters: every FMU whose code changed gets a new id, and only those
+    assert all(after[n] != before[n] for n in FMU_NAMES if "components.model.contact" in embedded_modules(n, source))
+
+
+@pytest.mark.parametrize("name", FMU_NAMES)
+def test_an_fmu_carries_only_its_slaves_import_closure(built_fmus, name):
+    with zipfile.ZipFile(built_fmus[name].path) as archive:
+        files = [f for f in archive.namelist() if f.startswith(f"resources/{built_fmus[name].package}/")]
+    code = {f.split("/", 2)[2] for f in files if f.endswith(".py")}
+    for forbidden in ("fatigue", "modes", "campbell", "modal_verification", "contact_loss", "spectrum", "solver",
+                      "cases", "results"):
+        assert not any(forbidden in f for f in code), (forbidden, sorted(code))
+    assert not any(f.startswith(("components/analysis/", "components/reference/")) for f in code)
+    # exactly the closure: one file per module, plus the embedding package's own __init__.py
+    assert len(code) == len(embedded_modules(name)) + 1
+
+
+@pytest.mark.parametrize("name, role, signals", [
+    ("WindSource", "wind_source", {"omega": "rotor_speed", "phi": "rotor_angle"}),
+    ("GeneratorRotor", "generator", {"omega": "generator_speed", "generator_torque": "generator_torque"}),
+    ("Gearbox", "gearbox", {"stage1.F_sp[1]": "contact_force", "stage3.F_mesh": "contact_force",
+                            "shaft3.torque": "shaft_torque", "omega_out": "output_speed",
+                            "stage1.sun.omega": "body_speed", "shaft_torque": "generator_shaft_torque"}),
+])
+def test_the_record_declares_role_model_and_signals(built_fmus, name, role, signals):
+    path = built_fmus[name].path
+    with zipfile.ZipFile(path) as archive:
+        record = json.loads(archive.read("resources/dtcosim.json"))
+        xml = archive.read("modelDescription.xml").decode()
+    assert record["role"] == role and record["fmu"] == name and record["source"] == "preset table6"
+    assert '<Tool name="dtcosim">' in xml and f'role="{role}"' in xml and 'record="resources/dtcosim.json"' in xml
+    for variable, kind in signals.items():
+        assert record["signals"][variable]["signal"] == kind
+    assert record["model"] == _model(name, "table6")
+    if name == "Gearbox":
+        assert record["signals"]["stage1.F_sp[2]"] == {"signal": "contact_force", "stage": "stage1",
+                                                       "mesh": "sun_planet", "planet": "2"}
+        assert build(record["model"]["drivetrain"]) == drivetrain_of_preset("table6")

@@ -12,9 +12,15 @@ import textwrap
 
 import pytest
 from fmpy.fmi1 import FMICallException
-from tests.helpers.fmu_hosts import FMI_ERROR, FMI_FATAL, Instance, gearbox_motion, run_python
 
 from components.model.presets import cosim_preset
+from tests.helpers.fmu_hosts import (
+    FMI_ERROR,
+    FMI_FATAL,
+    Instance,
+    gearbox_motion,
+    run_python,
+)
 
 RATIO = cosim_preset("table6").ratio
 DISCARD = 2

@@ -12,13 +12,13 @@ import zipfile
 import numpy as np
 import pytest
 from fmpy import read_model_description
-from tests.helpers.fmu_hosts import Instance, load_driver, run_python
 
 from components.model.gearbox_model import GearboxModel
 from components.model.generator import GeneratorRotor
 from components.model.presets import cosim_preset
 from components.model.wind import RotorSpeedProcess, WindParameters
 from fmus.build import SourceTree, build_fmu
+from tests.helpers.fmu_hosts import Instance, load_driver, run_python
 
 H = 1.0e-3
 

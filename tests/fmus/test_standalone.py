@@ -7,12 +7,12 @@ from dataclasses import replace
 import numpy as np
 import pytest
 from fmpy import simulate_fmu
-from tests.helpers.fmu_hosts import gearbox_motion
 
 from components.model.gearbox_model import GearboxModel
 from components.model.generator import GeneratorParameters, GeneratorRotor, LoadEvent
 from components.model.presets import cosim_preset, with_stage
 from components.model.wind import RotorSpeedProcess, WindParameters
+from tests.helpers.fmu_hosts import gearbox_motion
 
 H = 1.0e-3
 

@@ -6,9 +6,9 @@ import json
 import math
 
 import pytest
-from tests.helpers.fmu_hosts import Instance, gearbox_motion
 
 from components.model.presets import cosim_preset
+from tests.helpers.fmu_hosts import Instance, gearbox_motion
 
 H = 1.0e-3
 RATIO = cosim_preset("table6").ratio

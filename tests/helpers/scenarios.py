@@ -8,7 +8,6 @@ import sys
 from pathlib import Path
 
 
-
 def write_scenario(folder: Path, text: str, name: str = "scenario.toml") -> Path:
     """Write a scenario TOML file into ``folder``."""
     path = folder / name

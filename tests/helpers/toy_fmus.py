@@ -15,6 +15,8 @@ ToyMassA       mass on a wall spring, input force F; outputs x, v (exact step fo
 ToyMassB       mass coupled to A by a spring-damper, inputs xa, va; outputs F (force on A), x, v
 ToyFailer      output y = t; fails at t >= fail_at (mode 0: discard, 1: exception, 2: NaN output)
 ToyInit        parameter p0 (initial value); output y = p0 + u_start; input u
+ToyGenerator   a third-party generator rotor: input shaft_torque; outputs omega, phi and a force-named
+               output F_x (= shaft_torque / 1 m); parameters inertia, counter_torque, initial_speed
 """
 
 from __future__ import annotations
@@ -189,6 +191,32 @@ class ToyInit(Fmi2Slave):
     def exit_initialization_mode(self):
         self.u_start = self.u
     def do_step(self, t, h):
+        return True
+""",
+    "ToyGenerator": """
+class ToyGenerator(Fmi2Slave):
+    def __init__(self, **kw):
+        super().__init__(**kw)
+        self.inertia = 151.0
+        self.counter_torque = 25400.0
+        self.initial_speed = 0.0
+        self.shaft_torque = 0.0
+        self.omega = 0.0
+        self.phi = 0.0
+        self.F_x = 0.0
+        for name in ("inertia", "counter_torque", "initial_speed"):
+            self.register_variable(Real(name, causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed))
+        self.register_variable(Real("shaft_torque", causality=Fmi2Causality.input))
+        for name in ("omega", "phi", "F_x"):
+            self.register_variable(Real(name, causality=Fmi2Causality.output))
+    def exit_initialization_mode(self):
+        self.omega = self.initial_speed
+        self.phi = 0.0
+    def do_step(self, t, h):
+        alpha = (self.shaft_torque - self.counter_torque) / self.inertia
+        self.phi += self.omega * h + 0.5 * alpha * h * h
+        self.omega += alpha * h
+        self.F_x = self.shaft_torque / 1.0
         return True
 """,
 }

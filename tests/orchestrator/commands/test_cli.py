@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 
 import pytest
+
 from tests.helpers.scenarios import dtcosim
 
 pytestmark = pytest.mark.slow
@@ -19,7 +20,8 @@ def test_compare_reference_reports_every_statistic(fmu_dir, tmp_path):
     assert summary["window_s"] == [0.0, 2.0]  # [5, 60] clipped to the shortened run
     assert summary["fmus"]["wind"]["parameters"] == {"seed": 3}
     comparison = summary["comparison"]
-    assert comparison["reference_complete"] is True and comparison["preset"] == "table6"
+    assert comparison["reference_complete"] is True
+    assert comparison["built_from"] == {"wind_source": "preset table6", "gearbox": "preset table6", "generator": "preset table6"}
     variables = comparison["variables"]
     assert "gearbox.stage1.F_sp[1]" in variables and "generator.omega" in variables
     for name, entry in variables.items():

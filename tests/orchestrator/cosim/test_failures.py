@@ -11,9 +11,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from tests.helpers.scenarios import TOY_SCENARIO, dtcosim
 
 from orchestrator.result_files import read_timeseries
+from tests.helpers.scenarios import TOY_SCENARIO, dtcosim
 
 pytestmark = pytest.mark.slow
 

@@ -11,6 +11,7 @@ import pytest
 
 from components.model.generator import LoadEvent
 from orchestrator.cosim.event_slots import assign_events
+from orchestrator.cosim.physics_view import physics_view
 from orchestrator.cosim.system import resolve_system
 from orchestrator.errors import ScenarioError
 from orchestrator.inputs.analysis_settings import AnalysisSettings
@@ -21,7 +22,6 @@ from orchestrator.inputs.scenario import (
     packaged_scenarios,
     scenario_from_dict,
 )
-from orchestrator.run.comparison import monolithic_setup
 
 EVENT_SCENARIOS = ("grid-fault", "emergency-stop", "torque-step")
 
@@ -109,7 +109,7 @@ def test_packaged_event_scenarios_fill_the_generator_slots_and_the_reference(nam
     assert params["event1.kind"] == {"torque_step": 1, "grid_fault": 2, "emergency_stop": 3}[ev.kind]
     assert params["event1.start"] == 10.0 and params["event1.duration"] == ev.duration_s
     assert "event2.kind" not in params
-    reference = monolithic_setup(system).drivetrain.generator.events
+    reference = physics_view(system).drivetrain.generator.events
     assert reference == (ev.load_event(),)
 
 
@@ -179,7 +179,7 @@ def test_ssp_export_carries_events_and_analysis_settings(fmu_paths, tmp_path):
     gen = back.component("generator").parameters
     assert (gen["event1.kind"], gen["event1.start"], gen["event1.duration"], gen["event1.factor"]) == (1, 10.0, math.inf, 1.5)
     again = resolve_system(back, fmu_paths=fmu_paths)
-    assert monolithic_setup(again).drivetrain.generator.events == (LoadEvent("torque_step", 10.0, math.inf, 1.5),)
+    assert physics_view(again).drivetrain.generator.events == (LoadEvent("torque_step", 10.0, math.inf, 1.5),)
     # reported as events again (summary "events", event plot), read from the slot parameters
     assert [a.as_dict() for a in again.events] == [a.as_dict() for a in system.events]
 

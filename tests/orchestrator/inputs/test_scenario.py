@@ -5,7 +5,6 @@ from __future__ import annotations
 import re
 
 import pytest
-from tests.helpers.scenarios import TOY_SCENARIO
 
 from orchestrator.commands import cli
 from orchestrator.cosim.fmi_runtime import FmuInstance
@@ -17,6 +16,7 @@ from orchestrator.cosim.graph import (
 from orchestrator.cosim.system import resolve_system
 from orchestrator.errors import AlgebraicLoopError, ScenarioError
 from orchestrator.inputs.scenario import load_scenario
+from tests.helpers.scenarios import TOY_SCENARIO
 
 
 def _replace(old: str, new: str):

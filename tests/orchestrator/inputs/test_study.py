@@ -15,7 +15,6 @@ from orchestrator.inputs.study import (
     study_from_dict,
 )
 from orchestrator.study.prepare import prepare_study
-
 from tests.helpers.studies import SMALL_STUDY, run_cli
 
 MODEL_BASE = """

@@ -7,13 +7,13 @@ import zipfile
 
 import numpy as np
 import pytest
-from tests.helpers.scenarios import dtcosim
 
 from orchestrator.cosim.master import CoSimulation
 from orchestrator.cosim.system import resolve_system
 from orchestrator.inputs.scenario import find_scenario, load_scenario
 from orchestrator.interop.ssp import NS, export_ssp, import_ssp
 from orchestrator.run.runner import load_any
+from tests.helpers.scenarios import dtcosim
 
 TOY = """
 name = "toy-ssp"

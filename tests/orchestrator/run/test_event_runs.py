@@ -10,7 +10,6 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from tests.helpers.scenarios import dtcosim, write_scenario
 
 from components.analysis.contact_loss import contact_loss_summary
 from components.analysis.spectrum import amplitude_spectrum
@@ -20,6 +19,7 @@ from orchestrator.inputs.scenario import find_scenario, load_scenario
 from orchestrator.result_files import read_timeseries
 from orchestrator.run.comparison import run_reference
 from orchestrator.run.runner import run_scenario
+from tests.helpers.scenarios import dtcosim, write_scenario
 
 pytestmark = pytest.mark.slow
 

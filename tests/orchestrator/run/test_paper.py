@@ -11,10 +11,11 @@ import pytest
 
 from components.reference.cases import TABLE7_PAPER
 from orchestrator.cosim.master import CoSimulation
+from orchestrator.cosim.physics_view import physics_view
 from orchestrator.cosim.system import resolve_system
 from orchestrator.inputs.scenario import find_scenario, load_scenario
 from orchestrator.result_files import read_timeseries
-from orchestrator.run.comparison import compare, monolithic_setup, run_reference
+from orchestrator.run.comparison import compare, run_reference
 
 pytestmark = pytest.mark.slow
 
@@ -78,7 +79,7 @@ def test_timeseries_and_summary_format(paper_run):
 def test_cosimulation_agrees_with_the_monolithic_reference_at_1ms(paper_run):
     out, summary, _ = paper_run
     system = resolve_system(load_scenario(find_scenario(None)), fmu_dir=out.parent.parent / "fmus")
-    setup = monolithic_setup(system)
+    setup = physics_view(system)
     reference = run_reference(system, setup)
     assert reference.complete
     window = system.scenario.simulation.window_s
@@ -101,7 +102,7 @@ def _short(fmu_dir, step, stop=3.0, **gearbox):
 def _coupling_errors(fmu_dir, steps, **gearbox):
     """RMS difference to the monolithic solution on the common 10 ms grid over [1, 3] s."""
     system = _short(fmu_dir, steps[0], **gearbox)
-    setup = monolithic_setup(system)
+    setup = physics_view(system)
     reference = run_reference(system, setup)
     out = []
     for h in steps:

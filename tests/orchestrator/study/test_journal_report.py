@@ -17,7 +17,6 @@ from orchestrator.study.journal import (
 from orchestrator.study.prepare import prepare_study
 from orchestrator.study.report import read_table, write_outputs
 from orchestrator.study.sweep import pending_points
-
 from tests.helpers.studies import (
     SMALL_FAILURE,
     SMALL_HEAD,

@@ -15,7 +15,6 @@ import numpy as np
 import pytest
 
 from orchestrator.study.report import read_table
-
 from tests.helpers.studies import run_cli
 
 pytestmark = pytest.mark.slow

@@ -14,7 +14,6 @@ import pytest
 
 from orchestrator.study.journal import read_journal
 from orchestrator.study.report import read_table
-
 from tests.helpers.studies import SMALL_FAILURE, SMALL_STUDY, free_port, run_cli
 
 pytestmark = pytest.mark.slow

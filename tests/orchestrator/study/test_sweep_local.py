@@ -17,7 +17,6 @@ from orchestrator.study.journal import read_journal
 from orchestrator.study.prepare import prepare_study
 from orchestrator.study.report import read_table
 from orchestrator.study.sweep import run_sweep
-
 from tests.helpers.studies import (
     SMALL_FAILURE,
     SMALL_HEAD,

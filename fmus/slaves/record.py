@@ -1,0 +1,68 @@
+"""The record a dtcosim FMU carries of itself: ``resources/dtcosim.json``.
+
+Written by the build (:mod:`fmus.records`), read by the slave at instantiation
+(its ``model``: the parameter set the FMU's structure and defaults come from) and
+by hosts that want to know what the FMU is (:mod:`orchestrator.cosim.fmu_interface`):
+
+``format``
+    :data:`RECORD_FORMAT`.
+``fmu``, ``role``
+    Model name and declared role (:data:`ROLES`).
+``dtcosim``, ``source``
+    The dtcosim version and what the model was made from (``"preset table6"``, a drivetrain file).
+``model``
+    The parameter set as plain data (:mod:`components.model.description`), plus
+    operating-point defaults: WindSource ``{"wind"}``, Gearbox ``{"drivetrain",
+    "rotor_speed_rad_s"}``, GeneratorRotor ``{"generator", "initial_speed_rad_s"}``.
+``signals``
+    Output variable -> ``{"signal": kind, ...}`` (:data:`SIGNALS` of the role),
+    e.g. ``"stage1.F_sp[1]": {"signal": "contact_force", "stage": "stage1", "mesh":
+    "sun_planet", "planet": "1"}``. Analyses of a run use these, never the names.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+RECORD_FILE = "dtcosim.json"
+RECORD_FORMAT = 1
+
+#: roles a component of a drivetrain co-simulation can have
+WIND_SOURCE, GEARBOX, GENERATOR = "wind_source", "gearbox", "generator"
+ROLES = (WIND_SOURCE, GEARBOX, GENERATOR)
+
+#: signal kinds an output can be declared as, per role; ``many``: any number of variables, else at most one
+SIGNALS: dict[str, dict[str, bool]] = {
+    WIND_SOURCE: {"rotor_speed": False, "rotor_angle": False},
+    GEARBOX: {"contact_force": True, "shaft_torque": True, "body_speed": True, "output_speed": False,
+              "rotor_torque": False, "generator_shaft_torque": True, "output_acceleration_peak": False},
+    GENERATOR: {"generator_speed": False, "generator_angle": False, "generator_torque": False},
+}
+
+
+class RecordError(Exception):
+    """The FMU's record is missing or unreadable."""
+
+
+def read_record(resources: str | Path | None) -> dict[str, Any]:
+    """The record in the resources folder ``resources``.
+
+    Raises
+    ------
+    RecordError
+        Naming the file and what is wrong with it.
+    """
+    if resources is None:
+        raise RecordError("no resources folder given: a dtcosim FMU reads its model from resources/" + RECORD_FILE)
+    path = Path(resources) / RECORD_FILE
+    try:
+        record = json.loads(path.read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise RecordError(f"cannot read {path}: {exc.strerror or exc}") from None
+    except ValueError as exc:
+        raise RecordError(f"{path} is not valid JSON: {exc}") from None
+    if not isinstance(record, dict) or record.get("format") != RECORD_FORMAT or not isinstance(record.get("model"), dict):
+        raise RecordError(f"{path} is not a dtcosim record of format {RECORD_FORMAT}")
+    return record
