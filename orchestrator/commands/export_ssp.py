@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 from ..inputs.scenario import find_scenario
+from . import scenario_options
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -27,6 +28,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--out", type=Path, required=True, metavar="FILE.ssp", help="output archive")
     p.add_argument("--fmu-dir", type=Path, default=None, help="directory searched for FMUs after the scenario's own")
     p.add_argument("--no-build", action="store_true", help="do not build missing FMUs (fail instead)")
+    scenario_options.add_arguments(p)
     p.set_defaults(func=run)
 
 
@@ -38,7 +40,7 @@ def run(args: argparse.Namespace) -> int:
     from ..interop.ssp import export_ssp
     from ..run.runner import load_any
 
-    scenario = load_any(find_scenario(args.scenario))
+    scenario = scenario_options.apply(load_any(find_scenario(args.scenario)), args, "export-ssp")
     paths = ensure_fmus(scenario, args.fmu_dir, build=not args.no_build,
                         report=lambda m: print(m, file=sys.stderr))
     for warning in stale_project_fmus(paths):

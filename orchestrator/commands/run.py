@@ -11,8 +11,8 @@ import os
 import sys
 from pathlib import Path
 
-from ..errors import ScenarioError
-from ..inputs.scenario import ALGORITHMS, EXTRAPOLATIONS, find_scenario
+from ..inputs.scenario import find_scenario
+from . import scenario_options
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -33,13 +33,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="directory searched for FMUs after the scenario's own (default: $DTCOSIM_FMU_DIR or the project's fmus/)")
     p.add_argument("--compare-reference", action="store_true",
                    help="also run the monolithic reference solver on the same scenario and report every statistic of both")
-    p.add_argument("--step", type=float, default=None, metavar="H", help="override the communication step [s]")
-    p.add_argument("--stop", type=float, default=None, metavar="T", help="override the stop time [s] (clips the window)")
-    p.add_argument("--output-interval", type=float, default=None, metavar="DT", help="override the sampling interval [s]")
-    p.add_argument("--algorithm", choices=ALGORITHMS, default=None, help="override the master algorithm")
-    p.add_argument("--extrapolation", choices=EXTRAPOLATIONS, default=None, help="override the input extrapolation")
-    p.add_argument("--set", action="append", default=[], metavar="COMPONENT.PARAMETER=VALUE",
-                   help="override a parameter value, e.g. --set wind.seed=7 (repeatable)")
+    scenario_options.add_arguments(p)
     p.add_argument("--no-build", action="store_true", help="do not build missing FMUs (fail instead)")
     p.add_argument("--check", action="store_true",
                    help="only check the scenario against the FMUs' model descriptions (nothing is instantiated) and exit")
@@ -48,50 +42,6 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="time every FMI call per FMU and report where the stepping time goes (adds ~1 us per call)")
     p.add_argument("--quiet", "-q", action="store_true", help="no progress bar and no statistics table")
     p.set_defaults(func=run)
-
-
-def _parse_value(text: str):
-    low = text.strip().lower()
-    if low in ("true", "false"):
-        return low == "true"
-    try:
-        return int(text)
-    except ValueError:
-        pass
-    try:
-        return float(text)
-    except ValueError:
-        return text
-
-
-def apply_overrides(scenario, args: argparse.Namespace):
-    """The scenario with the command-line overrides applied (validated again)."""
-    sim = scenario.simulation
-    changes = {}
-    if args.step is not None:
-        changes["step_s"] = args.step
-        if args.output_interval is None and sim.output_interval_s < args.step:
-            changes["output_interval_s"] = args.step
-    if args.output_interval is not None:
-        changes["output_interval_s"] = args.output_interval
-    if args.stop is not None:
-        changes["stop_s"] = args.stop
-        w0, w1 = sim.window_s
-        end = min(w1, args.stop)
-        changes["window_s"] = (w0 if w0 < end else sim.start_s, end)  # clip the window to the new stop
-    if args.algorithm is not None:
-        changes["algorithm"] = args.algorithm
-    if args.extrapolation is not None:
-        changes["extrapolation"] = args.extrapolation
-    if changes:
-        scenario = scenario.with_simulation(**changes)
-    for item in args.set:
-        target, eq, value = item.partition("=")
-        comp, dot, param = target.partition(".")
-        if not eq or not dot or not comp or not param:
-            raise ScenarioError("--set", item, "COMPONENT.PARAMETER=VALUE")
-        scenario = scenario.with_parameters(comp, **{param: _parse_value(value)})
-    return scenario
 
 
 def _progress_bar(sim):
@@ -124,7 +74,7 @@ def run(args: argparse.Namespace) -> int:
 
     quiet = args.quiet
     say = (lambda msg: None) if quiet else (lambda msg: print(msg, file=sys.stderr))
-    scenario = apply_overrides(load_any(find_scenario(args.scenario)), args)
+    scenario = scenario_options.apply(load_any(find_scenario(args.scenario)), args, "run")
     paths = ensure_fmus(scenario, args.fmu_dir, build=not args.no_build, report=say)
     for warning in stale_project_fmus(paths):
         print(f"dtcosim run: warning: {warning}", file=sys.stderr)

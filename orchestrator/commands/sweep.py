@@ -89,6 +89,8 @@ def run(args: argparse.Namespace) -> int:
         except StudyError as exc:
             raise StudyError("--timeout", exc.value, exc.expected) from None
     prepared = prepare_study(study, fmu_dir=args.fmu_dir, build=not args.no_build)
+    for note in prepared.notes:
+        print(f"dtcosim sweep: warning: {note}", file=sys.stderr)
     out_dir = args.out if args.out is not None else Path("results") / study.name
     say = (lambda msg: None) if quiet else (lambda msg: print(msg, file=sys.stderr))
     if args.check:

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Mapping
+from typing import Any
 
 from components.analysis.fatigue import (
     DEFAULT_REFERENCE_FREQUENCY_HZ,
@@ -32,10 +32,9 @@ from components.model.contact import CONTACT_LOSS_THRESHOLD_N
 from components.validation import is_number
 
 from ..errors import ScenarioError
+from .schema import Table
 
 SPECTRUM_MODES = ("auto", "always", "never")
-ANALYSIS_KEYS = ("woehler_exponents", "reference_frequency_hz", "ldd_bins", "rainflow_residue",
-                 "contact_loss_threshold_n", "spectrum")
 
 
 def _positive_number(value: Any) -> bool:
@@ -105,19 +104,6 @@ class AnalysisSettings:
         if self.spectrum not in SPECTRUM_MODES:
             raise ScenarioError("analysis.spectrum", self.spectrum, "one of " + ", ".join(repr(m) for m in SPECTRUM_MODES))
 
-    @classmethod
-    def from_toml(cls, table: Any, source: str | None = None) -> "AnalysisSettings":
-        """Read the ``[analysis]`` table (errors name ``analysis.<key>``)."""
-        if not isinstance(table, Mapping):
-            raise ScenarioError("analysis", table, "an [analysis] table", source)
-        for key in table:
-            if key not in ANALYSIS_KEYS:
-                raise ScenarioError(f"analysis.{key}", table[key], "a known key here: " + ", ".join(ANALYSIS_KEYS), source)
-        try:
-            return cls(**dict(table))
-        except ScenarioError as exc:
-            raise ScenarioError(exc.key, exc.value, exc.expected, source) from None
-
     def fatigue_settings(self) -> FatigueSettings:
         """The :class:`components.analysis.fatigue.FatigueSettings` these settings describe."""
         return FatigueSettings(
@@ -137,3 +123,18 @@ class AnalysisSettings:
             "contact_loss_threshold_n": self.contact_loss_threshold_n,
             "spectrum": self.spectrum,
         }
+
+
+class AnalysisTable(Table):
+    """The ``[analysis]`` table of a scenario file (values checked by :class:`AnalysisSettings`)."""
+
+    woehler_exponents: Any = None
+    reference_frequency_hz: Any = None
+    ldd_bins: Any = None
+    rainflow_residue: Any = None
+    contact_loss_threshold_n: Any = None
+    spectrum: Any = None
+
+    def settings(self) -> AnalysisSettings:
+        """The checked settings (errors name ``analysis.<key>``)."""
+        return AnalysisSettings(**{k: getattr(self, k) for k in self.model_fields_set})

@@ -28,16 +28,18 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Annotated, Any
+
+from pydantic import AllowInfNan, Field
 
 from components.model.generator import EVENT_KINDS, LoadEvent
 from components.validation import is_number
 
 from ..errors import ScenarioError
+from .schema import Table
 
 #: FMU code of each event kind in the ``event{i}.kind`` slot parameters (0 = no event)
 EVENT_KIND_CODES = {kind: i + 1 for i, kind in enumerate(EVENT_KINDS)}
-EVENT_KEYS = ("kind", "start", "duration", "factor", "component")
 SLOT_FIELDS = ("kind", "start", "duration", "factor")
 
 
@@ -121,38 +123,23 @@ class ScenarioEvent:
                 "factor": self.factor, "component": self.component}
 
 
-def events_from_toml(items: Any, source: str | None = None) -> tuple[ScenarioEvent, ...]:
-    """Read the ``[[events]]`` array of tables.
+class EventTable(Table):
+    """One ``[[events]]`` table of a scenario file."""
 
-    Raises
-    ------
-    ScenarioError
-        Naming ``events[i].<key>``.
-    """
-    if not isinstance(items, list):
-        raise ScenarioError("events", items, "an array of tables [[events]] with kind, start, duration (, factor)", source)
-    out = []
-    for i, item in enumerate(items):
-        path = f"events[{i}]"
-        if not isinstance(item, dict):
-            raise ScenarioError(path, item, "a table with kind = ..., start = ..., duration = ...", source)
-        for key in item:
-            if key not in EVENT_KEYS:
-                raise ScenarioError(f"{path}.{key}", item[key], "a known key here: " + ", ".join(EVENT_KEYS), source)
-        for key in ("kind", "start"):
-            if key not in item:
-                raise ScenarioError(f"{path}.{key}", None, ("an event kind: " + ", ".join(EVENT_KINDS)) if key == "kind"
-                                    else "the start time [s] (missing)", source)
-        if "duration" not in item and item["kind"] in ("grid_fault", "emergency_stop"):
-            raise ScenarioError(f"{path}.duration", None, f"the duration [s] of the {item['kind']} (missing)", source)
-        try:
-            out.append(ScenarioEvent(
-                kind=item["kind"], start_s=item["start"], duration_s=item.get("duration", math.inf),
-                factor=item.get("factor"), component=item.get("component"),
-            ))
-        except ScenarioError as exc:
-            raise ScenarioError(exc.key.replace("event.", f"{path}.", 1), exc.value, exc.expected, source) from None
-    return tuple(out)
+    kind: str = Field(description="an event kind: " + ", ".join(EVENT_KINDS))
+    start: float = Field(description="the start time [s]")
+    duration: Annotated[float, AllowInfNan(True)] | None = Field(
+        None, description="a duration > 0 [s] (inf: a permanent torque_step)")
+    factor: float | None = Field(None, description="a finite number [-] (the torque factor)")
+    component: str | None = Field(None, description="a component name (string)")
+
+    def event(self) -> ScenarioEvent:
+        """The event (:class:`ScenarioEvent`; errors name ``event.<key>``)."""
+        if self.duration is None and self.kind in ("grid_fault", "emergency_stop"):
+            raise ScenarioError("event.duration", None, f"the duration [s] of the {self.kind} (missing)")
+        return ScenarioEvent(kind=self.kind, start_s=self.start,
+                             duration_s=math.inf if self.duration is None else self.duration,
+                             factor=self.factor, component=self.component)
 
 
 def check_events_in_run(events: tuple[ScenarioEvent, ...], start_s: float, stop_s: float, components: list[str],

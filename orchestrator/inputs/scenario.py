@@ -52,26 +52,30 @@ TOML format (units SI; see ``docs/orchestrator.md`` for the full reference)::
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Literal, Mapping
+
+from pydantic import Field
 
 from components.validation import is_number
 
 from ..errors import ScenarioError
 from ..frozen_map import FrozenMap
-from .analysis_settings import AnalysisSettings
+from .analysis_settings import AnalysisSettings, AnalysisTable
 from .files import find_input_file, packaged_files, read_toml
-from .load_events import ScenarioEvent, check_events_in_run, events_from_toml
+from .load_events import EventTable, ScenarioEvent, check_events_in_run
+from .schema import (
+    NAME_PATTERN,
+    ParameterValue,
+    Table,
+    flatten_parameters,
+    read_document,
+)
 
 ALGORITHMS = ("gauss-seidel", "jacobi")
 EXTRAPOLATIONS = ("hold", "linear")
 
-#: parameter values a scenario may give (FMI Real, Integer, Boolean, String)
-ParameterValue = float | int | bool | str
-
-_NAME_RE = re.compile(r"^[A-Za-z_][A-Za-z0-9_\-]*$")
 #: relative tolerance when checking that times are whole multiples of the step
 _MULTIPLE_RTOL = 1e-9
 
@@ -102,7 +106,7 @@ class VariableRef:
         if not isinstance(text, str):
             raise ScenarioError(key, text, 'a string "component.variable"', source)
         comp, dot, var = text.partition(".")
-        if not dot or not comp or not var or not _NAME_RE.match(comp):
+        if not dot or not comp or not var or not NAME_PATTERN.match(comp):
             raise ScenarioError(key, text, 'a string "component.variable"', source)
         return cls(comp, var)
 
@@ -140,7 +144,7 @@ class Component:
     def __post_init__(self) -> None:
         from fmus.slaves.record import ROLES
 
-        if not isinstance(self.name, str) or not _NAME_RE.match(self.name):
+        if not isinstance(self.name, str) or not NAME_PATTERN.match(self.name):
             raise ScenarioError("components", self.name, "a component name of letters, digits, '_' or '-' (no dots)")
         object.__setattr__(self, "fmu", Path(self.fmu))
         params = dict(self.parameters)
@@ -314,7 +318,7 @@ class Scenario:
 
     def __post_init__(self) -> None:
         src = self.source
-        if not isinstance(self.name, str) or not _NAME_RE.match(self.name):
+        if not isinstance(self.name, str) or not NAME_PATTERN.match(self.name):
             raise ScenarioError("name", self.name, "a name of letters, digits, '_' or '-'", src)
         object.__setattr__(self, "components", tuple(self.components))
         object.__setattr__(self, "connections", tuple(self.connections))
@@ -412,50 +416,55 @@ class Scenario:
 
 
 # ---------------------------------------------------------------------- TOML
-_TOP_KEYS = {"name", "description", "simulation", "components", "connections", "initial", "record", "events", "analysis"}
-_SIM_KEYS = {
-    "start": "start_s",
-    "stop": "stop_s",
-    "step": "step_s",
-    "output_interval": "output_interval_s",
-    "window": "window_s",
-    "algorithm": "algorithm",
-    "extrapolation": "extrapolation",
-    "order": "order",
-}
-_COMPONENT_KEYS = {"fmu", "parameters", "role", "signals"}
-_LINK_KEYS = {"from", "to"}
-_RECORD_KEYS = {"variables"}
+class _SimulationTable(Table):
+    start: float = Field(0.0, description="a finite number [s]")
+    stop: float = Field(description="a finite number [s]")
+    step: float = Field(description="a finite number [s] (the communication step H)")
+    output_interval: float | None = Field(None, description="a finite number [s]")
+    window: list[float] | None = Field(None, min_length=2, max_length=2, description="[begin, end] in seconds")
+    algorithm: Literal[ALGORITHMS] = "gauss-seidel"
+    extrapolation: Literal[EXTRAPOLATIONS] = "hold"
+    order: list[str] | None = Field(None, description="a list of component names")
 
 
-def _check_keys(table: Mapping[str, Any], allowed: set[str], prefix: str, source: str | None) -> None:
-    for key in table:
-        if key not in allowed:
-            where = f"{prefix}.{key}" if prefix else key
-            raise ScenarioError(where, table[key], "a known key here: " + ", ".join(sorted(allowed)), source)
+class _ComponentTable(Table):
+    fmu: str = Field(description="an FMU file name (string)")
+    parameters: dict[str, Any] = Field(default_factory=dict, description="a table of parameter values")
+    role: str | None = Field(None, description="a role name (string)")
+    signals: dict[str, Any] = Field(default_factory=dict, description="a table of signal kind = output name(s)")
 
 
-def _require(table: Mapping[str, Any], key: str, kind: type | tuple, what: str, path: str, source: str | None):
-    if key not in table:
-        raise ScenarioError(path, None, f"{what} (missing)", source)
-    value = table[key]
-    if not isinstance(value, kind) or (isinstance(value, bool) and bool not in (kind if isinstance(kind, tuple) else (kind,))):
-        raise ScenarioError(path, value, what, source)
-    return value
+class _LinkTable(Table):
+    source: str = Field(alias="from", description='a string "component.variable"')
+    to: str = Field(description='a string "component.variable"')
 
 
-def _flatten_parameters(table: Mapping[str, Any], prefix: str, path: str, source: str | None) -> dict[str, ParameterValue]:
-    """Nested TOML tables -> dotted parameter names (``stage1 = {k0 = 1}`` -> ``stage1.k0``)."""
-    out: dict[str, ParameterValue] = {}
-    for key, value in table.items():
-        name = f"{prefix}.{key}" if prefix else key
-        if isinstance(value, dict):
-            out.update(_flatten_parameters(value, name, path, source))
-        elif isinstance(value, (bool, int, float, str)):
-            out[name] = value
-        else:
-            raise ScenarioError(f"{path}.{name}", value, "a number, boolean or string", source)
-    return out
+class _RecordTable(Table):
+    variables: list[str] = Field(default_factory=list, description='a list of "component.variable" strings')
+
+
+class ScenarioFile(Table):
+    """The shape of a scenario TOML document (see the module docstring and ``docs/orchestrator.md``)."""
+
+    name: str | None = Field(None, description="a scenario name (string)")
+    description: str = Field("", description="a string")
+    simulation: _SimulationTable = Field(description="a [simulation] table")
+    components: dict[str, _ComponentTable] = Field(description="a [components.<name>] table per FMU")
+    connections: list[_LinkTable] = Field(default_factory=list,
+                                         description="an array of tables [[connections]] with from/to")
+    initial: list[_LinkTable] = Field(default_factory=list, description="an array of tables [[initial]] with from/to")
+    record: _RecordTable | None = Field(None, description="a [record] table with variables = [...]")
+    events: list[EventTable] = Field(default_factory=list,
+                                     description="an array of tables [[events]] with kind, start, duration (, factor)")
+    analysis: AnalysisTable | None = Field(None, description="an [analysis] table")
+
+
+_SIM_FIELDS = {"start": "start_s", "stop": "stop_s", "step": "step_s", "output_interval": "output_interval_s",
+               "window": "window_s", "algorithm": "algorithm", "extrapolation": "extrapolation", "order": "order"}
+
+
+def _rekeyed(exc: ScenarioError, key: str | None, source: str | None) -> ScenarioError:
+    return ScenarioError(key or exc.key, exc.value, exc.expected, source)
 
 
 def scenario_from_dict(data: Mapping[str, Any], name: str | None = None, base_dir: Path | None = None,
@@ -478,113 +487,55 @@ def scenario_from_dict(data: Mapping[str, Any], name: str | None = None, base_di
     ScenarioError
         Naming the first offending key.
     """
-    if not isinstance(data, Mapping):
-        raise ScenarioError("(document)", data, "a table", source)
-    _check_keys(data, _TOP_KEYS, "", source)
-    sc_name = data.get("name", name)
+    doc = read_document(ScenarioFile, data, ScenarioError, source)
+    sc_name = doc.name if doc.name is not None else name
     if sc_name is None:
         raise ScenarioError("name", None, "a scenario name (missing)", source)
-    if not isinstance(sc_name, str):
-        raise ScenarioError("name", sc_name, "a string", source)
-    description = data.get("description", "")
-    if not isinstance(description, str):
-        raise ScenarioError("description", description, "a string", source)
-
-    sim = _require(data, "simulation", dict, "a [simulation] table", "simulation", source)
-    _check_keys(sim, set(_SIM_KEYS), "simulation", source)
-    for key in ("stop", "step"):
-        _require(sim, key, (int, float), "a number [s]", f"simulation.{key}", source)
-    kwargs: dict[str, Any] = {}
-    for key, attr in _SIM_KEYS.items():
-        if key not in sim:
-            continue
-        value = sim[key]
-        path = f"simulation.{key}"
-        if key in ("start", "stop", "step", "output_interval"):
-            if not is_number(value):
-                raise ScenarioError(path, value, "a number [s]", source)
-        elif key == "window":
-            if not isinstance(value, list) or len(value) != 2 or not all(is_number(v) for v in value):
-                raise ScenarioError(path, value, "[begin, end] in seconds", source)
-            value = (float(value[0]), float(value[1]))
-        elif key in ("algorithm", "extrapolation"):
-            if not isinstance(value, str):
-                raise ScenarioError(path, value, "a string", source)
-        elif key == "order":
-            if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
-                raise ScenarioError(path, value, "a list of component names", source)
-            value = tuple(value)
-        kwargs[attr] = value
+    sim = doc.simulation
+    given = {k for k in sim.model_fields_set}
+    kwargs = {attr: getattr(sim, key) for key, attr in _SIM_FIELDS.items() if key in given}
+    if "window_s" in kwargs:
+        kwargs["window_s"] = tuple(kwargs["window_s"])
+    if "order" in kwargs:
+        kwargs["order"] = tuple(kwargs["order"])
     try:
         settings = SimulationSettings(**kwargs)
     except ScenarioError as exc:
-        raise ScenarioError(exc.key, exc.value, exc.expected, source) from None
+        raise _rekeyed(exc, None, source) from None
 
-    comps_table = _require(data, "components", dict, "a [components.<name>] table per FMU", "components", source)
     components = []
-    for cname, ctab in comps_table.items():
+    for cname, ctab in doc.components.items():
         path = f"components.{cname}"
-        if not isinstance(ctab, dict):
-            raise ScenarioError(path, ctab, "a table with fmu = ... and optional parameters", source)
-        _check_keys(ctab, _COMPONENT_KEYS, path, source)
-        fmu = _require(ctab, "fmu", str, "an FMU file name (string)", f"{path}.fmu", source)
-        params = ctab.get("parameters", {})
-        if not isinstance(params, dict):
-            raise ScenarioError(f"{path}.parameters", params, "a table of parameter values", source)
-        role = ctab.get("role")
-        if role is not None and not isinstance(role, str):
-            raise ScenarioError(f"{path}.role", role, "a role name (string)", source)
-        signals = ctab.get("signals", {})
-        if not isinstance(signals, dict):
-            raise ScenarioError(f"{path}.signals", signals, "a table of signal kind = output name(s)", source)
+        params = flatten_parameters(ctab.parameters, f"{path}.parameters", ScenarioError, source)
         try:
-            components.append(Component(cname, Path(fmu), _flatten_parameters(params, "", f"{path}.parameters", source),
-                                        role, signals))
+            components.append(Component(cname, Path(ctab.fmu), params, ctab.role, ctab.signals))
         except ScenarioError as exc:
-            key = path if exc.key == "components" else exc.key
-            raise ScenarioError(key, exc.value, exc.expected, source) from None
+            raise _rekeyed(exc, path if exc.key == "components" else None, source) from None
 
-    def links(key: str, cls):
-        items = data.get(key, [])
-        if not isinstance(items, list):
-            raise ScenarioError(key, items, f"an array of tables [[{key}]] with from/to", source)
-        out = []
-        for i, item in enumerate(items):
-            path = f"{key}[{i}]"
-            if not isinstance(item, dict):
-                raise ScenarioError(path, item, "a table with from = ... and to = ...", source)
-            _check_keys(item, _LINK_KEYS, path, source)
-            src = VariableRef.parse(_require(item, "from", str, '"component.variable"', f"{path}.from", source), f"{path}.from", source)
-            dst = VariableRef.parse(_require(item, "to", str, '"component.variable"', f"{path}.to", source), f"{path}.to", source)
-            out.append(cls(src, dst))
-        return tuple(out)
+    def links(tables: list[_LinkTable], key: str, cls):
+        return tuple(cls(VariableRef.parse(link.source, f"{key}[{i}].from", source),
+                         VariableRef.parse(link.to, f"{key}[{i}].to", source)) for i, link in enumerate(tables))
 
-    connections = links("connections", Connection)
-    initial = links("initial", InitialBinding)
-
-    record: tuple[str, ...] = ()
-    if "record" in data:
-        rec = data["record"]
-        if not isinstance(rec, dict):
-            raise ScenarioError("record", rec, "a [record] table with variables = [...]", source)
-        _check_keys(rec, _RECORD_KEYS, "record", source)
-        variables = rec.get("variables", [])
-        if not isinstance(variables, list) or not all(isinstance(v, str) for v in variables):
-            raise ScenarioError("record.variables", variables, 'a list of "component.variable" strings', source)
-        record = tuple(variables)
-
-    events = events_from_toml(data["events"], source) if "events" in data else ()
-    analysis = AnalysisSettings.from_toml(data["analysis"], source) if "analysis" in data else AnalysisSettings()
+    events = []
+    for i, table in enumerate(doc.events):
+        try:
+            events.append(table.event())
+        except ScenarioError as exc:
+            raise _rekeyed(exc, exc.key.replace("event.", f"events[{i}].", 1), source) from None
+    try:
+        analysis = doc.analysis.settings() if doc.analysis is not None else AnalysisSettings()
+    except ScenarioError as exc:
+        raise _rekeyed(exc, None, source) from None
 
     return Scenario(
         name=sc_name,
-        description=description,
+        description=doc.description,
         components=tuple(components),
-        connections=connections,
-        initial=initial,
+        connections=links(doc.connections, "connections", Connection),
+        initial=links(doc.initial, "initial", InitialBinding),
         simulation=settings,
-        record=record,
-        events=events,
+        record=tuple(doc.record.variables) if doc.record is not None else (),
+        events=tuple(events),
         analysis=analysis,
         base_dir=base_dir,
         source=source,

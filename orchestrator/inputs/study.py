@@ -36,48 +36,40 @@ combination of axis values x every seed, in that nesting order (seeds fastest).
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Annotated, Any, Literal, Mapping
 
 import numpy as np
+from pydantic import Field
 
 from components.validation import is_number
 
-from ..errors import EntryError, suggestion
+from ..errors import EntryError
 from ..frozen_map import FrozenMap
 from .files import find_input_file, packaged_files, read_toml
 from .measures import Measure, MeasureError, parse_measure
+from .overrides import SimulationOverrides
+from .scenario import ALGORITHMS, EXTRAPOLATIONS
+from .schema import (
+    NAME_PATTERN,
+    ParameterValue,
+    Table,
+    flatten_parameters,
+    is_parameter_value,
+    read_document,
+)
 
 ENGINES = ("cosim", "monolithic")
 SPACINGS = ("linear", "log")
 DEFAULT_SEED_PARAMETER = "wind.seed"
 
-#: parameter values a study may give (as a scenario: FMI Real, Integer, Boolean, String)
-ParameterValue = float | int | bool | str
-
-_NAME_RE = re.compile(r"^[A-Za-z_][A-Za-z0-9_\-]*$")
-_TOP_KEYS = {"name", "description", "engine", "base", "simulation", "solver", "axes", "points", "seeds",
-             "seed_parameter", "measures", "plots", "timeout"}
-_BASE_KEYS = {"scenario", "model", "parameters"}
-_SIMULATION_KEYS = {"start", "stop", "step", "output_interval", "window", "algorithm", "extrapolation"}
-_SOLVER_KEYS = {"rtol": "rtol", "atol_angle": "atol_angle_rad", "atol_speed": "atol_speed_rad_s",
-                "max_step": "max_step_s", "max_steps": "max_steps"}
-_AXIS_KEYS = {"parameter", "parameters", "values", "start", "stop", "num", "spacing", "label", "unit", "scale"}
-_PLOT_KEYS = {"measure", "title", "file", "x", "y", "log", "vmin", "vmax"}
 
 
 class StudyError(EntryError):
     """A study file (or the objects built from it) is invalid (key, value, expected, source)."""
 
     kind = "study"
-
-
-def _is_scalar(value: Any) -> bool:
-    if isinstance(value, float) and not math.isfinite(value):
-        return False
-    return isinstance(value, (int, float, bool, str))
 
 
 def split_parameter(name: str) -> tuple[str, str]:
@@ -90,32 +82,15 @@ def _check_parameter_name(name: Any, key: str, source: str | None) -> str:
     if not isinstance(name, str):
         raise StudyError(key, name, 'a parameter name "component.parameter"', source)
     comp, param = split_parameter(name)
-    if not comp or not param or not _NAME_RE.match(comp):
+    if not comp or not param or not NAME_PATTERN.match(comp):
         raise StudyError(key, name, 'a parameter name "component.parameter"', source)
     return name
 
 
-def _flatten(table: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
-    """Nested TOML tables -> dotted names (``gearbox = {R1 = 8}`` -> ``gearbox.R1``)."""
-    out: dict[str, Any] = {}
-    for key, value in table.items():
-        name = f"{prefix}.{key}" if prefix else key
-        if isinstance(value, dict):
-            out.update(_flatten(value, name))
-        else:
-            out[name] = value
-    return out
-
-
-def _parameter_table(table: Any, key: str, source: str | None) -> dict[str, ParameterValue]:
-    if not isinstance(table, dict):
-        raise StudyError(key, table, 'a table of "component.parameter" = value', source)
-    out = {}
-    for name, value in _flatten(table).items():
+def _parameter_table(table: Mapping[str, Any], key: str, source: str | None) -> dict[str, ParameterValue]:
+    out = flatten_parameters(table, key, StudyError, source)
+    for name in out:
         _check_parameter_name(name, f"{key}.{name}", source)
-        if not _is_scalar(value):
-            raise StudyError(f"{key}.{name}", value, "a finite number, boolean or string", source)
-        out[name] = value
     return out
 
 
@@ -268,9 +243,10 @@ class Study:
     seeds : tuple of int
         Values of ``seed_parameter`` (one more, innermost axis).
     seed_parameter : str
-    simulation : mapping
-        Overrides of the base's time grid (``start``, ``stop``, ``step``,
-        ``output_interval``, ``window``, ``algorithm``, ``extrapolation``).
+    simulation : SimulationOverrides
+        Changes of the base's time grid and master options (``[simulation]``:
+        ``start``, ``stop``, ``step``, ``output_interval``, ``window``, ``algorithm``,
+        ``extrapolation``), applied by the rules of :mod:`orchestrator.inputs.overrides`.
     solver : mapping
         Monolithic solver tolerances (:class:`components.reference.solver.SolverSettings` fields).
     plots : tuple of PlotSpec
@@ -293,7 +269,7 @@ class Study:
     points: tuple[Mapping[str, ParameterValue], ...] = ()
     seeds: tuple[int, ...] = ()
     seed_parameter: str = DEFAULT_SEED_PARAMETER
-    simulation: Mapping[str, Any] = field(default_factory=dict)
+    simulation: SimulationOverrides = field(default_factory=SimulationOverrides)
     solver: Mapping[str, Any] = field(default_factory=dict)
     plots: tuple[PlotSpec, ...] = ()
     timeout_s: float | None = None
@@ -306,9 +282,10 @@ class Study:
         for attr in ("measures", "axes", "points", "seeds", "plots"):
             object.__setattr__(self, attr, tuple(getattr(self, attr)))
         object.__setattr__(self, "points", tuple(FrozenMap(dict(p)) for p in self.points))
-        object.__setattr__(self, "simulation", FrozenMap(dict(self.simulation)))
+        if isinstance(self.simulation, Mapping):
+            object.__setattr__(self, "simulation", SimulationOverrides.from_table(self.simulation))
         object.__setattr__(self, "solver", FrozenMap(dict(self.solver)))
-        if not isinstance(self.name, str) or not _NAME_RE.match(self.name):
+        if not isinstance(self.name, str) or not NAME_PATTERN.match(self.name):
             raise StudyError("name", self.name, "a name of letters, digits, '_' or '-'", src)
         t = self.timeout_s
         if t is not None and not (is_number(t) and math.isfinite(t) and t > 0):
@@ -402,105 +379,138 @@ class Study:
 
 
 # ---------------------------------------------------------------------- TOML
-def _check_keys(table: Mapping[str, Any], allowed: set[str] | Mapping[str, Any], prefix: str, source: str | None) -> None:
-    for key in table:
-        if key not in allowed:
-            where = f"{prefix}.{key}" if prefix else key
-            hint = suggestion(key, allowed, n=1)
-            if prefix and key in _TOP_KEYS:
-                hint += f" ({key} is a top-level key: in TOML it must come before the first [table] header)"
-            raise StudyError(where, table[key], "a known key here: " + ", ".join(sorted(allowed)) + hint, source)
+_FINITE_S = "a finite number [s]"
 
 
-def _axis_values(tab: Mapping[str, Any], key: str, source: str | None) -> tuple[ParameterValue, ...]:
-    has_values = "values" in tab
-    has_range = any(k in tab for k in ("start", "stop", "num"))
+class _BaseTable(Table):
+    scenario: str | None = Field(None, description="a packaged scenario name or a scenario TOML path")
+    model: str | None = Field(None, description="the name of a built-in model (orchestrator.study.models)")
+    parameters: dict[str, Any] = Field(default_factory=dict, description='a table of "component.parameter" = value')
+
+
+class _SimulationTable(Table):
+    start: float | None = Field(None, description=_FINITE_S)
+    stop: float | None = Field(None, description=_FINITE_S)
+    step: float | None = Field(None, description=_FINITE_S)
+    output_interval: float | None = Field(None, description=_FINITE_S)
+    window: list[float] | None = Field(None, min_length=2, max_length=2, description="[begin, end] in seconds")
+    algorithm: Literal[ALGORITHMS] | None = None
+    extrapolation: Literal[EXTRAPOLATIONS] | None = None
+
+
+_POSITIVE = "a finite number > 0"
+
+
+class _SolverTable(Table):
+    rtol: float | None = Field(None, gt=0, description=_POSITIVE)
+    atol_angle: float | None = Field(None, gt=0, description=_POSITIVE + " [rad]")
+    atol_speed: float | None = Field(None, gt=0, description=_POSITIVE + " [rad/s]")
+    max_step: float | None = Field(None, ge=0, description="a finite number >= 0 [s] (0: no limit)")
+    max_steps: int | None = Field(None, gt=0, description="an integer > 0")
+
+
+_SOLVER_FIELDS = {"rtol": "rtol", "atol_angle": "atol_angle_rad", "atol_speed": "atol_speed_rad_s",
+                  "max_step": "max_step_s", "max_steps": "max_steps"}
+
+
+class _AxisTable(Table):
+    parameter: str | None = Field(None, description='a parameter name "component.parameter"')
+    parameters: list[str] | None = Field(None, min_length=1,
+                                         description='a non-empty list of "component.parameter" names')
+    values: list[Any] | None = Field(None, min_length=1,
+                                     description="a non-empty list of finite numbers, booleans or strings")
+    start: float | None = Field(None, description="a finite number")
+    stop: float | None = Field(None, description="a finite number")
+    num: int | None = Field(None, ge=1, description="an integer >= 1")
+    spacing: Literal[SPACINGS] | None = None
+    label: str = Field("", description="a string")
+    unit: str = Field("", description="a string")
+    scale: float = Field(1.0, description="a finite number other than 0")
+
+
+class _PlotTable(Table):
+    measure: str = Field(description="a measure name (string)")
+    title: str = Field("", description="a string")
+    file: str = Field("", description="a PNG file name without directories (*.png)")
+    x: int = Field(0, description="an axis index (integer)")
+    y: int = Field(1, description="an axis index (integer)")
+    log: bool = Field(False, description="true or false")
+    vmin: float | None = Field(None, description="a finite number in the measure's unit")
+    vmax: float | None = Field(None, description="a finite number in the measure's unit")
+
+
+class StudyFile(Table):
+    """The shape of a study TOML document (see the module docstring and ``docs/studies.md``)."""
+
+    name: str | None = Field(None, description="a study name (string)")
+    description: str = Field("", description="a string")
+    engine: Literal[ENGINES] = Field(description="one of " + ", ".join(ENGINES))
+    base: _BaseTable = Field(description='a [base] table with scenario = "..." or model = "..."')
+    simulation: _SimulationTable = Field(default_factory=_SimulationTable, description="a [simulation] table")
+    solver: _SolverTable | None = Field(None, description="a [solver] table")
+    axes: list[_AxisTable] = Field(default_factory=list, description="an array of tables [[axes]]")
+    points: list[dict[str, Any]] = Field(default_factory=list,
+                                         description='a list of tables {"component.parameter" = value, ...}')
+    seeds: list[Annotated[int, Field(ge=0)]] = Field(default_factory=list, description="a list of integers >= 0")
+    seed_parameter: str | None = Field(None, description='a parameter name "component.parameter"')
+    measures: list[str] = Field(min_length=1, description='a non-empty list such as ["I_max_acc", "cpu_time"]')
+    plots: list[_PlotTable] = Field(default_factory=list, description="an array of tables [[plots]]")
+    timeout: float | None = Field(None, description="a finite number of seconds > 0 (wall-clock time per point)")
+
+
+def _axis_values(tab: _AxisTable, key: str, source: str | None) -> tuple[ParameterValue, ...]:
+    has_values = tab.values is not None
+    has_range = any(v is not None for v in (tab.start, tab.stop, tab.num))
     if has_values == has_range:
-        raise StudyError(key, dict(tab), "either values = [...] or start, stop and num", source)
+        raise StudyError(key, tab.model_dump(exclude_none=True), "either values = [...] or start, stop and num", source)
     if has_values:
-        values = tab["values"]
-        if not isinstance(values, list) or not values or not all(_is_scalar(v) for v in values):
-            raise StudyError(f"{key}.values", values, "a non-empty list of finite numbers, booleans or strings", source)
-        if "spacing" in tab:
-            raise StudyError(f"{key}.spacing", tab["spacing"], "no spacing with explicit values", source)
-        return tuple(values)
-    for k in ("start", "stop"):
-        if k not in tab:
-            raise StudyError(f"{key}.{k}", None, "a number (missing)", source)
-        if not is_number(tab[k]) or not math.isfinite(tab[k]):
-            raise StudyError(f"{key}.{k}", tab[k], "a finite number", source)
-    num = tab.get("num")
-    if not isinstance(num, int) or isinstance(num, bool) or num < 1:
-        raise StudyError(f"{key}.num", num, "an integer >= 1", source)
-    spacing = tab.get("spacing", "linear")
-    if spacing not in SPACINGS:
-        raise StudyError(f"{key}.spacing", spacing, "one of " + ", ".join(SPACINGS), source)
-    start, stop = float(tab["start"]), float(tab["stop"])
-    if num > 1 and start == stop:
-        raise StudyError(f"{key}.stop", tab["stop"], f"a value other than start = {start:g} for num > 1", source)
+        for j, v in enumerate(tab.values):
+            if not is_parameter_value(v):
+                raise StudyError(f"{key}.values[{j}]", v, "a finite number, a boolean or a string", source)
+        if tab.spacing is not None:
+            raise StudyError(f"{key}.spacing", tab.spacing, "no spacing with explicit values", source)
+        return tuple(tab.values)
+    for k in ("start", "stop", "num"):
+        if getattr(tab, k) is None:
+            raise StudyError(f"{key}.{k}", None, ("an integer >= 1" if k == "num" else "a number") + " (missing)", source)
+    spacing = tab.spacing or "linear"
+    if tab.num > 1 and tab.start == tab.stop:
+        raise StudyError(f"{key}.stop", tab.stop, f"a value other than start = {tab.start:g} for num > 1", source)
     if spacing == "log":
-        if not (start > 0 and stop > 0):
-            raise StudyError(f"{key}.start", tab["start"], "start > 0 and stop > 0 for log spacing", source)
-        grid = np.geomspace(start, stop, num)
+        if not (tab.start > 0 and tab.stop > 0):
+            raise StudyError(f"{key}.start", tab.start, "start > 0 and stop > 0 for log spacing", source)
+        grid = np.geomspace(tab.start, tab.stop, tab.num)
     else:
-        grid = np.linspace(start, stop, num)
+        grid = np.linspace(tab.start, tab.stop, tab.num)
     return tuple(float(v) for v in grid)
 
 
-def _axis(tab: Any, i: int, source: str | None) -> Axis:
+def _axis(tab: _AxisTable, i: int, source: str | None) -> Axis:
     key = f"axes[{i}]"
-    if not isinstance(tab, dict):
-        raise StudyError(key, tab, "a table [[axes]] with parameter(s) and values", source)
-    _check_keys(tab, _AXIS_KEYS, key, source)
-    if ("parameter" in tab) == ("parameters" in tab):
-        raise StudyError(key, dict(tab), 'either parameter = "component.parameter" or parameters = [...]', source)
-    if "parameter" in tab:
-        params = [_check_parameter_name(tab["parameter"], f"{key}.parameter", source)]
+    if (tab.parameter is None) == (tab.parameters is None):
+        raise StudyError(key, tab.model_dump(exclude_none=True),
+                         'either parameter = "component.parameter" or parameters = [...]', source)
+    if tab.parameter is not None:
+        params = [_check_parameter_name(tab.parameter, f"{key}.parameter", source)]
     else:
-        plist = tab["parameters"]
-        if not isinstance(plist, list) or not plist:
-            raise StudyError(f"{key}.parameters", plist, 'a non-empty list of "component.parameter" names', source)
-        params = [_check_parameter_name(p, f"{key}.parameters[{j}]", source) for j, p in enumerate(plist)]
+        params = [_check_parameter_name(p, f"{key}.parameters[{j}]", source) for j, p in enumerate(tab.parameters)]
     values = _axis_values(tab, key, source)
-    label = tab.get("label", "")
-    unit = tab.get("unit", "")
-    scale = tab.get("scale", 1.0)
-    for k, v in (("label", label), ("unit", unit)):
-        if not isinstance(v, str):
-            raise StudyError(f"{key}.{k}", v, "a string", source)
-    if not is_number(scale) or not math.isfinite(scale) or scale == 0:
-        raise StudyError(f"{key}.scale", scale, "a finite number other than 0", source)
+    if tab.scale == 0:
+        raise StudyError(f"{key}.scale", tab.scale, "a finite number other than 0", source)
     try:
-        return Axis(tuple(params), values, label=label, unit=unit, scale=float(scale))
+        return Axis(tuple(params), values, label=tab.label, unit=tab.unit, scale=float(tab.scale))
     except StudyError as exc:
         raise StudyError(exc.key.replace("axes", key, 1), exc.value, exc.expected, source) from None
 
 
-def _plot(tab: Any, i: int, source: str | None) -> PlotSpec:
+def _plot(tab: _PlotTable, i: int, source: str | None) -> PlotSpec:
     key = f"plots[{i}]"
-    if not isinstance(tab, dict):
-        raise StudyError(key, tab, "a table [[plots]] with measure = ...", source)
-    _check_keys(tab, _PLOT_KEYS, key, source)
-    if "measure" not in tab or not isinstance(tab["measure"], str):
-        raise StudyError(f"{key}.measure", tab.get("measure"), "a measure name (string)", source)
-    for k in ("title", "file"):
-        if k in tab and not isinstance(tab[k], str):
-            raise StudyError(f"{key}.{k}", tab[k], "a string", source)
-    file = tab.get("file", "")
-    if file and (Path(file).name != file or not file.endswith(".png")):
-        raise StudyError(f"{key}.file", file, "a PNG file name without directories (*.png)", source)
-    if "log" in tab and not isinstance(tab["log"], bool):
-        raise StudyError(f"{key}.log", tab["log"], "true or false", source)
-    for k in ("x", "y"):
-        if k in tab and (not isinstance(tab[k], int) or isinstance(tab[k], bool)):
-            raise StudyError(f"{key}.{k}", tab[k], "an axis index (integer)", source)
-    for k in ("vmin", "vmax"):
-        if k in tab and (not is_number(tab[k]) or not math.isfinite(tab[k])):
-            raise StudyError(f"{key}.{k}", tab[k], "a finite number in the measure's unit", source)
-    if "vmin" in tab and "vmax" in tab and not tab["vmax"] > tab["vmin"]:
-        raise StudyError(f"{key}.vmax", tab["vmax"], f"> vmin = {tab['vmin']}", source)
-    return PlotSpec(measure=tab["measure"], title=tab.get("title", ""), file=file, x=tab.get("x", 0),
-                    y=tab.get("y", 1), log=tab.get("log", False), vmin=tab.get("vmin"), vmax=tab.get("vmax"))
+    if tab.file and (Path(tab.file).name != tab.file or not tab.file.endswith(".png")):
+        raise StudyError(f"{key}.file", tab.file, "a PNG file name without directories (*.png)", source)
+    if tab.vmin is not None and tab.vmax is not None and not tab.vmax > tab.vmin:
+        raise StudyError(f"{key}.vmax", tab.vmax, f"> vmin = {tab.vmin}", source)
+    return PlotSpec(measure=tab.measure, title=tab.title, file=tab.file, x=tab.x, y=tab.y, log=tab.log,
+                    vmin=tab.vmin, vmax=tab.vmax)
 
 
 def study_from_dict(data: Mapping[str, Any], name: str | None = None, base_dir: Path | None = None,
@@ -523,56 +533,27 @@ def study_from_dict(data: Mapping[str, Any], name: str | None = None, base_dir: 
     StudyError
         Naming the first offending key.
     """
-    if not isinstance(data, Mapping):
-        raise StudyError("(document)", data, "a table", source)
-    _check_keys(data, _TOP_KEYS, "", source)
-    st_name = data.get("name", name)
-    if not isinstance(st_name, str):
-        raise StudyError("name", st_name, "a study name (string)", source)
-    description = data.get("description", "")
-    if not isinstance(description, str):
-        raise StudyError("description", description, "a string", source)
-    if "engine" not in data:
-        raise StudyError("engine", None, "one of " + ", ".join(ENGINES) + " (missing)", source)
-    engine = data["engine"]
-    if engine not in ENGINES:
-        raise StudyError("engine", engine, "one of " + ", ".join(ENGINES), source)
-
-    base_tab = data.get("base")
-    if not isinstance(base_tab, dict):
-        raise StudyError("base", base_tab, 'a [base] table with scenario = "..." or model = "..."', source)
-    _check_keys(base_tab, _BASE_KEYS, "base", source)
-    if ("scenario" in base_tab) == ("model" in base_tab):
-        raise StudyError("base", dict(base_tab), 'exactly one of scenario = "..." or model = "..."', source)
-    params = _parameter_table(base_tab.get("parameters", {}), "base.parameters", source)
-    if "scenario" in base_tab:
-        spec = base_tab["scenario"]
-        if not isinstance(spec, str) or not spec:
-            raise StudyError("base.scenario", spec, "a packaged scenario name or a scenario TOML path", source)
-        base = Base("scenario", spec, _scenario_path(spec, base_dir, source), params)
+    doc = read_document(StudyFile, data, StudyError, source)
+    st_name = doc.name if doc.name is not None else name
+    engine = doc.engine
+    if (doc.base.scenario is None) == (doc.base.model is None):
+        raise StudyError("base", doc.base.model_dump(exclude_none=True),
+                         'exactly one of scenario = "..." or model = "..."', source)
+    params = _parameter_table(doc.base.parameters, "base.parameters", source)
+    if doc.base.scenario is not None:
+        if not doc.base.scenario:
+            raise StudyError("base.scenario", "", "a packaged scenario name or a scenario TOML path", source)
+        base = Base("scenario", doc.base.scenario, _scenario_path(doc.base.scenario, base_dir, source), params)
     else:
-        model = base_tab["model"]
-        if not isinstance(model, str) or not model:
+        model = doc.base.model
+        if not model:
             raise StudyError("base.model", model, "the name of a built-in model (orchestrator.study.models)", source)
         if engine != "monolithic":
             raise StudyError("engine", engine, f"monolithic for the built-in model {model!r} (the co-simulation "
                              "engine runs a scenario's FMUs: give base.scenario)", source)
         base = Base("model", model, None, params)
 
-    simulation = data.get("simulation", {})
-    if not isinstance(simulation, dict):
-        raise StudyError("simulation", simulation, "a [simulation] table", source)
-    _check_keys(simulation, _SIMULATION_KEYS, "simulation", source)
-    for key, value in simulation.items():
-        path = f"simulation.{key}"
-        if key in ("start", "stop", "step", "output_interval"):
-            if not is_number(value) or not math.isfinite(value):
-                raise StudyError(path, value, "a finite number [s]", source)
-        elif key == "window":
-            if not isinstance(value, list) or len(value) != 2 or not all(is_number(v) for v in value):
-                raise StudyError(path, value, "[begin, end] in seconds", source)
-        elif not isinstance(value, str):
-            raise StudyError(path, value, "a string", source)
+    simulation = doc.simulation.model_dump(exclude_none=True)
     if base.kind == "model":
         for key in ("step", "algorithm", "extrapolation"):
             if key in simulation:
@@ -580,62 +561,37 @@ def study_from_dict(data: Mapping[str, Any], name: str | None = None, base_dir: 
         if "stop" not in simulation:
             raise StudyError("simulation.stop", None, "the end time [s] of a built-in model's runs (missing)", source)
 
-    solver = data.get("solver", {})
-    if not isinstance(solver, dict):
-        raise StudyError("solver", solver, "a [solver] table", source)
-    _check_keys(solver, _SOLVER_KEYS, "solver", source)
-    if solver and engine != "monolithic":
-        raise StudyError("solver", dict(solver), "no [solver] table with the co-simulation engine (the Gearbox FMU has "
+    solver = doc.solver.model_dump(exclude_none=True) if doc.solver is not None else {}
+    if doc.solver is not None and engine != "monolithic":
+        raise StudyError("solver", solver, "no [solver] table with the co-simulation engine (the Gearbox FMU has "
                          "its own solver parameters: set them as gearbox parameters)", source)
-    for key, value in solver.items():
-        if not is_number(value) or not math.isfinite(value) or value < 0 or (key != "max_step" and value == 0):
-            raise StudyError(f"solver.{key}", value, "a finite number > 0 (max_step >= 0)", source)
-        if key == "max_steps" and not isinstance(value, int):
-            raise StudyError(f"solver.{key}", value, "an integer", source)
-    solver = {_SOLVER_KEYS[k]: v for k, v in solver.items()}
+    solver = {_SOLVER_FIELDS[k]: v for k, v in solver.items()}
 
-    axes_tab = data.get("axes", [])
-    if not isinstance(axes_tab, list):
-        raise StudyError("axes", axes_tab, "an array of tables [[axes]]", source)
-    axes = tuple(_axis(tab, i, source) for i, tab in enumerate(axes_tab))
-
-    points_tab = data.get("points", [])
-    if not isinstance(points_tab, list):
-        raise StudyError("points", points_tab, 'a list of tables {"component.parameter" = value, ...}', source)
+    axes = tuple(_axis(tab, i, source) for i, tab in enumerate(doc.axes))
     points = []
-    for i, pt in enumerate(points_tab):
+    for i, pt in enumerate(doc.points):
         table = _parameter_table(pt, f"points[{i}]", source)
         if not table:
             raise StudyError(f"points[{i}]", pt, "at least one parameter value", source)
         points.append(table)
 
-    seeds = data.get("seeds", [])
-    if not isinstance(seeds, list) or not all(isinstance(s, int) and not isinstance(s, bool) and s >= 0 for s in seeds):
-        raise StudyError("seeds", seeds, "a list of integers >= 0", source)
-    seed_parameter = data.get("seed_parameter", DEFAULT_SEED_PARAMETER)
+    seed_parameter = doc.seed_parameter or DEFAULT_SEED_PARAMETER
     _check_parameter_name(seed_parameter, "seed_parameter", source)
-    if "seed_parameter" in data and not seeds:
+    if doc.seed_parameter is not None and not doc.seeds:
         raise StudyError("seed_parameter", seed_parameter, "seeds = [...] as well", source)
 
-    measures_tab = data.get("measures")
-    if not isinstance(measures_tab, list) or not measures_tab:
-        raise StudyError("measures", measures_tab, 'a non-empty list such as ["I_max_acc", "cpu_time"]', source)
     measures = []
-    for i, text in enumerate(measures_tab):
+    for i, text in enumerate(doc.measures):
         try:
             measures.append(parse_measure(text))
         except MeasureError as exc:
             raise StudyError(f"measures[{i}]", text, exc.expected, source) from None
 
-    plots_tab = data.get("plots", [])
-    if not isinstance(plots_tab, list):
-        raise StudyError("plots", plots_tab, "an array of tables [[plots]]", source)
-    plots = tuple(_plot(tab, i, source) for i, tab in enumerate(plots_tab))
-
     return Study(
         name=st_name, engine=engine, base=base, measures=tuple(measures), axes=axes, points=tuple(points),
-        seeds=tuple(seeds), seed_parameter=seed_parameter, simulation=simulation, solver=solver, plots=plots,
-        timeout_s=data.get("timeout"), description=description, base_dir=base_dir, source=source,
+        seeds=tuple(doc.seeds), seed_parameter=seed_parameter, simulation=SimulationOverrides.from_table(simulation),
+        solver=solver, plots=tuple(_plot(tab, i, source) for i, tab in enumerate(doc.plots)),
+        timeout_s=doc.timeout, description=doc.description, base_dir=base_dir, source=source,
     )
 
 

@@ -108,6 +108,9 @@ class PreparedStudy:
         Everything the keys depend on besides the point's own parameters.
     fmu_paths : mapping of str -> pathlib.Path
         The base scenario's FMU files (empty for a built-in model).
+    notes : tuple of str
+        What the study's ``[simulation]`` changed beyond what it gives (e.g. a clipped
+        analysis window; :mod:`orchestrator.inputs.overrides`).
     """
 
     study: Study
@@ -116,6 +119,7 @@ class PreparedStudy:
     payload: StudyPayload
     identity: Mapping[str, Any]
     fmu_paths: Mapping[str, Path] = field(default_factory=dict)
+    notes: tuple[str, ...] = ()
 
 
 def _origins(study: Study) -> list[tuple[str, str, list]]:
@@ -139,25 +143,6 @@ def _study_key_of(exc: ScenarioError) -> str:
     if len(parts) == 4 and parts[0] == "components" and parts[2] == "parameters":
         return f"base.parameters.{parts[1]}.{parts[3]}"
     return f"base.scenario ({exc.key})"
-
-
-def _simulation_changes(scenario, overrides: Mapping[str, Any]) -> dict[str, Any]:
-    sim = scenario.simulation
-    names = {"start": "start_s", "stop": "stop_s", "step": "step_s", "output_interval": "output_interval_s",
-             "algorithm": "algorithm", "extrapolation": "extrapolation"}
-    changes = {names[k]: v for k, v in overrides.items() if k in names}
-    if "window" in overrides:
-        changes["window_s"] = tuple(float(v) for v in overrides["window"])
-    else:  # clip the base window to a changed time range, as `dtcosim run --stop` does
-        start = changes.get("start_s", sim.start_s)
-        stop = changes.get("stop_s", sim.stop_s)
-        w0, w1 = sim.window_s
-        if not (start <= w0 < w1 <= stop):
-            end = min(w1, stop)
-            changes["window_s"] = (w0 if start <= w0 < end else start, end)
-    if "step" in overrides and "output_interval" not in overrides and sim.output_interval_s < overrides["step"]:
-        changes["output_interval_s"] = overrides["step"]
-    return changes
 
 
 def _check_value(system, name: str, value: Any, key: str, source: str | None) -> None:
@@ -226,14 +211,14 @@ def _prepare_model(study: Study) -> tuple[StudyPayload, dict[str, Any]]:
     except ParameterError as exc:
         raise StudyError(f"base.parameters ({exc.name})", exc.value, exc.expected, src) from None
     sim = study.simulation
-    start = float(sim.get("start", 0.0))
-    stop = float(sim["stop"])
-    interval = float(sim.get("output_interval", 1e-3))
+    start = 0.0 if sim.start_s is None else float(sim.start_s)
+    stop = float(sim.stop_s)
+    interval = 1e-3 if sim.output_interval_s is None else float(sim.output_interval_s)
     if not stop > start:
-        raise StudyError("simulation.stop", sim["stop"], f"> simulation.start = {start:g} s", src)
+        raise StudyError("simulation.stop", sim.stop_s, f"> simulation.start = {start:g} s", src)
     if not 0 < interval <= stop - start:
         raise StudyError("simulation.output_interval", interval, f"> 0 and <= stop - start = {stop - start:g} s", src)
-    window = tuple(float(w) for w in sim.get("window", (start, stop)))
+    window = (start, stop) if sim.window_s is None else sim.window_s
     if not start <= window[0] < window[1] <= stop:
         raise StudyError("simulation.window", list(window), f"start <= begin < end <= stop, within [{start:g}, {stop:g}] s", src)
     settings = _solver_settings(study)
@@ -259,7 +244,8 @@ def _prepare_model(study: Study) -> tuple[StudyPayload, dict[str, Any]]:
     return payload, {"model": model.name}
 
 
-def _prepare_scenario(study: Study, fmu_dir, build: bool) -> tuple[StudyPayload, dict[str, Any], dict[str, Path]]:
+def _prepare_scenario(study: Study, fmu_dir,
+                      build: bool) -> tuple[StudyPayload, dict[str, Any], dict[str, Path], tuple[str, ...]]:
     from ..cosim.fmu_store import ensure_fmus
     from ..cosim.system import resolve_system
     from ..run.runner import load_any
@@ -270,7 +256,7 @@ def _prepare_scenario(study: Study, fmu_dir, build: bool) -> tuple[StudyPayload,
     except ScenarioError as exc:
         raise StudyError("base.scenario", study.base.name, f"a valid scenario ({exc})", src) from None
     try:
-        scenario = scenario.with_simulation(**_simulation_changes(scenario, study.simulation))
+        scenario, notes = study.simulation.apply(scenario)
     except ScenarioError as exc:
         key = exc.key if exc.key.startswith("simulation.") else "simulation"
         raise StudyError(key, exc.value, exc.expected, src) from None
@@ -359,7 +345,7 @@ def _prepare_scenario(study: Study, fmu_dir, build: bool) -> tuple[StudyPayload,
         "scenario_sha256": _content_sha256(Path(study.base.path)),
         "fmus": {c: i.sha256 for c, i in system.interfaces.items()},
     }
-    return payload, identity, dict(system.fmu_paths)
+    return payload, identity, dict(system.fmu_paths), tuple(notes)
 
 
 def _content_sha256(path: Path) -> str:
@@ -392,13 +378,14 @@ def prepare_study(study: Study, fmu_dir: str | Path | None = None, build: bool =
     if study.base.kind == "model":
         payload, base_identity = _prepare_model(study)
         fmu_paths: dict[str, Path] = {}
+        notes: tuple[str, ...] = ()
     else:
-        payload, base_identity, fmu_paths = _prepare_scenario(study, fmu_dir, build)
+        payload, base_identity, fmu_paths, notes = _prepare_scenario(study, fmu_dir, build)
     identity = {
         "engine": study.engine,
         "base": {"kind": study.base.kind, **base_identity},
         "base_parameters": dict(study.base.parameters),
-        "simulation": dict(study.simulation),
+        "simulation": study.simulation.as_table(),
         "solver": dict(study.solver),
         "measures": [m.name for m in study.measures],
         "code": code_version(),
@@ -406,4 +393,4 @@ def prepare_study(study: Study, fmu_dir: str | Path | None = None, build: bool =
     payload = replace(payload, timeout_s=study.timeout_s)  # not in the identity: it changes no result
     points = tuple(study.expand())
     keys = tuple(point_key(identity, p) for p in points)
-    return PreparedStudy(study, points, keys, payload, identity, fmu_paths)
+    return PreparedStudy(study, points, keys, payload, identity, fmu_paths, notes)
