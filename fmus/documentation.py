@@ -162,6 +162,3 @@ def write(directory: Path | str, facts: BuildFacts) -> Path:
     directory.mkdir(parents=True, exist_ok=True)
     (directory / INDEX).write_text(index_html(facts), encoding="utf-8")
     return directory
-
-
-
