@@ -136,6 +136,7 @@ def index_html(facts: BuildFacts) -> str:
     common = Template((CONTENT_DIR / "hosts.html").read_text(encoding="utf-8")).substitute(
         fmu=name, init_note=html.escape(INIT_NOTES[name]), pythonfmu=pythonfmu.__version__,
         python_specifier=html.escape(req.python_specifier), requirements_table=requirements_table(req),
+        python_dll="python%d%d.dll" % req.python_minimum[:2],
         platforms_table=platforms_table(name, facts.platforms),
     )
     title = f"dtcosim {name} FMU"

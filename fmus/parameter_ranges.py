@@ -24,7 +24,7 @@ from .slaves.interface import BOOLEAN, INPUT, INTEGER, OUTPUT, REAL
 PROBES = {REAL: (math.nan, -1.0e30, 1.0e30), INTEGER: (-10**9,), BOOLEAN: ()}
 _FINITENESS = ("a real number", "a finite real number")
 
-INPUT_RANGE = "finite (a non-finite input gives fmi2Discard)"
+INPUT_RANGE = "finite (else fmi2Discard)"
 OUTPUT_RANGE = "calculated"
 
 
