@@ -1,4 +1,8 @@
-"""Markdown tables of the FMU interfaces, generated from the slave classes.
+"""Tables of the FMU interfaces, generated from the slave classes.
+
+The rows (:func:`variable_rows`) feed the Markdown tables of ``docs/fmus.md``
+here and the HTML table of each FMU's ``documentation/index.html``
+(:mod:`fmus.documentation`).
 
 ``python -m fmus.docs --update docs/fmus.md`` rewrites the blocks between
 ``<!-- BEGIN GENERATED <FMU> -->`` and ``<!-- END GENERATED <FMU> -->``;
@@ -12,7 +16,7 @@ import importlib
 import re
 import sys
 from pathlib import Path
-from typing import Sequence
+from typing import Any, Mapping, Sequence
 
 from .build import FMU_NAMES, FMU_SLAVES, drivetrain_of_preset
 from .records import model_of
@@ -21,31 +25,43 @@ from .slaves.interface import REAL, Variable
 _CAUSALITY_ORDER = {"input": 0, "output": 1, "parameter": 2}
 
 
-def interface(name: str, preset: str = "table6") -> tuple[Variable, ...]:
-    """Variables of FMU ``name`` built for ``preset``, in value-reference order."""
+def interface(name: str, preset: str = "table6", model: Mapping[str, Any] | None = None) -> tuple[Variable, ...]:
+    """Variables of FMU ``name`` built from the record ``model`` (default: that of ``preset``), in value-reference order."""
     module, _ = FMU_SLAVES[name]
     slave = getattr(importlib.import_module(f"fmus.slaves.{module}"), name)
-    return tuple(slave.build_interface(model_of(name, drivetrain_of_preset(preset))))
+    return slave.interface(model if model is not None else model_of(name, drivetrain_of_preset(preset)))
 
 
-def _start(var: Variable) -> str:
+def start_text(var: Variable, exact: bool = False) -> str:
+    """Start value as text: ``""`` for outputs, ``true``/``false``, integers, reals with 6 digits
+    (``exact``: the shortest text that reads back as the same double, as in modelDescription.xml)."""
     if var.start is None:
         return ""
     if isinstance(var.start, bool):
         return "true" if var.start else "false"
     if isinstance(var.start, int):
         return str(var.start)
-    return f"{var.start:.6g}"
+    return repr(float(var.start)) if exact else f"{var.start:.6g}"
+
+
+def unit_text(var: Variable) -> str:
+    """The unit of a Real, ``-`` for Integers and Booleans (FMI 2 gives them none)."""
+    return var.unit if var.type == REAL else "-"
+
+
+def variable_rows(name: str, preset: str = "table6",
+                  model: Mapping[str, Any] | None = None) -> list[tuple[int, Variable]]:
+    """``(value reference, variable)``: inputs, outputs, then parameters (value-reference order within each)."""
+    return sorted(enumerate(interface(name, preset, model)),
+                  key=lambda iv: (_CAUSALITY_ORDER[iv[1].causality], iv[0]))
 
 
 def markdown_table(name: str, preset: str = "table6") -> str:
     """One Markdown table: inputs, outputs, then parameters (value-reference order within each)."""
-    rows = sorted(enumerate(interface(name, preset)), key=lambda iv: (_CAUSALITY_ORDER[iv[1].causality], iv[0]))
     lines = ["| name | causality | type | unit | start | vr | description |",
              "| --- | --- | --- | --- | --- | --- | --- |"]
-    for vr, var in rows:
-        unit = var.unit if var.type == REAL else "-"
-        lines.append(f"| `{var.name}` | {var.causality} | {var.type} | {unit} | {_start(var)} | {vr} | "
+    for vr, var in variable_rows(name, preset):
+        lines.append(f"| `{var.name}` | {var.causality} | {var.type} | {unit_text(var)} | {start_text(var)} | {vr} | "
                      f"{var.description.replace('|', '/')} |")
     return "\n".join(lines)
 

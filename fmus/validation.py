@@ -2,11 +2,17 @@
 
 from __future__ import annotations
 
+import zipfile
 from pathlib import Path
 from typing import Iterable
 
 from fmpy import read_model_description
 from fmpy.validation import validate_fmu
+
+from .requirements import ARCHIVE_MEMBER, read_from_fmu
+from .runtime_guard import RequirementsFormatError
+
+DOCUMENTATION_MEMBER = "documentation/index.html"
 
 
 def convention_problems(fmu_path: Path | str) -> list[str]:
@@ -23,6 +29,23 @@ def convention_problems(fmu_path: Path | str) -> list[str]:
         problems.append("The FMU does not support co-simulation.")
     elif not (cs.canGetAndSetFMUstate and cs.canSerializeFMUstate):
         problems.append("canGetAndSetFMUstate and canSerializeFMUstate must be true.")
+    return problems + runtime_declaration_problems(fmu_path)
+
+
+def runtime_declaration_problems(fmu_path: Path | str) -> list[str]:
+    """What a foreign host needs to be told: documentation and readable declared requirements."""
+    with zipfile.ZipFile(fmu_path) as archive:
+        names = set(archive.namelist())
+    problems = []
+    if DOCUMENTATION_MEMBER not in names:
+        problems.append(f"The FMU has no {DOCUMENTATION_MEMBER}.")
+    if ARCHIVE_MEMBER not in names:
+        problems.append(f"The FMU declares no requirements ({ARCHIVE_MEMBER}).")
+    else:
+        try:
+            read_from_fmu(fmu_path)
+        except RequirementsFormatError as exc:
+            problems.append(f"{ARCHIVE_MEMBER}: {exc}")
     return problems
 
 

@@ -95,6 +95,25 @@ def bare_python(tmp_path_factory) -> Path:
 
 
 @pytest.fixture(scope="session")
+def requirements_python(tmp_path_factory, fmu_dir) -> Path:
+    """Python of a fresh virtual environment holding only the FMUs' declared requirements and fmpy.
+
+    Made by ``fmus.selftest.create_environment`` (what ``dtcosim validate --host`` uses),
+    with the declared packages pinned by constraints to the versions installed here (the
+    versions the FMUs were built and tested with), so results can be compared bit for bit.
+    """
+    from importlib import metadata
+
+    from fmus.requirements import read_from_fmu
+    from fmus.selftest import create_environment
+
+    fmus = sorted(fmu_dir.glob("*.fmu"))
+    pins = sorted({f"{p.distribution}=={metadata.version(p.distribution)}"
+                   for path in fmus for p in read_from_fmu(path).packages})
+    return create_environment(tmp_path_factory.mktemp("venv-declared-requirements"), fmus, pins)
+
+
+@pytest.fixture(scope="session")
 def libpython() -> Path:
     """The shared libpython of this interpreter (to LD_PRELOAD for C hosts such as libcosim)."""
     path = Path(sysconfig.get_config_var("LIBDIR")) / sysconfig.get_config_var("LDLIBRARY")

@@ -7,7 +7,9 @@ Export
 ``ssc:Integer`` / ``ssc:Boolean`` / ``ssc:String`` type, unit) for every variable
 the scenario connects, binds, sets or records (the units are defined in
 ``ssd:Units`` from the FMUs' UnitDefinitions), its parameter values as an inline
-``ssv:ParameterSet``, the ``ssd:Connections``, and an ``ssd:DefaultExperiment``
+``ssv:ParameterSet`` named :data:`PARAMETER_SET` in every component (hosts that
+apply parameter sets by name, such as ecos's ``--parameterSet``, then apply all
+of them at once), the ``ssd:Connections``, and an ``ssd:DefaultExperiment``
 (start, stop) whose annotations carry
 
 * ``com.opensimulationplatform``: ``osp:FixedStepAlgorithm baseStepSize = H``,
@@ -68,6 +70,8 @@ NS = {
 OSP_ANNOTATION = "com.opensimulationplatform"
 DTCOSIM_ANNOTATION = "org.dtcosim.scenario"
 SSD_NAME = "SystemStructure.ssd"
+#: Name of every component's parameter set in an exported SSP.
+PARAMETER_SET = "dtcosim"
 for _prefix, _uri in NS.items():
     ET.register_namespace(_prefix, _uri)
 
@@ -185,7 +189,7 @@ def system_structure(system: ResolvedSystem, initial_values: Mapping[str, float]
             bindings = ET.SubElement(el, _q("ssd:ParameterBindings"))
             binding = ET.SubElement(bindings, _q("ssd:ParameterBinding"))
             pvals = ET.SubElement(binding, _q("ssd:ParameterValues"))
-            pset = ET.SubElement(pvals, _q("ssv:ParameterSet"), version="1.0", name=f"{comp.name}-parameters")
+            pset = ET.SubElement(pvals, _q("ssv:ParameterSet"), version="1.0", name=PARAMETER_SET)
             params = ET.SubElement(pset, _q("ssv:Parameters"))
             for pname, value in values.items():
                 _parameter(params, pname, iface.variables[pname].type, value)

@@ -25,6 +25,7 @@ from fmus.build import (
 )
 from fmus.model_description import read_member, rewrite_archive
 from fmus.records import model_of
+from fmus.runtime_files import GUARD_FILE
 from fmus.validation import check_fmu
 from orchestrator.commands.cli import main as dtcosim
 from tests.helpers.fmu_hosts import load_driver, run_python
@@ -247,8 +248,8 @@ def test_an_fmu_carries_only_its_slaves_import_closure(built_fmus, name):
                       "cases", "results"):
         assert not any(forbidden in f for f in code), (forbidden, sorted(code))
     assert not any(f.startswith(("components/analysis/", "components/reference/")) for f in code)
-    # exactly the closure: one file per module, plus the embedding package's own __init__.py
-    assert len(code) == len(embedded_modules(name)) + 1
+    # exactly the closure: one file per module, plus the embedding package's own __init__.py and the runtime guard
+    assert len(code) == len(embedded_modules(name)) + 2 and {"__init__.py", GUARD_FILE} <= code
 
 
 @pytest.mark.parametrize("name, role, signals", [

@@ -6,11 +6,14 @@ numpy, scipy and fmpy but not dtcosim; also a template for other hosts.
 Initialisation (the order the orchestrator uses): WindSource -> omega, phi at
 t0; Gearbox inputs from the wind, ``omega_gen = omega_out``, ``phi_gen =
 ratio * phi_rotor`` (zero twist); GeneratorRotor ``initial_speed/angle`` from
-those; then every FMU exits initialisation mode. Stepping (Gauss-Seidel, step
+those; then every FMU exits initialisation mode. With ``init="scenario"`` the
+generator angle is left at its default (0) and ``phi_gen`` is that angle, as
+``dtcosim run`` initialises the paper scenario (its only initial binding is the
+generator's initial speed), so the two give the same numbers. Stepping (Gauss-Seidel, step
 ``H``): the Gearbox steps with the wind and generator motion at ``t``, the
 generator steps with the Gearbox's ``shaft_torque``, the wind steps.
 
-Usage: ``python fmu_loop.py FMU_DIR T_END H OUT.npz``
+Usage: ``python fmu_loop.py FMU_DIR T_END H OUT.npz [zero-twist|scenario]``
 """
 
 from __future__ import annotations
@@ -78,8 +81,11 @@ class Instance:
         return get_values
 
 
-def run(fmu_dir: str | Path, t_end: float, step: float) -> dict[str, np.ndarray]:
-    """Run the loop; returns ``{"time": ..., "<FMU>.<variable>": ...}`` sampled after each step."""
+def run(fmu_dir: str | Path, t_end: float, step: float, init: str = "zero-twist") -> dict[str, np.ndarray]:
+    """Run the loop; returns ``{"time": ..., "<FMU>.<variable>": ...}`` sampled after each step.
+
+    ``init``: ``"zero-twist"`` (generator angle ``ratio * phi_rotor``) or ``"scenario"`` (as ``dtcosim run``).
+    """
     fmu_dir = Path(fmu_dir)
     wind = Instance(fmu_dir / "WindSource.fmu", "wind")
     gearbox = Instance(fmu_dir / "Gearbox.fmu", "gearbox")
@@ -90,8 +96,12 @@ def run(fmu_dir: str | Path, t_end: float, step: float) -> dict[str, np.ndarray]
     gearbox.set(omega_rotor=omega_rotor, phi_rotor=phi_rotor)
     (omega_out,) = gearbox.get("omega_out")
     ratio = omega_out / omega_rotor
-    gearbox.set(omega_gen=omega_out, phi_gen=ratio * phi_rotor)
-    generator.set(initial_speed=omega_out, initial_angle=ratio * phi_rotor)
+    if init == "scenario":
+        generator.set(initial_speed=omega_out)
+        gearbox.set(omega_gen=omega_out, phi_gen=generator.get("phi")[0])
+    else:
+        gearbox.set(omega_gen=omega_out, phi_gen=ratio * phi_rotor)
+        generator.set(initial_speed=omega_out, initial_angle=ratio * phi_rotor)
     for inst in instances.values():
         inst.fmu.exitInitializationMode()
 
@@ -132,5 +142,5 @@ def loaded_dtcosim_modules() -> list[str]:
 
 if __name__ == "__main__":
     fmu_dir, t_end, step, out_path = sys.argv[1], float(sys.argv[2]), float(sys.argv[3]), sys.argv[4]
-    result = run(fmu_dir, t_end, step)
+    result = run(fmu_dir, t_end, step, *sys.argv[5:6])
     np.savez(out_path, modules=np.array(loaded_dtcosim_modules()), **result)

@@ -11,7 +11,7 @@ import pytest
 from orchestrator.cosim.master import CoSimulation
 from orchestrator.cosim.system import resolve_system
 from orchestrator.inputs.scenario import find_scenario, load_scenario
-from orchestrator.interop.ssp import NS, export_ssp, import_ssp
+from orchestrator.interop.ssp import NS, PARAMETER_SET, export_ssp, import_ssp
 from orchestrator.run.runner import load_any
 from tests.helpers.scenarios import dtcosim
 
@@ -68,6 +68,8 @@ def test_export_import_round_trip_and_identical_run(toy_scenario, tmp_path):
     # the initial binding's value is in the parameter set for other hosts
     x0 = root.find(".//ssd:Component[@name='int']//ssv:Parameter[@name='x0']/ssv:Real", NS)
     assert float(x0.get("value")) == 6.0
+    # one parameter-set name for all components: hosts that apply sets by name (ecos) apply them all
+    assert {p.get("name") for p in root.iter(f"{{{NS['ssv']}}}ParameterSet")} == {PARAMETER_SET}
 
     # valid against the SSP 1.0 schema (fmpy validates while reading)
     from fmpy.ssp.ssd import read_ssd

@@ -1,0 +1,106 @@
+"""A host whose Python cannot import what an FMU needs gets NULL from fmi2Instantiate and a message naming it."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import zipfile
+
+import pytest
+from fmpy import read_model_description
+
+from fmus.model_description import rewrite_archive
+from tests.helpers.fmu_hosts import DRIVERS, run_python
+
+HIDE_NUMPY = DRIVERS / "hide_numpy"
+FATAL, WARNING = 4, 1
+
+
+def instantiate(python, fmu, attempts=3, logging_on=True, env=None):
+    proc = run_python(python, str(DRIVERS / "instantiate.py"), str(fmu), str(attempts), "1" if logging_on else "0",
+                      env=env)
+    assert proc.returncode == 0, proc.stderr[-3000:]  # the fmpy host process survived
+    return json.loads(proc.stdout.splitlines()[-1]), proc.stderr
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["WindSource", "Gearbox", "GeneratorRotor"])
+def test_hidden_numpy_gives_null_and_a_logged_message_naming_it(fmu_path, this_python, name):
+    report, stderr = instantiate(this_python, fmu_path(name), env={"PYTHONPATH": str(HIDE_NUMPY)})
+    assert [a["ok"] for a in report["attempts"]] == [False, False, False]
+    assert all(a["error"] == "Failed to instantiate model" for a in report["attempts"])  # fmpy: NULL instance
+    fatal = [m for s, m in report["messages"] if s == FATAL]
+    assert len(fatal) == 3
+    for message in fatal:
+        assert f"dtcosim {name} FMU cannot start: Python module 'numpy' cannot be imported" in message
+        assert "numpy>=2.4,<3" in message and "resources/requirements.txt" in message
+    assert stderr.count(f"dtcosim {name} FMU cannot start: Python module 'numpy'") == 3
+
+
+@pytest.mark.slow
+def test_without_logging_the_message_is_still_on_stderr(fmu_path, this_python):
+    report, stderr = instantiate(this_python, fmu_path("Gearbox"), attempts=1, logging_on=False,
+                                 env={"PYTHONPATH": str(HIDE_NUMPY)})
+    assert report["attempts"][0]["ok"] is False and report["messages"] == []  # pythonfmu drops the log
+    assert "Python module 'numpy' cannot be imported" in stderr
+
+
+@pytest.mark.slow
+def test_the_same_host_runs_the_fmu_when_numpy_is_importable(fmu_path, this_python):
+    report, stderr = instantiate(this_python, fmu_path("Gearbox"), attempts=2)
+    assert [a["ok"] for a in report["attempts"]] == [True, True]
+    assert "cannot start" not in stderr
+
+
+def _with_requirements(src, dst, edit):
+    shutil.copy(src, dst)
+    with zipfile.ZipFile(dst) as archive:
+        text = archive.read("resources/requirements.txt").decode()
+    rewrite_archive(dst, {"resources/requirements.txt": edit(text).encode()})
+    return dst
+
+
+@pytest.mark.slow
+def test_an_untested_numpy_version_runs_with_a_logged_warning(fmu_path, this_python, tmp_path):
+    fmu = _with_requirements(fmu_path("WindSource"), tmp_path / "WindSource.fmu",
+                             lambda t: "\n".join("numpy>=1.20,<2  # tested: 1.26.4 (import numpy)"
+                                                 if line.startswith("numpy") else line for line in t.splitlines()))
+    report, stderr = instantiate(this_python, fmu, attempts=1)
+    assert report["attempts"][0]["ok"] is True
+    warnings = [m for s, m in report["messages"] if s == WARNING]
+    assert any("dtcosim WindSource FMU: numpy" in m and "outside the tested range numpy>=1.20,<2" in m for m in warnings)
+    assert "[warning] dtcosim WindSource FMU: numpy" in stderr
+
+
+@pytest.mark.slow
+def test_a_too_old_python_gives_null_and_a_message(fmu_path, this_python, tmp_path):
+    fmu = _with_requirements(fmu_path("WindSource"), tmp_path / "WindSource.fmu",
+                             lambda t: t.replace("requires-python: >=3.11,<3.12", "requires-python: >=3.99,<3.100"))
+    report, _ = instantiate(this_python, fmu, attempts=1)
+    assert report["attempts"][0]["ok"] is False
+    assert any("cannot start: it requires Python >=3.99,<3.100" in m for s, m in report["messages"] if s == FATAL)
+
+
+@pytest.mark.slow
+def test_c_host_gets_null_and_the_message(fmu_path, libpython, tmp_path):
+    """A C host (drivers/c_host.c) with libpython preloaded and numpy hidden: NULL, the message, a clean exit."""
+    compiler = shutil.which("cc") or shutil.which("gcc")
+    if compiler is None:
+        pytest.skip("no C compiler")
+    host = tmp_path / "c_host"
+    subprocess.run([compiler, "-O1", "-o", str(host), str(DRIVERS / "c_host.c"), "-ldl"], check=True, capture_output=True)
+    unzipped = tmp_path / "Gearbox"
+    with zipfile.ZipFile(fmu_path("Gearbox")) as archive:
+        archive.extractall(unzipped)
+    md = read_model_description(str(fmu_path("Gearbox")))
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    args = [str(host), str(unzipped / "binaries" / "linux64" / "Gearbox.so"), (unzipped / "resources").as_uri(),
+            md.guid, "10"] + [str(vr[n]) for n in ("omega_rotor", "phi_rotor", "omega_gen", "phi_gen", "shaft_torque")]
+    env = {**os.environ, "LD_PRELOAD": str(libpython), "PYTHONPATH": str(HIDE_NUMPY)}
+    result = subprocess.run(args, capture_output=True, text=True, timeout=120, env=env)
+    assert result.returncode == 3, result.stderr[-3000:]  # the host's own "fmi2Instantiate failed" exit
+    assert "fmi2Instantiate failed" in result.stderr
+    assert "[gearbox status 4]" in result.stderr  # through the FMI logger ...
+    assert result.stderr.count("dtcosim Gearbox FMU cannot start: Python module 'numpy'") == 2  # ... and on stderr
