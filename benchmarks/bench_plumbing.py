@@ -7,7 +7,8 @@ through fmpy + pythonfmu and the master's own work. Compared:
 1. fmpy's high-level API in a plain Gauss-Seidel loop (``setReal``/``doStep``/``getReal``
    with Python lists, 8 calls per step) - DESIGN.md's reference loop;
 2. a hand-written loop calling the raw FMI functions with pre-built arrays (the floor);
-3. the dtcosim master (Gauss-Seidel/Jacobi, hold/linear), recording every step.
+3. the dtcosim master (Gauss-Seidel/Jacobi, hold/linear), recording every step, with its
+   generated step loop and with the plain-Python reference loop (what the code generation saves).
 
 Run: ``python benchmarks/bench_plumbing.py [--steps N]``. Prints microseconds per
 communication step and the master's overhead above the floor.
@@ -153,14 +154,15 @@ def raw_loop(paths, steps: int, h: float = 1e-3) -> float:
 
     The floor of the plumbing: nothing but the FMI round trips (no recording).
     """
-    from ctypes import CFUNCTYPE, addressof, c_int, c_size_t, c_void_p, cast
+    from ctypes import addressof, c_void_p, cast
 
-    proto = CFUNCTYPE(c_int, c_void_p, c_void_p, c_size_t, c_void_p)
+    from orchestrator.cosim.fmi_runtime import DO_STEP, REAL_VALUES
+
     fmus = _slaves(paths)
     c0, c1, c2 = (f.component for f in fmus)
-    do0, do1, do2 = (f._functions["fmi2DoStep"] for f in fmus)
-    g0, g1, g2 = (proto(cast(f._functions["fmi2GetReal"], c_void_p).value) for f in fmus)
-    s1, s2 = (proto(cast(f._functions["fmi2SetReal"], c_void_p).value) for f in fmus[1:])
+    do0, do1, do2 = (DO_STEP(cast(f.dll.fmi2DoStep, c_void_p).value) for f in fmus)
+    g0, g1, g2 = (REAL_VALUES(cast(f.dll.fmi2GetReal, c_void_p).value) for f in fmus)
+    s1, s2 = (REAL_VALUES(cast(f.dll.fmi2SetReal, c_void_p).value) for f in fmus[1:])
     keep = [(c_uint * 1)(v) for v in (0, 0, 1)] + [(c_double * 1)() for _ in range(3)]  # keep alive
     vr_src, vr_in, vr_out, b0, b1, b2 = (addressof(a) for a in keep)
     t0 = time.perf_counter()
@@ -180,7 +182,7 @@ def raw_loop(paths, steps: int, h: float = 1e-3) -> float:
     return dt
 
 
-def master_loop(folder: Path, steps: int, algorithm: str, extrapolation: str) -> float:
+def master_loop(folder: Path, steps: int, algorithm: str, extrapolation: str, step_loop: str = "generated") -> float:
     """The dtcosim master on the same FMUs (records every step); seconds per step of the loop."""
     from orchestrator.cosim.master import CoSimulation
     from orchestrator.cosim.system import resolve_system
@@ -188,7 +190,7 @@ def master_loop(folder: Path, steps: int, algorithm: str, extrapolation: str) ->
 
     path = folder / f"plumbing-{algorithm}-{extrapolation}.toml"
     path.write_text(SCENARIO.format(stop=steps * 1e-3, algorithm=algorithm, extrapolation=extrapolation))
-    out = CoSimulation(resolve_system(load_scenario(path))).run(handle_sigint=False)
+    out = CoSimulation(resolve_system(load_scenario(path)), step_loop=step_loop).run(handle_sigint=False)
     if algorithm == "gauss-seidel" and extrapolation == "hold":
         assert out.complete and abs(out.column("sink.y")[-1] - (steps - 1) * 1e-3) < 1e-12, "wrong data flow"
     return out.loop_time_s / out.steps
@@ -204,6 +206,8 @@ def main() -> None:
     labels = ["fmpy high-level loop (8 calls/step)", "raw FMI calls, plain addresses (floor)"]
     variants = [(alg, ex) for alg in ("gauss-seidel", "jacobi") for ex in ("hold", "linear")]
     labels += [f"dtcosim master {alg}/{ex}" for alg, ex in variants]
+    interpreted = [f"  same, interpreted loop {alg}/{ex}" for alg, ex in variants]
+    labels += interpreted
     times: dict[str, list[float]] = {label: [] for label in labels}
     with tempfile.TemporaryDirectory(prefix="dtcosim-bench-") as tmp:
         folder = Path(tmp)
@@ -213,12 +217,19 @@ def main() -> None:
             times[labels[1]].append(raw_loop(paths, args.steps))
             for label, (alg, ex) in zip(labels[2:], variants):
                 times[label].append(master_loop(folder, args.steps, alg, ex))
+            for label, (alg, ex) in zip(interpreted, variants):
+                times[label].append(master_loop(folder, args.steps, alg, ex, "interpreted"))
     median = {label: statistics.median(v) for label, v in times.items()}
     floor = median[labels[1]]
     print(f"three trivial pythonfmu FMUs, {args.steps} steps, median of {args.repeat} interleaved runs")
     for label in labels:
         dt = median[label]
         print(f"  {label:<42} {dt * 1e6:7.1f} us/step   ({(dt - floor) * 1e6:+6.1f} us vs floor)")
+    for (alg, ex), label in zip(variants, interpreted):
+        gen = median[f"dtcosim master {alg}/{ex}"] - floor
+        interp = median[label] - floor
+        print(f"master overhead {alg}/{ex}: generated {gen * 1e6:.1f} us, interpreted {interp * 1e6:.1f} us "
+              f"per step ({interp / gen if gen > 0 else float('inf'):.1f} x)")
 
 
 if __name__ == "__main__":

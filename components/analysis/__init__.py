@@ -2,7 +2,9 @@
 
 Modules
 -------
-modes                   static equilibrium, linearisation, undamped/complex modes
+equilibrium             static equilibrium and linearisation at an operating point
+eigen                   undamped and complex modes of any M, C, K
+modes                   the drivetrain's modes: named bodies, energy shares, mode kinds
 modal_verification      free response of the nonlinear model vs the linearised frequencies
 campbell                natural frequencies over rotor speed vs 1P/3P and gear-mesh lines
 fatigue                 rainflow, damage-equivalent loads, load duration/revolution distributions

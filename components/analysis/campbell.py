@@ -43,7 +43,8 @@ from ..model.drivetrain import Drivetrain
 from ..model.stages import PlanetaryStage
 from ..units import rad_per_s_to_rpm, rpm
 from ..validation import finite, one_of, positive
-from .modes import OperatingPoint, drivetrain_modes
+from .equilibrium import OperatingPoint
+from .modes import drivetrain_modes
 
 LOAD_LAWS = ("quadratic", "constant")
 

@@ -37,7 +37,8 @@ from ..model.wind import ConstantSpeed
 from ..reference.results import SimulationResult
 from ..reference.solver import SolverSettings, simulate_monolithic
 from ..validation import positive
-from .modes import DrivetrainModalAnalysis, OperatingPoint, drivetrain_modes
+from .equilibrium import OperatingPoint
+from .modes import DrivetrainModalAnalysis, drivetrain_modes
 from .spectrum import spectral_peak_hz
 
 

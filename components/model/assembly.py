@@ -484,10 +484,6 @@ class Assembly:
             + loads.shaft_torque_nm @ self.s_driver
         )
 
-    def port_torque(self, loads: InternalLoads) -> np.ndarray:
-        """Torque the assembly applies to the prescribed port(s) [N m], shape (..., n_port)."""
-        return -(loads.contact_force_n @ (self.cos_alpha[:, None] * self.A_port)) - loads.shaft_torque_nm @ self.S_port
-
     # ------------------------------------------------------------- dynamics
     def acceleration(
         self,

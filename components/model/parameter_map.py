@@ -28,7 +28,7 @@ the planets' orbital inertia). Per parallel stage: ``drive_radius``,
 ``generator.counter_torque`` [N m]. Without a generator: ``output_torque`` [N m].
 
 The WindSource and GeneratorRotor FMUs' parameters have flat names of their own
-(:func:`wind_values` / :func:`wind_from_values`: ``omega0``, ``a``, ``sigma``,
+(:func:`wind_from_values`: ``omega0``, ``a``, ``sigma``,
 ``n_harmonics``, ``f_min``, ``f_max``, ``seed``, ``amplitude``;
 :func:`generator_values` / :func:`generator_from_values`: ``inertia``,
 ``counter_torque`` and the load-event slots ``event{i}.kind`` (0 none, then
@@ -227,13 +227,6 @@ def _integer_code(name: str, value, choices: tuple[str, ...]) -> int:
             or not 0 <= int(value) < len(choices):
         raise ParameterError(name, value, ", ".join(f"{i} = {c}" for i, c in enumerate(choices)))
     return int(value)
-
-
-def wind_values(params: WindParameters) -> dict[str, float | int]:
-    """The WindSource FMU's parameter values of ``params`` by flat name (``amplitude`` as its code)."""
-    out: dict[str, float | int] = {k: getattr(params, f) for k, f in WIND_FIELDS.items()}
-    out["amplitude"] = AMPLITUDE_CONVENTIONS.index(params.amplitude)
-    return out
 
 
 def wind_from_values(values: Mapping[str, float | int], template: WindParameters | None = None) -> WindParameters:

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from components.analysis.campbell import LOAD_LAWS, LoadLaw
-from components.analysis.modes import OperatingPoint
+from components.analysis.equilibrium import OperatingPoint
 from components.errors import ParameterError
 from components.model.presets import PRESETS, preset
 from components.units import rpm

@@ -20,14 +20,30 @@ import atexit
 import shutil
 import tempfile
 from collections import deque
-from ctypes import byref, c_double, c_uint
+from ctypes import (
+    CFUNCTYPE,
+    addressof,
+    byref,
+    c_double,
+    c_int,
+    c_size_t,
+    c_uint,
+    c_void_p,
+    cast,
+)
 from pathlib import Path
 from typing import Any, Iterable
 
 from ..errors import FmuStepError, status_label
 from .fmu_interface import FmuInterface
 
-FMI_OK, FMI_WARNING, FMI_DISCARD, FMI_ERROR, FMI_FATAL = 0, 1, 2, 3, 4
+FMI_OK, FMI_WARNING, FMI_ERROR, FMI_FATAL = 0, 1, 3, 4
+
+#: our own prototypes of the hot FMI functions (FMI 2.0 fmi2Functions.h), called with plain addresses:
+#: fmi2DoStep(c, currentCommunicationPoint, communicationStepSize, noSetFMUStatePriorToCurrentPoint)
+DO_STEP = CFUNCTYPE(c_int, c_void_p, c_double, c_double, c_int)
+#: fmi2GetReal / fmi2SetReal(c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[])
+REAL_VALUES = CFUNCTYPE(c_int, c_void_p, c_void_p, c_size_t, c_void_p)
 
 _EXTRACTED: dict[str, Path] = {}
 #: log message lists of the live instances by instance name (see FmuInstance)
@@ -68,8 +84,9 @@ class FmuInstance:
     component : int
         The ``fmi2Component`` handle (as an integer address).
     do_step, set_real, get_real : ctypes function
-        Raw FMI functions; call as ``do_step(component, t, h, 1)``,
-        ``set_real(component, vr_array, n, value_array)``.
+        The FMU's FMI functions with this module's prototypes (:data:`DO_STEP`,
+        :data:`REAL_VALUES`); call as ``do_step(component, t, h, 1)``,
+        ``set_real(component, address_of_vrs, n, address_of_values)``.
     log : collections.deque of str
         Last log messages, formatted ``"[status] category: message"``.
     """
@@ -118,10 +135,10 @@ class FmuInstance:
             pass
         self._callbacks = cb
         self._logger = logger  # keep the ctypes callback alive
-        fns = self.slave._functions
-        self.do_step = fns["fmi2DoStep"]
-        self.set_real = fns["fmi2SetReal"]
-        self.get_real = fns["fmi2GetReal"]
+        dll = self.slave.dll  # fmpy's loaded shared library (public attribute)
+        self.do_step = DO_STEP(cast(getattr(dll, "fmi2DoStep"), c_void_p).value)
+        self.set_real = REAL_VALUES(cast(getattr(dll, "fmi2SetReal"), c_void_p).value)
+        self.get_real = REAL_VALUES(cast(getattr(dll, "fmi2GetReal"), c_void_p).value)
         self.component: Any = None
 
     # ----------------------------------------------------------------- checks
@@ -194,7 +211,7 @@ class FmuInstance:
         names = list(names)
         vrs = (c_uint * len(names))(*(self.interface.variables[n].value_reference for n in names))
         vals = (c_double * len(names))()
-        self._check(self.get_real(self.component, vrs, len(names), vals), "fmi2GetReal", time_s)
+        self._check(self.get_real(self.component, addressof(vrs), len(names), addressof(vals)), "fmi2GetReal", time_s)
         return list(vals)
 
     def set_reals(self, values: dict[str, float], time_s: float) -> None:
@@ -202,11 +219,7 @@ class FmuInstance:
         names = list(values)
         vrs = (c_uint * len(names))(*(self.interface.variables[n].value_reference for n in names))
         vals = (c_double * len(names))(*(float(values[n]) for n in names))
-        self._check(self.set_real(self.component, vrs, len(names), vals), "fmi2SetReal", time_s)
-
-    def check(self, status: int, function: str, time_s: float) -> int:
-        """Raise FmuStepError if ``status`` is discard, error or fatal."""
-        return self._check(status, function, time_s)
+        self._check(self.set_real(self.component, addressof(vrs), len(names), addressof(vals)), "fmi2SetReal", time_s)
 
     def close(self) -> None:
         """fmi2Terminate and fmi2FreeInstance as far as the FMU's state allows.

@@ -22,8 +22,6 @@ from typing import Any, Mapping
 from ..errors import ScenarioError
 from ..frozen_map import FrozenMap
 
-FMI_TYPES = ("Real", "Integer", "Boolean", "String", "Enumeration")
-
 
 @dataclass(frozen=True)
 class FmuVariable:

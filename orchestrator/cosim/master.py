@@ -43,14 +43,20 @@ Speed
 -----
 Per FMU and step the loop makes one ``fmi2SetReal`` (if the FMU has connected
 inputs), one ``fmi2DoStep`` and one ``fmi2GetReal`` that reads the coupling
-outputs and, on sampling steps, the recorded variables, calling the raw C
-functions with pre-built value-reference arrays. ``fmi2GetReal`` writes straight
-into the preallocated numpy result array (or, when not every step is sampled,
-into a three-row ring buffer copied into the results on sampling steps), and the
-coupled inputs are read from there: no per-step Python objects, no copies. The
-loop is generated and compiled per system (:func:`compile_step_loop`), with every
-FMI function, array and column offset bound to a name, so each coupling is one
-statement.
+outputs and, on sampling steps, the recorded variables, calling the C functions
+through this project's own prototypes with pre-built value-reference arrays
+(:mod:`orchestrator.cosim.fmi_runtime`). ``fmi2GetReal`` writes straight into the
+preallocated numpy result array (or, when not every step is sampled, into a
+three-row ring buffer copied into the results on sampling steps), and the coupled
+inputs are read from there: no per-step Python objects, no copies. The loop is
+generated and compiled per system (:func:`compile_step_loop`), with every FMI
+function, array and column offset bound to a name, so each coupling is one
+statement. That pays: above the floor of the bare FMI calls, the generated loop
+costs 0.7-1.3 us per step for three trivial FMUs, the same loop as plain Python
+over the slots (:func:`interpreted_step_loop`, kept as the reference the
+generated one is tested against) 2.3-3.2 us, in all four algorithm/extrapolation
+variants (``python benchmarks/bench_plumbing.py --repeat 7``, medians; the
+floor itself is ~12 us).
 
 Stopping
 --------
@@ -67,7 +73,7 @@ import math
 import signal
 import threading
 import time
-from ctypes import CFUNCTYPE, c_double, c_int, c_size_t, c_void_p
+from ctypes import c_double
 from dataclasses import dataclass, field
 from typing import Callable
 
@@ -77,6 +83,8 @@ from ..errors import FmuStepError, InitializationError
 from .fmi_runtime import FmuInstance, value_references
 from .system import RecordedVariable, ResolvedSystem
 
+#: stepping-loop implementations (see :func:`compile_step_loop`)
+STEP_LOOPS = ("generated", "interpreted")
 #: steps between checks for Ctrl-C and progress updates
 BLOCK_STEPS = 250
 #: maximum initialisation sweeps beyond the number of components
@@ -172,15 +180,6 @@ class _Slot:
         self.out_vr = None
 
 
-#: fmi2GetReal / fmi2SetReal with plain addresses (Python ints) as arguments
-_RAW_VALUES_FN = CFUNCTYPE(c_int, c_void_p, c_void_p, c_size_t, c_void_p)
-
-
-def _raw(fn) -> ctypes._CFuncPtr:
-    """The same C function, callable with integer addresses (no per-call type conversion)."""
-    return _RAW_VALUES_FN(ctypes.cast(fn, c_void_p).value)
-
-
 class CoSimulation:
     """Run a :class:`~orchestrator.cosim.system.ResolvedSystem` with the fixed-step master.
 
@@ -190,14 +189,18 @@ class CoSimulation:
         Checked scenario (settings: algorithm, extrapolation, step, times, recording).
     profile : bool
         Time every FMI call of the stepping loop per FMU (:attr:`RunOutcome.profile`).
+    step_loop : {"generated", "interpreted"}
+        :func:`compile_step_loop` (default) or its plain-Python reference :func:`interpreted_step_loop`.
     """
 
-    def __init__(self, system: ResolvedSystem, profile: bool = False) -> None:
+    def __init__(self, system: ResolvedSystem, profile: bool = False, step_loop: str = "generated") -> None:
+        if step_loop not in STEP_LOOPS:
+            raise ValueError(f"step_loop {step_loop!r}: expected one of {', '.join(STEP_LOOPS)}")
         self.system = system
         self.profile = bool(profile)
+        self.step_loop = step_loop
         self.settings = system.scenario.simulation
         self.instances: dict[str, FmuInstance] = {}
-        self.step_loop_source = ""
 
     # ------------------------------------------------------------------ run
     def run(self, progress: Callable[[int, int], None] | None = None, handle_sigint: bool = True,
@@ -246,8 +249,8 @@ class CoSimulation:
             if ring is not data:
                 ring[:] = data[0]
             timers = np.zeros((len(slots), 3)) if self.profile else None
-            advance = compile_step_loop(slots, sim.algorithm, sim.extrapolation, stride, data, ring, timers)
-            self.step_loop_source = advance.source
+            make_loop = compile_step_loop if self.step_loop == "generated" else interpreted_step_loop
+            advance = make_loop(slots, sim.algorithm, sim.extrapolation, stride, data, ring, timers)
             loop0 = time.perf_counter()
             deadline = wall0 + wall_time_limit_s if wall_time_limit_s else math.inf
             k_done, error, interrupted = self._loop(advance, slots, data, n_steps, stride, progress, handle_sigint,
@@ -492,7 +495,7 @@ def compile_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str, st
     for i, s in enumerate(slots):
         inst = s.inst
         ns.update({
-            f"c{i}": inst.component, f"do{i}": inst.do_step, f"set{i}": _raw(inst.set_real), f"get{i}": _raw(inst.get_real),
+            f"c{i}": inst.component, f"do{i}": inst.do_step, f"set{i}": inst.set_real, f"get{i}": inst.get_real,
             f"ib{i}": s.in_buf, f"IB{i}": ctypes.addressof(s.in_buf), f"keep{i}": (s.in_vr, s.out_vr),
             f"VRI{i}": ctypes.addressof(s.in_vr), f"VRO{i}": ctypes.addressof(s.out_vr),
         })
@@ -535,4 +538,67 @@ def compile_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str, st
     exec(compile(source, "<dtcosim step loop>", "exec"), ns)
     advance = ns["advance"]
     advance.source = source
+    return advance
+
+
+def interpreted_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str, stride: int,
+                          data: np.ndarray, ring: np.ndarray, timers: np.ndarray | None = None) -> Callable:
+    """The same stepping loop as :func:`compile_step_loop`, as plain Python over the slots (no generated code).
+
+    It makes the same FMI calls with the same values in the same order, so its
+    results are identical; it exists as the reference the generated loop is
+    tested against and as the baseline of ``benchmarks/bench_plumbing.py``
+    (``timers`` is not supported: profiling uses the generated loop).
+    """
+    if timers is not None:
+        raise ValueError("profiling timers need the generated step loop")
+    n_cols = ring.shape[1]
+    flat = ring.reshape(-1)
+    direct = ring is data
+    linear = extrapolation == "linear"
+    position = {id(s): i for i, s in enumerate(slots)}
+    plan = []
+    for i, s in enumerate(slots):
+        # (input index, source already stepped this step (Gauss-Seidel), source column)
+        feeds = [(j, algorithm == "gauss-seidel" and src < position[id(s)], col) for j, src, col in s.feeds]
+        plan.append((i, s.inst, s.in_buf, ctypes.addressof(s.in_buf), ctypes.addressof(s.in_vr), len(s.in_names),
+                     ctypes.addressof(s.out_vr), len(s.out_names), s.n_couple, s.col0 * ctypes.sizeof(c_double),
+                     feeds))
+    base = ring.ctypes.data
+
+    def row(k: int) -> int:
+        if direct:
+            return max(k, 0) * n_cols
+        return (k % 3) * n_cols
+
+    def advance(k_start: int, k_end: int, t0: float, H: float) -> int:
+        for k in range(k_start, k_end):
+            t = t0 + k * H
+            o1, o0, om = row(k + 1), row(k), row(k - 1)
+            sample = (k + 1) % stride == 0
+            a1 = base + o1 * ctypes.sizeof(c_double)
+            for i, inst, buf, buf_addr, vr_in, n_in, vr_out, n_all, n_couple, offset, feeds in plan:
+                for j, upstream, col in feeds:
+                    latest, previous = (o1, o0) if upstream else (o0, om)
+                    if linear:
+                        a = 0.5 if upstream else 1.5
+                        buf[j] = a * flat[latest + col] + (1.0 - a) * flat[previous + col]
+                    else:
+                        buf[j] = flat[latest + col]
+                if n_in:
+                    st = inst.set_real(inst.component, vr_in, n_in, buf_addr)
+                    if st > 1:
+                        raise _Stop(i, "fmi2SetReal", st, k)
+                st = inst.do_step(inst.component, t, H, 1)
+                if st > 1:
+                    raise _Stop(i, "fmi2DoStep", st, k)
+                n = n_all if (stride == 1 or sample) else n_couple
+                if n:
+                    st = inst.get_real(inst.component, vr_out, n, a1 + offset)
+                    if st > 1:
+                        raise _Stop(i, "fmi2GetReal", st, k)
+            if not direct and sample:
+                data[(k + 1) // stride] = ring[(k + 1) % 3]
+        return k_end
+
     return advance

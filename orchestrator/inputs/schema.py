@@ -31,7 +31,6 @@ from ..errors import EntryError, suggestion
 
 #: names of components, scenarios and studies: letters, digits, ``_`` and ``-``, starting with a letter or ``_``
 NAME_PATTERN = re.compile(r"^[A-Za-z_][A-Za-z0-9_\-]*$")
-NAME_TEXT = "a name of letters, digits, '_' or '-'"
 
 #: parameter values an input file may give (FMI Real, Integer, Boolean, String)
 ParameterValue = Union[float, int, bool, str]

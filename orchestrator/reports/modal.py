@@ -25,15 +25,12 @@ from components.analysis.campbell import (
     campbell_diagram,
     write_rows_csv,
 )
+from components.analysis.equilibrium import OperatingPoint
 from components.analysis.modal_verification import (
     FreeResponseCheck,
     free_response_check,
 )
-from components.analysis.modes import (
-    DrivetrainModalAnalysis,
-    OperatingPoint,
-    drivetrain_modes,
-)
+from components.analysis.modes import DrivetrainModalAnalysis, drivetrain_modes
 from components.model.drivetrain import Drivetrain
 
 from .modal_plots import plot_campbell, plot_mode_shapes

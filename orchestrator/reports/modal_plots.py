@@ -12,7 +12,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from components.analysis.campbell import CampbellDiagram  # noqa: E402
-from components.analysis.modes import DrivetrainModalAnalysis  # noqa: E402
+from components.analysis.modes import DrivetrainModalAnalysis
 
 from ..plotting import close_figure  # noqa: E402
 

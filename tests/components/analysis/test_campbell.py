@@ -13,12 +13,9 @@ from components.analysis.campbell import (
     campbell_diagram,
     excitation_frequencies,
 )
+from components.analysis.equilibrium import OperatingPoint, static_equilibrium
 from components.analysis.fatigue import load_duration_distribution
-from components.analysis.modes import (
-    OperatingPoint,
-    drivetrain_modes,
-    static_equilibrium,
-)
+from components.analysis.modes import drivetrain_modes
 from components.errors import ParameterError
 from components.model.presets import table6_gearbox
 from components.model.wind import ConstantSpeed

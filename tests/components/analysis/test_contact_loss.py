@@ -10,7 +10,7 @@ from components.analysis.contact_loss import (
     contact_loss_summary,
     write_contact_loss_csv,
 )
-from components.analysis.modes import static_equilibrium
+from components.analysis.equilibrium import static_equilibrium
 from components.errors import ParameterError
 from components.model.generator import LoadEvent
 from components.model.presets import table6_gearbox

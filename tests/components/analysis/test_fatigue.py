@@ -6,6 +6,7 @@ import json
 import numpy as np
 import pytest
 
+from components.analysis.equilibrium import static_equilibrium
 from components.analysis.fatigue import (
     FatigueSettings,
     damage_equivalent_load,
@@ -18,7 +19,6 @@ from components.analysis.fatigue import (
     write_del_csv,
     write_ldd_csv,
 )
-from components.analysis.modes import static_equilibrium
 from components.errors import ParameterError
 from components.model.presets import table6_gearbox
 from components.model.wind import RotorSpeedProcess, WindParameters

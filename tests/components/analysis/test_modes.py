@@ -7,16 +7,10 @@ import numpy as np
 import pytest
 
 from components import units
+from components.analysis.eigen import modal_analysis, state_space_modes, undamped_modes
+from components.analysis.equilibrium import OperatingPoint, static_equilibrium
 from components.analysis.modal_verification import free_response_check
-from components.analysis.modes import (
-    OperatingPoint,
-    drivetrain_modes,
-    modal_analysis,
-    state_space_modes,
-    static_equilibrium,
-    two_inertia_frequency_hz,
-    undamped_modes,
-)
+from components.analysis.modes import drivetrain_modes, two_inertia_frequency_hz
 from components.analysis.spectrum import spectral_peak_hz
 from components.errors import ParameterError
 from components.model.assembly import Assembly

@@ -8,7 +8,7 @@ import pytest
 
 from components import units
 from components.analysis.campbell import excitation_frequencies
-from components.analysis.modes import static_equilibrium
+from components.analysis.equilibrium import static_equilibrium
 from components.analysis.spectrum import amplitude_spectrum, spectral_peak_hz
 from components.errors import ParameterError
 from components.model.assembly import Assembly

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from components import units
-from components.analysis.modes import static_equilibrium
+from components.analysis.equilibrium import static_equilibrium
 from components.model.assembly import Assembly
 from components.model.parameter_map import flatten, unflatten
 from components.model.presets import (

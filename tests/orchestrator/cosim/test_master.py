@@ -226,3 +226,21 @@ def test_wall_time_limit_stops_between_blocks_and_keeps_the_samples(toy_scenario
     assert out.time_s.size == out.steps + 1 and np.all(np.isfinite(out.values))
     # no limit (None or 0): the same run completes
     assert CoSimulation(system).run(handle_sigint=False, wall_time_limit_s=0).complete
+
+
+@pytest.mark.parametrize("algorithm", ["gauss-seidel", "jacobi"])
+@pytest.mark.parametrize("extrapolation", ["hold", "linear"])
+@pytest.mark.parametrize("interval", [0.001, 0.003])
+def test_the_generated_step_loop_equals_its_plain_python_reference(toy_scenario, algorithm, extrapolation, interval):
+    text = MASSES.format(step=1e-3, algorithm=algorithm).replace(
+        "output_interval = 0.02", f'output_interval = {interval}\nextrapolation = "{extrapolation}"')
+    system = resolve_system(load_scenario(toy_scenario(text)))
+    generated = CoSimulation(system).run(handle_sigint=False)
+    reference = CoSimulation(system, step_loop="interpreted").run(handle_sigint=False)
+    assert generated.complete and reference.complete and generated.steps == reference.steps
+    np.testing.assert_array_equal(generated.values, reference.values)  # the same FMI calls with the same values
+
+
+def test_an_unknown_step_loop_is_refused(toy_scenario):
+    with pytest.raises(ValueError, match="step_loop 'compiled'"):
+        CoSimulation(resolve_system(load_scenario(toy_scenario())), step_loop="compiled")

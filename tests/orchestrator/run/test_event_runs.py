@@ -226,7 +226,8 @@ def test_dtcosim_modes_of_a_scenario(fmu_dir, tmp_path, capsys):
     path = write_scenario(tmp_path, stiff, "stiff.toml")
     assert main(["modes", str(path), "--out", str(tmp_path / "b"), *args]) == 0
     assert "scenario stiff at 12 rpm" in capsys.readouterr().out
-    from components.analysis.modes import OperatingPoint, drivetrain_modes
+    from components.analysis.equilibrium import OperatingPoint
+    from components.analysis.modes import drivetrain_modes
     from components.model.presets import table6_gearbox
     from components.units import rpm
 
