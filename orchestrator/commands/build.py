@@ -6,7 +6,7 @@ import argparse
 
 from fmus.build import add_arguments, run
 
-from ..cosim.system import default_fmu_dir
+from ..cosim.fmu_folder import default_fmu_dir
 
 
 def register(sub: argparse._SubParsersAction) -> None:

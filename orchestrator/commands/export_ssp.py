@@ -6,7 +6,6 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..inputs.scenario import find_scenario
 from . import scenario_options
 
 
@@ -37,6 +36,7 @@ def run(args: argparse.Namespace) -> int:
     from ..cosim.fmu_store import ensure_fmus, stale_project_fmus
     from ..cosim.master import CoSimulation
     from ..cosim.system import resolve_system
+    from ..inputs.scenario import find_scenario
     from ..interop.ssp import export_ssp
     from ..run.runner import load_any
 

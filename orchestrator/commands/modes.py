@@ -17,8 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
-from components.analysis.campbell import LOAD_LAWS, LoadLaw
 from components.analysis.equilibrium import OperatingPoint
+from components.analysis.load_law import LOAD_LAWS, LoadLaw
 from components.errors import ParameterError
 from components.model.presets import PRESETS, preset
 from components.units import rpm

@@ -11,7 +11,6 @@ import os
 import sys
 from pathlib import Path
 
-from ..inputs.scenario import find_scenario
 from . import scenario_options
 
 
@@ -69,6 +68,7 @@ def run(args: argparse.Namespace) -> int:
     """Run the scenario; write results; print a summary."""
     from ..cosim.fmu_store import ensure_fmus, stale_project_fmus
     from ..cosim.system import resolve_system
+    from ..inputs.scenario import find_scenario
     from ..run.analyses import format_analyses
     from ..run.runner import load_any, run_scenario
 

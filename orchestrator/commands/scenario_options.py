@@ -9,8 +9,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ..inputs.overrides import SimulationOverrides, apply_parameters, parse_assignment
-from ..inputs.scenario import ALGORITHMS, EXTRAPOLATIONS
+from ..inputs.master_options import ALGORITHMS, EXTRAPOLATIONS
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -27,6 +26,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def apply(scenario, args: argparse.Namespace, command: str):
     """The scenario with the options applied; notes of what else changed go to stderr as warnings."""
+    from ..inputs.overrides import (
+        SimulationOverrides,
+        apply_parameters,
+        parse_assignment,
+    )
+
     overrides = SimulationOverrides(stop_s=args.stop, step_s=args.step, output_interval_s=args.output_interval,
                                     algorithm=args.algorithm, extrapolation=args.extrapolation)
     scenario, notes = overrides.apply(scenario)

@@ -17,7 +17,7 @@ from pathlib import Path
 from fmus.requirements import check_environment, read_from_fmu
 from fmus.validation import check_fmu, fmu_files
 
-from ..cosim.system import default_fmu_dir
+from ..cosim.fmu_folder import default_fmu_dir
 
 
 def register(sub: argparse._SubParsersAction) -> None:

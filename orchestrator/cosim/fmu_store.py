@@ -1,7 +1,7 @@
 """Locating the scenario's FMUs and building the project's own FMUs when they are missing.
 
 A relative FMU path is looked up next to the scenario file, then in the FMU
-directory (:func:`orchestrator.cosim.system.default_fmu_dir`). ``dtcosim run`` builds a
+directory (:func:`orchestrator.cosim.fmu_folder.default_fmu_dir`). ``dtcosim run`` builds a
 missing ``WindSource.fmu``, ``Gearbox.fmu`` or ``GeneratorRotor.fmu`` (the FMUs
 this project makes, with ``fmus.build``) into the FMU directory; any other
 missing FMU is a scenario error naming the component.
@@ -16,7 +16,8 @@ from pathlib import Path
 from typing import Callable, Mapping
 
 from ..inputs.scenario import Scenario
-from .system import default_fmu_dir, resolve_fmu_paths
+from .fmu_folder import default_fmu_dir
+from .system import resolve_fmu_paths
 
 
 def buildable_fmu_names() -> tuple[str, ...]:
@@ -45,7 +46,7 @@ def ensure_fmus(scenario: Scenario, fmu_dir: str | Path | None = None, build: bo
     ----------
     scenario : Scenario
     fmu_dir : path, optional
-        FMU directory (default :func:`orchestrator.cosim.system.default_fmu_dir`).
+        FMU directory (default :func:`orchestrator.cosim.fmu_folder.default_fmu_dir`).
     build : bool
         Build missing project FMUs into ``fmu_dir``; if False a missing FMU is an error.
     report : callable(str), optional

@@ -11,8 +11,6 @@ a :class:`ResolvedSystem`, is what the master runs.
 
 from __future__ import annotations
 
-import importlib.util
-import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -24,6 +22,7 @@ from ..errors import AlgebraicLoopError, ScenarioError, suggestion
 from ..frozen_map import FrozenMap
 from ..inputs.scenario import Scenario, VariableRef
 from .event_slots import AssignedEvent, assign_events
+from .fmu_folder import default_fmu_dir
 from .fmu_interface import FmuInterface, FmuVariable, read_fmu_interface
 from .graph import find_algebraic_loop, initialization_order, stepping_order
 from .roles import ComponentRole, declared_roles
@@ -32,27 +31,6 @@ from .roles import ComponentRole, declared_roles
 SETTABLE_CAUSALITIES = ("parameter", "input")
 #: causalities a connection or initial binding may read from
 READABLE_CAUSALITIES = ("output", "calculatedParameter")
-
-
-def default_fmu_dir() -> Path:
-    """Directory of the built FMUs.
-
-    ``$DTCOSIM_FMU_DIR`` if set; else the project's ``fmus/`` folder (the
-    ``fmus`` package's own folder, where ``build_fmus.py`` writes) when running
-    from a source checkout (``build_fmus.py`` beside that folder); else
-    ``$XDG_CACHE_HOME/dtcosim/fmus`` (default ``~/.cache/dtcosim/fmus``) for an
-    installed package, whose folder may not be writable.
-    """
-    env = os.environ.get("DTCOSIM_FMU_DIR")
-    if env:
-        return Path(env)
-    spec = importlib.util.find_spec("fmus")
-    if spec is not None and spec.origin:
-        package_dir = Path(spec.origin).resolve().parent
-        if (package_dir.parent / "build_fmus.py").is_file():
-            return package_dir
-    cache = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(cache) / "dtcosim" / "fmus"
 
 
 @dataclass(frozen=True)

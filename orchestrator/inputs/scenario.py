@@ -65,6 +65,7 @@ from ..frozen_map import FrozenMap
 from .analysis_settings import AnalysisSettings, AnalysisTable
 from .files import find_input_file, packaged_files, read_toml
 from .load_events import EventTable, ScenarioEvent, check_events_in_run
+from .master_options import ALGORITHMS, EXTRAPOLATIONS
 from .schema import (
     NAME_PATTERN,
     ParameterValue,
@@ -72,9 +73,6 @@ from .schema import (
     flatten_parameters,
     read_document,
 )
-
-ALGORITHMS = ("gauss-seidel", "jacobi")
-EXTRAPOLATIONS = ("hold", "linear")
 
 #: relative tolerance when checking that times are whole multiples of the step
 _MULTIPLE_RTOL = 1e-9

@@ -48,9 +48,9 @@ from components.validation import is_number
 from ..errors import EntryError
 from ..frozen_map import FrozenMap
 from .files import find_input_file, packaged_files, read_toml
+from .master_options import ALGORITHMS, EXTRAPOLATIONS
 from .measures import Measure, MeasureError, parse_measure
 from .overrides import SimulationOverrides
-from .scenario import ALGORITHMS, EXTRAPOLATIONS
 from .schema import (
     NAME_PATTERN,
     ParameterValue,

@@ -366,7 +366,7 @@ def prepare_study(study: Study, fmu_dir: str | Path | None = None, build: bool =
     study : Study
     fmu_dir : path, optional
         Where the base scenario's FMUs are looked for (and missing project FMUs
-        built); default :func:`orchestrator.cosim.system.default_fmu_dir`.
+        built); default :func:`orchestrator.cosim.fmu_folder.default_fmu_dir`.
     build : bool
         Build missing project FMUs.
 
