@@ -29,6 +29,7 @@ from ..validation import finite, one_of
 from .assembly import Assembly
 from .drivetrain import Drivetrain
 from .integrators import Rosenbrock23, StepControl
+from .kernel import choose_kernel
 
 SHAFT_TORQUE_MODES = ("average", "end")
 
@@ -170,11 +171,19 @@ class GearboxModel:
     extrapolate : bool
         Estimate the input slopes from the last two inputs (True) or hold the
         input speeds over the step (False).
+    kernel : {"auto", "numpy", "compiled"}, optional
+        Implementation of the step (:mod:`components.model.kernel`; default:
+        ``$DTCOSIM_KERNEL``, else ``auto``). Both give the same results to round-off.
 
     Attributes
     ----------
     y : ndarray, shape (2 n_dof,)
         State ``[q, v]`` relative to the driver motion.
+    kernel : str
+        ``"compiled"`` or ``"numpy"``: the implementation in use.
+    kernel_note : str or None
+        Why the compiled kernel was wanted but is not used (None if it is, or if
+        ``numpy`` was asked for).
     """
 
     _SCALARS = (
@@ -189,12 +198,13 @@ class GearboxModel:
         control: StepControl | None = None,
         shaft_torque_mode: str = "average",
         extrapolate: bool = True,
+        kernel: str | None = None,
     ) -> None:
         self.assembly = a = Assembly(drivetrain, cut_at_generator=True)
         self.shaft_torque_mode = one_of("shaft_torque_mode", shaft_torque_mode, SHAFT_TORQUE_MODES)
         self.extrapolate = bool(extrapolate)
         self.system = _StepSystem(a)
-        self.integrator = Rosenbrock23(self.system, a.n_dof, control)
+        self._integrator = Rosenbrock23(self.system, a.n_dof, control)
         self._kx = float(a.port_ratio[0])
         self._out_member = a.dof_index(a.stage_members[drivetrain.stages[-1].name]["output"])
         self.initialized = False
@@ -220,7 +230,16 @@ class GearboxModel:
         self.alpha_out_max_rad_s2 = 0.0
         #: d omega_out / dt averaged over the last step [rad/s^2] (instantaneous before the first step)
         self.alpha_out_average_rad_s2 = 0.0
-        self.integrator.on_accept = self._track_output_acceleration
+        self._integrator.on_accept = self._track_output_acceleration
+        self.kernel, self.kernel_note = choose_kernel(kernel)
+        self._compiled = None
+        self._compiled_stale = True  # kernel arrays must be loaded from the numpy-side state
+        if self.kernel == "compiled":
+            from .gearbox_kernel import GearboxKernel
+            from .kernel import compiled_module
+
+            self._compiled = GearboxKernel(a, self._integrator.control, self._out_kinematic, self._out_rate_index,
+                                           compiled_module()[0])
 
     # ------------------------------------------------------------ outputs
     @property
@@ -384,7 +403,8 @@ class GearboxModel:
         self.last_omega_rotor = float(omega_rotor)
         self.last_omega_gen = float(omega_gen)
         self.last_step_s = 0.0
-        self.integrator.reset()
+        self._store_compiled()
+        self._integrator.reset()
         sysm = self.system
         sysm.angle0 = self.driver_angle_rad
         sysm.driver.fit(1.0, 0.0, self.driver_speed_rad_s, self.driver_speed_rad_s, self.driver_speed_rad_s)
@@ -427,16 +447,19 @@ class GearboxModel:
         speed_start = self.output_speed_rad_s
         # first stage reuses the loads at the end of the previous step: the prescribed
         # motions are C1, so only the driver-acceleration term changes
-        a0 = sysm.last_acceleration + a.kinematic_ratio * (sysm.last_alpha - sysm.driver.accel(0.0))
-        saved = (self.integrator.snapshot(), sysm.cache(), sysm.port_jacobian, self.alpha_out_max_rad_s2)
-        try:
-            self.y, _ = self.integrator.advance(0.0, self.y, h, a0=a0)
-        except SolverError as exc:
-            self.integrator.restore(saved[0])
-            sysm.restore(saved[1])
-            sysm.port_jacobian = saved[2]
-            self.alpha_out_max_rad_s2 = saved[3]
-            raise SolverError(str(exc).rsplit(" (at t =", 1)[0], t + exc.time_s) from None
+        if self._compiled is not None:
+            self._advance_compiled(t, h)
+        else:
+            a0 = sysm.last_acceleration + a.kinematic_ratio * (sysm.last_alpha - sysm.driver.accel(0.0))
+            saved = (self._integrator.snapshot(), sysm.cache(), sysm.port_jacobian, self.alpha_out_max_rad_s2)
+            try:
+                self.y, _ = self._integrator.advance(0.0, self.y, h, a0=a0)
+            except SolverError as exc:
+                self._integrator.restore(saved[0])
+                sysm.restore(saved[1])
+                sysm.port_jacobian = saved[2]
+                self.alpha_out_max_rad_s2 = saved[3]
+                raise SolverError(str(exc).rsplit(" (at t =", 1)[0], t + exc.time_s) from None
         self.time_s = t + h
         self.driver_angle_rad = angle1
         self.driver_speed_rad_s = speed1
@@ -452,6 +475,63 @@ class GearboxModel:
         self.shaft_torque_average_nm = k * 0.5 * (twist_start + twist_end) + a.shaft_c[-1] * (twist_end - twist_start) / h
         self.alpha_out_average_rad_s2 = (self.output_speed_rad_s - speed_start) / h
 
+    def _advance_compiled(self, t: float, h: float) -> None:
+        """The integration of :meth:`step` by the compiled kernel (same steps as ``Rosenbrock23.advance``)."""
+        kf = self._compiled
+        sysm = self.system
+        if self._compiled_stale:
+            self._load_compiled()
+        d, p = sysm.driver, sysm.port
+        kf.driver[:] = (d.c0, d.c1, d.c2, d.c3)
+        kf.port[:] = (p.c0, p.c1, p.c2, p.c3)
+        mod = kf.module
+        ist = kf.istate
+        ist[mod.ALPHA_OUT_MAX] = self.alpha_out_max_rad_s2
+        status, tau, h_fail, err = mod.advance(
+            self.y, h, sysm.last_alpha - d.accel(0.0), kf.driver, kf.port, sysm.angle0, kf.consts, ist, kf.control,
+            kf.dq, kf.dv, kf.winv, kf.w_basis, kf.port_jac, kf.last_acc, kf.last_force, kf.last_defl, kf.backup,
+        )
+        if status != mod.OK:  # the kernel restored every array to the start of the step
+            c = self._integrator.control
+            if status == mod.STEP_TOO_SMALL:
+                message = f"step size {h_fail:.3g} s below h_min {c.h_min:.3g} s (error norm {err:.3g})"
+            else:
+                message = f"more than {c.max_steps} steps in one advance"
+            raise SolverError(message, t + tau)
+        sysm.last_alpha = d.accel(h)
+        self.alpha_out_max_rad_s2 = float(ist[mod.ALPHA_OUT_MAX])
+
+    @property
+    def integrator(self) -> Rosenbrock23:
+        """The integrator (its counters and state current also when the compiled kernel steps)."""
+        self._store_compiled()
+        return self._integrator
+
+    def _store_compiled(self) -> None:
+        """Hand the state held by the compiled kernel's arrays back to the numpy side (reloaded on the next step)."""
+        if self._compiled is not None and not self._compiled_stale:
+            self._compiled.store_integrator(self._integrator)
+            sysm = self.system
+            sysm.last_acceleration = sysm.last_acceleration.copy()
+            sysm.last_force = sysm.last_force.copy()
+            sysm.last_deflection = sysm.last_deflection.copy()
+            sysm.port_jacobian = sysm.port_jacobian.copy()
+            self._compiled_stale = True
+
+    def _load_compiled(self) -> None:
+        """Load the compiled kernel's arrays from the numpy-side state; from now on they hold it."""
+        kf = self._compiled
+        sysm = self.system
+        kf.load_integrator(self._integrator)
+        kf.last_acc[:] = sysm.last_acceleration
+        kf.last_force[:] = sysm.last_force
+        kf.last_defl[:] = sysm.last_deflection
+        kf.port_jac[:] = sysm.port_jacobian
+        self.y = np.array(self.y, dtype=float)
+        sysm.last_acceleration, sysm.last_force, sysm.last_deflection = kf.last_acc, kf.last_force, kf.last_defl
+        sysm.port_jacobian = kf.port_jac
+        self._compiled_stale = False
+
     def _output_twist(self) -> float:
         """Twist of the output shaft (shaft 3) [rad]."""
         return float(self._twist_q @ self.y) + self._twist_port * self.port_angle_rad
@@ -459,12 +539,13 @@ class GearboxModel:
     # ---------------------------------------------------------------- state
     def get_state(self) -> dict:
         """Complete internal state, integrator included (JSON-serialisable, exact float round trip)."""
+        self._store_compiled()
         state = {name: float(getattr(self, name)) for name in self._SCALARS}
         sysm = self.system
         state.update(
             y=self.y.tolist(),
             initialized=self.initialized,
-            integrator=self.integrator.get_state(),
+            integrator=self._integrator.get_state(),
             last_acceleration=sysm.last_acceleration.tolist(),
             last_alpha=sysm.last_alpha,
             last_force=sysm.last_force.tolist(),
@@ -482,10 +563,11 @@ class GearboxModel:
             setattr(self, name, float(state[name]))
         self.y = y
         self.initialized = bool(state["initialized"])
-        self.integrator.set_state(state["integrator"])
+        self._integrator.set_state(state["integrator"])
         sysm = self.system
         sysm.last_acceleration = np.array(state["last_acceleration"], dtype=float)
         sysm.last_alpha = float(state["last_alpha"])
         sysm.last_force = np.array(state["last_force"], dtype=float)
         sysm.last_deflection = np.array(state["last_deflection"], dtype=float)
         sysm.port_jacobian = np.array(state["port_jacobian"], dtype=float)
+        self._compiled_stale = True

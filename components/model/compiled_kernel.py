@@ -1,0 +1,534 @@
+"""Compiled (numba) twin of the gearbox hot path: contact law, accelerations, Jacobian, Rosenbrock step.
+
+The equations are those of the numpy path, which stays the single source of
+truth: :mod:`components.model.contact` (eq. 1-4, flank-consistent clipping),
+:class:`components.model.assembly.Assembly` (deflections ``d = A q``,
+accelerations through the folded ``_fast_matrix``, Jacobian ``-M^-1 (B^T diag(dF/dd)
+A + S^T k S)``), :class:`components.model.mesh_stiffness.MeshPhasing` (stiffness
+factor and slope) and :class:`components.model.integrators.Rosenbrock23` (the
+ROS2(3) W-method, step control and Jacobian reuse, line for line). Every
+constant matrix is taken from the :class:`~components.model.assembly.Assembly`
+(see :mod:`components.model.gearbox_kernel`), so the kernel is generic over any
+stage sequence, planet count, contact law and stiffness option; the tests
+compare it with the numpy path to 1e-9 on every preset and variant.
+
+Only numbers cross the boundary: one call of :func:`advance` integrates a whole
+communication step. This module imports numba; :mod:`components.model.kernel`
+decides whether it is used.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .integrators import OBSERVED_ORDER_MAX, OBSERVED_ORDER_MIN
+from .numba_cache import enable_stable_cache
+
+# columns of the per-mesh contact parameter table (gearbox_kernel.contact_table)
+K0, EXPONENT, DAMPING, LAMBDA, HALF_JT, IMPACT, DMAX, CMAX, DEEP = range(9)
+N_CONTACT_COLUMNS = 9
+
+# entries of the integrator/state vector ``istate``
+H_NEXT, ACCEPTED, REJECTED, JACOBIANS, AGE, HD, BASIS_VALID, ALPHA_OUT_MAX = range(8)
+N_ISTATE = 8
+
+# entries of the settings vector ``control``
+RTOL, ATOL_Q, ATOL_V, H_MIN, MAX_STEPS, JAC_MAX_AGE, OUT_KINEMATIC, OUT_RATE_INDEX = range(8)
+
+# status codes of advance()
+OK, STEP_TOO_SMALL, TOO_MANY_STEPS = 0, 1, 2
+
+_D = 1.0 / (2.0 + math.sqrt(2.0))
+_E32 = 6.0 + math.sqrt(2.0)
+ORDER_MIN, ORDER_MAX = OBSERVED_ORDER_MIN, OBSERVED_ORDER_MAX
+
+
+@njit(cache=False)
+def _sign(x):
+    if x > 0.0:
+        return 1.0
+    if x < 0.0:
+        return -1.0
+    return 0.0
+
+
+@njit(cache=False)
+def contact_force(d, rate, factor, p):
+    """Force [N], dF/dd, dF/d(rate) and elastic part of one mesh (``ContactLaw.evaluate``, one element)."""
+    k = p[K0] * factor
+    e = p[EXPONENT]
+    h = p[HALF_JT]
+    if p[IMPACT] != 0.0:  # eq. 1: sharp backlash, cubic STEP damping
+        if d > h:
+            pen = d - h
+        elif d < -h:
+            pen = d + h
+        else:
+            pen = 0.0
+        abs_p = abs(pen)
+        sgn = _sign(pen)
+        pow_em1 = math.sqrt(abs_p) if e == 1.5 else abs_p ** (e - 1.0)
+        elastic = k * sgn * pow_em1 * abs_p
+        s = min(max(abs_p / p[DMAX], 0.0), 1.0)
+        step = p[CMAX] * s * s * (3.0 - 2.0 * s)
+        d_step = p[CMAX] * 6.0 * s * (1.0 - s) / p[DMAX]
+        force = elastic + step * rate
+        df_dd = k * e * pow_em1 + d_step * sgn * rate
+        df_dv = step
+        active = force * sgn > 0.0
+    else:  # CFS, eq. 2-4
+        abs_d = abs(d)
+        if abs_d >= p[DEEP]:  # tanh saturated exactly: d_BL = delta -+ j_t/2
+            d_bl = d - _sign(d) * h
+            d_bl_p = 1.0
+            d_bl_pp = 0.0
+        else:
+            lam = p[LAMBDA]
+            x1 = d - h
+            x2 = d + h
+            u1 = lam * x1
+            u2 = lam * x2
+            t1 = math.tanh(u1)
+            t2 = math.tanh(u2)
+            d_bl = d + 0.5 * (x1 * t1 - x2 * t2)
+            s1 = 1.0 - t1 * t1
+            s2 = 1.0 - t2 * t2
+            d_bl_p = 1.0 + 0.5 * (t1 + u1 * s1 - t2 - u2 * s2)
+            d_bl_pp = lam * (s1 * (1.0 - u1 * t1) - s2 * (1.0 - u2 * t2))
+        abs_bl = abs(d_bl)
+        sgn = _sign(d_bl)
+        pow_em1 = math.sqrt(abs_bl) if e == 1.5 else abs_bl ** (e - 1.0)
+        elastic = k * sgn * pow_em1 * abs_bl
+        c = p[DAMPING]
+        rate_bl = d_bl_p * rate
+        force = elastic + c * abs_bl * rate_bl
+        df_dd = (k * e * pow_em1 + c * sgn * rate_bl) * d_bl_p + c * abs_bl * d_bl_pp * rate
+        df_dv = c * abs_bl * d_bl_p
+        active = force * _sign(d) > 0.0
+    if not active:
+        return 0.0, 0.0, 0.0, elastic
+    return force, df_dd, df_dv, elastic
+
+
+@njit(cache=False)
+def stiffness_factors(angle, phasing, out_factor, out_slope):
+    """``MeshPhasing.factor_and_slope`` at a driver angle; ``phasing`` rows: cycles/rad, cycle0, p/2, 1/w, v, v p, slope scale."""
+    m = out_factor.shape[0]
+    for i in range(m):
+        y = (phasing[1, i] + phasing[0, i] * angle) % 1.0 - 0.5
+        s = min(max((phasing[2, i] - abs(y)) * phasing[3, i] + 0.5, 0.0), 1.0)
+        s2 = s * s
+        out_factor[i] = 1.0 - phasing[5, i] + phasing[4, i] * (s2 * s * (s * (6.0 * s - 15.0) + 10.0))
+        u = s - s2
+        out_slope[i] = phasing[6, i] * _sign(y) * (u * u)
+
+
+@njit(cache=False)
+def _hermite(c, tau):
+    return c[0] + tau * (c[1] + tau * (c[2] + tau * c[3]))
+
+
+@njit(cache=False)
+def _hermite_rate(c, tau):
+    return c[1] + tau * (2.0 * c[2] + 3.0 * tau * c[3])
+
+
+@njit(cache=False)
+def _hermite_accel(c, tau):
+    return 2.0 * c[2] + 6.0 * tau * c[3]
+
+
+@njit(cache=False)
+def deflections(y, n, a_t, a_port, port, port_rate, out):
+    """Mesh deflections (row 0) and rates (row 1) of ``[q, v]`` plus the port (``Assembly._mesh_deflections``)."""
+    m = a_t.shape[1]
+    for i in range(m):
+        d = 0.0
+        r = 0.0
+        for j in range(n):
+            d += y[j] * a_t[j, i]
+            r += y[n + j] * a_t[j, i]
+        out[0, i] = d + a_port[i] * port
+        out[1, i] = r + a_port[i] * port_rate
+
+
+@njit(cache=False)
+def acceleration(y, port, port_rate, alpha, factor, k):
+    """Deviation accelerations ``[force, y, port, port_rate, alpha] @ _fast_matrix`` (``Assembly.fast_acceleration``).
+
+    ``k`` is the kernel tuple of :class:`components.model.gearbox_kernel.GearboxKernel`; writes the
+    forces and deflections into its work arrays and returns the acceleration array (also a work array).
+    """
+    a_t, a_port, fast, contact, force, defl, acc = k[0], k[1], k[2], k[3], k[4], k[5], k[6]
+    n = acc.shape[0]
+    m = force.shape[0]
+    deflections(y, n, a_t, a_port, port, port_rate, defl)
+    for i in range(m):
+        force[i] = contact_force(defl[0, i], defl[1, i], factor[i], contact[i])[0]
+    for j in range(n):
+        s = 0.0
+        for i in range(m):
+            s += force[i] * fast[i, j]
+        for i in range(2 * n):
+            s += y[i] * fast[m + i, j]
+        s += port * fast[m + 2 * n, j] + port_rate * fast[m + 2 * n + 1, j] + alpha * fast[m + 2 * n + 2, j]
+        acc[j] = s
+    return acc
+
+
+@njit(cache=False)
+def jacobian(y, port, port_rate, factor, k, dq, dv, port_jac):
+    """``Assembly.acceleration_jacobian``: dq, dv (n x n) and the port columns (rows of ``port_jac``)."""
+    a_t, a_port, contact, defl = k[0], k[1], k[3], k[5]
+    bt, stks, stcs, stks_port, stcs_port, inv_m = k[7], k[8], k[9], k[10], k[11], k[12]
+    fd, fv = k[13], k[14]
+    n = dq.shape[0]
+    m = fd.shape[0]
+    deflections(y, n, a_t, a_port, port, port_rate, defl)
+    for i in range(m):
+        _, fd[i], fv[i], _ = contact_force(defl[0, i], defl[1, i], factor[i], contact[i])
+    for j in range(n):
+        for col in range(n):
+            sq = 0.0
+            sv = 0.0
+            for i in range(m):
+                sq += bt[j, i] * fd[i] * a_t[col, i]
+                sv += bt[j, i] * fv[i] * a_t[col, i]
+            dq[j, col] = -inv_m[j] * (sq + stks[j, col])
+            dv[j, col] = -inv_m[j] * (sv + stcs[j, col])
+        sq = 0.0
+        sv = 0.0
+        for i in range(m):
+            sq += bt[j, i] * fd[i] * a_port[i]
+            sv += bt[j, i] * fv[i] * a_port[i]
+        port_jac[0, j] = -inv_m[j] * (sq + stks_port[j])
+        port_jac[1, j] = -inv_m[j] * (sv + stcs_port[j])
+
+
+@njit(cache=False)
+def _factor(hd, dq, dv, winv):
+    """``Rosenbrock23._factor``: W^-1 = (I - hd J)^-1 through the n x n Schur complement."""
+    n = dq.shape[0]
+    g = np.empty((n, n))
+    for i in range(n):
+        for j in range(n):
+            g[i, j] = -hd * dv[i, j] - (hd * hd) * dq[i, j]
+        g[i, i] += 1.0
+    ginv = np.linalg.inv(g)
+    ginv_dq = ginv @ dq
+    for i in range(n):
+        for j in range(n):
+            winv[i, j] = (hd * hd) * ginv_dq[i, j]
+            winv[i, n + j] = hd * ginv[i, j]
+            winv[n + i, j] = hd * ginv_dq[i, j]
+            winv[n + i, n + j] = ginv[i, j]
+        winv[i, i] += 1.0
+
+
+@njit(cache=False)
+def _matvec(w, x, out):
+    n2 = x.shape[0]
+    for i in range(n2):
+        s = 0.0
+        for j in range(n2):
+            s += w[i, j] * x[j]
+        out[i] = s
+
+
+@njit(cache=False)
+def _stiffness_sensitivity(defl, factor, contact, sqrt_cfs, out):
+    """``ContactLaw.stiffness_sensitivity``: dF / d(stiffness factor) of every mesh."""
+    m = out.shape[0]
+    for i in range(m):
+        p = contact[i]
+        d = defl[0, i]
+        rate = defl[1, i]
+        if sqrt_cfs:
+            abs_d = abs(d)
+            h = p[HALF_JT]
+            if abs_d >= p[DEEP]:
+                d_bl = d - _sign(d) * h
+                d_bl_p = 1.0
+            else:
+                lam = p[LAMBDA]
+                x1 = d - h
+                x2 = d + h
+                t1 = math.tanh(lam * x1)
+                t2 = math.tanh(lam * x2)
+                d_bl = d + 0.5 * (x1 * t1 - x2 * t2)
+                d_bl_p = 1.0 + 0.5 * (lam * x1 * (1.0 - t1 * t1) + t1 - lam * x2 * (1.0 - t2 * t2) - t2)
+            abs_bl = abs(d_bl)
+            elastic = p[K0] * _sign(d_bl) * abs_bl * math.sqrt(abs_bl)
+            active = _sign(d) * (elastic * factor[i] + p[DAMPING] * abs_bl * d_bl_p * rate) > 0.0
+            out[i] = elastic if active else 0.0
+        else:
+            force, _, _, elastic = contact_force(d, rate, factor[i], p)
+            out[i] = elastic / factor[i] if force != 0.0 else 0.0
+
+
+@njit(cache=False)
+def advance(y, t_end, alpha_shift, driver, port, angle0, k, istate, control, dq, dv, winv, w_basis, port_jac,
+            last_acc, last_force, last_defl, backup):
+    """Integrate one communication step ``[0, t_end]`` (``Rosenbrock23.advance`` with ``_StepSystem``).
+
+    Parameters
+    ----------
+    y : ndarray (2n,)
+        State ``[q, v]`` at tau = 0; overwritten with the state at ``t_end`` on success.
+    alpha_shift : float
+        Driver acceleration of the last evaluation minus the driver acceleration at tau = 0: the
+        acceleration at tau = 0 is ``last_acc + kappa alpha_shift`` (the prescribed motions are C1).
+    driver, port : ndarray (4,)
+        Hermite coefficients of the driver angle (relative to ``angle0``) and of the port angle.
+    k : tuple
+        Constant matrices and work arrays (:class:`components.model.gearbox_kernel.GearboxKernel`).
+    istate : ndarray (N_ISTATE,)
+        Step-size memory, counters, Jacobian age, factorised ``h d``, basis flag, eq. 11 maximum.
+    control : ndarray
+        Tolerances and output-member constants (see the module constants).
+    dq, dv, winv, w_basis, port_jac : ndarray
+        Jacobian blocks, ``W^-1``, ``W^-1`` applied to the time-derivative basis, port Jacobian rows.
+    last_acc, last_force, last_defl : ndarray
+        Loads of the last evaluation (written at the end state on success).
+    backup : tuple of ndarray
+        Scratch copies used to restore everything on failure.
+
+    Returns
+    -------
+    status, time, step, error : (int, float, float, float)
+        ``OK`` or the failure code with the local time, step size and error norm at the failure.
+    """
+    n = dq.shape[0]
+    n2 = 2 * n
+    m = last_force.shape[0]
+    tvs = k[15]
+    phasing, kappa, force_rows, sqrt_cfs = k[16], k[17], k[18], k[19]
+    factor, slope, sens = k[20], k[21], k[22]
+    f0 = k[23]
+    f1 = k[24]
+    fn = k[25]
+    k1 = k[26]
+    k2 = k[27]
+    k3 = k[28]
+    y1 = k[29]
+    yn = k[30]
+    rhs = k[31]
+    w_hdt = k[32]
+    da = k[33]
+    # save the state for a failure
+    _save(y, istate, dq, dv, winv, w_basis, port_jac, last_acc, last_force, last_defl, backup)
+
+    rtol = control[RTOL]
+    atol_q = control[ATOL_Q]
+    atol_v = control[ATOL_V]
+    h_min = control[H_MIN]
+    max_steps = control[MAX_STEPS]
+    max_age = control[JAC_MAX_AGE]
+    out_kin = control[OUT_KINEMATIC]
+    out_idx = int(control[OUT_RATE_INDEX])
+    for i in range(m):
+        factor[i] = 1.0
+    t = 0.0
+    h = istate[H_NEXT] if istate[H_NEXT] > 0.0 else t_end - t
+    for i in range(n):
+        f0[i] = y[n + i]
+        f0[n + i] = last_acc[i] + kappa[i] * alpha_shift
+    steps = 0
+    prev_h = -1.0  # (h, err) of a rejected attempt at this t with a fresh Jacobian (prev_h < 0: none)
+    prev_err = 0.0
+    while t < t_end:
+        remaining = t_end - t
+        last = h >= remaining * (1.0 - 1e-12)
+        if last:
+            h = remaining
+        if istate[AGE] < 0.0 or istate[AGE] >= max_age:  # refresh the Jacobian
+            if tvs:
+                stiffness_factors(angle0 + _hermite(driver, t), phasing, factor, slope)
+            jacobian(y, _hermite(port, t), _hermite_rate(port, t), factor, k, dq, dv, port_jac)
+            istate[AGE] = 0.0
+            istate[HD] = -1.0
+            istate[JACOBIANS] += 1.0
+        # ---- one step (Rosenbrock23._step)
+        hd = h * _D
+        if hd != istate[HD]:
+            _factor(hd, dq, dv, winv)
+            istate[HD] = hd
+            istate[BASIS_VALID] = 0.0
+        if not tvs:  # W^-1 [0, h d a_t] with a_t = [port speed, port accel, jerk] @ [pj0; pj1; -kappa]
+            if istate[BASIS_VALID] == 0.0:
+                for i in range(n2):
+                    s0 = 0.0
+                    s1 = 0.0
+                    s2 = 0.0
+                    for j in range(n):
+                        w = winv[i, n + j]
+                        s0 += w * port_jac[0, j]
+                        s1 += w * port_jac[1, j]
+                        s2 += w * (-kappa[j])
+                    w_basis[i, 0] = s0
+                    w_basis[i, 1] = s1
+                    w_basis[i, 2] = s2
+                istate[BASIS_VALID] = 1.0
+            c0 = hd * _hermite_rate(port, t)
+            c1 = hd * _hermite_accel(port, t)
+            c2 = hd * (6.0 * driver[3])
+            for i in range(n2):
+                w_hdt[i] = w_basis[i, 0] * c0 + w_basis[i, 1] * c1 + w_basis[i, 2] * c2
+        else:
+            pr = _hermite_rate(port, t)
+            pa = _hermite_accel(port, t)
+            jerk = 6.0 * driver[3]
+            for j in range(n):
+                da[j] = port_jac[0, j] * pr + port_jac[1, j] * pa - kappa[j] * jerk
+            stiffness_factors(angle0 + _hermite(driver, t), phasing, factor, slope)
+            deflections(y, n, k[0], k[1], _hermite(port, t), pr, k[5])
+            _stiffness_sensitivity(k[5], factor, k[3], sqrt_cfs, sens)
+            rate = _hermite_rate(driver, t)
+            for j in range(n):
+                s = 0.0
+                for i in range(m):
+                    s += sens[i] * (slope[i] * rate) * force_rows[i, j]
+                da[j] += s
+            for i in range(n2):
+                s = 0.0
+                for j in range(n):
+                    s += winv[i, n + j] * (hd * da[j])
+                w_hdt[i] = s
+        _matvec(winv, f0, k1)
+        for i in range(n2):
+            k1[i] += w_hdt[i]
+            y1[i] = y[i] + (0.5 * h) * k1[i]
+        tau = t + 0.5 * h
+        if tvs:
+            stiffness_factors(angle0 + _hermite(driver, tau), phasing, factor, slope)
+        acc = acceleration(y1, _hermite(port, tau), _hermite_rate(port, tau), _hermite_accel(driver, tau), factor, k)
+        for i in range(n):
+            f1[i] = y1[n + i]
+            f1[n + i] = acc[i]
+        for i in range(n2):
+            rhs[i] = f1[i] - k1[i]
+        _matvec(winv, rhs, k2)
+        for i in range(n2):
+            k2[i] += k1[i]
+            yn[i] = y[i] + h * k2[i]
+        tau = t + h
+        if tvs:
+            stiffness_factors(angle0 + _hermite(driver, tau), phasing, factor, slope)
+        alpha_n = _hermite_accel(driver, tau)
+        acc = acceleration(yn, _hermite(port, tau), _hermite_rate(port, tau), alpha_n, factor, k)
+        for i in range(n):
+            fn[i] = yn[n + i]
+            fn[n + i] = acc[i]
+        for i in range(n2):
+            rhs[i] = fn[i] - _E32 * (k2[i] - f1[i]) - 2.0 * (k1[i] - f0[i])
+        _matvec(winv, rhs, k3)
+        err = 0.0
+        for i in range(n2):
+            k3[i] += w_hdt[i]
+            atol = atol_q if i < n else atol_v
+            scale = atol + rtol * max(abs(y[i]), abs(yn[i]))
+            e = abs(k1[i] + k3[i] - 2.0 * k2[i]) / scale
+            if e > err or e != e:
+                err = e
+        err = (h / 6.0) * err
+        if not math.isfinite(err):
+            err = math.inf
+        # ---- step control (Rosenbrock23.advance)
+        steps += 1
+        if err <= 1.0:
+            prev_h = -1.0
+            istate[ACCEPTED] += 1.0
+            istate[AGE] += 1.0
+            t = t_end if last else t + h
+            for i in range(n2):
+                y[i] = yn[i]
+                f0[i] = fn[i]
+            for i in range(n):
+                last_acc[i] = fn[n + i]
+            for i in range(m):
+                last_force[i] = k[4][i]
+                last_defl[0, i] = k[5][0, i]
+                last_defl[1, i] = k[5][1, i]
+            alpha_out = abs(out_kin * _hermite_accel(driver, t) + f0[out_idx])
+            if alpha_out > istate[ALPHA_OUT_MAX]:
+                istate[ALPHA_OUT_MAX] = alpha_out
+            fac = 5.0 if err == 0.0 else min(5.0, 0.9 * err ** (-1.0 / 3.0))
+            fac = 1.0 if 1.0 <= fac <= 2.0 else fac
+            if not last or fac < 1.0:
+                istate[H_NEXT] = h * fac
+            else:
+                istate[H_NEXT] = max(istate[H_NEXT], h * fac)
+            h = istate[H_NEXT]
+        else:
+            istate[REJECTED] += 1.0
+            if istate[AGE] > 0.0:
+                if tvs:
+                    stiffness_factors(angle0 + _hermite(driver, t), phasing, factor, slope)
+                jacobian(y, _hermite(port, t), _hermite_rate(port, t), factor, k, dq, dv, port_jac)
+                istate[AGE] = 0.0
+                istate[HD] = -1.0
+                istate[JACOBIANS] += 1.0
+                h *= max(0.5, min(1.0, 0.9 * err ** (-1.0 / 3.0))) if math.isfinite(err) else 0.1
+                prev_h = -1.0
+            else:  # integrators.shrink_after_rejection
+                if not math.isfinite(err):
+                    fac = 0.1
+                elif prev_h > 0.0 and err < prev_err and h < prev_h:
+                    order = math.log(prev_err / err) / math.log(prev_h / h)
+                    order = min(ORDER_MAX, max(ORDER_MIN, order))
+                    fac = max(0.1, (0.9 / err) ** (1.0 / order))
+                else:
+                    fac = max(0.1, 0.9 * err ** (-1.0 / 3.0))
+                if math.isfinite(err):
+                    prev_h = h
+                    prev_err = err
+                else:
+                    prev_h = -1.0
+                h *= fac
+            istate[H_NEXT] = h
+            if h < h_min:
+                _restore(y, istate, dq, dv, winv, w_basis, port_jac, last_acc, last_force, last_defl, backup)
+                return STEP_TOO_SMALL, t, h, err
+        if steps > max_steps:
+            _restore(y, istate, dq, dv, winv, w_basis, port_jac, last_acc, last_force, last_defl, backup)
+            return TOO_MANY_STEPS, t, h, err
+    return OK, t, h, 0.0
+
+
+@njit(cache=False)
+def _save(y, istate, dq, dv, winv, w_basis, port_jac, last_acc, last_force, last_defl, backup):
+    b_y, b_ist, b_dq, b_dv, b_winv, b_wb, b_pj, b_acc, b_force, b_defl = backup
+    b_y[:] = y
+    b_ist[:] = istate
+    b_dq[:, :] = dq
+    b_dv[:, :] = dv
+    b_winv[:, :] = winv
+    b_wb[:, :] = w_basis
+    b_pj[:, :] = port_jac
+    b_acc[:] = last_acc
+    b_force[:] = last_force
+    b_defl[:, :] = last_defl
+
+
+@njit(cache=False)
+def _restore(y, istate, dq, dv, winv, w_basis, port_jac, last_acc, last_force, last_defl, backup):
+    b_y, b_ist, b_dq, b_dv, b_winv, b_wb, b_pj, b_acc, b_force, b_defl = backup
+    y[:] = b_y
+    istate[:] = b_ist
+    dq[:, :] = b_dq
+    dv[:, :] = b_dv
+    winv[:, :] = b_winv
+    w_basis[:, :] = b_wb
+    port_jac[:, :] = b_pj
+    last_acc[:] = b_acc
+    last_force[:] = b_force
+    last_defl[:, :] = b_defl
+
+
+DISPATCHERS = (_sign, contact_force, stiffness_factors, _hermite, _hermite_rate, _hermite_accel, deflections,
+               acceleration, jacobian, _factor, _matvec, _stiffness_sensitivity, advance, _save, _restore)
+#: True when the machine code is cached on disk (see :mod:`components.model.numba_cache`)
+DISK_CACHE = enable_stable_cache(DISPATCHERS, __file__)
