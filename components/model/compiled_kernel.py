@@ -156,13 +156,11 @@ def deflections(y, n, a_t, a_port, port, port_rate, out):
 
 
 @njit(cache=False)
-def acceleration(y, port, port_rate, alpha, factor, k):
+def acceleration(y, port, port_rate, alpha, factor, a_t, a_port, fast, contact, force, defl, acc):
     """Deviation accelerations ``[force, y, port, port_rate, alpha] @ _fast_matrix`` (``Assembly.fast_acceleration``).
 
-    ``k`` is the kernel tuple of :class:`components.model.gearbox_kernel.GearboxKernel`; writes the
-    forces and deflections into its work arrays and returns the acceleration array (also a work array).
+    Writes the forces and deflections into ``force`` and ``defl`` and returns ``acc``.
     """
-    a_t, a_port, fast, contact, force, defl, acc = k[0], k[1], k[2], k[3], k[4], k[5], k[6]
     n = acc.shape[0]
     m = force.shape[0]
     deflections(y, n, a_t, a_port, port, port_rate, defl)
@@ -180,11 +178,9 @@ def acceleration(y, port, port_rate, alpha, factor, k):
 
 
 @njit(cache=False)
-def jacobian(y, port, port_rate, factor, k, dq, dv, port_jac):
+def jacobian(y, port, port_rate, factor, a_t, a_port, contact, defl, bt, stks, stcs, stks_port, stcs_port, inv_m,
+             fd, fv, dq, dv, port_jac):
     """``Assembly.acceleration_jacobian``: dq, dv (n x n) and the port columns (rows of ``port_jac``)."""
-    a_t, a_port, contact, defl = k[0], k[1], k[3], k[5]
-    bt, stks, stcs, stks_port, stcs_port, inv_m = k[7], k[8], k[9], k[10], k[11], k[12]
-    fd, fv = k[13], k[14]
     n = dq.shape[0]
     m = fd.shape[0]
     deflections(y, n, a_t, a_port, port, port_rate, defl)
@@ -271,7 +267,7 @@ def _stiffness_sensitivity(defl, factor, contact, sqrt_cfs, out):
 
 @njit(cache=False)
 def advance(y, t_end, alpha_shift, driver, port, angle0, k, istate, control, dq, dv, winv, w_basis, port_jac,
-            last_acc, last_force, last_defl, backup):
+            last_acc, last_force, last_defl, state, backup):
     """Integrate one communication step ``[0, t_end]`` (``Rosenbrock23.advance`` with ``_StepSystem``).
 
     Parameters
@@ -293,8 +289,9 @@ def advance(y, t_end, alpha_shift, driver, port, angle0, k, istate, control, dq,
         Jacobian blocks, ``W^-1``, ``W^-1`` applied to the time-derivative basis, port Jacobian rows.
     last_acc, last_force, last_defl : ndarray
         Loads of the last evaluation (written at the end state on success).
-    backup : tuple of ndarray
-        Scratch copies used to restore everything on failure.
+    state, backup : ndarray
+        The contiguous region of the buffer holding all of the above state, and room for a copy of it
+        (restored on failure).
 
     Returns
     -------
@@ -319,7 +316,7 @@ def advance(y, t_end, alpha_shift, driver, port, angle0, k, istate, control, dq,
     w_hdt = k[32]
     da = k[33]
     # save the state for a failure
-    _save(y, istate, dq, dv, winv, w_basis, port_jac, last_acc, last_force, last_defl, backup)
+    backup[:] = state
 
     rtol = control[RTOL]
     atol_q = control[ATOL_Q]
@@ -347,7 +344,8 @@ def advance(y, t_end, alpha_shift, driver, port, angle0, k, istate, control, dq,
         if istate[AGE] < 0.0 or istate[AGE] >= max_age:  # refresh the Jacobian
             if tvs:
                 stiffness_factors(angle0 + _hermite(driver, t), phasing, factor, slope)
-            jacobian(y, _hermite(port, t), _hermite_rate(port, t), factor, k, dq, dv, port_jac)
+            jacobian(y, _hermite(port, t), _hermite_rate(port, t), factor, k[0], k[1], k[3], k[5], k[7], k[8], k[9],
+                     k[10], k[11], k[12], k[13], k[14], dq, dv, port_jac)
             istate[AGE] = 0.0
             istate[HD] = -1.0
             istate[JACOBIANS] += 1.0
@@ -404,7 +402,8 @@ def advance(y, t_end, alpha_shift, driver, port, angle0, k, istate, control, dq,
         tau = t + 0.5 * h
         if tvs:
             stiffness_factors(angle0 + _hermite(driver, tau), phasing, factor, slope)
-        acc = acceleration(y1, _hermite(port, tau), _hermite_rate(port, tau), _hermite_accel(driver, tau), factor, k)
+        acc = acceleration(y1, _hermite(port, tau), _hermite_rate(port, tau), _hermite_accel(driver, tau), factor,
+                           k[0], k[1], k[2], k[3], k[4], k[5], k[6])
         for i in range(n):
             f1[i] = y1[n + i]
             f1[n + i] = acc[i]
@@ -418,7 +417,8 @@ def advance(y, t_end, alpha_shift, driver, port, angle0, k, istate, control, dq,
         if tvs:
             stiffness_factors(angle0 + _hermite(driver, tau), phasing, factor, slope)
         alpha_n = _hermite_accel(driver, tau)
-        acc = acceleration(yn, _hermite(port, tau), _hermite_rate(port, tau), alpha_n, factor, k)
+        acc = acceleration(yn, _hermite(port, tau), _hermite_rate(port, tau), alpha_n, factor,
+                           k[0], k[1], k[2], k[3], k[4], k[5], k[6])
         for i in range(n):
             fn[i] = yn[n + i]
             fn[n + i] = acc[i]
@@ -467,7 +467,8 @@ def advance(y, t_end, alpha_shift, driver, port, angle0, k, istate, control, dq,
             if istate[AGE] > 0.0:
                 if tvs:
                     stiffness_factors(angle0 + _hermite(driver, t), phasing, factor, slope)
-                jacobian(y, _hermite(port, t), _hermite_rate(port, t), factor, k, dq, dv, port_jac)
+                jacobian(y, _hermite(port, t), _hermite_rate(port, t), factor, k[0], k[1], k[3], k[5], k[7], k[8], k[9],
+                     k[10], k[11], k[12], k[13], k[14], dq, dv, port_jac)
                 istate[AGE] = 0.0
                 istate[HD] = -1.0
                 istate[JACOBIANS] += 1.0
@@ -490,45 +491,181 @@ def advance(y, t_end, alpha_shift, driver, port, angle0, k, istate, control, dq,
                 h *= fac
             istate[H_NEXT] = h
             if h < h_min:
-                _restore(y, istate, dq, dv, winv, w_basis, port_jac, last_acc, last_force, last_defl, backup)
+                state[:] = backup
                 return STEP_TOO_SMALL, t, h, err
         if steps > max_steps:
-            _restore(y, istate, dq, dv, winv, w_basis, port_jac, last_acc, last_force, last_defl, backup)
+            state[:] = backup
             return TOO_MANY_STEPS, t, h, err
     return OK, t, h, 0.0
 
 
-@njit(cache=False)
-def _save(y, istate, dq, dv, winv, w_basis, port_jac, last_acc, last_force, last_defl, backup):
-    b_y, b_ist, b_dq, b_dv, b_winv, b_wb, b_pj, b_acc, b_force, b_defl = backup
-    b_y[:] = y
-    b_ist[:] = istate
-    b_dq[:, :] = dq
-    b_dv[:, :] = dv
-    b_winv[:, :] = winv
-    b_wb[:, :] = w_basis
-    b_pj[:, :] = port_jac
-    b_acc[:] = last_acc
-    b_force[:] = last_force
-    b_defl[:, :] = last_defl
+# ---------------------------------------------------------------- one communication step
+# slots of the flat buffer (gearbox_kernel.BufferLayout lists them with their shapes, in this order)
+SLOTS = (
+    "a_t", "a_port", "fast", "contact", "force_w", "defl_w", "acc_w", "bt", "stks", "stcs", "stks_port",
+    "stcs_port", "inv_m", "fd_w", "fv_w", "phasing", "kappa", "force_rows", "factor_w", "slope_w", "sens_w",
+    "f0", "f1", "fn", "k1", "k2", "k3", "y1", "yn", "rhs", "w_hdt", "da", "control",
+    # the state a failed step restores: contiguous, so that saving it is one copy into "backup"
+    "istate", "dq", "dv", "winv", "w_basis", "port_jac", "last_acc", "last_force", "last_defl", "y",
+    "backup", "driver", "port", "scalars", "twist_q", "output_matrix", "outputs",
+)
+(A_T, A_PORT, FAST, CONTACT, FORCE_W, DEFL_W, ACC_W, BT, STKS, STCS, STKS_PORT, STCS_PORT, INV_M, FD_W, FV_W,
+ PHASING, KAPPA, FORCE_ROWS, FACTOR_W, SLOPE_W, SENS_W, F0, F1, FN, K1, K2, K3, Y1, YN, RHS, W_HDT, DA, CONTROL,
+ ISTATE, DQ, DV, WINV, W_BASIS, PORT_JAC, LAST_ACC, LAST_FORCE, LAST_DEFL, Y, BACKUP, DRIVER, PORT, SCALARS,
+ TWIST_Q, OUTPUT_MATRIX, OUTPUTS) = range(len(SLOTS))
+#: first and last slot of the restorable state
+STATE_FIRST, STATE_LAST = ISTATE, Y
+
+# scalars of GearboxModel kept in the buffer (``scalars`` slot)
+SCALAR_NAMES = (
+    "time_s", "driver_angle_rad", "driver_speed_rad_s", "driver_accel_rad_s2", "port_angle_rad",
+    "port_speed_rad_s", "last_step_s", "last_omega_rotor", "last_omega_gen", "shaft_torque_average_nm",
+    "output_twist_rad", "alpha_out_average_rad_s2", "angle0", "last_alpha", "kx", "twist_port", "shaft_k",
+    "shaft_c",
+)
+(S_TIME, S_DRIVER_ANGLE, S_DRIVER_SPEED, S_DRIVER_ACCEL, S_PORT_ANGLE, S_PORT_SPEED, S_LAST_STEP, S_LAST_OMEGA_ROTOR,
+ S_LAST_OMEGA_GEN, S_SHAFT_TORQUE_AVG, S_OUTPUT_TWIST, S_ALPHA_OUT_AVG, S_ANGLE0, S_LAST_ALPHA, S_KX, S_TWIST_PORT,
+ S_SHAFT_K, S_SHAFT_C) = range(len(SCALAR_NAMES))
+
+# entries of the integer vector ``dims``
+D_N, D_M, D_TVS, D_SQRT_CFS, D_EXTRAPOLATE, D_END_TORQUE = range(6)
+NON_FINITE_INPUT = 3
 
 
 @njit(cache=False)
-def _restore(y, istate, dq, dv, winv, w_basis, port_jac, last_acc, last_force, last_defl, backup):
-    b_y, b_ist, b_dq, b_dv, b_winv, b_wb, b_pj, b_acc, b_force, b_defl = backup
-    y[:] = b_y
-    istate[:] = b_ist
-    dq[:, :] = b_dq
-    dv[:, :] = b_dv
-    winv[:, :] = b_winv
-    w_basis[:, :] = b_wb
-    port_jac[:, :] = b_pj
-    last_acc[:] = b_acc
-    last_force[:] = b_force
-    last_defl[:, :] = b_defl
+def _vec(buf, lay, slot):
+    return buf[lay[slot]:lay[slot + 1]]
+
+
+@njit(cache=False)
+def _mat(buf, lay, slot, rows):
+    v = buf[lay[slot]:lay[slot + 1]]
+    return v.reshape((rows, v.shape[0] // rows))
+
+
+@njit(cache=False)
+def _fit(c, h, x0, dx0, x1, dx1):
+    """``gearbox_model._Hermite.fit``: cubic with value and slope at both ends of [0, h]."""
+    delta = (x1 - x0) / h
+    c[0] = x0
+    c[1] = dx0
+    c[2] = (3.0 * delta - 2.0 * dx0 - dx1) / h
+    c[3] = (dx0 + dx1 - 2.0 * delta) / (h * h)
+
+
+@njit(cache=False)
+def _constants(buf, lay, dims):
+    n = dims[D_N]
+    m = dims[D_M]
+    n2 = 2 * n
+    return (
+        _mat(buf, lay, A_T, n), _vec(buf, lay, A_PORT), _mat(buf, lay, FAST, m + n2 + 3), _mat(buf, lay, CONTACT, m),
+        _vec(buf, lay, FORCE_W), _mat(buf, lay, DEFL_W, 2), _vec(buf, lay, ACC_W), _mat(buf, lay, BT, n),
+        _mat(buf, lay, STKS, n), _mat(buf, lay, STCS, n), _vec(buf, lay, STKS_PORT), _vec(buf, lay, STCS_PORT),
+        _vec(buf, lay, INV_M), _vec(buf, lay, FD_W), _vec(buf, lay, FV_W), dims[D_TVS] != 0,
+        _mat(buf, lay, PHASING, 7), _vec(buf, lay, KAPPA), _mat(buf, lay, FORCE_ROWS, m), dims[D_SQRT_CFS] != 0,
+        _vec(buf, lay, FACTOR_W), _vec(buf, lay, SLOPE_W), _vec(buf, lay, SENS_W),
+        _vec(buf, lay, F0), _vec(buf, lay, F1), _vec(buf, lay, FN), _vec(buf, lay, K1), _vec(buf, lay, K2),
+        _vec(buf, lay, K3), _vec(buf, lay, Y1), _vec(buf, lay, YN), _vec(buf, lay, RHS), _vec(buf, lay, W_HDT),
+        _vec(buf, lay, DA),
+    )
+
+
+@njit(cache=False)
+def outputs(buf, lay, dims):
+    """``GearboxModel.output_vector`` into the ``outputs`` slot."""
+    n = dims[D_N]
+    m = dims[D_M]
+    sc = _vec(buf, lay, SCALARS)
+    y = _vec(buf, lay, Y)
+    force = _vec(buf, lay, LAST_FORCE)
+    om = _mat(buf, lay, OUTPUT_MATRIX, m + 2 * n + 4)
+    out = _vec(buf, lay, OUTPUTS)
+    ist = _vec(buf, lay, ISTATE)
+    cols = om.shape[1]
+    for col in range(cols):
+        s = 0.0
+        for i in range(m):
+            s += force[i] * om[i, col]
+        for i in range(2 * n):
+            s += y[i] * om[m + i, col]
+        s += (sc[S_PORT_ANGLE] * om[m + 2 * n, col] + sc[S_PORT_SPEED] * om[m + 2 * n + 1, col]
+              + sc[S_DRIVER_SPEED] * om[m + 2 * n + 2, col] + sc[S_DRIVER_ACCEL] * om[m + 2 * n + 3, col])
+        out[2 + col] = s
+    avg = sc[S_SHAFT_TORQUE_AVG]
+    out[0] = out[2] if dims[D_END_TORQUE] != 0 else avg
+    out[1] = avg
+    out[2 + cols] = sc[S_ALPHA_OUT_AVG]
+    out[3 + cols] = ist[ALPHA_OUT_MAX]
+
+
+@njit(cache=False)
+def gearbox_step(buf, lay, dims, t, h, omega_rotor, phi_rotor, omega_gen, phi_gen):
+    """``GearboxModel.step`` from ``t`` to ``t + h`` on the state in ``buf``; outputs into the ``outputs`` slot.
+
+    Returns ``(status, local time, step size, error norm)`` as :func:`advance`, or ``NON_FINITE_INPUT``;
+    on failure the buffer is as it was at ``t``.
+    """
+    n = dims[D_N]
+    m = dims[D_M]
+    sc = _vec(buf, lay, SCALARS)
+    y = _vec(buf, lay, Y)
+    control = _vec(buf, lay, CONTROL)
+    out_kin = control[OUT_KINEMATIC]
+    out_idx = int(control[OUT_RATE_INDEX])
+    if dims[D_EXTRAPOLATE] != 0 and sc[S_LAST_STEP] > 0.0:
+        alpha_rotor = (omega_rotor - sc[S_LAST_OMEGA_ROTOR]) / sc[S_LAST_STEP]
+        alpha_gen = (omega_gen - sc[S_LAST_OMEGA_GEN]) / sc[S_LAST_STEP]
+    else:
+        alpha_rotor = 0.0
+        alpha_gen = 0.0
+    kx = sc[S_KX]
+    angle1 = phi_rotor + h * (omega_rotor + 0.5 * h * alpha_rotor)
+    speed1 = omega_rotor + h * alpha_rotor
+    port1 = phi_gen + h * (omega_gen + 0.5 * h * alpha_gen) - kx * angle1
+    port_speed1 = omega_gen + h * alpha_gen - kx * speed1
+    if not math.isfinite(port1 + port_speed1):
+        return NON_FINITE_INPUT, 0.0, h, 0.0
+    driver = _vec(buf, lay, DRIVER)
+    port = _vec(buf, lay, PORT)
+    sc[S_ANGLE0] = sc[S_DRIVER_ANGLE]
+    _fit(driver, h, 0.0, sc[S_DRIVER_SPEED], angle1 - sc[S_DRIVER_ANGLE], speed1)
+    _fit(port, h, sc[S_PORT_ANGLE], sc[S_PORT_SPEED], port1, port_speed1)
+    twist_start = sc[S_OUTPUT_TWIST]
+    speed_start = out_kin * sc[S_DRIVER_SPEED] + y[out_idx]
+    status, tau, h_fail, err = advance(
+        y, h, sc[S_LAST_ALPHA] - _hermite_accel(driver, 0.0), driver, port, sc[S_ANGLE0], _constants(buf, lay, dims),
+        _vec(buf, lay, ISTATE), control, _mat(buf, lay, DQ, n), _mat(buf, lay, DV, n), _mat(buf, lay, WINV, 2 * n),
+        _mat(buf, lay, W_BASIS, 2 * n), _mat(buf, lay, PORT_JAC, 2), _vec(buf, lay, LAST_ACC),
+        _vec(buf, lay, LAST_FORCE), _mat(buf, lay, LAST_DEFL, 2), buf[lay[STATE_FIRST]:lay[STATE_LAST + 1]],
+        _vec(buf, lay, BACKUP),
+    )
+    if status != OK:
+        return status, tau, h_fail, err
+    sc[S_TIME] = t + h
+    sc[S_DRIVER_ANGLE] = angle1
+    sc[S_DRIVER_SPEED] = speed1
+    sc[S_DRIVER_ACCEL] = _hermite_accel(driver, h)
+    sc[S_LAST_ALPHA] = sc[S_DRIVER_ACCEL]
+    sc[S_PORT_ANGLE] = port1
+    sc[S_PORT_SPEED] = port_speed1
+    sc[S_LAST_OMEGA_ROTOR] = omega_rotor
+    sc[S_LAST_OMEGA_GEN] = omega_gen
+    sc[S_LAST_STEP] = h
+    twist_q = _vec(buf, lay, TWIST_Q)
+    twist_end = 0.0
+    for i in range(2 * n):
+        twist_end += twist_q[i] * y[i]
+    twist_end += sc[S_TWIST_PORT] * port1
+    sc[S_OUTPUT_TWIST] = twist_end
+    sc[S_SHAFT_TORQUE_AVG] = sc[S_SHAFT_K] * 0.5 * (twist_start + twist_end) + sc[S_SHAFT_C] * (twist_end - twist_start) / h
+    sc[S_ALPHA_OUT_AVG] = (out_kin * speed1 + y[out_idx] - speed_start) / h
+    outputs(buf, lay, dims)
+    return OK, tau, h, 0.0
 
 
 DISPATCHERS = (_sign, contact_force, stiffness_factors, _hermite, _hermite_rate, _hermite_accel, deflections,
-               acceleration, jacobian, _factor, _matvec, _stiffness_sensitivity, advance, _save, _restore)
+               acceleration, jacobian, _factor, _matvec, _stiffness_sensitivity, advance,
+               _vec, _mat, _fit, _constants, outputs, gearbox_step)
 #: True when the machine code is cached on disk (see :mod:`components.model.numba_cache`)
 DISK_CACHE = enable_stable_cache(DISPATCHERS, __file__)

@@ -186,6 +186,13 @@ class GearboxModel:
         ``numpy`` was asked for).
     """
 
+    def __new__(cls, *args, kernel: str | None = None, **kwargs):
+        if cls is GearboxModel and choose_kernel(kernel)[0] == "compiled":
+            from .gearbox_kernel import CompiledGearboxModel
+
+            cls = CompiledGearboxModel
+        return super().__new__(cls)
+
     _SCALARS = (
         "time_s", "driver_angle_rad", "driver_speed_rad_s", "driver_accel_rad_s2", "port_angle_rad",
         "port_speed_rad_s", "last_step_s", "last_omega_rotor", "last_omega_gen", "shaft_torque_average_nm",
@@ -201,6 +208,9 @@ class GearboxModel:
         kernel: str | None = None,
     ) -> None:
         self.assembly = a = Assembly(drivetrain, cut_at_generator=True)
+        self.kernel, self.kernel_note = choose_kernel(kernel)
+        self._compiled_stale = True  # (compiled model) the buffer must be loaded from the numpy-side state
+        self._allocate()
         self.shaft_torque_mode = one_of("shaft_torque_mode", shaft_torque_mode, SHAFT_TORQUE_MODES)
         self.extrapolate = bool(extrapolate)
         self.system = _StepSystem(a)
@@ -231,15 +241,7 @@ class GearboxModel:
         #: d omega_out / dt averaged over the last step [rad/s^2] (instantaneous before the first step)
         self.alpha_out_average_rad_s2 = 0.0
         self._integrator.on_accept = self._track_output_acceleration
-        self.kernel, self.kernel_note = choose_kernel(kernel)
-        self._compiled = None
-        self._compiled_stale = True  # kernel arrays must be loaded from the numpy-side state
-        if self.kernel == "compiled":
-            from .gearbox_kernel import GearboxKernel
-            from .kernel import compiled_module
-
-            self._compiled = GearboxKernel(a, self._integrator.control, self._out_kinematic, self._out_rate_index,
-                                           compiled_module()[0])
+        self._finish_allocation()
 
     # ------------------------------------------------------------ outputs
     @property
@@ -377,6 +379,10 @@ class GearboxModel:
         tail = (self.alpha_out_average_rad_s2, self.alpha_out_max_rad_s2)
         return np.concatenate((head, linear, tail))
 
+    def output_list(self) -> list[float]:
+        """:meth:`output_vector` as a list of floats (what an FMU writes into its variables)."""
+        return self.output_vector().tolist()
+
     def _output_extra(self) -> tuple[float, float, float, float]:
         return (self.port_angle_rad, self.port_speed_rad_s, self.driver_speed_rad_s, self.driver_accel_rad_s2)
 
@@ -447,19 +453,16 @@ class GearboxModel:
         speed_start = self.output_speed_rad_s
         # first stage reuses the loads at the end of the previous step: the prescribed
         # motions are C1, so only the driver-acceleration term changes
-        if self._compiled is not None:
-            self._advance_compiled(t, h)
-        else:
-            a0 = sysm.last_acceleration + a.kinematic_ratio * (sysm.last_alpha - sysm.driver.accel(0.0))
-            saved = (self._integrator.snapshot(), sysm.cache(), sysm.port_jacobian, self.alpha_out_max_rad_s2)
-            try:
-                self.y, _ = self._integrator.advance(0.0, self.y, h, a0=a0)
-            except SolverError as exc:
-                self._integrator.restore(saved[0])
-                sysm.restore(saved[1])
-                sysm.port_jacobian = saved[2]
-                self.alpha_out_max_rad_s2 = saved[3]
-                raise SolverError(str(exc).rsplit(" (at t =", 1)[0], t + exc.time_s) from None
+        a0 = sysm.last_acceleration + a.kinematic_ratio * (sysm.last_alpha - sysm.driver.accel(0.0))
+        saved = (self._integrator.snapshot(), sysm.cache(), sysm.port_jacobian, self.alpha_out_max_rad_s2)
+        try:
+            self.y, _ = self._integrator.advance(0.0, self.y, h, a0=a0)
+        except SolverError as exc:
+            self._integrator.restore(saved[0])
+            sysm.restore(saved[1])
+            sysm.port_jacobian = saved[2]
+            self.alpha_out_max_rad_s2 = saved[3]
+            raise SolverError(str(exc).rsplit(" (at t =", 1)[0], t + exc.time_s) from None
         self.time_s = t + h
         self.driver_angle_rad = angle1
         self.driver_speed_rad_s = speed1
@@ -475,62 +478,20 @@ class GearboxModel:
         self.shaft_torque_average_nm = k * 0.5 * (twist_start + twist_end) + a.shaft_c[-1] * (twist_end - twist_start) / h
         self.alpha_out_average_rad_s2 = (self.output_speed_rad_s - speed_start) / h
 
-    def _advance_compiled(self, t: float, h: float) -> None:
-        """The integration of :meth:`step` by the compiled kernel (same steps as ``Rosenbrock23.advance``)."""
-        kf = self._compiled
-        sysm = self.system
-        if self._compiled_stale:
-            self._load_compiled()
-        d, p = sysm.driver, sysm.port
-        kf.driver[:] = (d.c0, d.c1, d.c2, d.c3)
-        kf.port[:] = (p.c0, p.c1, p.c2, p.c3)
-        mod = kf.module
-        ist = kf.istate
-        ist[mod.ALPHA_OUT_MAX] = self.alpha_out_max_rad_s2
-        status, tau, h_fail, err = mod.advance(
-            self.y, h, sysm.last_alpha - d.accel(0.0), kf.driver, kf.port, sysm.angle0, kf.consts, ist, kf.control,
-            kf.dq, kf.dv, kf.winv, kf.w_basis, kf.port_jac, kf.last_acc, kf.last_force, kf.last_defl, kf.backup,
-        )
-        if status != mod.OK:  # the kernel restored every array to the start of the step
-            c = self._integrator.control
-            if status == mod.STEP_TOO_SMALL:
-                message = f"step size {h_fail:.3g} s below h_min {c.h_min:.3g} s (error norm {err:.3g})"
-            else:
-                message = f"more than {c.max_steps} steps in one advance"
-            raise SolverError(message, t + tau)
-        sysm.last_alpha = d.accel(h)
-        self.alpha_out_max_rad_s2 = float(ist[mod.ALPHA_OUT_MAX])
-
     @property
     def integrator(self) -> Rosenbrock23:
         """The integrator (its counters and state current also when the compiled kernel steps)."""
         self._store_compiled()
         return self._integrator
 
-    def _store_compiled(self) -> None:
-        """Hand the state held by the compiled kernel's arrays back to the numpy side (reloaded on the next step)."""
-        if self._compiled is not None and not self._compiled_stale:
-            self._compiled.store_integrator(self._integrator)
-            sysm = self.system
-            sysm.last_acceleration = sysm.last_acceleration.copy()
-            sysm.last_force = sysm.last_force.copy()
-            sysm.last_deflection = sysm.last_deflection.copy()
-            sysm.port_jacobian = sysm.port_jacobian.copy()
-            self._compiled_stale = True
+    def _allocate(self) -> None:
+        """Hook of the compiled model: allocate its buffer (called before any state is set)."""
 
-    def _load_compiled(self) -> None:
-        """Load the compiled kernel's arrays from the numpy-side state; from now on they hold it."""
-        kf = self._compiled
-        sysm = self.system
-        kf.load_integrator(self._integrator)
-        kf.last_acc[:] = sysm.last_acceleration
-        kf.last_force[:] = sysm.last_force
-        kf.last_defl[:] = sysm.last_deflection
-        kf.port_jac[:] = sysm.port_jacobian
-        self.y = np.array(self.y, dtype=float)
-        sysm.last_acceleration, sysm.last_force, sysm.last_deflection = kf.last_acc, kf.last_force, kf.last_defl
-        sysm.port_jacobian = kf.port_jac
-        self._compiled_stale = False
+    def _finish_allocation(self) -> None:
+        """Hook of the compiled model: fill its buffer's constants (called at the end of ``__init__``)."""
+
+    def _store_compiled(self) -> None:
+        """Hook of the compiled model: hand the state its buffer holds back to the numpy side."""
 
     def _output_twist(self) -> float:
         """Twist of the output shaft (shaft 3) [rad]."""
