@@ -664,8 +664,68 @@ def gearbox_step(buf, lay, dims, t, h, omega_rotor, phi_rotor, omega_gen, phi_ge
     return OK, tau, h, 0.0
 
 
+# ---------------------------------------------------------------- monolithic reference
+@njit(cache=False)
+def monolithic_rhs(y, omega, alpha, factor, load, out_dof, kappa_out, inertia_in, a_t, a_port, fast, contact, s_mat,
+                   shaft_k, shaft_c, bt_driver, s_driver, cos_alpha, inv_m, force, elastic, defl, acc, out):
+    """``MonolithicSystem.rhs``: ``[v, q_ddot, rotor power, output power, dissipated power]`` into ``out``.
+
+    The accelerations through the Assembly's folded matrix (no port), the counter torque on the
+    output body, rotor torque ``I_in alpha + cos(alpha) a_in . F + s_in . T``, and the dissipation
+    ``((F - F_el) d_dot) . cos(alpha) + sum c s_dot^2`` (``Assembly.dissipation_power``).
+    """
+    n = inv_m.shape[0]
+    m = force.shape[0]
+    deflections(y, n, a_t, a_port, 0.0, 0.0, defl)
+    for i in range(m):
+        f, _, _, el = contact_force(defl[0, i], defl[1, i], factor[i], contact[i])
+        force[i] = f
+        elastic[i] = el
+    for j in range(n):
+        s = 0.0
+        for i in range(m):
+            s += force[i] * fast[i, j]
+        for i in range(2 * n):
+            s += y[i] * fast[m + i, j]
+        acc[j] = s + alpha * fast[m + 2 * n + 2, j]
+    acc[out_dof] -= inv_m[out_dof] * load
+    rotor = inertia_in * alpha
+    dissipation = 0.0
+    for i in range(m):
+        rotor += force[i] * bt_driver[i]
+        dissipation += (force[i] - elastic[i]) * defl[1, i] * cos_alpha[i]
+    for r in range(shaft_k.shape[0]):
+        tw = 0.0
+        rate = 0.0
+        for j in range(n):
+            tw += s_mat[r, j] * y[j]
+            rate += s_mat[r, j] * y[n + j]
+        rotor += (shaft_k[r] * tw + shaft_c[r] * rate) * s_driver[r]
+        dissipation += shaft_c[r] * rate * rate
+    for j in range(n):
+        out[j] = y[n + j]
+        out[n + j] = acc[j]
+    out[2 * n] = rotor * omega
+    out[2 * n + 1] = load * (kappa_out * omega + y[n + out_dof])
+    out[2 * n + 2] = dissipation
+
+
+@njit(cache=False)
+def monolithic_jacobian(y, factor, a_t, a_port, contact, defl, bt, stks, stcs, stks_port, stcs_port, inv_m, fd, fv,
+                        dq, dv, port_jac, jac):
+    """``MonolithicSystem.jacobian``: the acceleration rows of ``jac`` (the rest is fixed)."""
+    n = inv_m.shape[0]
+    jacobian(y, 0.0, 0.0, factor, a_t, a_port, contact, defl, bt, stks, stcs, stks_port, stcs_port, inv_m, fd, fv,
+             dq, dv, port_jac)
+    for i in range(n):
+        for j in range(n):
+            jac[n + i, j] = dq[i, j]
+            jac[n + i, n + j] = dv[i, j]
+
+
 DISPATCHERS = (_sign, contact_force, stiffness_factors, _hermite, _hermite_rate, _hermite_accel, deflections,
                acceleration, jacobian, _factor, _matvec, _stiffness_sensitivity, advance,
-               _vec, _mat, _fit, _constants, outputs, gearbox_step)
+               _vec, _mat, _fit, _constants, outputs, gearbox_step, monolithic_rhs,
+               monolithic_jacobian)
 #: True when the machine code is cached on disk (see :mod:`components.model.numba_cache`)
 DISK_CACHE = enable_stable_cache(DISPATCHERS, __file__)
