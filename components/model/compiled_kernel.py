@@ -723,9 +723,22 @@ def monolithic_jacobian(y, factor, a_t, a_port, contact, defl, bt, stks, stcs, s
             jac[n + i, n + j] = dv[i, j]
 
 
+def ensure_compiled() -> None:
+    """Compile (or load from the disk cache) the entry points for the argument types they are called with.
+
+    Called when a model is built, so that the one-off cost (first run on a machine: tens of
+    seconds; later: a cache load) is paid there and not inside a stepping loop.
+    """
+    from numba import types
+
+    vector, index = types.float64[::1], types.int64[::1]
+    gearbox_step.compile((vector, index, index) + (types.float64,) * 6)
+    outputs.compile((vector, index, index))
+
+
 DISPATCHERS = (_sign, contact_force, stiffness_factors, _hermite, _hermite_rate, _hermite_accel, deflections,
                acceleration, jacobian, _factor, _matvec, _stiffness_sensitivity, advance,
                _vec, _mat, _fit, _constants, outputs, gearbox_step, monolithic_rhs,
                monolithic_jacobian)
 #: True when the machine code is cached on disk (see :mod:`components.model.numba_cache`)
-DISK_CACHE = enable_stable_cache(DISPATCHERS, __file__)
+DISK_CACHE = enable_stable_cache(DISPATCHERS, __file__, __name__)

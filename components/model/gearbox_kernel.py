@@ -114,6 +114,7 @@ class CompiledGearboxModel(GearboxModel):
         if module is None:
             raise ParameterError("kernel", "compiled", f"an importable numba ({reason})")
         self._module = module
+        module.ensure_compiled()
         a = self.assembly
         self._kb = KernelBuffer(slot_shapes(a.n_dof, a.n_mesh, a.n_shaft, module), module.SLOTS)
         v = self._kb.views

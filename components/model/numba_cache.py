@@ -6,13 +6,16 @@ to a new temporary folder on every load, so that folder changes every run and
 numba would compile again each time (seconds). :func:`enable_stable_cache` gives
 the kernel's dispatchers a locator whose directory is
 
-    <user cache>/dtcosim/numba-<numba version>/<sha256 of the kernel source>[:16]
+    <user cache>/dtcosim/numba-<numba version>/<sha256 of the kernel source>[:16]/<module name>
 
 (``<user cache>``: ``$DTCOSIM_CACHE_DIR``, else ``$XDG_CACHE_HOME`` or
 ``~/.cache`` on POSIX, ``%LOCALAPPDATA%`` on Windows), and whose freshness stamp is
 the same hash: any copy of the same kernel source, wherever it was extracted,
-finds the machine code compiled by the first run. Nothing else numba caches in
-the process is affected.
+finds the machine code compiled by the first run. The module name is part of
+the key because numba's cache refers to the module by name: every FMU build
+imports the kernel under its own private package name (stable for a build, see
+:mod:`fmus.build`), so each build compiles once and then reuses its cache.
+Nothing else numba caches in the process is affected.
 
 This uses numba's cache classes (``numba.core.caching``), which are not public
 API; if they change, :func:`enable_stable_cache` returns False and the kernel is
@@ -46,14 +49,18 @@ def source_hash(path: str | os.PathLike) -> str:
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
 
 
-def kernel_cache_dir(source_path: str | os.PathLike) -> Path:
-    """Cache directory of the kernel compiled from ``source_path`` (keyed by numba version and code hash)."""
+def kernel_cache_dir(source_path: str | os.PathLike, module_name: str) -> Path:
+    """Cache directory of the kernel module ``module_name`` compiled from ``source_path``.
+
+    Keyed by numba version, code hash and module name.
+    """
     import numba
 
-    return user_cache_root() / f"numba-{numba.__version__}" / source_hash(source_path)[:16]
+    safe = "".join(c if c.isalnum() or c in "._-" else "_" for c in module_name)
+    return user_cache_root() / f"numba-{numba.__version__}" / source_hash(source_path)[:16] / safe
 
 
-def enable_stable_cache(dispatchers, source_path: str | os.PathLike) -> bool:
+def enable_stable_cache(dispatchers, source_path: str | os.PathLike, module_name: str) -> bool:
     """Make ``dispatchers`` (numba ``njit`` functions of one module) cache under :func:`kernel_cache_dir`.
 
     Returns
@@ -68,7 +75,7 @@ def enable_stable_cache(dispatchers, source_path: str | os.PathLike) -> bool:
         base_locator = getattr(caching, "_CacheLocator")
         impl = getattr(caching, "CompileResultCacheImpl")
         function_cache = getattr(caching, "FunctionCache")
-        directory = kernel_cache_dir(source_path)
+        directory = kernel_cache_dir(source_path, module_name)
         stamp = source_hash(source_path)
 
         class _StableLocator(base_locator):
