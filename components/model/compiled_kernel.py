@@ -205,6 +205,46 @@ def jacobian(y, port, port_rate, factor, a_t, a_port, contact, defl, bt, stks, s
 
 
 @njit(cache=False)
+def _invert(g, out):
+    """``out = g^-1`` by Gauss-Jordan elimination with partial pivoting (``g`` is overwritten).
+
+    Written out rather than ``np.linalg.inv`` so the kernel needs no LAPACK (numba's LAPACK
+    binding goes through SciPy's Fortran runtime, which is also loaded inside FMUs).
+    """
+    n = g.shape[0]
+    for i in range(n):
+        for j in range(n):
+            out[i, j] = 1.0 if i == j else 0.0
+    for col in range(n):
+        pivot = col
+        best = abs(g[col, col])
+        for r in range(col + 1, n):
+            if abs(g[r, col]) > best:
+                best = abs(g[r, col])
+                pivot = r
+        if pivot != col:
+            for j in range(n):
+                tmp = g[col, j]
+                g[col, j] = g[pivot, j]
+                g[pivot, j] = tmp
+                tmp = out[col, j]
+                out[col, j] = out[pivot, j]
+                out[pivot, j] = tmp
+        inv_p = 1.0 / g[col, col]
+        for j in range(n):
+            g[col, j] *= inv_p
+            out[col, j] *= inv_p
+        for r in range(n):
+            if r != col:
+                f = g[r, col]
+                if f != 0.0:
+                    for j in range(n):
+                        g[r, j] -= f * g[col, j]
+                        out[r, j] -= f * out[col, j]
+    return out
+
+
+@njit(cache=False)
 def _factor(hd, dq, dv, winv):
     """``Rosenbrock23._factor``: W^-1 = (I - hd J)^-1 through the n x n Schur complement."""
     n = dq.shape[0]
@@ -213,13 +253,16 @@ def _factor(hd, dq, dv, winv):
         for j in range(n):
             g[i, j] = -hd * dv[i, j] - (hd * hd) * dq[i, j]
         g[i, i] += 1.0
-    ginv = np.linalg.inv(g)
-    ginv_dq = ginv @ dq
+    ginv = np.empty((n, n))
+    _invert(g, ginv)
     for i in range(n):
         for j in range(n):
-            winv[i, j] = (hd * hd) * ginv_dq[i, j]
+            s = 0.0
+            for k in range(n):
+                s += ginv[i, k] * dq[k, j]
+            winv[i, j] = (hd * hd) * s
             winv[i, n + j] = hd * ginv[i, j]
-            winv[n + i, j] = hd * ginv_dq[i, j]
+            winv[n + i, j] = hd * s
             winv[n + i, n + j] = ginv[i, j]
         winv[i, i] += 1.0
 
@@ -737,7 +780,7 @@ def ensure_compiled() -> None:
 
 
 DISPATCHERS = (_sign, contact_force, stiffness_factors, _hermite, _hermite_rate, _hermite_accel, deflections,
-               acceleration, jacobian, _factor, _matvec, _stiffness_sensitivity, advance,
+               acceleration, jacobian, _invert, _factor, _matvec, _stiffness_sensitivity, advance,
                _vec, _mat, _fit, _constants, outputs, gearbox_step, monolithic_rhs,
                monolithic_jacobian)
 #: True when the machine code is cached on disk (see :mod:`components.model.numba_cache`)

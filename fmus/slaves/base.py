@@ -58,6 +58,7 @@ from components import __version__ as COMPONENTS_VERSION
 from components.errors import DtcosimError, ParameterError
 
 from .interface import BOOLEAN, INPUT, INTEGER, OUTPUT, PARAMETER, REAL, Value, Variable
+from .shutdown import register_state_release
 
 #: Life-cycle phases of an instance.
 INSTANTIATED, INITIALIZATION, STEPPING, TERMINATED = "instantiated", "initialization", "stepping", "terminated"
@@ -137,6 +138,7 @@ class DtcosimSlave(Fmi2Slave):
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__(**kwargs)
+        register_state_release(self.resources)  # pythonfmu's exit-time use-after-free, see .shutdown
         variables = self.interface()
         self.variables: tuple[Variable, ...] = variables
         self.vr: dict[str, int] = {v.name: i for i, v in enumerate(variables)}
