@@ -288,9 +288,6 @@ class CompiledGearboxModel(GearboxModel):
             return super().output_vector()
         return self._outputs_view.copy()
 
-    def output_list(self) -> list[float]:
-        """:meth:`output_vector` as a list of floats (what an FMU writes into its variables)."""
-        if self._compiled_stale:
-            return super().output_vector().tolist()
-        return self._outputs_view.tolist()
+    def _output_array(self) -> np.ndarray:
+        return super().output_vector() if self._compiled_stale else self._outputs_view
 

@@ -381,7 +381,11 @@ class GearboxModel:
 
     def output_list(self) -> list[float]:
         """:meth:`output_vector` as a list of floats (what an FMU writes into its variables)."""
-        return self.output_vector().tolist()
+        return self._output_array().tolist()
+
+    def _output_array(self) -> np.ndarray:
+        """The outputs as an array that may be reused (the compiled model returns its buffer's view)."""
+        return self.output_vector()
 
     def _output_extra(self) -> tuple[float, float, float, float]:
         return (self.port_angle_rad, self.port_speed_rad_s, self.driver_speed_rad_s, self.driver_accel_rad_s2)
