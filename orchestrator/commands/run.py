@@ -70,8 +70,9 @@ def apply_overrides(scenario, args: argparse.Namespace):
     changes = {}
     if args.step is not None:
         changes["step_s"] = args.step
-        if args.output_interval is None and sim.output_interval_s < args.step:
-            changes["output_interval_s"] = args.step
+        ratio = sim.output_interval_s / args.step
+        if args.output_interval is None and (ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-9 * ratio):
+            changes["output_interval_s"] = args.step  # the file's interval is no whole multiple of the new step
     if args.output_interval is not None:
         changes["output_interval_s"] = args.output_interval
     if args.stop is not None:
