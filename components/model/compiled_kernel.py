@@ -178,30 +178,50 @@ def acceleration(y, port, port_rate, alpha, factor, a_t, a_port, fast, contact, 
 
 
 @njit(cache=False)
-def jacobian(y, port, port_rate, factor, a_t, a_port, contact, defl, bt, stks, stcs, stks_port, stcs_port, inv_m,
-             fd, fv, dq, dv, port_jac):
-    """``Assembly.acceleration_jacobian``: dq, dv (n x n) and the port columns (rows of ``port_jac``)."""
+def jacobian(y, port, port_rate, factor, a_t, a_port, contact, defl, nz_index, nz_value, cos_alpha, stks, stcs,
+             stks_port, stcs_port, inv_m, fd, fv, dq, dv, port_jac):
+    """``Assembly.acceleration_jacobian``: dq, dv (n x n) and the port columns (rows of ``port_jac``).
+
+    ``dq = -M^-1 (sum_i cos(alpha_i) dF_i/dd a_i a_i^T + S^T k S)`` summed over the few bodies each
+    mesh row ``a_i`` touches (``nz_index``, ``nz_value``: its nonzero columns and entries, index < 0
+    for padding); ``dv`` likewise with dF/d(rate) and ``S^T c S``.
+    """
     n = dq.shape[0]
     m = fd.shape[0]
+    width = nz_index.shape[1]
     deflections(y, n, a_t, a_port, port, port_rate, defl)
     for i in range(m):
         _, fd[i], fv[i], _ = contact_force(defl[0, i], defl[1, i], factor[i], contact[i])
     for j in range(n):
         for col in range(n):
-            sq = 0.0
-            sv = 0.0
-            for i in range(m):
-                sq += bt[j, i] * fd[i] * a_t[col, i]
-                sv += bt[j, i] * fv[i] * a_t[col, i]
-            dq[j, col] = -inv_m[j] * (sq + stks[j, col])
-            dv[j, col] = -inv_m[j] * (sv + stcs[j, col])
-        sq = 0.0
-        sv = 0.0
-        for i in range(m):
-            sq += bt[j, i] * fd[i] * a_port[i]
-            sv += bt[j, i] * fv[i] * a_port[i]
-        port_jac[0, j] = -inv_m[j] * (sq + stks_port[j])
-        port_jac[1, j] = -inv_m[j] * (sv + stcs_port[j])
+            dq[j, col] = stks[j, col]
+            dv[j, col] = stcs[j, col]
+        port_jac[0, j] = stks_port[j]
+        port_jac[1, j] = stcs_port[j]
+    for i in range(m):
+        cq = cos_alpha[i] * fd[i]
+        cv = cos_alpha[i] * fv[i]
+        for p in range(width):
+            jp = int(nz_index[i, p])
+            if jp < 0:
+                break
+            bq = cq * nz_value[i, p]
+            bv = cv * nz_value[i, p]
+            for q in range(width):
+                jq = int(nz_index[i, q])
+                if jq < 0:
+                    break
+                dq[jp, jq] += bq * nz_value[i, q]
+                dv[jp, jq] += bv * nz_value[i, q]
+            port_jac[0, jp] += bq * a_port[i]
+            port_jac[1, jp] += bv * a_port[i]
+    for j in range(n):
+        s = -inv_m[j]
+        for col in range(n):
+            dq[j, col] *= s
+            dv[j, col] *= s
+        port_jac[0, j] *= s
+        port_jac[1, j] *= s
 
 
 @njit(cache=False)
@@ -387,8 +407,8 @@ def advance(y, t_end, alpha_shift, driver, port, angle0, k, istate, control, dq,
         if istate[AGE] < 0.0 or istate[AGE] >= max_age:  # refresh the Jacobian
             if tvs:
                 stiffness_factors(angle0 + _hermite(driver, t), phasing, factor, slope)
-            jacobian(y, _hermite(port, t), _hermite_rate(port, t), factor, k[0], k[1], k[3], k[5], k[7], k[8], k[9],
-                     k[10], k[11], k[12], k[13], k[14], dq, dv, port_jac)
+            jacobian(y, _hermite(port, t), _hermite_rate(port, t), factor, k[0], k[1], k[3], k[5], k[34], k[35], k[36],
+                     k[8], k[9], k[10], k[11], k[12], k[13], k[14], dq, dv, port_jac)
             istate[AGE] = 0.0
             istate[HD] = -1.0
             istate[JACOBIANS] += 1.0
@@ -510,8 +530,8 @@ def advance(y, t_end, alpha_shift, driver, port, angle0, k, istate, control, dq,
             if istate[AGE] > 0.0:
                 if tvs:
                     stiffness_factors(angle0 + _hermite(driver, t), phasing, factor, slope)
-                jacobian(y, _hermite(port, t), _hermite_rate(port, t), factor, k[0], k[1], k[3], k[5], k[7], k[8], k[9],
-                     k[10], k[11], k[12], k[13], k[14], dq, dv, port_jac)
+                jacobian(y, _hermite(port, t), _hermite_rate(port, t), factor, k[0], k[1], k[3], k[5], k[34], k[35], k[36],
+                     k[8], k[9], k[10], k[11], k[12], k[13], k[14], dq, dv, port_jac)
                 istate[AGE] = 0.0
                 istate[HD] = -1.0
                 istate[JACOBIANS] += 1.0
@@ -547,13 +567,15 @@ def advance(y, t_end, alpha_shift, driver, port, angle0, k, istate, control, dq,
 SLOTS = (
     "a_t", "a_port", "fast", "contact", "force_w", "defl_w", "acc_w", "bt", "stks", "stcs", "stks_port",
     "stcs_port", "inv_m", "fd_w", "fv_w", "phasing", "kappa", "force_rows", "factor_w", "slope_w", "sens_w",
-    "f0", "f1", "fn", "k1", "k2", "k3", "y1", "yn", "rhs", "w_hdt", "da", "control",
+    "f0", "f1", "fn", "k1", "k2", "k3", "y1", "yn", "rhs", "w_hdt", "da", "nz_index", "nz_value", "cos_alpha",
+    "control",
     # the state a failed step restores: contiguous, so that saving it is one copy into "backup"
     "istate", "dq", "dv", "winv", "w_basis", "port_jac", "last_acc", "last_force", "last_defl", "y",
     "backup", "driver", "port", "scalars", "twist_q", "output_matrix", "outputs",
 )
 (A_T, A_PORT, FAST, CONTACT, FORCE_W, DEFL_W, ACC_W, BT, STKS, STCS, STKS_PORT, STCS_PORT, INV_M, FD_W, FV_W,
- PHASING, KAPPA, FORCE_ROWS, FACTOR_W, SLOPE_W, SENS_W, F0, F1, FN, K1, K2, K3, Y1, YN, RHS, W_HDT, DA, CONTROL,
+ PHASING, KAPPA, FORCE_ROWS, FACTOR_W, SLOPE_W, SENS_W, F0, F1, FN, K1, K2, K3, Y1, YN, RHS, W_HDT, DA, NZ_INDEX,
+ NZ_VALUE, COS_ALPHA, CONTROL,
  ISTATE, DQ, DV, WINV, W_BASIS, PORT_JAC, LAST_ACC, LAST_FORCE, LAST_DEFL, Y, BACKUP, DRIVER, PORT, SCALARS,
  TWIST_Q, OUTPUT_MATRIX, OUTPUTS) = range(len(SLOTS))
 #: first and last slot of the restorable state
@@ -610,7 +632,7 @@ def _constants(buf, lay, dims):
         _vec(buf, lay, FACTOR_W), _vec(buf, lay, SLOPE_W), _vec(buf, lay, SENS_W),
         _vec(buf, lay, F0), _vec(buf, lay, F1), _vec(buf, lay, FN), _vec(buf, lay, K1), _vec(buf, lay, K2),
         _vec(buf, lay, K3), _vec(buf, lay, Y1), _vec(buf, lay, YN), _vec(buf, lay, RHS), _vec(buf, lay, W_HDT),
-        _vec(buf, lay, DA),
+        _vec(buf, lay, DA), _mat(buf, lay, NZ_INDEX, m), _mat(buf, lay, NZ_VALUE, m), _vec(buf, lay, COS_ALPHA),
     )
 
 
@@ -754,12 +776,12 @@ def monolithic_rhs(y, omega, alpha, factor, load, out_dof, kappa_out, inertia_in
 
 
 @njit(cache=False)
-def monolithic_jacobian(y, factor, a_t, a_port, contact, defl, bt, stks, stcs, stks_port, stcs_port, inv_m, fd, fv,
-                        dq, dv, port_jac, jac):
+def monolithic_jacobian(y, factor, a_t, a_port, contact, defl, nz_index, nz_value, cos_alpha, stks, stcs, stks_port,
+                        stcs_port, inv_m, fd, fv, dq, dv, port_jac, jac):
     """``MonolithicSystem.jacobian``: the acceleration rows of ``jac`` (the rest is fixed)."""
     n = inv_m.shape[0]
-    jacobian(y, 0.0, 0.0, factor, a_t, a_port, contact, defl, bt, stks, stcs, stks_port, stcs_port, inv_m, fd, fv,
-             dq, dv, port_jac)
+    jacobian(y, 0.0, 0.0, factor, a_t, a_port, contact, defl, nz_index, nz_value, cos_alpha, stks, stcs, stks_port,
+             stcs_port, inv_m, fd, fv, dq, dv, port_jac)
     for i in range(n):
         for j in range(n):
             jac[n + i, j] = dq[i, j]

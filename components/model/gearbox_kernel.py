@@ -51,7 +51,25 @@ def phasing_table(assembly: Assembly) -> np.ndarray:
     return np.vstack([ph._cycles_per_rad, ph._cycle0, ph._half_p, ph._inv_w, ph._v, ph._vp, ph._slope_scale])
 
 
-def slot_shapes(n: int, m: int, n_shaft: int, module) -> dict[str, tuple[int, ...]]:
+def mesh_sparsity(assembly: Assembly) -> tuple[np.ndarray, np.ndarray]:
+    """Nonzero columns of every mesh row of ``A`` (free bodies) and their entries, padded with -1 / 0.
+
+    Returns
+    -------
+    index, value : ndarray, shape (n_mesh, width)
+        ``width`` is the largest number of free bodies one mesh touches (at least 1).
+    """
+    rows = [np.flatnonzero(row) for row in assembly.A]
+    width = max([1] + [r.size for r in rows])
+    index = np.full((assembly.n_mesh, width), -1.0)
+    value = np.zeros((assembly.n_mesh, width))
+    for i, cols in enumerate(rows):
+        index[i, : cols.size] = cols
+        value[i, : cols.size] = assembly.A[i, cols]
+    return index, value
+
+
+def slot_shapes(n: int, m: int, n_shaft: int, module, width: int = 3) -> dict[str, tuple[int, ...]]:
     """Shape of every slot of the buffer for ``n`` degrees of freedom and ``m`` meshes."""
     n2 = 2 * n
     n_linear = 3 + m + n_shaft + n
@@ -61,7 +79,7 @@ def slot_shapes(n: int, m: int, n_shaft: int, module) -> dict[str, tuple[int, ..
         "stks_port": (n,), "stcs_port": (n,), "inv_m": (n,), "fd_w": (m,), "fv_w": (m,), "phasing": (7, m),
         "kappa": (n,), "force_rows": (m, n), "factor_w": (m,), "slope_w": (m,), "sens_w": (m,),
         **{name: (n2,) for name in ("f0", "f1", "fn", "k1", "k2", "k3", "y1", "yn", "rhs", "w_hdt")},
-        "da": (n,), "control": (8,), "istate": (module.N_ISTATE,), "dq": (n, n), "dv": (n, n), "winv": (n2, n2),
+        "da": (n,), "nz_index": (m, width), "nz_value": (m, width), "cos_alpha": (m,), "control": (8,), "istate": (module.N_ISTATE,), "dq": (n, n), "dv": (n, n), "winv": (n2, n2),
         "w_basis": (n2, 3), "port_jac": (2, n), "last_acc": (n,), "last_force": (m,), "last_defl": (2, m),
         "y": (n2,), "driver": (4,), "port": (4,), "scalars": (len(module.SCALAR_NAMES),), "twist_q": (n2,),
         "output_matrix": (m + n2 + 4, n_linear), "outputs": (n_linear + 4,),
@@ -116,7 +134,9 @@ class CompiledGearboxModel(GearboxModel):
         self._module = module
         module.ensure_compiled()
         a = self.assembly
-        self._kb = KernelBuffer(slot_shapes(a.n_dof, a.n_mesh, a.n_shaft, module), module.SLOTS)
+        self._sparsity = mesh_sparsity(a)
+        self._kb = KernelBuffer(slot_shapes(a.n_dof, a.n_mesh, a.n_shaft, module, self._sparsity[0].shape[1]),
+                                module.SLOTS)
         v = self._kb.views
         self._scalars = v["scalars"]
         self._istate = v["istate"]
@@ -134,6 +154,8 @@ class CompiledGearboxModel(GearboxModel):
         v["fast"][:] = a._fast_matrix
         v["contact"][:] = contact_table(a, mod)
         v["bt"][:] = a.BT
+        v["nz_index"][:], v["nz_value"][:] = self._sparsity
+        v["cos_alpha"][:] = a.cos_alpha
         v["stks"][:] = a.STkS
         v["stcs"][:] = a.STcS
         v["stks_port"][:] = a.STkS_port[:, 0]

@@ -115,7 +115,7 @@ class MonolithicSystem:
         self._compiled = self._compiled_arrays() if self.kernel == "compiled" else None
 
     def _compiled_arrays(self):
-        from ..model.gearbox_kernel import contact_table
+        from ..model.gearbox_kernel import contact_table, mesh_sparsity
 
         module = compiled_module()[0]
         a = self.assembly
@@ -130,10 +130,11 @@ class MonolithicSystem:
             c(a.s_driver), c(a.cos_alpha), c(a.inv_inertia), np.zeros(m), np.zeros(m), np.zeros((2, m)), np.zeros(n),
             self._rhs_out,
         )
+        nz_index, nz_value = mesh_sparsity(a)
         jac_args = (
-            c(a._A_T), np.zeros(m), contact_table(a, module), np.zeros((2, m)), c(a.BT), c(a.STkS), c(a.STcS),
-            np.zeros(n), np.zeros(n), c(a.inv_inertia), np.zeros(m), np.zeros(m), np.zeros((n, n)), np.zeros((n, n)),
-            np.zeros((2, n)), self._jac,
+            c(a._A_T), np.zeros(m), contact_table(a, module), np.zeros((2, m)), nz_index, nz_value, c(a.cos_alpha),
+            c(a.STkS), c(a.STcS), np.zeros(n), np.zeros(n), c(a.inv_inertia), np.zeros(m), np.zeros(m),
+            np.zeros((n, n)), np.zeros((n, n)), np.zeros((2, n)), self._jac,
         )
         # compile or load from the disk cache now, not inside the timed integration
         module.monolithic_rhs(np.zeros(2 * n + 3), 0.0, 0.0, self._ones, 0.0, *rhs_args)
