@@ -86,7 +86,7 @@ def main() -> None:
     from orchestrator.cosim.system import resolve_system
     from orchestrator.inputs.scenario import find_scenario, load_scenario
     from orchestrator.run.analyses import analyse_run
-    from orchestrator.run.comparison import generator_vs_ideal
+    from orchestrator.run.derived import generator_vs_ideal
     from orchestrator.run.plots import plot_run
     from orchestrator.run.results import SUMMARY_FILE, TIMESERIES_FILE, build_summary, write_timeseries
     from orchestrator.result_files import write_summary
