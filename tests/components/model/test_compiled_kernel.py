@@ -19,6 +19,7 @@ import pytest
 from components.errors import ParameterError, SolverError
 from components.model.assembly import Assembly
 from components.model.gearbox_model import GearboxModel
+from components.model.gearbox_kernel import contact_table, phasing_table
 from components.model.generator import GeneratorRotor
 from components.model.integrators import StepControl
 from components.model.kernel import ENVIRONMENT_VARIABLE, choose_kernel, compiled_module
@@ -117,7 +118,7 @@ def test_a_coupled_run_stays_close_over_many_steps():
 @pytest.mark.parametrize("name", ["table6", "table6-impact", "table6-mixed-laws", "table6-exponent-2"])
 def test_contact_law_matches_evaluate(name):
     a = Assembly(VARIANTS[name], cut_at_generator=True)
-    table = __import__("components.model.gearbox_kernel", fromlist=["contact_table"]).contact_table(a, ck)
+    table = contact_table(a, ck)
     rng = np.random.default_rng(3)
     half = a.law._half_jt
     d = (rng.uniform(-3.0, 3.0, (400, a.n_mesh)) * half) + rng.normal(0.0, 1e-5, (400, a.n_mesh))
@@ -132,8 +133,6 @@ def test_contact_law_matches_evaluate(name):
 
 
 def test_stiffness_factors_match_mesh_phasing():
-    from components.model.gearbox_kernel import phasing_table
-
     a = Assembly(VARIANTS["table6-stiffness-variation"], cut_at_generator=True)
     table = phasing_table(a)
     factor, slope = np.empty(a.n_mesh), np.empty(a.n_mesh)
