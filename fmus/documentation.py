@@ -115,6 +115,7 @@ def requirements_table(req: RuntimeRequirements) -> str:
     """Python and the packages: requirement, version tested, module imported."""
     rows = [("Python (CPython)", req.python_specifier, req.python_tested, "-")]
     rows += [(p.distribution, p.specifier, p.tested, p.module) for p in req.packages]
+    rows += [(f"{p.distribution} (optional: {p.purpose})", p.specifier, p.tested, p.module) for p in req.optional]
     lines = ['<table id="requirements-table">',
              "<tr><th>what</th><th>requirement</th><th>tested with</th><th>imported as</th></tr>"]
     lines += ["<tr>" + "".join(_cell(c) for c in row) + "</tr>" for row in rows]

@@ -6,7 +6,10 @@ Exactly the third-party top-level modules that the FMU's embedded code imports
 (:func:`third_party_modules`: every absolute ``import`` of the embedded modules'
 syntax trees, less the standard library and what the FMU carries itself:
 its copy of ``components``/``fmus.slaves`` and pythonfmu's Python package),
-mapped to the distributions that provide them in the build environment.
+mapped to the distributions that provide them in the build environment. An
+import whose line says ``# optional requirement: <what it gives>`` (the code
+falls back without it, e.g. numba for the compiled gearbox kernel) makes an
+*optional* requirement, unless the module is also imported without that note.
 
 Which versions (the range policy)
 ---------------------------------
@@ -57,18 +60,44 @@ EMBEDDED_PACKAGES = frozenset({"components", "fmus", "pythonfmu"})
 ARCHIVE_MEMBER = f"resources/{REQUIREMENTS_FILE}"
 
 
-def third_party_modules(sources: Iterable[Path]) -> tuple[str, ...]:
-    """Sorted top-level modules imported by ``sources`` that are neither stdlib nor embedded."""
-    found: set[str] = set()
+#: the note on an import line that makes its module an optional requirement
+OPTIONAL_NOTE = "# optional requirement:"
+
+
+def imported_modules(sources: Iterable[Path]) -> tuple[dict[str, None], dict[str, str]]:
+    """Third-party top-level modules imported by ``sources``: ``(required, optional -> purpose)``.
+
+    Neither the standard library nor what the FMU carries counts; a module imported
+    both with and without :data:`OPTIONAL_NOTE` is required.
+    """
+    required: dict[str, None] = {}
+    optional: dict[str, str] = {}
     for path in sources:
-        tree = ast.parse(Path(path).read_text(encoding="utf-8"), filename=str(path))
-        for node in ast.walk(tree):
+        text = Path(path).read_text(encoding="utf-8")
+        lines = text.splitlines()
+        for node in ast.walk(ast.parse(text, filename=str(path))):
             if isinstance(node, ast.Import):
-                found.update(alias.name.split(".")[0] for alias in node.names)
+                names = [alias.name.split(".")[0] for alias in node.names]
             elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
-                found.add(node.module.split(".")[0])
-    stdlib = set(sys.stdlib_module_names) | {"__future__"}
-    return tuple(sorted(found - stdlib - EMBEDDED_PACKAGES))
+                names = [node.module.split(".")[0]]
+            else:
+                continue
+            line = lines[node.lineno - 1]
+            note = line.partition(OPTIONAL_NOTE)[2].strip() if OPTIONAL_NOTE in line else None
+            for name in names:
+                if note is None:
+                    required[name] = None
+                else:
+                    optional.setdefault(name, note)
+    ignored = set(sys.stdlib_module_names) | {"__future__"} | EMBEDDED_PACKAGES
+    required = {m: None for m in sorted(required) if m not in ignored}
+    optional = {m: p for m, p in sorted(optional.items()) if m not in ignored and m not in required}
+    return required, optional
+
+
+def third_party_modules(sources: Iterable[Path]) -> tuple[str, ...]:
+    """Sorted top-level modules the code of ``sources`` requires (optional ones left out)."""
+    return tuple(imported_modules(sources)[0])
 
 
 def distribution_of(module: str) -> str:
@@ -90,7 +119,8 @@ def python_range(version: tuple[int, ...]) -> tuple[tuple[int, ...], tuple[int, 
 
 def from_environment(fmu: str, modules: Iterable[str], python: tuple[int, ...] | None = None,
                      version_of: Callable[[str], str] = metadata.version,
-                     distribution: Callable[[str], str] = distribution_of) -> RuntimeRequirements:
+                     distribution: Callable[[str], str] = distribution_of,
+                     optional: dict[str, str] | None = None) -> RuntimeRequirements:
     """Requirements of FMU ``fmu`` whose code imports ``modules``, from the versions installed here.
 
     Parameters
@@ -103,6 +133,9 @@ def from_environment(fmu: str, modules: Iterable[str], python: tuple[int, ...] |
         Python version of the build (default: this interpreter).
     version_of, distribution : callable
         Installed version of a distribution; distribution of a module (default: this environment).
+    optional : mapping of str -> str, optional
+        Optional modules and what they give (:func:`imported_modules`); those not installed here
+        are left out (the FMU was tested without them).
 
     Raises
     ------
@@ -116,8 +149,17 @@ def from_environment(fmu: str, modules: Iterable[str], python: tuple[int, ...] |
         version = version_of(dist)
         minimum, below = tested_range(version)
         packages.append(PackageRequirement(dist, module, minimum, below, version))
+    extras = []
+    for module, purpose in sorted((optional or {}).items()):
+        dist = distribution(module)
+        try:
+            version = version_of(dist)
+        except metadata.PackageNotFoundError:
+            continue
+        minimum, below = tested_range(version)
+        extras.append(PackageRequirement(dist, module, minimum, below, version, purpose))
     py_min, py_below = python_range(python)
-    return RuntimeRequirements(fmu, py_min, py_below, ".".join(map(str, python)), tuple(packages))
+    return RuntimeRequirements(fmu, py_min, py_below, ".".join(map(str, python)), tuple(packages), tuple(extras))
 
 
 def read_from_fmu(fmu_path: Path | str) -> RuntimeRequirements | None:
@@ -156,6 +198,10 @@ def check_environment(req: RuntimeRequirements, python: tuple[int, ...] | None =
     for p in req.packages:
         if find_module(p.module) is None:
             missing.append(f"module {p.module!r} not found: install {p.specifier} (tested with {p.tested})")
-    present = {p.module for p in req.packages if find_module(p.module) is not None}
-    warnings = version_warnings(req, python, lambda p: installed(p) if p.module in present else None)
+    present = {p.module for p in req.packages + req.optional if find_module(p.module) is not None}
+    warnings = list(version_warnings(req, python, lambda p: installed(p) if p.module in present else None))
+    for p in req.optional:
+        if p.module not in present:
+            warnings.append(f"optional module {p.module!r} not found ({p.specifier}: {p.purpose}); the FMU runs "
+                            "without it")
     return EnvironmentCheck(tuple(missing), tuple(warnings))

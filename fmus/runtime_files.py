@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Any, Iterable, Mapping
 from xml.etree import ElementTree as ET
 
-from .requirements import from_environment, third_party_modules
+from .requirements import from_environment, imported_modules
 from .runtime_guard import REQUIREMENTS_FILE, RuntimeRequirements, format_requirements
 
 #: The guard's source and its file name inside the embedded package.
@@ -70,7 +70,8 @@ def write(staging_dir: Path, name: str, origin: str, model: Mapping[str, Any], b
 
     out = Path(staging_dir) / "runtime"
     out.mkdir(parents=True, exist_ok=True)
-    req = from_environment(name, third_party_modules(sources))
+    required, optional = imported_modules(sources)
+    req = from_environment(name, required, optional=optional)
     requirements_file = out / REQUIREMENTS_FILE
     requirements_file.write_text(format_requirements(req, _HEADER), encoding="utf-8")
     docs = write_documentation(out / "documentation", BuildFacts(name, origin, model, build_id, version, req,

@@ -10,6 +10,11 @@ time) is a pip requirements file whose comments carry what pip cannot express::
 
     # requires-python: >=3.11,<3.12  (tested: 3.11.7)
     numpy>=2.4,<3  # tested: 2.4.6 (import numpy)
+    # optional: numba>=0.68,<1  # tested: 0.68.1 (import numba) compiled gearbox kernel ...
+
+An optional package is one the FMU's code can do without (declared next to its
+import with the comment ``# optional requirement: <what it gives>``); it is a
+comment line, so ``pip install -r`` installs only what is required.
 
 What the FMU does with it (:func:`load_slave`, called by the entry script):
 
@@ -37,7 +42,9 @@ Version = Tuple[int, ...]
 _PYTHON_LINE = re.compile(r"^#\s*requires-python:\s*>=([0-9.]+),<([0-9.]+)\s*\(tested:\s*([^)\s]+)\)")
 _PACKAGE_LINE = re.compile(
     r"^([A-Za-z0-9][A-Za-z0-9._-]*)>=([0-9.]+),<([0-9.]+)\s*#\s*tested:\s*(\S+)\s*\(import\s+([A-Za-z_][\w]*)\)"
+    r"\s*(.*)$"
 )
+_OPTIONAL_PREFIX = "# optional:"
 
 
 class RequirementsFormatError(ValueError):
@@ -80,6 +87,7 @@ class PackageRequirement:
     minimum: Version
     below: Version
     tested: str
+    purpose: str = ""
 
     @property
     def specifier(self) -> str:
@@ -104,6 +112,9 @@ class RuntimeRequirements:
     python_tested : str
         Python version of the build.
     packages : tuple of PackageRequirement
+        Required: without one of them the FMU cannot start.
+    optional : tuple of PackageRequirement
+        Used where present (``purpose`` says for what); the FMU runs without them.
     """
 
     fmu: str
@@ -111,6 +122,7 @@ class RuntimeRequirements:
     python_below: Version
     python_tested: str
     packages: Tuple[PackageRequirement, ...]
+    optional: Tuple[PackageRequirement, ...] = ()
 
     @property
     def python_specifier(self) -> str:
@@ -122,11 +134,13 @@ class RuntimeRequirements:
         text = "Python " + self.python_specifier
         if self.packages:
             text += " with " + ", ".join(p.specifier for p in self.packages)
+        if self.optional:
+            text += " (optional: " + ", ".join(p.specifier for p in self.optional) + ")"
         return text
 
     def package(self, module: str) -> Optional[PackageRequirement]:
         """The requirement providing top-level module ``module``, if any."""
-        for p in self.packages:
+        for p in self.packages + self.optional:
             if p.module == module:
                 return p
         return None
@@ -140,6 +154,9 @@ def format_requirements(req: RuntimeRequirements, header: str = "") -> str:
     lines.append("# requires-python: %s  (tested: %s)" % (req.python_specifier, req.python_tested))
     for p in req.packages:
         lines.append("%s  # tested: %s (import %s)" % (p.specifier, p.tested, p.module))
+    for p in req.optional:
+        lines.append("%s %s  # tested: %s (import %s) %s" % (_OPTIONAL_PREFIX, p.specifier, p.tested, p.module,
+                                                             p.purpose))
     return "\n".join(lines) + "\n"
 
 
@@ -154,6 +171,7 @@ def parse_requirements(text: str, fmu: str = "") -> RuntimeRequirements:
     """
     python = None
     packages = []
+    optional = []
     for number, raw in enumerate(text.splitlines(), 1):
         line = raw.strip()
         if not line:
@@ -162,17 +180,20 @@ def parse_requirements(text: str, fmu: str = "") -> RuntimeRequirements:
         if m:
             python = (release(m.group(1)), release(m.group(2)), m.group(3))
             continue
-        if line.startswith("#"):
+        target = packages
+        if line.startswith(_OPTIONAL_PREFIX):
+            line, target = line[len(_OPTIONAL_PREFIX):].strip(), optional
+        elif line.startswith("#"):
             continue
         m = _PACKAGE_LINE.match(line)
         if not m:
             raise RequirementsFormatError(
                 "line %d %r: expected 'name>=A.B,<C  # tested: X.Y.Z (import module)'" % (number, line))
-        packages.append(PackageRequirement(m.group(1), m.group(5), release(m.group(2)), release(m.group(3)),
-                                           m.group(4)))
+        target.append(PackageRequirement(m.group(1), m.group(5), release(m.group(2)), release(m.group(3)),
+                                         m.group(4), m.group(6).strip()))
     if python is None:
         raise RequirementsFormatError("no '# requires-python: >=A.B,<C.D  (tested: X.Y.Z)' line")
-    return RuntimeRequirements(fmu, python[0], python[1], python[2], tuple(packages))
+    return RuntimeRequirements(fmu, python[0], python[1], python[2], tuple(packages), tuple(optional))
 
 
 def read_requirements(resources_dir: str, fmu: str = "") -> Optional[RuntimeRequirements]:
@@ -217,7 +238,7 @@ def version_warnings(req: RuntimeRequirements, version: Version = None,
     if not version < req.python_below:
         out.append("Python %s is outside the tested range %s (tested with %s)"
                    % (dotted(version), req.python_specifier, req.python_tested))
-    for p in req.packages:
+    for p in req.packages + req.optional:
         found = installed(p)
         if found is not None and not p.admits(found):
             out.append("%s %s is outside the tested range %s (tested with %s)"

@@ -130,7 +130,7 @@ def run_fmus(python: Path, fmu_paths: Sequence[Path], steps: int = STEPS, timeou
     for path in fmu_paths:
         report = reports[str(path)]
         req = read_from_fmu(path)
-        declared = {p.module for p in req.packages}
+        declared = {p.module for p in req.packages + req.optional}
         undeclared = tuple(m for m in report["imports"] if m not in declared)
         error = report["error"]
         if error is None and undeclared:

@@ -125,7 +125,11 @@ class ShaftElement:
 
 @dataclass(frozen=True)
 class InternalLoads:
-    """Mesh and shaft loads at one or many states; arrays shaped ``(..., n_mesh)`` / ``(..., n_shaft)``."""
+    """Mesh and shaft loads at one or many states; arrays shaped ``(..., n_mesh)`` / ``(..., n_shaft)``.
+
+    ``d_force_d_deflection`` and ``d_force_d_rate`` are None when the loads were
+    evaluated without derivatives (``Assembly.loads(..., derivatives=False)``).
+    """
 
     deflection_m: np.ndarray
     deflection_rate_m_s: np.ndarray
@@ -402,6 +406,7 @@ class Assembly:
         q_port: np.ndarray | None = None,
         v_port: np.ndarray | None = None,
         stiffness_factor: np.ndarray | float = 1.0,
+        derivatives: bool = True,
     ) -> InternalLoads:
         """Deflections, contact forces and shaft torques.
 
@@ -413,6 +418,8 @@ class Assembly:
             Deviation angle [rad] and speed [rad/s] of the prescribed port(s).
         stiffness_factor : ndarray or float
             Mesh stiffness multiplier, shape broadcastable to ``(..., n_mesh)``.
+        derivatives : bool
+            Also the force derivatives (for a Jacobian); False leaves them None and costs less.
         """
         d = q @ self.A.T
         dd = v @ self.A.T
@@ -423,8 +430,11 @@ class Assembly:
             dd = dd + v_port @ self.A_port.T
             s = s + q_port @ self.S_port.T
             sd = sd + v_port @ self.S_port.T
-        cf = self.law.evaluate(d, dd, stiffness_factor)
         torque = self.shaft_k * s + self.shaft_c * sd
+        if not derivatives:
+            force, elastic = self.law.force_and_elastic(d, dd, stiffness_factor)
+            return InternalLoads(d, dd, force, None, None, elastic, s, sd, torque)
+        cf = self.law.evaluate(d, dd, stiffness_factor)
         return InternalLoads(d, dd, cf.force, cf.d_force_d_deflection, cf.d_force_d_rate, cf.elastic, s, sd, torque)
 
     def fast_acceleration(

@@ -320,6 +320,34 @@ class ContactLaw:
             elastic = np.where(sel, imp.elastic, elastic)
         return ContactForces(force, dF_dd, dF_dv, elastic)
 
+    def force_and_elastic(
+        self, deflection: np.ndarray, rate: np.ndarray, stiffness_factor: np.ndarray | float = 1.0
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Contact force [N] and its elastic part [N] at one or many states, without derivatives.
+
+        The same numbers as ``evaluate(...).force`` and ``evaluate(...).elastic`` (same
+        operations in the same order) for callers that need no Jacobian: the monolithic
+        right-hand side and the evaluation of recorded results.
+
+        Parameters
+        ----------
+        deflection, rate : ndarray, shape (..., n_mesh)
+            Deflection [m] and its rate [m/s].
+        stiffness_factor : ndarray or float
+            Multiplier on k0.
+        """
+        if self._any_impact:
+            cf = self.evaluate(deflection, rate, stiffness_factor)
+            return cf.force, cf.elastic
+        k = self._k * stiffness_factor
+        d_bl, d_bl_p, _ = self.backlash_deflection(deflection)
+        abs_bl = np.abs(d_bl)
+        sgn = np.sign(d_bl)
+        pow_em1 = np.sqrt(abs_bl) if self._sqrt_law else abs_bl ** (self._e - 1.0)
+        elastic = k * sgn * pow_em1 * abs_bl  # eq. 2
+        force = elastic + self._c * abs_bl * (d_bl_p * rate)  # eq. 2, 9
+        return np.where(force * np.sign(deflection) > 0.0, force, 0.0), elastic  # flank-consistent clipping
+
     def force(self, deflection: np.ndarray, rate: np.ndarray, stiffness_factor: np.ndarray | float = 1.0) -> np.ndarray:
         """Contact forces only (no derivatives) for one state, shape (n_mesh,) [N].
 

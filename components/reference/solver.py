@@ -24,6 +24,7 @@ from scipy.integrate import odeint
 from ..errors import ParameterError, SolverError, WallTimeLimitError
 from ..model.assembly import Assembly
 from ..model.drivetrain import Drivetrain
+from ..model.kernel import choose_kernel, compiled_module
 from ..validation import finite, non_negative, positive
 from .results import EnergyAudit, SimulationResult
 
@@ -78,15 +79,23 @@ class SolverSettings:
 class MonolithicSystem:
     """Right-hand side and Jacobian of the monolithic ODE.
 
+    The right-hand side evaluates the driver once per call (its ``motion(t)`` where it
+    has one: angle, speed and acceleration from one set of phases) and the contact forces
+    without their derivatives; the Jacobian evaluates the derivatives. With the compiled
+    kernel (:mod:`components.model.kernel`) both run in
+    :func:`components.model.compiled_kernel.monolithic_rhs` / ``monolithic_jacobian``.
+
     Parameters
     ----------
     drivetrain : Drivetrain
         Gearbox (and generator, if any).
     driver : SpeedDriver
         Kinematic rotor-speed driver of the first stage's input member.
+    kernel : {"auto", "numpy", "compiled"}, optional
+        Implementation (default ``$DTCOSIM_KERNEL``, else ``auto``).
     """
 
-    def __init__(self, drivetrain: Drivetrain, driver: SpeedDriver) -> None:
+    def __init__(self, drivetrain: Drivetrain, driver: SpeedDriver, kernel: str | None = None) -> None:
         self.assembly = Assembly(drivetrain)
         self.driver = driver
         self.schedule = drivetrain.load_schedule()
@@ -101,6 +110,36 @@ class MonolithicSystem:
         self.jac_calls = 0
         self.deadline = math.inf  # time.perf_counter() value past which rhs raises (see start_clock)
         self.wall_time_limit_s = 0.0
+        self._motion = getattr(driver, "motion", None)
+        self.kernel, self.kernel_note = choose_kernel(kernel)
+        self._compiled = self._compiled_arrays() if self.kernel == "compiled" else None
+
+    def _compiled_arrays(self):
+        from ..model.gearbox_kernel import contact_table, mesh_sparsity
+
+        module = compiled_module()[0]
+        a = self.assembly
+        n, m = a.n_dof, a.n_mesh
+        c = np.ascontiguousarray
+        self._module = module
+        self._ones = np.ones(m)
+        self._rhs_out = np.zeros(2 * n + 3)
+        rhs_args = (
+            self._out, self._kappa_out, float(a.driver_inertia_kgm2), c(a._A_T), np.zeros(m), c(a._fast_matrix),
+            contact_table(a, module), c(a.S), c(a.shaft_k, dtype=float), c(a.shaft_c, dtype=float), c(a.BT_driver),
+            c(a.s_driver), c(a.cos_alpha), c(a.inv_inertia), np.zeros(m), np.zeros(m), np.zeros((2, m)), np.zeros(n),
+            self._rhs_out,
+        )
+        nz_index, nz_value = mesh_sparsity(a)
+        jac_args = (
+            c(a._A_T), np.zeros(m), contact_table(a, module), np.zeros((2, m)), nz_index, nz_value, c(a.cos_alpha),
+            c(a.STkS), c(a.STcS), np.zeros(n), np.zeros(n), c(a.inv_inertia), np.zeros(m), np.zeros(m),
+            np.zeros((n, n)), np.zeros((n, n)), np.zeros((2, n)), self._jac,
+        )
+        # compile or load from the disk cache now, not inside the timed integration
+        module.monolithic_rhs(np.zeros(2 * n + 3), 0.0, 0.0, self._ones, 0.0, *rhs_args)
+        module.monolithic_jacobian(np.zeros(2 * n + 3), self._ones, *jac_args)
+        return rhs_args, jac_args
 
     def start_clock(self, wall_time_limit_s: float) -> None:
         """Let :meth:`rhs` raise :class:`WallTimeLimitError` ``wall_time_limit_s`` [s] from now (0: never)."""
@@ -108,22 +147,37 @@ class MonolithicSystem:
         self.deadline = time.perf_counter() + wall_time_limit_s if wall_time_limit_s > 0 else math.inf
 
     def _driver_state(self, t: float) -> tuple[float, float, float | np.ndarray]:
-        alpha = float(self.driver.acceleration(t))
-        omega = float(self.driver.speed(t))
-        kfac = self.assembly.stiffness_factor(float(self.driver.angle(t))) if self.assembly.time_varying_stiffness else 1.0
+        """Driver speed [rad/s], acceleration [rad/s^2] and the mesh stiffness factors at ``t``, one evaluation."""
+        if self._motion is not None:
+            angle, omega, alpha = self._motion(t)
+        else:
+            omega, alpha = float(self.driver.speed(t)), float(self.driver.acceleration(t))
+            angle = float(self.driver.angle(t)) if self.assembly.time_varying_stiffness else 0.0
+        kfac = self.assembly.stiffness_factor(angle) if self.assembly.time_varying_stiffness else 1.0
         return omega, alpha, kfac
+
+    def _stiffness_factor(self, t: float) -> np.ndarray | float:
+        """Mesh stiffness factors at ``t`` (1.0 without the option; the driver angle only is evaluated)."""
+        if not self.assembly.time_varying_stiffness:
+            return 1.0
+        return self.assembly.stiffness_factor(float(self.driver.angle(t)))
 
     def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
         """dy/dt at time t [s]."""
         self.rhs_calls += 1
         if time.perf_counter() > self.deadline:
             raise WallTimeLimitError(self.wall_time_limit_s, t)
+        omega_in, alpha_in, kfac = self._driver_state(t)
+        if self._compiled is not None:
+            factor = self._ones if type(kfac) is float else np.ascontiguousarray(kfac, dtype=float)
+            self._module.monolithic_rhs(np.ascontiguousarray(y, dtype=float), omega_in, alpha_in, factor,
+                                        self.load_torque_nm, *self._compiled[0])
+            return self._rhs_out.copy()
         a = self.assembly
         n = self.n
         q = y[:n]
         v = y[n : 2 * n]
-        omega_in, alpha_in, kfac = self._driver_state(t)
-        loads = a.loads(q, v, stiffness_factor=kfac)
+        loads = a.loads(q, v, stiffness_factor=kfac, derivatives=False)
         Q = a.generalised_forces(loads)
         Q[self._out] -= self.load_torque_nm
         acc = a.inv_inertia * Q - a.kinematic_ratio * alpha_in
@@ -141,7 +195,11 @@ class MonolithicSystem:
         self.jac_calls += 1
         a = self.assembly
         n = self.n
-        _, _, kfac = self._driver_state(t)
+        kfac = self._stiffness_factor(t)
+        if self._compiled is not None:
+            factor = self._ones if type(kfac) is float else np.ascontiguousarray(kfac, dtype=float)
+            self._module.monolithic_jacobian(np.ascontiguousarray(y, dtype=float), factor, *self._compiled[1])
+            return self._jac
         loads = a.loads(y[:n], y[n : 2 * n], stiffness_factor=kfac)
         dq, dv, _, _ = a.acceleration_jacobian(loads)
         J = self._jac
@@ -159,6 +217,7 @@ def simulate_monolithic(
     t_start_s: float = 0.0,
     raise_on_failure: bool = False,
     initial_state: np.ndarray | None = None,
+    kernel: str | None = None,
 ) -> SimulationResult:
     """Integrate the monolithic drivetrain model.
 
@@ -187,6 +246,8 @@ def simulate_monolithic(
         ``[q, v]`` at ``t_start_s``: deviation angles [rad] and deviation speeds
         [rad/s] of the free bodies (order of ``Assembly.dof_names``), relative to
         the kinematic motion ``kappa * theta_in``. Default: zeros.
+    kernel : {"auto", "numpy", "compiled"}, optional
+        Implementation of the right-hand side and Jacobian (see :class:`MonolithicSystem`).
 
     Returns
     -------
@@ -195,7 +256,9 @@ def simulate_monolithic(
         samples up to the failure if the integrator stopped early. ``info`` holds
         ``rhs_calls``, ``jacobian_calls``, ``steps`` (LSODA's internal steps) and
         ``cpu_time_s`` (process CPU time of the integration alone [s], like
-        ``wall_time_s`` without the evaluation of the recorded variables).
+        ``wall_time_s`` without the evaluation of the recorded variables),
+        ``total_cpu_time_s`` (integration and evaluation of the recorded variables [s])
+        and ``kernel`` (``compiled`` or ``numpy``).
     """
     settings = settings or SolverSettings()
     t0 = finite("t_start_s", t_start_s)
@@ -203,7 +266,7 @@ def simulate_monolithic(
     if not t1 > t0:
         raise ParameterError("t_end_s", t_end_s, f"> t_start_s = {t0:g}")
     dt = positive("output_interval_s", output_interval_s)
-    system = MonolithicSystem(drivetrain, driver)
+    system = MonolithicSystem(drivetrain, driver, kernel)
     n = system.n
     # whole output intervals that fit (never past t_end), then t_end itself if it is not one of them
     n_out = int(math.floor((t1 - t0) / dt + 1e-9))
@@ -297,11 +360,12 @@ def simulate_monolithic(
     cpu = time.process_time() - cpu_start
     valid = reached + 1 if not complete else t_out.size
     result = _collect(system, t_out[:valid], Y[:valid])
+    total_cpu = time.process_time() - cpu_start
     result.complete = complete
     result.message = message
     result.wall_time_s = wall
     result.info = {"rhs_calls": system.rhs_calls, "jacobian_calls": system.jac_calls, "solver": "LSODA",
-                   "steps": steps, "cpu_time_s": cpu}
+                   "steps": steps, "cpu_time_s": cpu, "total_cpu_time_s": total_cpu, "kernel": system.kernel}
     return result
 
 
@@ -319,7 +383,7 @@ def _collect(system: MonolithicSystem, t: np.ndarray, Y: np.ndarray) -> Simulati
         alpha_in = np.asarray(drv.acceleration(t), dtype=float) * np.ones_like(t)
         angle_in = np.asarray(drv.angle(t), dtype=float) * np.ones_like(t)
     kfac = a.stiffness_factor(angle_in) if a.time_varying_stiffness else 1.0
-    loads = a.loads(q, v, stiffness_factor=kfac)
+    loads = a.loads(q, v, stiffness_factor=kfac, derivatives=False)
     load_torque = np.asarray(system.schedule(t), dtype=float) * np.ones_like(t)
     Q = a.generalised_forces(loads)
     Q[:, system._out] -= load_torque

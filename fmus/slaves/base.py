@@ -61,6 +61,7 @@ from components.errors import DtcosimError, ParameterError
 
 from .interface import BOOLEAN, INPUT, INTEGER, OUTPUT, PARAMETER, REAL, Value, Variable
 from .record import read_record
+from .shutdown import register_state_release
 
 #: Life-cycle phases of an instance.
 INSTANTIATED, INITIALIZATION, STEPPING, TERMINATED = "instantiated", "initialization", "stepping", "terminated"
@@ -140,6 +141,7 @@ class DtcosimSlave(Fmi2Slave):
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__(**kwargs)
+        register_state_release(self.resources)  # pythonfmu's exit-time use-after-free, see .shutdown
         #: the parameter set of this FMU's record (structure and defaults)
         self.model: dict[str, Any] = read_record(self.resources)["model"]
         variables = self.interface(self.model)

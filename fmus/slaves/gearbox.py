@@ -22,6 +22,8 @@ from __future__ import annotations
 
 from typing import Any, Hashable, Iterable, Mapping
 
+from pythonfmu.enums import Fmi2Status
+
 from components.errors import ParameterError
 from components.model.assembly import Assembly
 from components.model.description import build
@@ -135,6 +137,7 @@ class Gearbox(DtcosimSlave):
         contiguous = self._vr_outputs == list(range(first, first + len(names)))
         self._output_slice = slice(first, first + len(names)) if contiguous else None
         self.model: GearboxModel | None = None
+        self._kernel_reported = False
 
     def output_group(self, name: str) -> Hashable:
         return _OUTPUTS
@@ -147,6 +150,9 @@ class Gearbox(DtcosimSlave):
         drivetrain = drivetrain_from_values(self._template, self.value)
         control = control_from_values(self.value)
         self.model = GearboxModel(drivetrain, control, SHAFT_TORQUE_MODES[mode], bool(self.value("extrapolate_inputs")))
+        if self.model.kernel_note and not self._kernel_reported:  # once per instance: the host sees why it is slower
+            self._report(f"Gearbox: {self.model.kernel_note}", Fmi2Status.warning)
+            self._kernel_reported = True
 
     def _initialize(self, start_time: float) -> None:
         values = self._values
@@ -158,7 +164,7 @@ class Gearbox(DtcosimSlave):
         self.model.step(time, step_size, values[i[0]], values[i[1]], values[i[2]], values[i[3]])
 
     def _refresh(self, group: Hashable) -> None:
-        out = self.model.output_vector().tolist()
+        out = self.model.output_list()
         if self._output_slice is not None:
             self._values[self._output_slice] = out
         else:

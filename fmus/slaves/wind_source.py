@@ -5,7 +5,9 @@ Parameters (SI, paper defaults): ``omega0``, ``a``, ``sigma``, ``n_harmonics``,
 ``W_k = sqrt(2 S df)``, 1 = the paper's literal ``W_k = S df``).
 Outputs: rotor speed ``omega`` [rad/s] and angle ``phi`` [rad] (``phi(0) = 0``)
 at the current communication point. The signal is a closed-form function of
-time, so the only state is the time itself.
+time; the FMU steps it by rotating the harmonics' phasors
+(:class:`components.model.wind.PhasorStepper`, re-anchored on the closed form
+periodically), whose state the FMU state carries.
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ from typing import Any, Hashable, Iterable, Mapping
 from components.errors import ParameterError
 from components.model.description import build
 from components.model.parameter_map import WIND_FIELDS, wind_from_values
-from components.model.wind import AMPLITUDE_CONVENTIONS, RotorSpeedProcess
+from components.model.wind import AMPLITUDE_CONVENTIONS, PhasorStepper, RotorSpeedProcess
 
 from .base import DtcosimSlave
 from .interface import (
@@ -60,21 +62,27 @@ class WindSource(DtcosimSlave):
     def _configure(self) -> None:
         values = {name: self.value(name) for name in (*WIND_FIELDS, "amplitude")}
         self.process = RotorSpeedProcess(wind_from_values(values, build(self.model["wind"], "model.wind")))
+        self.stepper = PhasorStepper(self.process)
         self._vr_omega = self.vr["omega"]
         self._vr_phi = self.vr["phi"]
 
     def _initialize(self, start_time: float) -> None:
-        pass  # closed form in time: nothing to initialise
+        self.stepper.reset(start_time)
 
     def _step(self, time: float, step_size: float) -> None:
         if not step_size > 0.0:
             raise ParameterError("step_size", step_size, "> 0")
+        self.stepper.advance(time, step_size)
 
     def _refresh(self, group: Hashable) -> None:
-        self._values[self._vr_omega], self._values[self._vr_phi] = self.process.speed_and_angle(self._time)
+        stepper = self.stepper
+        if stepper.time_s != self._time:  # e.g. outputs read in initialisation mode at another start time
+            stepper.reset(self._time)
+        self._values[self._vr_omega], self._values[self._vr_phi] = stepper.speed_and_angle()
 
     def _component_state(self) -> dict:
-        return {}
+        return self.stepper.get_state()
 
     def _restore_component_state(self, state: dict) -> None:
-        pass
+        if state:  # an empty dict: a state of the closed-form FMU (before the phasor stepper)
+            self.stepper.set_state(state)

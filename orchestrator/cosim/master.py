@@ -116,6 +116,9 @@ class RunOutcome:
         Whole run: instantiation, initialisation, stepping, cleanup [s].
     loop_time_s : float
         Stepping loop only [s].
+    cpu_time_s, loop_cpu_time_s : float
+        Process CPU time [s] of the whole run and of the stepping loop (the FMUs run in
+        this process, so it includes their work; use it for benchmarks on a shared machine).
     initial_values : dict of str -> float
         Values transferred by the initialisation sweeps (``"generator.omega0"`` ...).
     fmu_log : dict of str -> list of str
@@ -135,6 +138,8 @@ class RunOutcome:
     interrupted: bool = False
     wall_time_s: float = 0.0
     loop_time_s: float = 0.0
+    cpu_time_s: float = 0.0
+    loop_cpu_time_s: float = 0.0
     initial_values: dict[str, float] = field(default_factory=dict)
     fmu_log: dict[str, list[str]] = field(default_factory=dict)
     profile: dict[str, dict[str, float]] | None = None
@@ -230,6 +235,7 @@ class CoSimulation:
             If instantiation or initialisation fails (nothing to record yet).
         """
         wall0 = time.perf_counter()
+        cpu0 = time.process_time()
         sim = self.settings
         n_steps = sim.n_steps
         stride = sim.output_stride
@@ -252,10 +258,12 @@ class CoSimulation:
             make_loop = compile_step_loop if self.step_loop == "generated" else interpreted_step_loop
             advance = make_loop(slots, sim.algorithm, sim.extrapolation, stride, data, ring, timers)
             loop0 = time.perf_counter()
+            loop_cpu0 = time.process_time()
             deadline = wall0 + wall_time_limit_s if wall_time_limit_s else math.inf
             k_done, error, interrupted = self._loop(advance, slots, data, n_steps, stride, progress, handle_sigint,
                                                     deadline, wall_time_limit_s)
             loop_time = time.perf_counter() - loop0
+            loop_cpu = time.process_time() - loop_cpu0
         finally:
             self._close()
         rows = k_done // stride + 1
@@ -273,6 +281,8 @@ class CoSimulation:
             interrupted=interrupted,
             wall_time_s=time.perf_counter() - wall0,
             loop_time_s=loop_time,
+            cpu_time_s=time.process_time() - cpu0,
+            loop_cpu_time_s=loop_cpu,
             initial_values=initial_values,
             fmu_log={name: list(inst.log) for name, inst in self.instances.items()},
             profile=None if timers is None else {

@@ -5,8 +5,8 @@ A command line (``--stop``, ``--step``, ``--output-interval``, ``--algorithm``,
 and parameter values) change a scenario the same way:
 
 * the given time-grid values and master options replace the scenario's;
-* a new step larger than the scenario's output interval raises the output
-  interval to the step (unless an output interval is given too);
+* with a new step the output interval, unless given too, stays the scenario's if
+  it is a whole multiple of the step, and becomes the step otherwise;
 * the analysis window, unless given, is kept if it lies inside the new run, and
   clipped to it otherwise: it ends at ``min(end, stop)`` and begins where it did
   if that is still inside, else at the start. The change is reported as a note,
@@ -75,9 +75,12 @@ class SimulationOverrides:
         """The :class:`~orchestrator.inputs.scenario.SimulationSettings` changes and notes for ``sim``."""
         changes = {f.name: getattr(self, f.name) for f in fields(self) if getattr(self, f.name) is not None}
         notes: list[str] = []
-        if self.step_s is not None and self.output_interval_s is None and sim.output_interval_s < self.step_s:
-            changes["output_interval_s"] = self.step_s
-            notes.append(f"output interval raised from {sim.output_interval_s:g} s to the new step {self.step_s:g} s")
+        if self.step_s is not None and self.output_interval_s is None:
+            ratio = sim.output_interval_s / self.step_s
+            if ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-9 * ratio:
+                changes["output_interval_s"] = self.step_s
+                notes.append(f"output interval {sim.output_interval_s:g} s is no whole multiple of the new step "
+                             f"{self.step_s:g} s: sampling every step")
         if self.window_s is None:
             start = changes.get("start_s", sim.start_s)
             stop = changes.get("stop_s", sim.stop_s)

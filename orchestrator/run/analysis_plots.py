@@ -19,7 +19,7 @@ import numpy as np  # noqa: E402
 from components.analysis.fatigue import LoadDurationDistribution  # noqa: E402
 from components.analysis.spectrum import amplitude_spectrum  # noqa: E402
 
-from ..plotting import close_figure, shade_inside_backlash  # noqa: E402
+from ..plotting import close_figure, envelope, shade_inside_backlash  # noqa: E402
 
 
 def plot_force_spectra(
@@ -53,7 +53,10 @@ def plot_force_spectra(
     cmap = plt.get_cmap("tab10")
     for ax, (name, x) in zip(axes[:, 0], series.items()):
         f, amp = amplitude_spectrum(np.asarray(x)[sel], dt)
-        ax.semilogy(f[1:], np.maximum(amp[1:], 1e-12), lw=0.8, color="black")
+        if max_frequency_hz:  # only the shown band, drawn as its envelope (every peak kept)
+            band = f <= max_frequency_hz * 1.001
+            f, amp = f[band], amp[band]
+        ax.semilogy(*envelope(f[1:], np.maximum(amp[1:], 1e-12)), lw=0.8, color="black")
         for k, (label, fm) in enumerate((mesh_frequencies_hz or {}).items()):
             ax.axvline(fm, ls="--", lw=1.0, color=cmap(k % 10), label=f"{label} {fm:.4g} Hz")
         ax.set_ylabel(f"|{name}| [N]")

@@ -16,7 +16,7 @@ from fmpy import read_model_description
 from components.model.gearbox_model import GearboxModel
 from components.model.generator import GeneratorRotor
 from components.model.presets import cosim_preset
-from components.model.wind import RotorSpeedProcess, WindParameters
+from components.model.wind import PhasorStepper, RotorSpeedProcess, WindParameters
 from fmus.build import SourceTree, build_fmu
 from tests.helpers.fmu_hosts import Instance, load_driver, run_python
 
@@ -33,20 +33,19 @@ def reference_loop(t_end: float) -> dict[str, np.ndarray]:
     """The same Gauss-Seidel loop with the components called directly (as the FMUs compute it)."""
     drivetrain = cosim_preset("table6")
     gearbox = GearboxModel(drivetrain)
-    wind = RotorSpeedProcess(WindParameters())
-    w0, p0 = wind.speed(0.0), wind.angle(0.0)
+    wind = PhasorStepper(RotorSpeedProcess(WindParameters()))  # as the WindSource FMU steps it
+    w0, p0 = wind.speed_and_angle()
     gearbox.initialize(0.0, w0, p0, gearbox.ratio * w0, gearbox.ratio * p0)  # initialisation-mode outputs
     w_out = gearbox.output_speed_rad_s
     ratio = w_out / w0
     gearbox.initialize(0.0, w0, p0, w_out, ratio * p0)
     generator = GeneratorRotor(drivetrain.generator, w_out, ratio * p0)
     speed, torque = [generator.speed_rad_s], [gearbox.shaft_torque_nm]
-    t_wind = 0.0  # the WindSource's time after a step is t + h, as computed in the FMU
     for n in range(int(round(t_end / H))):
         t = n * H
-        gearbox.step(t, H, wind.speed(t_wind), wind.angle(t_wind), generator.speed_rad_s, generator.angle_rad)
+        gearbox.step(t, H, *wind.speed_and_angle(), generator.speed_rad_s, generator.angle_rad)
         generator.step(t, H, gearbox.shaft_torque_nm)
-        t_wind = t + H
+        wind.advance(t, H)
         speed.append(generator.speed_rad_s)
         torque.append(gearbox.shaft_torque_nm)
     return {"GeneratorRotor.omega": np.array(speed), "Gearbox.shaft_torque": np.array(torque)}
@@ -61,16 +60,21 @@ def test_fmpy_loop_reproduces_the_components_bit_for_bit(fmu_dir):
 
 
 @pytest.mark.slow
-def test_loop_runs_in_a_fresh_venv_without_dtcosim(fmu_dir, bare_python, tmp_path):
+def test_loop_runs_in_a_fresh_venv_without_dtcosim(fmu_dir, bare_python, tmp_path, monkeypatch):
     assert run_python(bare_python, "-c", "import components").returncode != 0
     assert run_python(bare_python, "-c", "import fmus").returncode != 0
+    assert run_python(bare_python, "-c", "import numba").returncode != 0  # only numpy and scipy: the fallback
     out = tmp_path / "bare.npz"
     driver = load_driver("fmu_loop").__file__
-    result = run_python(bare_python, driver, str(fmu_dir), "1.0", str(H), str(out))
+    # the default kernel choice (auto), whatever this process was asked for: the FMU must find numba missing
+    result = run_python(bare_python, driver, str(fmu_dir), "1.0", str(H), str(out), env={"DTCOSIM_KERNEL": "auto"})
     assert result.returncode == 0, result.stderr[-3000:]
+    # the Gearbox says once, through the FMI logger, that it runs the numpy path
+    assert (result.stdout + result.stderr).count("compiled gearbox kernel unavailable") == 1, result.stdout[-2000:]
     bare = np.load(out)
     modules = list(bare["modules"])
     assert modules and all(m.startswith("_dtcosim_") for m in modules), modules  # only the FMUs' private copies
+    monkeypatch.setenv("DTCOSIM_KERNEL", "numpy")  # compare like with like: this process has the compiled kernel
     in_process = load_driver("fmu_loop").run(fmu_dir, 1.0, H)
     for key in ("GeneratorRotor.omega", "Gearbox.shaft_torque", "Gearbox.stage1.F_sp[1]", "WindSource.omega"):
         np.testing.assert_allclose(bare[key], in_process[key], rtol=1e-9, atol=1e-6, err_msg=key)
@@ -100,6 +104,7 @@ PATCH = f'''
 
 # --- test patch: this copy of the code reports a marker rotor torque ---
 GearboxModel.output_vector = lambda self: __import__('numpy').full(len(self.output_names), {MARKER!r})
+GearboxModel.output_list = lambda self: [{MARKER!r}] * len(self.output_names)
 '''
 
 

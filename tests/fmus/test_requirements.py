@@ -11,6 +11,7 @@ from fmus import requirements, runtime_guard
 from fmus.requirements import (
     check_environment,
     from_environment,
+    imported_modules,
     python_range,
     read_from_fmu,
     third_party_modules,
@@ -137,3 +138,24 @@ def test_guard_refuses_an_older_python_before_importing(tmp_path, capsys):
     with pytest.raises(ImportError, match=r"dtcosim Future FMU cannot start: it requires Python >=3.99,<3.100"):
         runtime_guard.load_slave("Future", str(tmp_path / "_entry.py"), lambda: imported.append(1))
     assert imported == []
+
+
+def test_an_import_marked_optional_is_an_optional_requirement(tmp_path):
+    (tmp_path / "a.py").write_text("import numpy\nfrom numba import njit  # optional requirement: a faster path\n")
+    (tmp_path / "b.py").write_text("import numpy as np\nimport scipy.linalg  # optional requirement: x\nimport scipy\n")
+    required, optional = imported_modules([tmp_path / "a.py", tmp_path / "b.py"])
+    assert list(required) == ["numpy", "scipy"]  # scipy also imported without the note: required
+    assert optional == {"numba": "a faster path"}
+
+
+def test_optional_requirements_round_trip_and_are_only_warnings(tmp_path):
+    req = from_environment("X", ["numpy"], python=(3, 11, 7), version_of=lambda d: {"numpy": "2.4.6", "numba": "0.68.1"}[d],
+                           distribution=lambda m: m, optional={"numba": "the compiled kernel"})
+    text = format_requirements(req)
+    assert "# optional: numba>=0.68,<1  # tested: 0.68.1 (import numba) the compiled kernel" in text
+    assert not any(line.startswith("numba") for line in text.splitlines())  # pip -r installs only what is required
+    again = parse_requirements(text, "X")
+    assert again == req and again.summary().endswith("(optional: numba>=0.68,<1)")
+    check = check_environment(again, python=(3, 11, 7), find_module=lambda m: None if m == "numba" else object(),
+                              installed=lambda p: "2.4.6")
+    assert check.missing == () and any("optional module 'numba' not found" in w for w in check.warnings)

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from components import units
+from components.errors import ParameterError
 from components.model.generator import (
     GeneratorParameters,
     GeneratorRotor,
@@ -89,3 +90,43 @@ def test_generator_integrates_through_an_event_exactly():
     gen.step(0.0, 1.0, shaft_torque_nm=10.0)  # net torque 10 only during the fault
     assert gen.speed_rad_s == pytest.approx(5.0)
     assert gen.angle_rad == pytest.approx(10.0 * 0.5 * (0.75**2 - 0.25**2))
+
+
+def test_phasor_stepper_follows_the_closed_form():
+    from components.model.wind import PhasorStepper
+
+    process = RotorSpeedProcess(WindParameters())
+    stepper = PhasorStepper(process)
+    h = 1e-3
+    n = 2 * PhasorStepper.REANCHOR_STEPS + 100  # across two re-anchorings
+    got = np.empty((n, 2))
+    for k in range(n):
+        stepper.advance(k * h, h)  # the master's t = k h, not a running sum
+        got[k] = stepper.speed_and_angle()
+    t = (np.arange(n) + 1) * h
+    angle, speed, _ = process.kinematics(t)
+    np.testing.assert_allclose(got[:, 0], speed, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(got[:, 1], angle, rtol=1e-14, atol=1e-12)
+    assert stepper.steps_since_anchor < PhasorStepper.REANCHOR_STEPS
+
+
+def test_phasor_stepper_state_continues_bit_identically_and_jumps_are_exact():
+    import json
+
+    from components.model.wind import PhasorStepper
+
+    process = RotorSpeedProcess(WindParameters(seed=4))
+    a = PhasorStepper(process)
+    for k in range(500):
+        a.advance(k * 2e-3, 2e-3)
+    state = json.loads(json.dumps(a.get_state()))
+    b = PhasorStepper(process)
+    b.set_state(state)
+    for k in range(500, 800):
+        a.advance(k * 2e-3, 2e-3)
+        b.advance(k * 2e-3, 2e-3)
+        assert a.speed_and_angle() == b.speed_and_angle()
+    b.advance(10.0, 1e-3)  # not where the phasors are: closed form at 10.001 s
+    assert b.speed_and_angle() == pytest.approx((process.speed(10.001), process.angle(10.001)), abs=1e-12)
+    with pytest.raises(ParameterError, match="phasors"):
+        b.set_state({**state, "re": state["re"][:3]})

@@ -12,10 +12,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from orchestrator.inputs.scenario import find_scenario, load_scenario
+
 from orchestrator.result_files import read_timeseries
 from tests.helpers.scenarios import TOY_SCENARIO, dtcosim
 
 pytestmark = pytest.mark.slow
+
+PAPER = load_scenario(find_scenario("paper-60s")).simulation  # the packaged step and output interval
 
 # Tolerances so loose that the gearbox's integrator accepts wrong steps until it diverges
 # (about 0.65 s into the run with the Table 6 defaults).
@@ -36,7 +40,7 @@ def test_gearbox_diverging_mid_run_leaves_partial_results(fmu_dir, tmp_path):
     assert "FMU 'gearbox'" in error and "fmi2DoStep" in error and "discard" in error and f"t = {t_stop:g} s" in error
     assert "failed" in error  # the FMU's own message is included
     header, data = read_timeseries(out / "timeseries.csv")
-    assert data.shape[0] == round(t_stop / 1e-3) + 1
+    assert data.shape[0] == round(t_stop / PAPER.output_interval_s) + 1
     assert data[-1, 0] == pytest.approx(t_stop) and np.all(np.isfinite(data))
     assert (out / "contact_forces.png").exists()
     assert "partial results written" in proc.stderr
@@ -58,15 +62,19 @@ def test_fmu_exception_is_reported_with_its_message(toy_scenario, tmp_path):
 def test_ctrl_c_stops_the_run_and_writes_partial_results(fmu_dir, tmp_path):
     out = tmp_path / "interrupted"
     exe = Path(sys.executable).parent / "dtcosim"
-    proc = subprocess.Popen([str(exe), "run", "--fmu-dir", str(fmu_dir), "--out", str(out), "--no-plots"],
+    # 600 s at H = 1 ms: tens of seconds of stepping, so the signal arrives while stepping
+    proc = subprocess.Popen([str(exe), "run", "--fmu-dir", str(fmu_dir), "--out", str(out), "--no-plots",
+                             "--stop", "600", "--step", "0.001", "--output-interval", "0.001"],
                             cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    time.sleep(5.0)  # past loading and initialisation, well before 60 s of simulated time
+    header = proc.stderr.readline()  # printed before the FMUs are instantiated
+    assert "3 FMUs" in header, header
+    time.sleep(8.0)  # past instantiation (numba's cache load included) and initialisation, well before 600 s
     proc.send_signal(signal.SIGINT)
     stdout, stderr = proc.communicate(timeout=120)
     assert proc.returncode == 130, stderr
     summary = json.loads((out / "summary.json").read_text())
     assert summary["complete"] is False and summary["interrupted"] is True
-    assert 0.0 < summary["stopped_at"] < 60.0
+    assert 0.0 < summary["stopped_at"] < 600.0
     assert "interrupted" in summary["error"]
     header, data = read_timeseries(out / "timeseries.csv")
     assert data.shape[0] == round(summary["stopped_at"] / 1e-3) + 1

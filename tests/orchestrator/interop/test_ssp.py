@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import xml.etree.ElementTree as ET
 import zipfile
 
@@ -112,15 +113,36 @@ def test_reimported_paper_ssp_runs_identically(paper_ssp, fmu_dir):
     np.testing.assert_array_equal(a.values, b.values)
 
 
+def ours_interval(path) -> float:
+    """Output interval of a scenario or SSP [s]."""
+    return load_any(path).simulation.output_interval_s
+
+
+@pytest.fixture(scope="module")
+def paper_ssp_1ms(fmu_dir, tmp_path_factory):
+    """The paper scenario at H = 1 ms, exported as SSP (libcosim's coupling is first order: 1e-3 holds at 1 ms)."""
+    work = tmp_path_factory.mktemp("ssp1ms")
+    text = find_scenario("paper-60s").read_text()
+    text = re.sub(r"(?m)^step = \S+", "step = 1.0e-3", text)
+    text = re.sub(r"(?m)^output_interval = \S+", "output_interval = 1.0e-3", text)
+    scenario = work / "paper-1ms.toml"
+    scenario.write_text(text)
+    assert load_scenario(scenario).simulation.step_s == 1e-3
+    proc = dtcosim("export-ssp", str(scenario), "--out", str(work / "paper.ssp"), "--fmu-dir", str(fmu_dir), cwd=work)
+    assert proc.returncode == 0, proc.stderr
+    return work / "paper.ssp"
+
+
 @pytest.mark.slow
-def test_exported_ssp_runs_in_libcosim_like_dtcosim(paper_ssp):
+def test_exported_ssp_runs_in_libcosim_like_dtcosim(paper_ssp_1ms):
     from orchestrator.interop.libcosim import run_ssp_in_libcosim
 
+    paper_ssp = paper_ssp_1ms
     stop = 10.0
     lib = run_ssp_in_libcosim(paper_ssp, stop, ["generator.omega", "wind.omega"])
     ours = CoSimulation(resolve_system(load_any(paper_ssp).with_simulation(stop_s=stop, window_s=(0.0, stop)))).run(
         handle_sigint=False)
-    assert lib.time_s.size == ours.time_s.size == 10001
+    assert lib.time_s.size == ours.time_s.size == round(stop / ours_interval(paper_ssp)) + 1 == 10001
     np.testing.assert_allclose(lib.time_s, ours.time_s, rtol=0, atol=1e-9)
     np.testing.assert_allclose(lib.values["wind.omega"], ours.column("wind.omega"), rtol=1e-12)
     deviation = np.max(np.abs(lib.values["generator.omega"] / ours.column("generator.omega") - 1.0))

@@ -22,6 +22,9 @@ pytestmark = pytest.mark.slow
 FORCES = [f"gearbox.stage{s}.F_{k}[{i}]" for s in (1, 2) for k in ("sp", "rp") for i in (1, 2, 3)] + ["gearbox.stage3.F_mesh"]
 
 
+PAPER = load_scenario(find_scenario("paper-60s")).simulation  # the packaged step and output interval
+
+
 def test_run_without_arguments_builds_fmus_and_writes_results(paper_run):
     out, summary, proc = paper_run
     for name in ("timeseries.csv", "summary.json", "rotor_speed.png", "generator_speed.png", "contact_forces.png"):
@@ -29,8 +32,8 @@ def test_run_without_arguments_builds_fmus_and_writes_results(paper_run):
     fmu_dir = out.parent.parent / "fmus"
     assert sorted(p.name for p in fmu_dir.glob("*.fmu")) == ["Gearbox.fmu", "GeneratorRotor.fmu", "WindSource.fmu"]
     assert "building" in proc.stderr
-    assert "paper-60s: complete, 60000 steps" in proc.stdout
-    assert summary["complete"] is True and summary["steps"] == 60000
+    assert f"paper-60s: complete, {PAPER.n_steps} steps" in proc.stdout
+    assert summary["complete"] is True and summary["steps"] == PAPER.n_steps
     assert summary["scenario"] == "paper-60s" and summary["window_s"] == [5.0, 60.0]
 
 
@@ -62,13 +65,14 @@ def test_timeseries_and_summary_format(paper_run):
     for col in ("gearbox.stage1.F_sp[1] [N]", "gearbox.stage3.F_mesh [N]", "gearbox.shaft3.torque [N.m]",
                 "generator.omega [rad/s]", "wind.omega [rad/s]", "gearbox.omega_out [rad/s]"):
         assert col in header
-    assert data.shape == (60001, len(header))
-    np.testing.assert_allclose(data[:, 0], np.arange(60001) * 1e-3, rtol=0, atol=1e-12)
+    rows = round(60.0 / PAPER.output_interval_s) + 1
+    assert data.shape == (rows, len(header))
+    np.testing.assert_allclose(data[:, 0], np.arange(rows) * PAPER.output_interval_s, rtol=0, atol=1e-12)
     stats = summary["statistics"]
     assert set(stats) == {h.rsplit(" [", 1)[0] for h in header[1:]}
     for st in stats.values():
         assert set(st) == {"mean", "std", "min", "max"} and st["min"] <= st["mean"] <= st["max"]
-    assert summary["wall_time_s"] > 0 and summary["steps"] == 60000
+    assert summary["wall_time_s"] > 0 and summary["steps"] == PAPER.n_steps
     assert set(summary["versions"]) >= {"dtcosim", "python", "numpy", "scipy", "fmpy", "pythonfmu"}
     for comp, info in summary["fmus"].items():
         digest = hashlib.sha256(open(info["file"], "rb").read()).hexdigest()

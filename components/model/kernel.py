@@ -1,0 +1,76 @@
+"""Which implementation of the gearbox hot path runs: the compiled kernel or the numpy path.
+
+``DTCOSIM_KERNEL`` (environment) or the ``kernel`` argument of
+:class:`~components.model.gearbox_model.GearboxModel` and
+:class:`~components.reference.solver.MonolithicSystem` chooses:
+
+* ``auto`` (default): the compiled kernel (:mod:`components.model.compiled_kernel`,
+  numba) where numba imports, else the numpy path;
+* ``numpy``: always the numpy path (the single source of truth of the equations);
+* ``compiled``: the compiled kernel, or a :class:`~components.errors.ParameterError`
+  saying why it is unavailable.
+
+Both paths give the same results to round-off (the tests compare them to 1e-9).
+"""
+
+from __future__ import annotations
+
+import os
+from types import ModuleType
+
+from ..errors import ParameterError
+
+KERNELS = ("auto", "numpy", "compiled")
+ENVIRONMENT_VARIABLE = "DTCOSIM_KERNEL"
+
+_compiled: ModuleType | None = None
+_import_error: str | None = None
+
+
+def requested_kernel(kernel: str | None = None) -> str:
+    """The kernel asked for: ``kernel`` if given, else ``$DTCOSIM_KERNEL``, else ``auto``."""
+    value = kernel if kernel is not None else os.environ.get(ENVIRONMENT_VARIABLE, "auto")
+    value = str(value).strip().lower() or "auto"
+    if value not in KERNELS:
+        source = "kernel" if kernel is not None else ENVIRONMENT_VARIABLE
+        raise ParameterError(source, value, f"one of {', '.join(KERNELS)}")
+    return value
+
+
+def compiled_module() -> tuple[ModuleType | None, str | None]:
+    """The compiled kernel module, or None and the reason it cannot be used (imported once per process)."""
+    global _compiled, _import_error
+    if _compiled is None and _import_error is None:
+        try:
+            from . import compiled_kernel
+        except Exception as exc:  # noqa: BLE001 - numba missing or broken: the numpy path runs instead
+            _import_error = f"{type(exc).__name__}: {exc}"
+        else:
+            _compiled = compiled_kernel
+    return _compiled, _import_error
+
+
+def choose_kernel(kernel: str | None = None) -> tuple[str, str | None]:
+    """Resolve the kernel to ``"compiled"`` or ``"numpy"``.
+
+    Returns
+    -------
+    kernel : str
+        ``"compiled"`` or ``"numpy"``.
+    fallback_reason : str or None
+        Why the compiled kernel was wanted (``auto``) but is not used; None otherwise.
+
+    Raises
+    ------
+    ParameterError
+        Unknown name, or ``compiled`` requested where it cannot be imported.
+    """
+    wanted = requested_kernel(kernel)
+    if wanted == "numpy":
+        return "numpy", None
+    module, reason = compiled_module()
+    if module is not None:
+        return "compiled", None
+    if wanted == "compiled":
+        raise ParameterError("kernel", "compiled", f"an importable numba ({reason})")
+    return "numpy", f"compiled gearbox kernel unavailable ({reason}); using the numpy path"

@@ -1,0 +1,110 @@
+"""Where numba keeps the compiled gearbox kernel: one per-user directory keyed by the code hash.
+
+numba's own cache lives next to the source file or under ``NUMBA_CACHE_DIR`` in a
+folder named after the source file's *directory*. An FMU's sources are extracted
+to a new temporary folder on every load, so that folder changes every run and
+numba would compile again each time (seconds). :func:`enable_stable_cache` gives
+the kernel's dispatchers a locator whose directory is
+
+    <user cache>/dtcosim/numba-<numba version>/<sha256 of the kernel source>[:16]/<module name>
+
+(``<user cache>``: ``$DTCOSIM_CACHE_DIR``, else ``$XDG_CACHE_HOME`` or
+``~/.cache`` on POSIX, ``%LOCALAPPDATA%`` on Windows), and whose freshness stamp is
+the same hash: any copy of the same kernel source, wherever it was extracted,
+finds the machine code compiled by the first run. The module name is part of
+the key because numba's cache refers to the module by name: every FMU build
+imports the kernel under its own private package name (stable for a build, see
+:mod:`fmus.build`), so each build compiles once and then reuses its cache.
+Nothing else numba caches in the process is affected.
+
+This uses numba's cache classes (``numba.core.caching``), which are not public
+API; if they change, :func:`enable_stable_cache` returns False and the kernel is
+compiled in memory once per process instead (correct, only slower to start).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import sys
+from pathlib import Path
+
+
+def user_cache_root() -> Path:
+    """Per-user cache directory of dtcosim (not created here)."""
+    explicit = os.environ.get("DTCOSIM_CACHE_DIR")
+    if explicit:
+        return Path(explicit)
+    if sys.platform == "win32":
+        base = Path(os.environ.get("LOCALAPPDATA") or Path.home() / "AppData" / "Local")
+    elif sys.platform == "darwin":
+        base = Path.home() / "Library" / "Caches"
+    else:
+        base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
+    return base / "dtcosim"
+
+
+def source_hash(path: str | os.PathLike) -> str:
+    """sha256 of a source file's bytes, hex."""
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def kernel_cache_dir(source_path: str | os.PathLike, module_name: str) -> Path:
+    """Cache directory of the kernel module ``module_name`` compiled from ``source_path``.
+
+    Keyed by numba version, code hash and module name.
+    """
+    import numba  # optional requirement: the compiled gearbox kernel
+
+    safe = "".join(c if c.isalnum() or c in "._-" else "_" for c in module_name)
+    return user_cache_root() / f"numba-{numba.__version__}" / source_hash(source_path)[:16] / safe
+
+
+def enable_stable_cache(dispatchers, source_path: str | os.PathLike, module_name: str) -> bool:
+    """Make ``dispatchers`` (numba ``njit`` functions of one module) cache under :func:`kernel_cache_dir`.
+
+    Returns
+    -------
+    bool
+        True if the on-disk cache is in use; False if it could not be set up (the
+        functions still compile, in memory).
+    """
+    try:
+        from numba.core import caching  # optional requirement: the compiled gearbox kernel
+
+        base_locator = getattr(caching, "_CacheLocator")
+        impl = getattr(caching, "CompileResultCacheImpl")
+        function_cache = getattr(caching, "FunctionCache")
+        directory = kernel_cache_dir(source_path, module_name)
+        stamp = source_hash(source_path)
+
+        class _StableLocator(base_locator):
+            def __init__(self, py_func, py_file):
+                self._lineno = py_func.__code__.co_firstlineno
+
+            def get_cache_path(self):
+                return str(directory)
+
+            def get_source_stamp(self):
+                return stamp
+
+            def get_disambiguator(self):
+                return str(self._lineno)
+
+            @classmethod
+            def from_function(cls, py_func, py_file):
+                locator = cls(py_func, py_file)
+                locator.ensure_cache_path()
+                return locator
+
+        class _StableImpl(impl):
+            _locator_classes = [_StableLocator]
+
+        class _StableCache(function_cache):
+            _impl_class = _StableImpl
+
+        for dispatcher in dispatchers:
+            dispatcher._cache = _StableCache(dispatcher.py_func)
+        return True
+    except Exception:  # noqa: BLE001 - any problem with numba's internals: compile in memory instead
+        return False
