@@ -21,7 +21,7 @@ def _check(passed: bool | None) -> str:
 def format_design_table(table: DesignTable, source: str = "") -> str:
     """Readable design table: per stage ratio, radii, centre distance, bodies, mesh frequency, static forces, checks."""
     lines = [f"drivetrain {table.name}" + (f" ({source})" if source else ""),
-             f"total ratio {table.ratio:.6g}; operating point: rotor {rad_per_s_to_rpm(table.rotor_speed_rad_s):.6g} rpm, "
+             f"total ratio {table.ratio:.3f} (= {table.ratio:.10g}); operating point: rotor {rad_per_s_to_rpm(table.rotor_speed_rad_s):.6g} rpm, "
              f"input torque {table.input_torque_nm:.6g} N m"]
     for st in table.stages:
         lines.append("")
