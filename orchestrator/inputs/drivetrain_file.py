@@ -104,7 +104,7 @@ FOLDER = "drivetrains"
 #: rotor speed of the operating point when the file gives none: the paper's 16 rpm (Sec. 4.2)
 DEFAULT_ROTOR_SPEED_RAD_S = units.rpm(16.0)
 #: names a stage or shaft may not take (they are other flat parameter prefixes)
-RESERVED_NAMES = ("generator", "output_torque", "solver", "wind")
+RESERVED_NAMES = ("generator", "output_torque", "solver", "wind", "drivetrain")
 
 
 class DrivetrainFileError(EntryError):
