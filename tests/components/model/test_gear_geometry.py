@@ -94,3 +94,13 @@ def test_separate_sun_and_ring_meshes_have_their_own_flat_names():
     assert back.stages[0].sun_mesh.damping == 1.0e9 and back.stages[0].ring_mesh.damping == st.ring_mesh.damping
     assert unflatten(split, flatten(split)) == split
     assert isinstance(back.stages[0], PlanetaryStage)
+
+
+def test_planet_angles_travel_in_the_fmu_record_description():
+    from components.model.description import build, describe
+
+    dt = with_stage(table6_gearbox(), 0, planet_angles_rad=(0.0, 2.0, 4.0))
+    data = describe(dt)
+    assert data["stages"][0]["planet_angles_rad"] == [0.0, 2.0, 4.0]
+    assert build(data) == dt
+    assert build(describe(table6_gearbox())) == table6_gearbox()  # None: equally spaced

@@ -106,3 +106,30 @@ def test_four_planets_modes_have_the_planet_modes_of_stage1_three_times(tmp_path
     others = [m["undamped_frequency_hz"] for m in modes if m not in planet]
     assert min(abs(np.array(others) - f[0])) > 1e-3 * f[0]  # a multiplicity of exactly three
     assert "drivetrain file paper-table6-4planets.toml" in proc.stdout
+
+
+def test_cli_errors_name_the_file_and_key_without_a_traceback(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text(find_drivetrain("grc-like").read_text().replace("planets = 3", "planets = 0"))
+    proc = dtcosim("drivetrain", "show", str(bad), cwd=tmp_path)
+    assert proc.returncode == 1 and "Traceback" not in proc.stderr
+    assert f"{bad}: invalid drivetrain entry stages[0].planets = 0: expected a whole number of planets >= 1" in proc.stderr
+    proc = dtcosim("build", "--drivetrain", "paper-table3", "--out", str(tmp_path / "f"), cwd=tmp_path)
+    assert proc.returncode == 1 and "Traceback" not in proc.stderr
+    assert "paper-table3.toml: invalid drivetrain entry generator = None: expected a [generator] table" in proc.stderr
+    assert not (tmp_path / "f").exists()
+    proc = dtcosim("drivetrain", "show", "no-such-gearbox", cwd=tmp_path)
+    assert proc.returncode == 1 and "one of the packaged drivetrain files: " in proc.stderr and "grc-like" in proc.stderr
+
+
+def test_reference_of_a_drivetrain_file_runs_the_constant_and_the_wind_case(tmp_path):
+    proc = dtcosim("reference", "--drivetrain", "grc-like", "--t-end", "6", "--json", "--out", str(tmp_path / "r"),
+                   "--no-plots", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    constant, wind = json.loads(proc.stdout)
+    assert constant["case"] == "constant" and wind["case"] == "wind"
+    assert constant["drivetrain"].startswith("drivetrain file grc-like.toml (sha256 ")
+    assert (tmp_path / "r" / "constant" / "summary.json").is_file() and (tmp_path / "r" / "wind" / "summary.json").is_file()
+    for name in ("planetary.F_sp[2]", "intermediate.F_mesh", "high_speed.F_mesh"):
+        assert constant["statistics"][name]["mean"] == pytest.approx(constant["static_force_n"][name], rel=1e-3)
+    assert wind["statistics"]["omega_rotor"]["std"] > 1e-3 > 1e-12 > constant["statistics"]["omega_rotor"]["std"]
