@@ -94,6 +94,7 @@ def test_four_planets_constant_load_run_means_are_the_static_forces(tmp_path):
     assert static["stage1.F_sp[1]"] == pytest.approx(25400.0 * 10.0 / (4 * 0.1 * math.cos(math.radians(20.0))))
 
 
+@pytest.mark.slow
 def test_four_planets_modes_have_the_planet_modes_of_stage1_three_times(tmp_path):
     proc = dtcosim("modes", "--drivetrain", "paper-table6-4planets", "--out", str(tmp_path / "m"),
                    "--speed-points", "3", cwd=tmp_path)
@@ -122,6 +123,7 @@ def test_cli_errors_name_the_file_and_key_without_a_traceback(tmp_path):
     assert proc.returncode == 1 and "one of the packaged drivetrain files: " in proc.stderr and "grc-like" in proc.stderr
 
 
+@pytest.mark.slow
 def test_reference_of_a_drivetrain_file_runs_the_constant_and_the_wind_case(tmp_path):
     proc = dtcosim("reference", "--drivetrain", "grc-like", "--t-end", "6", "--json", "--out", str(tmp_path / "r"),
                    "--no-plots", cwd=tmp_path)
