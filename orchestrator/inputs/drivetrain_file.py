@@ -405,7 +405,7 @@ class _Reader:
         if given:
             for name in ("mass", "inertia"):
                 if getattr(table, name) is None:
-                    raise self.error(f"{key}.{name}", None, f"a value (mass and inertia are given together, "
+                    raise self.error(f"{key}.{name}", None, "a value (mass and inertia are given together, "
                                      "or neither with disc = \"solid\" or \"bored\")")
             for name in ("bore_diameter", "density"):
                 if getattr(table, name) is not None:

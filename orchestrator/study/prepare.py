@@ -264,7 +264,7 @@ def _prepare_scenario(study: Study, fmu_dir,
         paths = ensure_fmus(scenario, fmu_dir, build=build)
     except ScenarioError as exc:
         raise StudyError("base.scenario", study.base.name, f"FMUs that exist or can be built ({exc})", src) from None
-    from .drivetrain_variants import drivetrain_variants, is_file_entry
+    from .drivetrain_variants import is_file_entry
 
     by_comp: dict[str, dict[str, Any]] = {}
     for name, value in study.base.parameters.items():
