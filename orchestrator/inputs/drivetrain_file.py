@@ -1,6 +1,8 @@
 """Drivetrain description files (TOML): any stage list, any number of planets, one source for every tool.
 
-A drivetrain file describes the gearbox from rotor to generator; it is read into
+A drivetrain file describes the gearbox from rotor to generator (its tables:
+:mod:`orchestrator.inputs.drivetrain_schema`, units: :mod:`orchestrator.inputs.drivetrain_units`,
+changed entries for studies: :mod:`orchestrator.inputs.drivetrain_entries`); it is read into
 a :class:`~components.model.drivetrain.Drivetrain` (what the Gearbox FMU, the
 monolithic reference, ``dtcosim modes`` and studies use) together with the
 derived design table (:mod:`components.model.design_table`: which masses were
@@ -76,9 +78,7 @@ import hashlib
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Literal, Mapping
-
-from pydantic import Field
+from typing import Any, Mapping
 
 from components import units
 from components.errors import ParameterError
@@ -93,11 +93,20 @@ from components.model.gear_geometry import (
     ring_teeth_check,
 )
 from components.model.generator import GeneratorParameters
-from components.model.stages import STEEL_DENSITY_KG_M3, ParallelStage, PlanetaryStage, Shaft
+from components.model.stages import ParallelStage, PlanetaryStage, Shaft
 
-from ..errors import EntryError
+from .drivetrain_schema import (
+    STAGE_TABLES,
+    DrivetrainFile,
+    DrivetrainFileError,
+    GearTable,
+    MeshTable,
+    ParallelTable,
+    PlanetaryTable,
+)
+from .drivetrain_units import FileUnits
 from .files import find_input_file, packaged_files, read_toml
-from .schema import NAME_PATTERN, Table, read_document
+from .schema import NAME_PATTERN, read_document
 
 #: folder of the packaged drivetrain files (beside ``scenarios/`` and ``studies/``)
 FOLDER = "drivetrains"
@@ -105,148 +114,6 @@ FOLDER = "drivetrains"
 DEFAULT_ROTOR_SPEED_RAD_S = units.rpm(16.0)
 #: names a stage or shaft may not take (they are other flat parameter prefixes)
 RESERVED_NAMES = ("generator", "output_torque", "solver", "wind", "drivetrain")
-
-
-class DrivetrainFileError(EntryError):
-    """A drivetrain file is invalid (key, value, expected, source)."""
-
-    kind = "drivetrain"
-
-
-# ----------------------------------------------------------------- the schema
-class UnitsTable(Table):
-    """``[units]``: the unit of each quantity; SI unless named here."""
-
-    length: Literal["m", "mm"] = "m"
-    angle: Literal["rad", "deg"] = "rad"
-    inertia: Literal["kg.m2", "kg.mm2"] = "kg.m2"
-    contact_stiffness: Literal["N/m^e", "N/mm^e"] = "N/m^e"
-    contact_damping: Literal["N.s/m2", "N.s/mm2"] = "N.s/m2"
-    regularisation: Literal["1/m", "1/mm"] = "1/m"
-    impact_damping: Literal["N.s/m", "N.s/mm"] = "N.s/m"
-    torsional_stiffness: Literal["N.m/rad", "N.mm/deg"] = "N.m/rad"
-    torsional_damping: Literal["N.m.s/rad", "N.mm.s/deg"] = "N.m.s/rad"
-    torque: Literal["N.m", "N.mm"] = "N.m"
-    speed: Literal["rad/s", "rpm"] = "rad/s"
-
-
-class MeshTable(Table):
-    """Contact law and parameters of a mesh; missing entries come from the file's ``[mesh]``."""
-
-    law: Literal["cfs", "impact"] | None = None
-    k0: float | None = Field(None, gt=0, description="a number > 0: contact stiffness k0 [contact_stiffness unit]")
-    exponent: float | None = Field(None, ge=1, le=3, description="a number in [1, 3]: the force exponent e")
-    c0: float | None = Field(None, ge=0, description="a number >= 0: contact damping c0 [contact_damping unit]")
-    lambda_: float | None = Field(None, alias="lambda", gt=0,
-                                  description="a number > 0: backlash regularisation lambda [regularisation unit]")
-    backlash: float | None = Field(None, ge=0, description="a number >= 0: normal backlash j_n [length unit]")
-    impact_depth: float | None = Field(None, gt=0, description="a number > 0: impact penetration d_max [length unit]")
-    impact_damping: float | None = Field(None, ge=0, description="a number >= 0: impact damping c_max")
-    contact_ratio: float | None = Field(None, ge=1, le=10, description="a number in [1, 10]")
-    stiffness_variation: float | None = Field(None, ge=0, le=0.9, description="a number in [0, 0.9]")
-
-
-class GearTable(Table):
-    """A gear body: ``mass`` and ``inertia`` given, or ``disc = "solid" | "bored"`` derived from the geometry."""
-
-    mass: float | None = Field(None, gt=0, description="a number > 0 [kg]")
-    inertia: float | None = Field(None, gt=0, description="a number > 0 [inertia unit]")
-    disc: Literal["solid", "bored"] | None = None
-    bore_diameter: float | None = Field(None, gt=0, description="a number > 0 [length unit]")
-    density: float | None = Field(None, gt=0, description="a number > 0 [kg/m3]")
-
-
-class PlanetaryTeeth(Table):
-    sun: int = Field(gt=0, description="a whole number of teeth > 0")
-    planet: int = Field(gt=0, description="a whole number of teeth > 0")
-    ring: int = Field(gt=0, description="a whole number of teeth > 0")
-
-
-class PlanetaryRadii(Table):
-    sun: float = Field(gt=0, description="a pitch radius > 0 [length unit]")
-    ring: float = Field(gt=0, description="a pitch radius > 0 [length unit]")
-    planet: float | None = Field(None, gt=0, description="a pitch radius > 0 [length unit]")
-
-
-class ParallelTeeth(Table):
-    drive: int = Field(gt=0, description="a whole number of teeth > 0")
-    driven: int = Field(gt=0, description="a whole number of teeth > 0")
-
-
-class ParallelRadii(Table):
-    drive: float = Field(gt=0, description="a pitch radius > 0 [length unit]")
-    driven: float = Field(gt=0, description="a pitch radius > 0 [length unit]")
-
-
-class _StageCommon(Table):
-    name: str | None = Field(None, description="a stage name (letters, digits, '_', '-')")
-    module: float = Field(gt=0, description="a number > 0: the gear module [length unit]")
-    pressure_angle: float = Field(gt=0, description="a number > 0: the pressure angle [angle unit]")
-    face_width: float = Field(gt=0, description="a number > 0: the face width [length unit]")
-
-
-class PlanetaryTable(_StageCommon):
-    """``[[stages]]`` with ``kind = "planetary"`` (ring fixed, carrier in, sun out)."""
-
-    kind: Literal["planetary"]
-    teeth: PlanetaryTeeth | None = None
-    radii: PlanetaryRadii | None = None
-    planets: int = Field(ge=1, description="a whole number of planets >= 1")
-    planet_angles: list[float] | None = Field(None, description="a list of planet carrier angles [angle unit]")
-    carrier_inertia: float = Field(0.0, ge=0, description="a number >= 0: extra carrier inertia [inertia unit]")
-    sun: GearTable
-    planet: GearTable
-    mesh: MeshTable | None = None
-    sun_mesh: MeshTable | None = None
-    ring_mesh: MeshTable | None = None
-
-
-class ParallelTable(_StageCommon):
-    """``[[stages]]`` with ``kind = "parallel"`` (drive gear in, driven gear out)."""
-
-    kind: Literal["parallel"]
-    teeth: ParallelTeeth | None = None
-    radii: ParallelRadii | None = None
-    drive: GearTable
-    driven: GearTable
-    mesh: MeshTable | None = None
-
-
-class ShaftTable(Table):
-    name: str | None = Field(None, description="a shaft name (letters, digits, '_', '-')")
-    stiffness: float = Field(gt=0, description="a number > 0: torsional stiffness [torsional_stiffness unit]")
-    damping: float = Field(0.0, ge=0, description="a number >= 0: torsional damping [torsional_damping unit]")
-
-
-class GeneratorTable(Table):
-    inertia: float = Field(gt=0, description="a number > 0: generator rotor inertia [inertia unit]")
-    counter_torque: float = Field(description="a number: generator counter torque [torque unit]")
-
-
-class OutputTable(Table):
-    torque: float = Field(description="a number: counter torque on the last stage's output member [torque unit]")
-
-
-class OperatingPointTable(Table):
-    rotor_speed: float = Field(gt=0, description="a number > 0: rotor speed [speed unit]")
-
-
-class DrivetrainFile(Table):
-    """The shape of a drivetrain TOML document (see the module docstring)."""
-
-    name: str | None = Field(None, description="a drivetrain name (letters, digits, '_', '-')")
-    description: str = Field("", description="a string")
-    density: float = Field(STEEL_DENSITY_KG_M3, gt=0, description="a number > 0 [kg/m3]")
-    units: UnitsTable = Field(default_factory=UnitsTable, description="a [units] table")
-    mesh: MeshTable = Field(default_factory=MeshTable, description="a [mesh] table of contact defaults")
-    stages: list[dict[str, Any]] = Field(min_length=1, description="an array of tables [[stages]], at least one")
-    shafts: list[ShaftTable] = Field(default_factory=list, description="an array of tables [[shafts]]")
-    generator: GeneratorTable | None = Field(None, description="a [generator] table with inertia, counter_torque")
-    output: OutputTable | None = Field(None, description="an [output] table with torque")
-    operating_point: OperatingPointTable | None = Field(None, description="an [operating_point] table")
-
-
-_STAGE_TABLES = {"planetary": PlanetaryTable, "parallel": ParallelTable}
 
 
 # ------------------------------------------------------------------ the result
@@ -315,47 +182,7 @@ class DrivetrainSpec:
         return self.drivetrain
 
 
-# ----------------------------------------------------------------- conversion
-class _Units:
-    """Conversions of the file's numbers to SI, per the ``[units]`` table."""
-
-    def __init__(self, table: UnitsTable) -> None:
-        self.t = table
-
-    def length(self, v: float) -> float:
-        return units.mm(v) if self.t.length == "mm" else v
-
-    def angle(self, v: float) -> float:
-        return math.radians(v) if self.t.angle == "deg" else v
-
-    def inertia(self, v: float) -> float:
-        return units.kgmm2(v) if self.t.inertia == "kg.mm2" else v
-
-    def k0(self, v: float, exponent: float) -> float:
-        return units.contact_stiffness(v, exponent) if self.t.contact_stiffness == "N/mm^e" else v
-
-    def c0(self, v: float) -> float:
-        return units.contact_damping(v) if self.t.contact_damping == "N.s/mm2" else v
-
-    def regularisation(self, v: float) -> float:
-        return units.regularisation(v) if self.t.regularisation == "1/mm" else v
-
-    def impact_damping(self, v: float) -> float:
-        return v * 1e3 if self.t.impact_damping == "N.s/mm" else v
-
-    def shaft_stiffness(self, v: float) -> float:
-        return units.torsional_stiffness(v) if self.t.torsional_stiffness == "N.mm/deg" else v
-
-    def shaft_damping(self, v: float) -> float:
-        return units.torsional_damping(v) if self.t.torsional_damping == "N.mm.s/deg" else v
-
-    def torque(self, v: float) -> float:
-        return units.nmm(v) if self.t.torque == "N.mm" else v
-
-    def speed(self, v: float) -> float:
-        return units.rpm(v) if self.t.speed == "rpm" else v
-
-
+#: mesh entries with a default, and those every mesh needs (from itself, its stage or [mesh])
 _MESH_DEFAULTS = {"law": "cfs", "exponent": 1.5}
 _MESH_REQUIRED = ("k0", "c0", "lambda", "backlash")
 
@@ -366,7 +193,7 @@ class _Reader:
     def __init__(self, doc: DrivetrainFile, source: str | None) -> None:
         self.doc = doc
         self.source = source
-        self.u = _Units(doc.units)
+        self.u = FileUnits(doc.units)
 
     def error(self, key: str, value: Any, expected: str) -> DrivetrainFileError:
         return DrivetrainFileError(key, value, expected, self.source)
@@ -433,11 +260,11 @@ class _Reader:
         if not isinstance(data, Mapping):
             raise self.error(key, data, "a table")
         kind = data.get("kind")
-        if kind not in _STAGE_TABLES:
+        if kind not in STAGE_TABLES:
             raise self.error(f"{key}.kind", kind, 'the stage kind: "planetary" or "parallel"'
                              + (" (missing)" if kind is None else ""))
         try:
-            table = read_document(_STAGE_TABLES[kind], data, DrivetrainFileError, self.source)
+            table = read_document(STAGE_TABLES[kind], data, DrivetrainFileError, self.source)
         except DrivetrainFileError as exc:
             raise self.error(f"{key}.{exc.key}", exc.value, exc.expected) from None
         name = table.name if table.name is not None else f"stage{i + 1}"
@@ -612,62 +439,6 @@ def load_drivetrain_file(path: str | Path) -> DrivetrainSpec:
     data = read_toml(path, DrivetrainFileError)
     sha = hashlib.sha256(path.read_bytes()).hexdigest()
     return drivetrain_from_dict(data, name=path.stem, source=str(path), sha256=sha)
-
-
-def with_entries(spec: DrivetrainSpec, entries: Mapping[str, Any]) -> DrivetrainSpec:
-    """The file's document with entries changed by key path (``stages[0].planets``, ``generator.inertia``), read again.
-
-    The content hash of the result is that of the changed document (canonical JSON), so
-    FMUs built from it are kept apart from the original's.
-
-    Raises
-    ------
-    DrivetrainFileError
-        A key path that is not in the document, or a changed document that is invalid.
-    """
-    import copy
-    import json
-
-    data = copy.deepcopy(dict(spec.data))
-    for path, value in entries.items():
-        set_entry(data, path, value, spec.source)
-    sha = hashlib.sha256(json.dumps(data, sort_keys=True, default=str).encode()).hexdigest()
-    return drivetrain_from_dict(data, name=spec.name, source=spec.source, sha256=sha)
-
-
-def _split_path(path: str) -> list[str | int]:
-    parts: list[str | int] = []
-    for piece in path.split("."):
-        name, _, rest = piece.partition("[")
-        if name:
-            parts.append(name)
-        while rest:
-            index, _, rest = rest.partition("]")
-            parts.append(int(index))
-            rest = rest.lstrip("[")
-    return parts
-
-
-def set_entry(data: dict, path: str, value: Any, source: str | None = None) -> None:
-    """Set the entry at a key path (``stages[1].teeth.ring``) of a parsed document; the entry must exist."""
-    try:
-        parts = _split_path(path)
-    except ValueError:
-        raise DrivetrainFileError(path, value, "a key path such as stages[0].planets", source) from None
-    node: Any = data
-    for i, part in enumerate(parts):
-        last = i == len(parts) - 1
-        ok = (isinstance(part, int) and isinstance(node, list) and 0 <= part < len(node)) or (
-            isinstance(part, str) and isinstance(node, dict) and part in node)
-        if not ok:
-            raise DrivetrainFileError(path, value, "an entry the drivetrain file has (only existing entries can "
-                                      "be changed)", source)
-        if last:
-            if isinstance(node[part], (dict, list)):
-                raise DrivetrainFileError(path, value, "a number entry, not a table or list", source)
-            node[part] = value
-        else:
-            node = node[part]
 
 
 def packaged_drivetrains() -> dict[str, Path]:

@@ -26,7 +26,8 @@ from components.model.drivetrain import Drivetrain
 from components.model.parameter_map import flatten, unflatten
 
 from ..errors import EntryError
-from ..inputs.drivetrain_file import DrivetrainSpec, with_entries
+from ..inputs.drivetrain_entries import with_entries
+from ..inputs.drivetrain_file import DrivetrainSpec
 from ..inputs.study import Point, Study, StudyError, split_parameter
 
 #: ``<component>.drivetrain.<key path>``
