@@ -47,6 +47,7 @@ import components
 from components.errors import DtcosimError
 from components.model.drivetrain import Drivetrain
 from components.model.presets import PRESETS, cosim_preset
+from components.model.wind import WindParameters
 
 from . import model_description, runtime_files
 from .records import full_record, model_of
@@ -273,7 +274,8 @@ def drivetrain_of_preset(preset: str) -> Drivetrain:
 
 
 def build_fmu(name: str, out_dir: Path | str, preset: str = "table6", source: SourceTree | None = None,
-              validate: bool = True, *, drivetrain: Drivetrain | None = None, origin: str | None = None) -> BuiltFmu:
+              validate: bool = True, *, drivetrain: Drivetrain | None = None, origin: str | None = None,
+              rotor_speed_rad_s: float | None = None) -> BuiltFmu:
     """Build one FMU into ``out_dir`` (``<out_dir>/<name>.fmu``).
 
     Parameters
@@ -291,6 +293,9 @@ def build_fmu(name: str, out_dir: Path | str, preset: str = "table6", source: So
         The co-simulation drivetrain (with generator and output shaft) to build from instead of a preset.
     origin : str, optional
         What the drivetrain was made from, for the record (default ``"preset <preset>"``).
+    rotor_speed_rad_s : float, optional
+        Rotor speed of the operating point [rad/s]: the start values of the Gearbox's inputs, the
+        generator's initial speed and the WindSource's omega0 (default: the paper's 16 rpm).
     """
     _check_pythonfmu()
     if name not in FMU_SLAVES:
@@ -300,7 +305,8 @@ def build_fmu(name: str, out_dir: Path | str, preset: str = "table6", source: So
         drivetrain = drivetrain_of_preset(preset)
         origin = origin or f"preset {preset}"
     origin = origin or "a drivetrain given to fmus.build"
-    model = model_of(name, drivetrain)
+    wind = None if rotor_speed_rad_s is None else WindParameters(mean_speed_rad_s=rotor_speed_rad_s)
+    model = model_of(name, drivetrain, wind)
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="dtcosim_fmu_") as tmp:

@@ -198,12 +198,13 @@ class Assembly:
                 planets = [body(f"{n}.planet[{i + 1}]", st.planet_inertia_kgm2, n, "planet") for i in range(st.n_planets)]
                 z_s = 2.0 * r_s / st.module_m
                 z_r = 2.0 * r_r / st.module_m
+                positions = st.planet_positions_rad  # psi_i: given, or equally spaced
                 for i, p in enumerate(planets):  # eq. 8
-                    psi = 2.0 * math.pi * i / st.n_planets
+                    psi = positions[i]
                     mesh_rows.append({s: -r_s, p: -r_p, c: r_s + r_p})
                     meshes.append((f"{n}.F_sp[{i + 1}]", n, "sun_planet", st.sun_mesh, c, z_r, -z_s * psi))
                 for i, p in enumerate(planets):  # eq. 10, ring fixed
-                    psi = 2.0 * math.pi * i / st.n_planets
+                    psi = positions[i]
                     mesh_rows.append({p: r_p, c: r_r - r_p})
                     meshes.append((f"{n}.F_rp[{i + 1}]", n, "ring_planet", st.ring_mesh, c, z_r, z_r * psi))
                 members = {"input": c, "output": s}

@@ -19,11 +19,15 @@ Per planetary stage ``stageK``: ``sun_radius``, ``ring_radius``, ``module``,
 the planets' orbital inertia). Per parallel stage: ``drive_radius``,
 ``driven_radius``, ``module``, ``width`` [m]; ``drive_mass``, ``driven_mass``
 [kg]; ``drive_inertia``, ``driven_inertia`` [kg m^2]. Mesh contact of every stage
-(sun-planet and ring-planet share them): ``k0`` [N/m^e], ``exponent`` [-], ``c0``
+(the sun-planet and ring-planet meshes of a planetary stage share one set while
+their contact parameters are equal, as in the paper's presets; a stage whose two
+meshes differ has them as ``stageK.sun_mesh.<name>`` and ``stageK.ring_mesh.<name>``
+instead; :func:`mesh_prefixes`): ``k0`` [N/m^e], ``exponent`` [-], ``c0``
 [N s/m^2], ``lambda`` [1/m], ``backlash`` [m] (normal), ``pressure_angle`` [rad],
 ``contact_law`` (0 = CFS, 1 = impact), ``impact_depth`` [m], ``impact_damping``
 [N s/m] (negative: ``c0 * impact_depth``), ``contact_ratio`` [-],
-``stiffness_variation`` [-]. Per shaft ``shaftK``: ``stiffness`` [N m/rad],
+``stiffness_variation`` [-]. Planet angles are structure (like the number of
+planets), not parameters. Per shaft ``shaftK``: ``stiffness`` [N m/rad],
 ``damping`` [N m s/rad]. Generator: ``generator.inertia`` [kg m^2],
 ``generator.counter_torque`` [N m]. Without a generator: ``output_torque`` [N m].
 
@@ -125,13 +129,25 @@ def _mesh_values(prefix: str, mesh: MeshContact) -> dict[str, float]:
     return out
 
 
+def mesh_prefixes(stage) -> dict[str, str]:
+    """Flat-name prefix of each mesh field of a stage: ``{"mesh": "stage3"}`` for a parallel stage;
+    ``{"sun_mesh": "stage1", "ring_mesh": "stage1"}`` for a planetary stage whose two meshes are equal
+    (one shared set of names), else ``{"sun_mesh": "stage1.sun_mesh", "ring_mesh": "stage1.ring_mesh"}``."""
+    if not isinstance(stage, PlanetaryStage):
+        return {"mesh": stage.name}
+    if stage.sun_mesh == stage.ring_mesh:
+        return {"sun_mesh": stage.name, "ring_mesh": stage.name}
+    return {"sun_mesh": f"{stage.name}.sun_mesh", "ring_mesh": f"{stage.name}.ring_mesh"}
+
+
 def flatten(drivetrain: Drivetrain) -> dict[str, float]:
     """All parameter values of a drivetrain by flat name (SI units)."""
     out: dict[str, float] = {}
     for st in drivetrain.stages:
         fields = _PLANETARY_FIELDS if isinstance(st, PlanetaryStage) else _PARALLEL_FIELDS
         out.update({f"{st.name}.{k}": float(getattr(st, f)) for k, f in fields.items()})
-        out.update(_mesh_values(st.name, st.sun_mesh if isinstance(st, PlanetaryStage) else st.mesh))
+        for field_name, prefix in mesh_prefixes(st).items():
+            out.update(_mesh_values(prefix, getattr(st, field_name)))
     for sh in drivetrain.all_shafts:
         out[f"{sh.name}.stiffness"] = sh.stiffness_nm_per_rad
         out[f"{sh.name}.damping"] = sh.damping_nms_per_rad
@@ -186,11 +202,8 @@ def unflatten(template: Drivetrain, values: Mapping[str, float]) -> Drivetrain:
     for st in template.stages:
         fields = _PLANETARY_FIELDS if isinstance(st, PlanetaryStage) else _PARALLEL_FIELDS
         changes = {f: values[f"{st.name}.{k}"] for k, f in fields.items() if f"{st.name}.{k}" in values}
-        if isinstance(st, PlanetaryStage):
-            mesh = _mesh_from(st.name, st.sun_mesh, values)
-            changes.update(sun_mesh=mesh, ring_mesh=mesh)
-        else:
-            changes["mesh"] = _mesh_from(st.name, st.mesh, values)
+        for field_name, prefix in mesh_prefixes(st).items():
+            changes[field_name] = _mesh_from(prefix, getattr(st, field_name), values)
         try:
             stages.append(replace(st, **changes))
         except ParameterError as exc:

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 from .. import units
 from ..errors import ParameterError
-from ..validation import integer_at_least, non_negative, positive, set_fields
+from ..validation import finite, integer_at_least, non_negative, positive, set_fields
 from .contact import MeshContact
 
 STEEL_DENSITY_KG_M3 = 7800.0
@@ -54,6 +54,12 @@ class PlanetaryStage:
         Contact parameters of the sun-planet and ring-planet meshes.
     width_m : float
         Face width [m] (informational; used by the solid-disc mass check).
+    module_m : float
+        Gear module [m] (tooth counts ``2 r / m`` for the mesh frequency and phasing).
+    planet_angles_rad : tuple of float, optional
+        Carrier angle ``psi_i`` [rad] of each planet, increasing in ``[0, 2 pi)``; None
+        (default) means equally spaced, ``psi_i = 2 pi (i - 1) / n``. The torsional model
+        uses them for the mesh phasing only (:mod:`components.model.mesh_stiffness`).
     """
 
     name: str
@@ -69,6 +75,7 @@ class PlanetaryStage:
     carrier_inertia_kgm2: float = 0.0
     width_m: float = 0.05
     module_m: float = 0.01
+    planet_angles_rad: tuple[float, ...] | None = None
 
     kind = "planetary"
 
@@ -94,6 +101,8 @@ class PlanetaryStage:
         for field_name in ("sun_mesh", "ring_mesh"):
             if not isinstance(getattr(self, field_name), MeshContact):
                 raise ParameterError(f"{n}.{field_name}", getattr(self, field_name), "a MeshContact")
+        if self.planet_angles_rad is not None:
+            set_fields(self, planet_angles_rad=_planet_angles(n, self.planet_angles_rad, self.n_planets))
 
     @staticmethod
     def radii_from_teeth(name: str, module_mm: float, z_sun: float, z_ring: float) -> tuple[float, float]:
@@ -110,6 +119,13 @@ class PlanetaryStage:
             raise ParameterError(f"{name}.ratio", ratio, "> 2 (planet radius must be positive)")
         r_s = positive(f"{name}.sun_radius_m", sun_radius_m)
         return r_s, (R - 1.0) * r_s
+
+    @property
+    def planet_positions_rad(self) -> tuple[float, ...]:
+        """Carrier angle psi_i [rad] of every planet (the given ones, else equally spaced)."""
+        if self.planet_angles_rad is not None:
+            return self.planet_angles_rad
+        return tuple(2.0 * math.pi * i / self.n_planets for i in range(self.n_planets))
 
     @property
     def planet_radius_m(self) -> float:
@@ -157,7 +173,19 @@ class PlanetaryStage:
             carrier_inertia_kgm2=self.carrier_inertia_kgm2 * f,
             width_m=self.width_m,
             module_m=self.module_m,
+            planet_angles_rad=self.planet_angles_rad,
         )
+
+
+def _planet_angles(stage: str, angles, n_planets: int) -> tuple[float, ...]:
+    """Validated planet angles: ``n_planets`` finite values, strictly increasing in ``[0, 2 pi)``."""
+    name = f"{stage}.planet_angles_rad"
+    if not isinstance(angles, (tuple, list)) or len(angles) != n_planets:
+        raise ParameterError(name, angles, f"{n_planets} angles [rad], one per planet")
+    out = tuple(float(finite(f"{name}[{i}]", a)) for i, a in enumerate(angles))
+    if not all(0.0 <= a < 2.0 * math.pi for a in out) or any(b <= a for a, b in zip(out, out[1:])):
+        raise ParameterError(name, list(out), "strictly increasing angles in [0, 2 pi) rad")
+    return out
 
 
 @dataclass(frozen=True)

@@ -90,6 +90,27 @@ CASES: dict[str, ReferenceCase] = {
 }
 
 
+def drivetrain_cases(name: str, drivetrain: Drivetrain, rotor_speed_rad_s: float) -> dict[str, ReferenceCase]:
+    """The two reference cases of any drivetrain (a drivetrain file's): constant load and wind.
+
+    ``constant``: the rotor turns at ``rotor_speed_rad_s`` and the load (generator counter torque,
+    or the output torque without a generator) is constant; 10 s, statistics over [5, 10] s, when
+    the start transient has decayed (the means are then the static forces of the design table).
+    ``wind``: the paper's stochastic rotor speed (eq. 13-14, defaults of Sec. 4.2) about
+    ``rotor_speed_rad_s``; 60 s, statistics over [5, 60] s as for Table 7.
+    """
+    rpm_text = f"{units.rad_per_s_to_rpm(rotor_speed_rad_s):.6g} rpm"
+    return {
+        "constant": ReferenceCase(
+            "constant", f"{name}: constant rotor speed {rpm_text}, constant load, 10 s",
+            lambda: (drivetrain, ConstantSpeed(rotor_speed_rad_s)), 10.0, (5.0, 10.0)),
+        "wind": ReferenceCase(
+            "wind", f"{name}: stochastic rotor speed about {rpm_text} (eq. 13-14), constant load, 60 s",
+            lambda: (drivetrain, RotorSpeedProcess(WindParameters(mean_speed_rad_s=rotor_speed_rad_s))), 60.0,
+            (5.0, 60.0)),
+    }
+
+
 def run_case(name: str, **overrides) -> tuple[SimulationResult, dict[str, dict[str, float]]]:
     """Run a reference case with the monolithic solver.
 
@@ -110,7 +131,11 @@ def run_case(name: str, **overrides) -> tuple[SimulationResult, dict[str, dict[s
     """
     if name not in CASES:
         raise ParameterError("case", name, "one of " + ", ".join(CASES))
-    case = CASES[name]
+    return run_reference_case(CASES[name], **overrides)
+
+
+def run_reference_case(case: ReferenceCase, **overrides) -> tuple[SimulationResult, dict[str, dict[str, float]]]:
+    """Run a :class:`ReferenceCase` with the monolithic solver (see :func:`run_case`)."""
     drivetrain, driver = case.build()
     t_end = overrides.pop("t_end_s", case.t_end_s)
     dt = overrides.pop("output_interval_s", case.output_interval_s)

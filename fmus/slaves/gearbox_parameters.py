@@ -3,7 +3,8 @@
 Drivetrain parameters are exactly those of :mod:`components.model.parameter_map`
 (shared with the orchestrator's scenarios): per stage ``stageK.<field>`` (the
 sun-planet and ring-planet meshes of a planetary stage share one set of mesh
-parameters), per shaft ``shaftK.stiffness`` and ``shaftK.damping``; start values
+parameters while they are equal, else ``stageK.sun_mesh.<field>`` and
+``stageK.ring_mesh.<field>``), per shaft ``shaftK.stiffness`` and ``shaftK.damping``; start values
 are the template's (the build preset's) values. The generator's parameters
 belong to the GeneratorRotor FMU and are not exposed. Integrator tolerances are
 ``solver.<field>`` (:class:`~components.model.integrators.StepControl`).
@@ -50,7 +51,11 @@ def _context(template: Drivetrain, name: str) -> str:
     prefix = name.split(".", 1)[0]
     for stage in template.stages:
         if stage.name == prefix:
-            meshes = " (sun-planet and ring-planet meshes)" if isinstance(stage, PlanetaryStage) else ""
+            meshes = ""
+            if isinstance(stage, PlanetaryStage):
+                meshes = {".sun_mesh.": " (sun-planet meshes)", ".ring_mesh.": " (ring-planet meshes)"}.get(
+                    next((m for m in (".sun_mesh.", ".ring_mesh.") if m in name), ""),
+                    " (sun-planet and ring-planet meshes)")
             field = name.rsplit(".", 1)[-1]
             in_mesh = field in ("k0", "exponent", "c0", "lambda", "backlash", "pressure_angle", "contact_law",
                                 "impact_depth", "impact_damping", "contact_ratio", "stiffness_variation")

@@ -1,10 +1,10 @@
-"""``dtcosim build``: build the FMUs WindSource, Gearbox and GeneratorRotor."""
+"""``dtcosim build``: build the FMUs WindSource, Gearbox and GeneratorRotor (from a preset or a drivetrain file)."""
 
 from __future__ import annotations
 
 import argparse
 
-from fmus.build import add_arguments, run
+from fmus.build import add_arguments, run as run_preset
 
 from ..cosim.fmu_folder import default_fmu_dir
 
@@ -14,7 +14,33 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "build",
         help="build the FMUs WindSource, Gearbox and GeneratorRotor",
-        description="Build the self-contained pythonfmu FMUs WindSource.fmu, Gearbox.fmu and GeneratorRotor.fmu.",
+        description=("Build the self-contained pythonfmu FMUs WindSource.fmu, Gearbox.fmu and GeneratorRotor.fmu. "
+                     "With --drivetrain FILE: Gearbox.fmu and GeneratorRotor.fmu of that drivetrain file, by default "
+                     "into the FMU directory's folder of the file's content (drivetrains/<name>-<sha256>/), where "
+                     "scenarios naming the file find them."),
     )
     add_arguments(p, default_out=default_fmu_dir())  # where `dtcosim run` looks for them
+    p.add_argument("--drivetrain", default=None, metavar="FILE",
+                   help="drivetrain TOML file or packaged name (grc-like, paper-table6, ...) instead of --preset")
     p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Build from the preset or the drivetrain file and print what was written."""
+    if args.drivetrain is None:
+        return run_preset(args)
+    from components.errors import ParameterError
+
+    from ..cosim.drivetrain_fmus import DRIVETRAIN_FMU_NAMES, build_drivetrain_fmus
+    from ..inputs.drivetrain_file import find_drivetrain, load_drivetrain_file
+    from ..inputs.scenario import drivetrain_fmu_dir
+
+    if args.preset != "table6":
+        raise ParameterError("--preset", args.preset, "no preset together with --drivetrain")
+    spec = load_drivetrain_file(find_drivetrain(args.drivetrain))
+    names = args.fmu or list(DRIVETRAIN_FMU_NAMES)
+    explicit_out = args.out != default_fmu_dir()
+    out = args.out if explicit_out else drivetrain_fmu_dir(args.out, spec)
+    for built in build_drivetrain_fmus(spec, out, names):
+        print(f"{built.path}  ({built.name}, {spec.origin}, build {built.build_id})")
+    return 0

@@ -21,6 +21,7 @@ COMMAND_MODULES = (
     "orchestrator.commands.build",
     "orchestrator.commands.validate",
     "orchestrator.commands.modes",
+    "orchestrator.commands.drivetrain",
     "orchestrator.commands.sweep",
 )
 

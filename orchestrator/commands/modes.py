@@ -7,7 +7,8 @@ counter torque, rebuilt as for the monolithic reference
 scenario's: the WindSource's mean rotor speed ``omega0`` and the generator's
 base counter torque (load events and the wind's fluctuation are not part of a
 linearisation). ``--rotor-speed-rpm`` and ``--torque-nm`` override either.
-Without a scenario: ``--preset`` (default table6) at 16 rpm and the preset's load.
+Without a scenario: ``--drivetrain FILE`` at the file's operating point and load, or
+``--preset`` (default table6) at 16 rpm and the preset's load.
 """
 
 from __future__ import annotations
@@ -39,8 +40,11 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="take drivetrain and operating point from this scenario (TOML/SSP file or packaged name, "
                         "e.g. paper-60s); default: --preset")
     p.add_argument("--preset", choices=PRESETS, default=None, help="drivetrain preset without a scenario (default: table6)")
+    p.add_argument("--drivetrain", default=None, metavar="FILE",
+                   help="drivetrain file (TOML path or packaged name, e.g. grc-like) without a scenario, at its "
+                        "operating point (rotor speed) and its counter torque")
     p.add_argument("--rotor-speed-rpm", type=float, default=None,
-                   help="rotor speed of the operating point [rpm] (default: the scenario's omega0, else 16)")
+                   help="rotor speed of the operating point [rpm] (default: the scenario's omega0, the drivetrain file's, else 16)")
     p.add_argument("--torque-nm", type=float, default=None,
                    help="output (generator) counter torque [N m] (default: the scenario's or the preset's, 25400 for table6)")
     p.add_argument("--fmu-dir", type=Path, default=None,
@@ -95,9 +99,16 @@ def scenario_drivetrain(spec: str, fmu_dir: Path | None = None):
 
 def run(args: argparse.Namespace) -> int:
     """Run the modal analysis and write the files."""
-    if args.scenario is not None and args.preset is not None:
-        raise ParameterError("--preset", args.preset, f"no preset together with the scenario {args.scenario!r}")
-    if args.scenario is not None:
+    if sum(x is not None for x in (args.scenario, args.preset, args.drivetrain)) > 1:
+        raise ParameterError("--preset/--drivetrain", args.preset or args.drivetrain,
+                             "one of SCENARIO, --preset and --drivetrain")
+    if args.drivetrain is not None:
+        from ..inputs.drivetrain_file import find_drivetrain, load_drivetrain_file
+
+        spec = load_drivetrain_file(find_drivetrain(args.drivetrain))
+        drivetrain, omega0, origin = spec.drivetrain, spec.rotor_speed_rad_s, spec.origin
+        out_dir = args.out if args.out is not None else Path("results") / spec.name / "modes"
+    elif args.scenario is not None:
         drivetrain, omega0, source = scenario_drivetrain(args.scenario, args.fmu_dir)
         origin = f"scenario {source}"
         out_dir = args.out if args.out is not None else Path("results") / source / "modes"

@@ -4,7 +4,9 @@ A relative FMU path is looked up next to the scenario file, then in the FMU
 directory (:func:`orchestrator.cosim.fmu_folder.default_fmu_dir`). ``dtcosim run`` builds a
 missing ``WindSource.fmu``, ``Gearbox.fmu`` or ``GeneratorRotor.fmu`` (the FMUs
 this project makes, with ``fmus.build``) into the FMU directory; any other
-missing FMU is a scenario error naming the component.
+missing FMU is a scenario error naming the component. A component built from a
+drivetrain file (``drivetrain = "..."``) gets its FMU in the folder of that file's
+content (:mod:`orchestrator.cosim.drivetrain_fmus`), built when missing or stale.
 """
 
 from __future__ import annotations
@@ -63,10 +65,21 @@ def ensure_fmus(scenario: Scenario, fmu_dir: str | Path | None = None, build: bo
         ``components.<name>.fmu`` for a missing FMU that cannot be built.
     """
     fmu_dir = default_fmu_dir() if fmu_dir is None else Path(fmu_dir)
+    if build:  # FMUs of drivetrain files: in their content's folder, built when missing or stale
+        from .drivetrain_fmus import ensure_drivetrain_fmus
+
+        wanted: dict[str, tuple] = {}
+        for comp in scenario.components:
+            if comp.drivetrain is not None:
+                spec, names = wanted.get(comp.drivetrain.sha256, (comp.drivetrain, []))
+                wanted[spec.sha256] = (spec, names + [comp.fmu.stem])
+        for spec, names in wanted.values():
+            ensure_drivetrain_fmus(spec, fmu_dir, names, report)
     missing = missing_fmus(scenario, fmu_dir)
     if missing and build:
         buildable = buildable_fmu_names()
-        names = sorted({p.stem for p in missing.values() if p.parent == Path(".") and p.suffix == ".fmu" and p.stem in buildable})
+        names = sorted({scenario.component(c).fmu.stem for c, p in missing.items() if p.parent == Path(".")
+                        and p.suffix == ".fmu" and p.stem in buildable and scenario.component(c).drivetrain is None})
         if names:
             from fmus.build import build_all
 

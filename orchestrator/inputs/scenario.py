@@ -63,6 +63,7 @@ from components.validation import is_number
 from ..errors import ScenarioError
 from ..frozen_map import FrozenMap
 from .analysis_settings import AnalysisSettings, AnalysisTable
+from .drivetrain_file import DrivetrainSpec, find_drivetrain, load_drivetrain_file
 from .files import find_input_file, packaged_files, read_toml
 from .load_events import EventTable, ScenarioEvent, check_events_in_run
 from .master_options import ALGORITHMS, EXTRAPOLATIONS
@@ -73,6 +74,18 @@ from .schema import (
     flatten_parameters,
     read_document,
 )
+
+#: the project FMU files a drivetrain file is built into, and the generator's (which inherits the gearbox's file)
+DRIVETRAIN_FMU_FILES = ("Gearbox.fmu", "GeneratorRotor.fmu")
+GENERATOR_FMU_FILE = "GeneratorRotor.fmu"
+#: folder of the FMU directory with the FMUs built from drivetrain files, one subfolder per file content
+DRIVETRAIN_FMU_FOLDER = "drivetrains"
+
+
+def drivetrain_fmu_dir(fmu_dir: Path, spec: DrivetrainSpec) -> Path:
+    """Where the FMUs built from a drivetrain file live: ``<fmu_dir>/drivetrains/<name>-<sha256[:16]>/``."""
+    return Path(fmu_dir) / DRIVETRAIN_FMU_FOLDER / spec.key
+
 
 #: relative tolerance when checking that times are whole multiples of the step
 _MULTIPLE_RTOL = 1e-9
@@ -131,6 +144,10 @@ class Component:
     signals : mapping of str -> tuple of str
         With ``role``: signal kind -> the FMU outputs that are that signal
         (``{"generator_speed": ("w",)}``).
+    drivetrain : DrivetrainSpec, optional
+        The drivetrain file this project FMU (``Gearbox.fmu`` or ``GeneratorRotor.fmu``) is
+        built from (:mod:`orchestrator.inputs.drivetrain_file`); the FMU lives in a folder
+        of the FMU directory keyed by the file's content (:meth:`Scenario.fmu_candidates`).
     """
 
     name: str
@@ -138,6 +155,7 @@ class Component:
     parameters: Mapping[str, ParameterValue] = field(default_factory=dict)
     role: str | None = None
     signals: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
+    drivetrain: DrivetrainSpec | None = None
 
     def __post_init__(self) -> None:
         from fmus.slaves.record import ROLES
@@ -160,6 +178,10 @@ class Component:
                                     "an output name or a list of output names")
             signals[kind] = tuple(names)
         object.__setattr__(self, "signals", FrozenMap(signals))
+        if self.drivetrain is not None and str(self.fmu) not in DRIVETRAIN_FMU_FILES:
+            raise ScenarioError(f"components.{self.name}.drivetrain", self.drivetrain.name,
+                                "a drivetrain file only for a project FMU built from it: fmu = "
+                                + " or ".join(f'"{f}"' for f in DRIVETRAIN_FMU_FILES) + f" (not {str(self.fmu)!r})")
 
 
 @dataclass(frozen=True)
@@ -399,8 +421,13 @@ class Scenario:
         """Where the component's FMU is looked for, in order.
 
         An absolute path is used as is; a relative one is tried against the
-        scenario's directory, then the FMU directory.
+        scenario's directory, then the FMU directory. A component built from a
+        drivetrain file has one place: the folder of that file's content in the FMU
+        directory (:func:`drivetrain_fmu_dir`).
         """
+        if component.drivetrain is not None:  # built from a drivetrain file: only its content-keyed folder
+            root = Path(fmu_dir) if fmu_dir is not None else Path.cwd()
+            return [drivetrain_fmu_dir(root, component.drivetrain) / component.fmu.name]
         if component.fmu.is_absolute():
             return [component.fmu]
         out = []
@@ -430,6 +457,8 @@ class _ComponentTable(Table):
     parameters: dict[str, Any] = Field(default_factory=dict, description="a table of parameter values")
     role: str | None = Field(None, description="a role name (string)")
     signals: dict[str, Any] = Field(default_factory=dict, description="a table of signal kind = output name(s)")
+    drivetrain: str | None = Field(None, description="a drivetrain file (path relative to this file, or a packaged "
+                                   "name such as grc-like)")
 
 
 class _LinkTable(Table):
@@ -502,11 +531,17 @@ def scenario_from_dict(data: Mapping[str, Any], name: str | None = None, base_di
         raise _rekeyed(exc, None, source) from None
 
     components = []
+    specs = {cname: _drivetrain_of(ctab.drivetrain, f"components.{cname}.drivetrain", base_dir, source)
+             for cname, ctab in doc.components.items() if ctab.drivetrain is not None}
+    inherited = next(iter(specs.values())) if len({s.sha256 for s in specs.values()}) == 1 else None
     for cname, ctab in doc.components.items():
         path = f"components.{cname}"
         params = flatten_parameters(ctab.parameters, f"{path}.parameters", ScenarioError, source)
+        spec = specs.get(cname)
+        if spec is None and inherited is not None and ctab.fmu == GENERATOR_FMU_FILE:
+            spec = inherited  # the generator of a drivetrain file's gearbox takes its defaults from the same file
         try:
-            components.append(Component(cname, Path(ctab.fmu), params, ctab.role, ctab.signals))
+            components.append(Component(cname, Path(ctab.fmu), params, ctab.role, ctab.signals, spec))
         except ScenarioError as exc:
             raise _rekeyed(exc, path if exc.key == "components" else None, source) from None
 
@@ -538,6 +573,17 @@ def scenario_from_dict(data: Mapping[str, Any], name: str | None = None, base_di
         base_dir=base_dir,
         source=source,
     )
+
+
+def _drivetrain_of(spec: str, key: str, base_dir: Path | None, source: str | None) -> DrivetrainSpec:
+    """The drivetrain file a component names: a path relative to the scenario file, or a packaged name."""
+    if not spec:
+        raise ScenarioError(key, spec, "a drivetrain file path or a packaged drivetrain name", source)
+    local = (base_dir / spec) if base_dir is not None else Path(spec)
+    path = local if local.is_file() else find_drivetrain(spec)
+    drivetrain = load_drivetrain_file(path)
+    drivetrain.cosim_drivetrain()  # a generator behind an output shaft, or an error naming the file
+    return drivetrain
 
 
 def load_scenario(path: str | Path) -> Scenario:

@@ -76,6 +76,11 @@ class StudyPayload:
         Co-simulation: FMU file content by SHA-256.
     timeout_s : float or None
         Wall-clock time [s] one point may take (``Study.timeout_s``); None: no limit.
+    structures : mapping of str -> ResolvedSystem
+        A study varying drivetrain file entries: the system of each drivetrain structure
+        (:mod:`orchestrator.study.drivetrain_variants`).
+    variants : mapping of int -> PointVariant
+        Point index -> its structure and the FMU parameter values that replace its file entries.
     """
 
     study: str
@@ -90,6 +95,8 @@ class StudyPayload:
     series_names: Mapping[str, str] = field(default_factory=dict)
     fmu_blobs: Mapping[str, bytes] = field(default_factory=dict)
     timeout_s: float | None = None
+    structures: Mapping[str, Any] = field(default_factory=dict)
+    variants: Mapping[int, Any] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -155,9 +162,15 @@ def _point_system(payload: StudyPayload, task: PointTask, local_files: bool):
     from ..inputs.study import split_parameter
 
     system = payload.system
+    parameters = dict(task.parameters)
+    variant = payload.variants.get(task.index)
+    if variant is not None:  # drivetrain file entries: the structure's FMUs and the flat values they give
+        system = payload.structures[variant.structure]
+        parameters = {k: v for k, v in parameters.items() if ".drivetrain." not in k}
+        parameters.update(variant.parameters)
     scenario = system.scenario
     by_component: dict[str, dict[str, Any]] = {}
-    for name, value in task.parameters.items():
+    for name, value in parameters.items():
         comp, param = split_parameter(name)
         by_component.setdefault(comp, {})[param] = value
     for comp, values in by_component.items():

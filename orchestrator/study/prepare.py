@@ -264,8 +264,12 @@ def _prepare_scenario(study: Study, fmu_dir,
         paths = ensure_fmus(scenario, fmu_dir, build=build)
     except ScenarioError as exc:
         raise StudyError("base.scenario", study.base.name, f"FMUs that exist or can be built ({exc})", src) from None
+    from .drivetrain_variants import is_file_entry
+
     by_comp: dict[str, dict[str, Any]] = {}
     for name, value in study.base.parameters.items():
+        if is_file_entry(name):  # drivetrain file entries: see drivetrain_variants
+            continue
         comp, param = split_parameter(name)
         by_comp.setdefault(comp, {})[param] = value
     try:
@@ -275,7 +279,7 @@ def _prepare_scenario(study: Study, fmu_dir,
     except ScenarioError as exc:
         raise StudyError(_study_key_of(exc), exc.value, exc.expected, src) from None
     for key, name, values in _origins(study):
-        for value in values:
+        for value in values if not is_file_entry(name) else ():
             _check_value(system, name, value, key, src)
     _check_measure_engines(study)
 
@@ -308,9 +312,11 @@ def _prepare_scenario(study: Study, fmu_dir,
         if extra:
             scenario = replace(scenario, record=scenario.record + tuple(dict.fromkeys(extra)))
             system = resolve_system(scenario, fmu_paths=paths)
+        variants = _variants(study, scenario, fmu_dir, build)
         blobs = {}
-        for comp, path in system.fmu_paths.items():
-            blobs[system.interfaces[comp].sha256] = Path(path).read_bytes()
+        for each in [system] + list(variants.systems.values() if variants else ()):
+            for comp, path in each.fmu_paths.items():
+                blobs[each.interfaces[comp].sha256] = Path(path).read_bytes()
         payload = StudyPayload(study=study.name, engine="cosim", measures=study.measures, system=system,
                                window_s=scenario.simulation.window_s, series_names=series_names, fmu_blobs=blobs)
         settings = None
@@ -320,6 +326,7 @@ def _prepare_scenario(study: Study, fmu_dir,
         from ..cosim.physics_view import PhysicsUnavailable, physics_view
         from ..run.comparison import reference_name
 
+        variants = _variants(study, scenario, fmu_dir, build)
         try:
             setup = physics_view(system)
         except PhysicsUnavailable as exc:
@@ -345,7 +352,32 @@ def _prepare_scenario(study: Study, fmu_dir,
         "scenario_sha256": _content_sha256(Path(study.base.path)),
         "fmus": {c: i.sha256 for c, i in system.interfaces.items()},
     }
+    if variants is not None:  # the FMUs of every drivetrain structure the points run on
+        identity["structures"] = {sid: {c: i.sha256 for c, i in s.interfaces.items()}
+                                  for sid, s in variants.systems.items()}
+        payload = replace(payload, structures=dict(variants.systems), variants=dict(variants.points))
     return payload, identity, dict(system.fmu_paths), tuple(notes)
+
+
+def _variants(study: Study, scenario, fmu_dir, build: bool):
+    """The drivetrain structures of a study varying drivetrain file entries, the measures checked on each."""
+    from ..cosim.fmu_folder import default_fmu_dir
+    from .drivetrain_variants import drivetrain_variants
+
+    fmu_dir = default_fmu_dir() if fmu_dir is None else Path(fmu_dir)
+    try:
+        variants = drivetrain_variants(study, scenario, study.expand(), fmu_dir, build)
+    except ScenarioError as exc:
+        raise StudyError("base.scenario", study.base.name, f"FMUs that exist or can be built ({exc})", study.source) from None
+    for sid, each in (variants.systems.items() if variants else ()):
+        for i, m in enumerate(study.measures):
+            if m.builtin:
+                continue
+            comp, var = split_parameter(m.variable)
+            if comp not in each.interfaces or var not in each.interfaces[comp].variables:
+                raise StudyError(f"measures[{i}]", m.name, f"a variable every drivetrain structure of the study has "
+                                 f"(not the structure {sid})", study.source)
+    return variants
 
 
 def _content_sha256(path: Path) -> str:

@@ -1,0 +1,63 @@
+"""FMUs built from drivetrain files, kept apart by the file's content.
+
+A Gearbox (and its GeneratorRotor) built from a drivetrain file lives in
+``<FMU directory>/drivetrains/<name>-<sha256[:16]>/`` (:func:`orchestrator.inputs.scenario.drivetrain_fmu_dir`),
+so two scenarios with different drivetrains never overwrite each other's
+``Gearbox.fmu`` and a changed file gets new FMUs. The FMUs' records name the file
+and its content hash (``source``) and carry the drivetrain (``model``), which the
+reference, the comparison and ``dtcosim modes`` read.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Callable, Iterable
+
+from ..inputs.drivetrain_file import DrivetrainSpec
+from ..inputs.scenario import drivetrain_fmu_dir
+
+#: the FMUs a drivetrain file is built into
+DRIVETRAIN_FMU_NAMES = ("Gearbox", "GeneratorRotor")
+
+
+def build_drivetrain_fmus(spec: DrivetrainSpec, out_dir: Path, names: Iterable[str] = DRIVETRAIN_FMU_NAMES,
+                          report: Callable[[str], None] | None = None, validate: bool = True) -> list:
+    """Build FMUs ``names`` from a drivetrain file into ``out_dir``.
+
+    Returns
+    -------
+    list of fmus.build.BuiltFmu
+
+    Raises
+    ------
+    DrivetrainFileError
+        The file has no generator (a Gearbox FMU is cut at the generator).
+    """
+    from fmus.build import build_fmu
+
+    drivetrain = spec.cosim_drivetrain()
+    names = list(names)
+    if report:
+        report(f"building {', '.join(n + '.fmu' for n in names)} from {spec.origin} into {out_dir} ...")
+    return [build_fmu(n, out_dir, drivetrain=drivetrain, origin=spec.origin, rotor_speed_rad_s=spec.rotor_speed_rad_s,
+                      validate=validate) for n in names]
+
+
+def ensure_drivetrain_fmus(spec: DrivetrainSpec, fmu_dir: Path, names: Iterable[str],
+                           report: Callable[[str], None] | None = None) -> Path:
+    """The folder of ``spec``'s FMUs in ``fmu_dir``, with FMUs ``names`` built if missing or stale.
+
+    Stale: built from other code than the installed dtcosim (:func:`orchestrator.cosim.fmu_store.stale_project_fmus`);
+    these folders are the project's own cache, so a stale FMU is rebuilt, not only reported.
+    """
+    from .fmu_store import stale_project_fmus
+
+    folder = drivetrain_fmu_dir(fmu_dir, spec)
+    names = list(dict.fromkeys(names))
+    paths = {n: folder / f"{n}.fmu" for n in names}
+    todo = [n for n, p in paths.items() if not p.is_file()]
+    present = {n: p for n, p in paths.items() if p.is_file()}
+    todo += [n for n in present if stale_project_fmus({n: present[n]})]
+    if todo:
+        build_drivetrain_fmus(spec, folder, sorted(set(todo)), report)
+    return folder

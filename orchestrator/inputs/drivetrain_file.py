@@ -1,0 +1,452 @@
+"""Drivetrain description files (TOML): any stage list, any number of planets, one source for every tool.
+
+A drivetrain file describes the gearbox from rotor to generator (its tables:
+:mod:`orchestrator.inputs.drivetrain_schema`, units: :mod:`orchestrator.inputs.drivetrain_units`,
+changed entries for studies: :mod:`orchestrator.inputs.drivetrain_entries`); it is read into
+a :class:`~components.model.drivetrain.Drivetrain` (what the Gearbox FMU, the
+monolithic reference, ``dtcosim modes`` and studies use) together with the
+derived design table (:mod:`components.model.design_table`: which masses were
+given and which derived, the geometry checks). Every mistake is a
+:class:`DrivetrainFileError` naming the file, the key path, the value and the
+expectation, raised while the file is read, before anything is built. The
+format in full is in the README ("Your own gearbox")::
+
+    name = "grc-like"                     # optional, default: file stem
+    description = "..."
+    density = 7800.0                      # kg/m3, default for derived gear bodies
+
+    [units]                               # optional: SI unless a quantity is named here
+    length = "mm"                         # m | mm: radii, module, face width, backlash, bores
+    angle = "deg"                         # rad | deg: pressure angles, planet angles
+    inertia = "kg.mm2"                    # kg.m2 | kg.mm2
+    contact_stiffness = "N/mm^e"          # N/m^e | N/mm^e (k0)
+    contact_damping = "N.s/mm2"           # N.s/m2 | N.s/mm2 (c0)
+    regularisation = "1/mm"               # 1/m | 1/mm (lambda)
+    torsional_stiffness = "N.mm/deg"      # N.m/rad | N.mm/deg
+    torsional_damping = "N.mm.s/deg"      # N.m.s/rad | N.mm.s/deg
+    torque = "N.mm"                       # N.m | N.mm
+    speed = "rpm"                         # rad/s | rpm
+
+    [mesh]                                # contact defaults of every mesh (each mesh may override)
+    law = "cfs"                           # cfs | impact
+    k0 = 5.0e5
+    exponent = 1.5
+    c0 = 5.0e4
+    lambda = 600.0
+    backlash = 0.56
+
+    [[stages]]
+    name = "stage1"
+    kind = "planetary"                    # ring fixed, carrier in, sun out
+    module = 10.0
+    pressure_angle = 20.0
+    face_width = 50.0
+    teeth = { sun = 20, planet = 80, ring = 180 }   # or radii = { sun = ..., ring = ... }
+    planets = 3
+    # planet_angles = [0.0, 120.0, 240.0]           # default: equally spaced
+    carrier_inertia = 0.0                 # extra, on top of the planets' orbital inertia
+    sun = { mass = 12.25, inertia = 6.12e4 }
+    planet = { disc = "bored", bore_diameter = 100.0 }   # derived from the geometry
+    # sun_mesh = { k0 = ... }  ring_mesh = { ... }  mesh = { ... }  (per-mesh contact)
+
+    [[stages]]
+    name = "stage3"
+    kind = "parallel"
+    module = 10.0
+    pressure_angle = 20.0
+    face_width = 50.0
+    teeth = { drive = 20, driven = 16 }
+    drive = { mass = 12.25, inertia = 6.12e4 }
+    driven = { disc = "solid" }
+
+    [[shafts]]                            # between stages, then one to the generator
+    name = "shaft1"
+    stiffness = 1.0e9
+    damping = 1.0e8
+
+    [generator]                           # or [output] torque = ... (no generator)
+    inertia = 1.51e8
+    counter_torque = 2.54e7
+
+    [operating_point]
+    rotor_speed = 16.0                    # for the design table, FMU start values, reference and modes
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Mapping
+
+from components import units
+from components.errors import ParameterError
+from components.model.contact import MeshContact
+from components.model.design_table import BodyRow, DesignTable, design_table
+from components.model.drivetrain import Drivetrain
+from components.model.gear_geometry import (
+    GeometryCheck,
+    assembly_check,
+    clearance_check,
+    disc_body,
+    ring_teeth_check,
+)
+from components.model.generator import GeneratorParameters
+from components.model.stages import ParallelStage, PlanetaryStage, Shaft
+
+from .drivetrain_schema import (
+    STAGE_TABLES,
+    DrivetrainFile,
+    DrivetrainFileError,
+    GearTable,
+    MeshTable,
+    ParallelTable,
+    PlanetaryTable,
+)
+from .drivetrain_units import FileUnits
+from .files import find_input_file, packaged_files, read_toml
+from .schema import NAME_PATTERN, read_document
+
+#: folder of the packaged drivetrain files (beside ``scenarios/`` and ``studies/``)
+FOLDER = "drivetrains"
+#: rotor speed of the operating point when the file gives none: the paper's 16 rpm (Sec. 4.2)
+DEFAULT_ROTOR_SPEED_RAD_S = units.rpm(16.0)
+#: names a stage or shaft may not take (they are other flat parameter prefixes)
+RESERVED_NAMES = ("generator", "output_torque", "solver", "wind", "drivetrain")
+
+
+# ------------------------------------------------------------------ the result
+@dataclass(frozen=True)
+class DrivetrainSpec:
+    """A drivetrain file read and checked.
+
+    Attributes
+    ----------
+    name : str
+    description : str
+    drivetrain : Drivetrain
+        SI, validated.
+    rotor_speed_rad_s : float
+        The file's operating point (default 16 rpm).
+    bodies : mapping of str -> tuple of BodyRow
+        Per stage, each body with where its mass and inertia come from (given or derived).
+    checks : mapping of str -> tuple of GeometryCheck
+        Per stage, the geometry checks that apply (all passed: a failed one is an error).
+    source : str or None
+        The file.
+    sha256 : str
+        SHA-256 of the file's content (hex).
+    data : mapping
+        The parsed TOML document (studies change entries of it).
+    """
+
+    name: str
+    description: str
+    drivetrain: Drivetrain
+    rotor_speed_rad_s: float
+    bodies: Mapping[str, tuple[BodyRow, ...]]
+    checks: Mapping[str, tuple[GeometryCheck, ...]]
+    source: str | None = None
+    sha256: str = ""
+    data: Mapping[str, Any] = field(default_factory=dict, compare=False, repr=False)
+
+    @property
+    def origin(self) -> str:
+        """What an FMU built from it records as its source: ``"drivetrain file X (sha256 ...)"``."""
+        where = Path(self.source).name if self.source else self.name
+        return f"drivetrain file {where} (sha256 {self.sha256[:16]})"
+
+    @property
+    def key(self) -> str:
+        """Folder name of FMUs built from this content: ``<name>-<first 16 hex digits of the SHA-256>``."""
+        return f"{self.name}-{self.sha256[:16]}"
+
+    def design_table(self, rotor_speed_rad_s: float | None = None, input_torque_nm: float | None = None) -> DesignTable:
+        """The derived design table at the file's operating point (or the given one)."""
+        speed = self.rotor_speed_rad_s if rotor_speed_rad_s is None else rotor_speed_rad_s
+        return design_table(self.drivetrain, speed, input_torque_nm, self.name, self.bodies, self.checks)
+
+    def cosim_drivetrain(self) -> Drivetrain:
+        """The drivetrain, which must have a generator behind an output shaft (a Gearbox FMU's structure).
+
+        Raises
+        ------
+        DrivetrainFileError
+            The file has ``[output]`` instead of ``[generator]``.
+        """
+        if self.drivetrain.generator is None:
+            raise DrivetrainFileError("generator", None, "a [generator] table and a shaft to it: a Gearbox FMU is "
+                                      "cut at the generator (this file loads its last stage with [output] torque)",
+                                      self.source)
+        return self.drivetrain
+
+
+#: mesh entries with a default, and those every mesh needs (from itself, its stage or [mesh])
+_MESH_DEFAULTS = {"law": "cfs", "exponent": 1.5}
+_MESH_REQUIRED = ("k0", "c0", "lambda", "backlash")
+
+
+class _Reader:
+    """Turns the validated tables into the model's dataclasses, naming file keys in every error."""
+
+    def __init__(self, doc: DrivetrainFile, source: str | None) -> None:
+        self.doc = doc
+        self.source = source
+        self.u = FileUnits(doc.units)
+
+    def error(self, key: str, value: Any, expected: str) -> DrivetrainFileError:
+        return DrivetrainFileError(key, value, expected, self.source)
+
+    # -- meshes
+    def mesh(self, key: str, pressure_angle_rad: float, *tables: MeshTable | None) -> MeshContact:
+        merged: dict[str, Any] = dict(_MESH_DEFAULTS)
+        for table in (self.doc.mesh, *tables):
+            if table is not None:
+                merged.update(table.model_dump(by_alias=True, exclude_none=True))
+        for name in _MESH_REQUIRED:
+            if name not in merged:
+                raise self.error(f"{key}.{name}", None, f"a value for {name} (missing: give it in this mesh, the "
+                                 "stage's mesh table or the file's [mesh] table)")
+        e = merged["exponent"]
+        u = self.u
+        try:
+            return MeshContact(
+                stiffness=u.k0(merged["k0"], e), exponent=e, damping=u.c0(merged["c0"]),
+                regularisation=u.regularisation(merged["lambda"]), backlash_normal_m=u.length(merged["backlash"]),
+                pressure_angle_rad=pressure_angle_rad, law=merged["law"],
+                **({"impact_depth_m": u.length(merged["impact_depth"])} if "impact_depth" in merged else {}),
+                **({"impact_damping": u.impact_damping(merged["impact_damping"])} if "impact_damping" in merged else {}),
+                **{k: merged[k] for k in ("contact_ratio", "stiffness_variation") if k in merged},
+            )
+        except ParameterError as exc:
+            raise self.error(f"{key} ({exc.name})", exc.value, exc.expected) from None
+
+    # -- gear bodies
+    def body(self, key: str, body_name: str, table: GearTable, pitch_radius_m: float,
+             width_m: float) -> BodyRow:
+        given = table.mass is not None or table.inertia is not None
+        if given and table.disc is not None:
+            raise self.error(f"{key}.disc", table.disc, "no disc when mass and inertia are given (either the "
+                             "values or a disc to derive them from)")
+        if given:
+            for name in ("mass", "inertia"):
+                if getattr(table, name) is None:
+                    raise self.error(f"{key}.{name}", None, "a value (mass and inertia are given together, "
+                                     "or neither with disc = \"solid\" or \"bored\")")
+            for name in ("bore_diameter", "density"):
+                if getattr(table, name) is not None:
+                    raise self.error(f"{key}.{name}", getattr(table, name), "no disc data when mass and inertia "
+                                     "are given")
+            return BodyRow(body_name, table.mass, self.u.inertia(table.inertia), "given")
+        if table.disc is None:
+            raise self.error(key, table.model_dump(exclude_none=True),
+                             'mass and inertia, or disc = "solid" or "bored" (with bore_diameter) to derive them')
+        if table.disc == "bored" and table.bore_diameter is None:
+            raise self.error(f"{key}.bore_diameter", None, 'a bore diameter [length unit] for disc = "bored"')
+        if table.disc == "solid" and table.bore_diameter is not None:
+            raise self.error(f"{key}.bore_diameter", table.bore_diameter, 'no bore for disc = "solid"')
+        bore = 0.5 * self.u.length(table.bore_diameter) if table.bore_diameter is not None else 0.0
+        density = table.density if table.density is not None else self.doc.density
+        try:
+            disc = disc_body(pitch_radius_m, width_m, density, bore)
+        except ParameterError as exc:
+            raise self.error(f"{key}.{exc.name}", exc.value, exc.expected) from None
+        return BodyRow(body_name, disc.mass_kg, disc.inertia_kgm2, f"derived: {disc.description}")
+
+    # -- stages
+    def stage(self, i: int, data: Mapping[str, Any]):
+        key = f"stages[{i}]"
+        if not isinstance(data, Mapping):
+            raise self.error(key, data, "a table")
+        kind = data.get("kind")
+        if kind not in STAGE_TABLES:
+            raise self.error(f"{key}.kind", kind, 'the stage kind: "planetary" or "parallel"'
+                             + (" (missing)" if kind is None else ""))
+        try:
+            table = read_document(STAGE_TABLES[kind], data, DrivetrainFileError, self.source)
+        except DrivetrainFileError as exc:
+            raise self.error(f"{key}.{exc.key}", exc.value, exc.expected) from None
+        name = table.name if table.name is not None else f"stage{i + 1}"
+        if not NAME_PATTERN.match(name) or name in RESERVED_NAMES:
+            raise self.error(f"{key}.name", name, "a stage name of letters, digits, '_' or '-', not "
+                             + ", ".join(RESERVED_NAMES))
+        if (table.teeth is None) == (table.radii is None):
+            raise self.error(f"{key}.teeth", None if table.teeth is None else "both teeth and radii",
+                             "either teeth = {...} or radii = {...} (exactly one)")
+        if isinstance(table, PlanetaryTable):
+            return self.planetary(key, name, table)
+        return self.parallel(key, name, table)
+
+    def planetary(self, key: str, name: str, t: PlanetaryTable):
+        u = self.u
+        module = u.length(t.module)
+        alpha = u.angle(t.pressure_angle)
+        if not alpha < 0.5 * math.pi:
+            raise self.error(f"{key}.pressure_angle", t.pressure_angle, f"an angle below 90 deg [{self.doc.units.angle}]")
+        width = u.length(t.face_width)
+        checks: list[GeometryCheck] = []
+        angles = None
+        if t.planet_angles is not None:
+            if len(t.planet_angles) != t.planets:
+                raise self.error(f"{key}.planet_angles", t.planet_angles, f"{t.planets} angles, one per planet")
+            angles = tuple(u.angle(a) for a in t.planet_angles)
+            if not all(0.0 <= a < 2.0 * math.pi for a in angles) or any(b <= a for a, b in zip(angles, angles[1:])):
+                raise self.error(f"{key}.planet_angles", t.planet_angles,
+                                 "strictly increasing angles in [0, 360) deg ([0, 2 pi) rad)")
+        if t.teeth is not None:
+            z = t.teeth
+            r_s, r_p, r_r = (u.length(t.module * n / 2.0) for n in (z.sun, z.planet, z.ring))
+            ring = ring_teeth_check(z.sun, z.planet, z.ring)
+            if not ring.passed:
+                raise self.error(f"{key}.teeth.ring", z.ring, f"Z_sun + 2 Z_planet = {z.sun + 2 * z.planet} for "
+                                 f"standard gears ({ring.detail})")
+            assembly = assembly_check(z.sun, z.ring, t.planets, angles)
+            if not assembly.passed:
+                where = "planet_angles" if angles is not None else "planets"
+                raise self.error(f"{key}.{where}", t.planet_angles if angles is not None else t.planets,
+                                 f"planets that can be assembled: {assembly.detail}")
+            checks += [ring, assembly]
+        else:
+            r = t.radii
+            r_s, r_r = u.length(r.sun), u.length(r.ring)
+            if not r_r > r_s:
+                raise self.error(f"{key}.radii.ring", r.ring, f"> the sun radius {r.sun:g}")
+            r_p = 0.5 * (r_r - r_s)
+            if r.planet is not None and not math.isclose(u.length(r.planet), r_p, rel_tol=1e-9):
+                raise self.error(f"{key}.radii.planet", r.planet, f"(ring - sun) / 2 = {0.5 * (r.ring - r.sun):g} "
+                                 "(coaxial sun, planet and ring)")
+            checks.append(GeometryCheck("ring teeth", None, "radii given: no tooth counts to check"))
+            checks.append(GeometryCheck("assembly", None, "radii given: no tooth counts to check"))
+        positions = angles if angles is not None else tuple(2.0 * math.pi * i / t.planets for i in range(t.planets))
+        clearance = clearance_check(r_s, r_p, module, positions)
+        if not clearance.passed:
+            raise self.error(f"{key}.planets", t.planets, f"planets that do not overlap ({clearance.detail})")
+        checks.append(clearance)
+        sun = self.body(f"{key}.sun", f"{name}.sun", t.sun, r_s, width)
+        planet = self.body(f"{key}.planet", f"{name}.planet", t.planet, r_p, width)
+        carrier = BodyRow(f"{name}.carrier", None, u.inertia(t.carrier_inertia),
+                          "given (extra carrier inertia; the planets' orbital inertia n m_p a^2 is added)")
+        # precedence: the file's [mesh] < the stage's mesh < its sun_mesh / ring_mesh
+        sun_mesh = self.mesh(f"{key}.sun_mesh", alpha, t.mesh, t.sun_mesh)
+        ring_mesh = self.mesh(f"{key}.ring_mesh", alpha, t.mesh, t.ring_mesh)
+        try:
+            stage = PlanetaryStage(
+                name=name, sun_radius_m=r_s, ring_radius_m=r_r, n_planets=t.planets,
+                sun_mass_kg=sun.mass_kg, sun_inertia_kgm2=sun.inertia_kgm2,
+                planet_mass_kg=planet.mass_kg, planet_inertia_kgm2=planet.inertia_kgm2,
+                sun_mesh=sun_mesh, ring_mesh=ring_mesh, carrier_inertia_kgm2=carrier.inertia_kgm2,
+                width_m=width, module_m=module, planet_angles_rad=angles,
+            )
+        except ParameterError as exc:
+            raise self.error(f"{key} ({exc.name})", exc.value, exc.expected) from None
+        return stage, (carrier, sun, planet), tuple(checks)
+
+    def parallel(self, key: str, name: str, t: ParallelTable):
+        u = self.u
+        module = u.length(t.module)
+        alpha = u.angle(t.pressure_angle)
+        if not alpha < 0.5 * math.pi:
+            raise self.error(f"{key}.pressure_angle", t.pressure_angle, f"an angle below 90 deg [{self.doc.units.angle}]")
+        width = u.length(t.face_width)
+        if t.teeth is not None:
+            r1, r2 = (u.length(t.module * n / 2.0) for n in (t.teeth.drive, t.teeth.driven))
+        else:
+            r1, r2 = u.length(t.radii.drive), u.length(t.radii.driven)
+        drive = self.body(f"{key}.drive", f"{name}.drive", t.drive, r1, width)
+        driven = self.body(f"{key}.driven", f"{name}.driven", t.driven, r2, width)
+        mesh = self.mesh(f"{key}.mesh", alpha, t.mesh)
+        try:
+            stage = ParallelStage(
+                name=name, drive_radius_m=r1, driven_radius_m=r2, drive_mass_kg=drive.mass_kg,
+                drive_inertia_kgm2=drive.inertia_kgm2, driven_mass_kg=driven.mass_kg,
+                driven_inertia_kgm2=driven.inertia_kgm2, mesh=mesh, width_m=width, module_m=module,
+            )
+        except ParameterError as exc:
+            raise self.error(f"{key} ({exc.name})", exc.value, exc.expected) from None
+        return stage, (drive, driven), ()
+
+    # -- the whole
+    def drivetrain(self) -> tuple[Drivetrain, dict, dict]:
+        doc = self.doc
+        stages, bodies, checks = [], {}, {}
+        for i, data in enumerate(doc.stages):
+            stage, rows, stage_checks = self.stage(i, data)
+            if stage.name in bodies:
+                raise self.error(f"stages[{i}].name", stage.name, "a stage name not used by another stage")
+            stages.append(stage)
+            bodies[stage.name] = rows
+            checks[stage.name] = stage_checks
+        if (doc.generator is None) == (doc.output is None):
+            raise self.error("generator", None, "either a [generator] table (with a shaft to it) or an [output] "
+                             "table with the counter torque on the last stage (exactly one)")
+        n_shafts = len(stages) if doc.generator is not None else len(stages) - 1
+        if len(doc.shafts) != n_shafts:
+            what = (f"{n_shafts} [[shafts]] for {len(stages)} stage(s) and a generator: one between each pair of "
+                    "stages and one to the generator") if doc.generator is not None else (
+                    f"{n_shafts} [[shafts]] for {len(stages)} stage(s) without a generator: one between each pair "
+                    "of stages")
+            raise self.error("shafts", len(doc.shafts), what)
+        shafts = []
+        taken = set(bodies)
+        for k, t in enumerate(doc.shafts):
+            name = t.name if t.name is not None else f"shaft{k + 1}"
+            if not NAME_PATTERN.match(name) or name in RESERVED_NAMES or name in taken:
+                raise self.error(f"shafts[{k}].name", name, "a shaft name of letters, digits, '_' or '-', used by no "
+                                 "other stage or shaft, not " + ", ".join(RESERVED_NAMES))
+            taken.add(name)
+            shafts.append(Shaft(name, self.u.shaft_stiffness(t.stiffness), self.u.shaft_damping(t.damping)))
+        try:
+            if doc.generator is not None:
+                gen = GeneratorParameters(self.u.inertia(doc.generator.inertia),
+                                          self.u.torque(doc.generator.counter_torque))
+                dt = Drivetrain(tuple(stages), tuple(shafts[:-1]), generator=gen, output_shaft=shafts[-1])
+            else:
+                dt = Drivetrain(tuple(stages), tuple(shafts), output_torque_nm=self.u.torque(doc.output.torque))
+        except ParameterError as exc:
+            raise self.error(f"(drivetrain) {exc.name}", exc.value, exc.expected) from None
+        return dt, bodies, checks
+
+
+def drivetrain_from_dict(data: Mapping[str, Any], name: str | None = None, source: str | None = None,
+                         sha256: str = "") -> DrivetrainSpec:
+    """Read a parsed drivetrain document.
+
+    Raises
+    ------
+    DrivetrainFileError
+        Naming the first offending key.
+    """
+    doc = read_document(DrivetrainFile, data, DrivetrainFileError, source)
+    dt_name = doc.name if doc.name is not None else name
+    if dt_name is None or not NAME_PATTERN.match(dt_name):
+        raise DrivetrainFileError("name", dt_name, "a drivetrain name of letters, digits, '_' or '-'", source)
+    reader = _Reader(doc, source)
+    drivetrain, bodies, checks = reader.drivetrain()
+    speed = reader.u.speed(doc.operating_point.rotor_speed) if doc.operating_point else DEFAULT_ROTOR_SPEED_RAD_S
+    return DrivetrainSpec(dt_name, doc.description, drivetrain, speed, bodies, checks, source, sha256, dict(data))
+
+
+def load_drivetrain_file(path: str | Path) -> DrivetrainSpec:
+    """Read and check a drivetrain TOML file.
+
+    Raises
+    ------
+    DrivetrainFileError
+        A missing or unreadable file, a TOML syntax error, or any invalid entry.
+    """
+    path = Path(path)
+    data = read_toml(path, DrivetrainFileError)
+    sha = hashlib.sha256(path.read_bytes()).hexdigest()
+    return drivetrain_from_dict(data, name=path.stem, source=str(path), sha256=sha)
+
+
+def packaged_drivetrains() -> dict[str, Path]:
+    """Drivetrain files shipped with dtcosim, by name (``paper-table6``, ``grc-like``, ...)."""
+    return packaged_files(FOLDER)
+
+
+def find_drivetrain(spec: str | Path) -> Path:
+    """A drivetrain file from a path or the name of a packaged one."""
+    return find_input_file(spec, FOLDER, DrivetrainFileError, described="a drivetrain file",
+                           plural="drivetrain files")
