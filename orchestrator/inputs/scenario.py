@@ -131,6 +131,10 @@ class Component:
     signals : mapping of str -> tuple of str
         With ``role``: signal kind -> the FMU outputs that are that signal
         (``{"generator_speed": ("w",)}``).
+    no_feedthrough : tuple of str
+        Outputs that do not depend directly on any input, for an FMU whose model
+        description does not say (no ``dependencies`` attribute: FMI 2 then means
+        "depends on all inputs"); a loop through them is not algebraic.
     """
 
     name: str
@@ -138,6 +142,7 @@ class Component:
     parameters: Mapping[str, ParameterValue] = field(default_factory=dict)
     role: str | None = None
     signals: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
+    no_feedthrough: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         from fmus.slaves.record import ROLES
@@ -160,6 +165,11 @@ class Component:
                                     "an output name or a list of output names")
             signals[kind] = tuple(names)
         object.__setattr__(self, "signals", FrozenMap(signals))
+        outputs = (self.no_feedthrough,) if isinstance(self.no_feedthrough, str) else self.no_feedthrough
+        if not isinstance(outputs, (list, tuple)) or not all(isinstance(n, str) and n for n in outputs):
+            raise ScenarioError(f"components.{self.name}.no_feedthrough", self.no_feedthrough,
+                                "a list of output names")
+        object.__setattr__(self, "no_feedthrough", tuple(outputs))
 
 
 @dataclass(frozen=True)
@@ -430,6 +440,8 @@ class _ComponentTable(Table):
     parameters: dict[str, Any] = Field(default_factory=dict, description="a table of parameter values")
     role: str | None = Field(None, description="a role name (string)")
     signals: dict[str, Any] = Field(default_factory=dict, description="a table of signal kind = output name(s)")
+    no_feedthrough: list[str] = Field(default_factory=list,
+                                      description="a list of outputs that do not depend directly on any input")
 
 
 class _LinkTable(Table):
@@ -506,7 +518,8 @@ def scenario_from_dict(data: Mapping[str, Any], name: str | None = None, base_di
         path = f"components.{cname}"
         params = flatten_parameters(ctab.parameters, f"{path}.parameters", ScenarioError, source)
         try:
-            components.append(Component(cname, Path(ctab.fmu), params, ctab.role, ctab.signals))
+            components.append(Component(cname, Path(ctab.fmu), params, ctab.role, ctab.signals,
+                                        tuple(ctab.no_feedthrough)))
         except ScenarioError as exc:
             raise _rekeyed(exc, path if exc.key == "components" else None, source) from None
 
