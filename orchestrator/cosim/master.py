@@ -479,8 +479,9 @@ class CoSimulation:
                     k = advance(k, k_end, t0, H)
                 except _Stop as stop:
                     s = slots[stop.slot]
-                    discard = discard_status(s.inst, stop.function, stop.status, t0 + (stop.k + 1) * H)
-                    if discard is not None and discard.terminated:  # the FMU ended the simulation
+                    discard = discard_status(s.inst, stop.function, stop.status, t0 + stop.k * H,
+                                             t0 + (stop.k + 1) * H)
+                    if discard is not None and discard.ends_run:  # the FMU ended the simulation
                         try:
                             k = advance.finish_step(stop.k, stop.slot, t0, H) if discard.reached_step_end else stop.k
                         except _Stop as second:

@@ -13,7 +13,10 @@ naming the FMU):
 * at ``t_k`` when it stopped inside the step (the last sample is the one at ``t_k``).
 
 A discard without termination stays a failure; its message then gives the last
-successful time the FMU reports.
+successful time the FMU reports. So does a "termination" without progress (last
+successful time ``t_k`` or none): pythonfmu 0.7 FMUs answer ``fmi2Terminated =
+true`` after *every* discarded step, also when their solver failed and they kept
+the state at ``t_k`` (dtcosim's Gearbox), which is a failure, not an end.
 """
 
 from __future__ import annotations
@@ -39,23 +42,36 @@ class Discard:
         ``fmi2LastSuccessfulTime`` (None when the FMU cannot tell).
     reached_step_end : bool
         The last successful time is the end of the discarded step ``t_{k+1}``.
+    progressed : bool
+        The last successful time is after the start of the step ``t_k``.
     """
 
     terminated: bool
     last_successful_time_s: float | None
     reached_step_end: bool
+    progressed: bool
+
+    @property
+    def ends_run(self) -> bool:
+        """The FMU ended the simulation: terminated after computing past ``t_k``."""
+        return self.terminated and self.progressed
 
     def note(self) -> str:
-        """Text appended to the failure message of a discard without termination."""
-        if self.last_successful_time_s is None:
-            return "; the FMU did not terminate and reports no last successful time"
-        return f"; the FMU did not terminate, last successful time {self.last_successful_time_s:.9g} s"
+        """Text appended to the failure message of a discard that does not end the run."""
+        last = self.last_successful_time_s
+        when = "no last successful time" if last is None else f"last successful time {last:.9g} s"
+        if self.terminated:
+            return f"; the FMU reports fmi2Terminated without progress in the step ({when}): a failed step"
+        return f"; the FMU did not terminate ({when})"
 
 
-def discard_status(inst: FmuInstance, function: str, status: int, step_end_s: float) -> Discard | None:
+def discard_status(inst: FmuInstance, function: str, status: int, step_start_s: float,
+                   step_end_s: float) -> Discard | None:
     """The FMU's termination status after a discarded ``fmi2DoStep``; None for any other failure."""
     if function != "fmi2DoStep" or status != FMI_DISCARD:
         return None
     terminated, last = inst.termination_status()
-    reached = last is not None and abs(last - step_end_s) <= TIME_RTOL * max(1.0, abs(step_end_s))
-    return Discard(terminated, last, reached)
+    tol = TIME_RTOL * max(1.0, abs(step_end_s))
+    reached = last is not None and abs(last - step_end_s) <= tol
+    progressed = last is not None and last > step_start_s + tol
+    return Discard(terminated, last, reached, progressed)
