@@ -91,6 +91,8 @@ class FmuInterface:
         e.g. ``("linux64", "win64")``).
     default_start_s, default_stop_s : float or None
         DefaultExperiment startTime and stopTime.
+    enumerations : mapping of str -> mapping of str -> int
+        Enumeration types (TypeDefinitions): type name -> item name -> value.
     """
 
     path: Path
@@ -110,6 +112,7 @@ class FmuInterface:
     platforms: tuple[str, ...] = ()
     default_start_s: float | None = None
     default_stop_s: float | None = None
+    enumerations: Mapping[str, Mapping[str, int]] = field(default_factory=dict)
     _inputs: tuple[str, ...] = field(default=(), repr=False)
 
     def variable(self, name: str) -> FmuVariable:
@@ -305,6 +308,8 @@ def read_fmu_interface(path: str | Path, key: str = "fmu") -> FmuInterface:
         platforms=binary_platforms(p, cs.modelIdentifier),
         default_start_s=default_start,
         default_stop_s=default_stop,
+        enumerations=FrozenMap({t.name: FrozenMap({i.name: int(i.value) for i in t.items})
+                                for t in md.typeDefinitions or () if t.type == "Enumeration"}),
         _inputs=inputs,
     )
     _CACHE[cache_key] = iface

@@ -188,6 +188,7 @@ class _Slot:
         self.n_couple = 0
         self.col0 = 0  # first column of the block
         self.feeds: list[tuple[int, int, int]] = []  # (input index, source slot, source column)
+        self.linear: dict[int, tuple[float, float]] = {}  # input index -> (factor, offset) of a transformed connection
         self.in_vr = None
         self.in_buf = None
         self.out_vr = None
@@ -343,10 +344,11 @@ class CoSimulation:
         """Sweeps in dependency order until the transferred values are a fixed point."""
         sc = self.system.scenario
         t0 = self.settings.start_s
-        links = [(c.source, c.target) for c in sc.connections] + [(b.source, b.target) for b in sc.initial]
+        links = [(c.source, c.target, self.system.loop_transformation(c)) for c in sc.connections] \
+            + [(b.source, b.target, None) for b in sc.initial]
         incoming: dict[str, list] = {name: [] for name in self.system.init_order}
-        for src, dst in links:
-            incoming[dst.component].append((src, dst))
+        for src, dst, transform in links:
+            incoming[dst.component].append((src, dst, transform))
         last: dict[str, float] = {}
         max_sweeps = len(self.system.init_order) + EXTRA_INIT_SWEEPS
         changed: list[str] = []
@@ -356,8 +358,12 @@ class CoSimulation:
                 if not incoming[name]:
                     continue
                 values = {}
-                for src, dst in incoming[name]:
+                for src, dst, transform in incoming[name]:
                     v = self.instances[src.component].get_values([src.variable], t0)[0]
+                    if isinstance(transform, dict):
+                        v = type(v)(transform.get(int(v), int(v)))
+                    elif transform is not None:
+                        v = transform.apply(v)
                     if isinstance(v, float) and not math.isfinite(v):
                         raise InitializationError(f"initialisation: {src} = {v!r} at t = {t0:g} s (needed by {dst})")
                     key = str(dst)
@@ -438,11 +444,16 @@ class CoSimulation:
             s.in_vr = value_references(s.inst.interface, s.in_names)
             s.in_buf = (c_double * max(1, len(s.in_names)))()
             s.feeds = []
+            s.linear = {}
             for j, c in enumerate(incoming):
                 src = by_name[c.source.component]
                 s.feeds.append((j, slots.index(src), src.col0 + src.out_names.index(c.source.variable)))
+                transform = sysd.loop_transformation(c)
+                if transform is not None:
+                    s.linear[j] = (transform.factor, transform.offset)
             typed_in = [(c.target.variable, self.system.interfaces[s.name].variables[c.target.variable].type,
-                         slots.index(by_name[c.source.component]), typed_column[(c.source.component, c.source.variable)])
+                         slots.index(by_name[c.source.component]), typed_column[(c.source.component, c.source.variable)],
+                         sysd.loop_transformation(c))
                         for c in sc.connections if c.target.component == s.name
                         and not is_real(c.target.component, c.target.variable)]
             if outputs[s.name] or typed_in:
@@ -598,9 +609,13 @@ def compile_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str, st
             latest, previous = ("o1", "o0") if upstream else ("o0", "om")
             if linear:
                 a = 0.5 if upstream else 1.5
-                body.append(f"ib{i}[{j_in}] = {a!r} * RING[{latest} + {col}] + {1.0 - a!r} * RING[{previous} + {col}]")
+                value = f"{a!r} * RING[{latest} + {col}] + {1.0 - a!r} * RING[{previous} + {col}]"
             else:
-                body.append(f"ib{i}[{j_in}] = RING[{latest} + {col}]")
+                value = f"RING[{latest} + {col}]"
+            if j_in in s.linear:  # an SSP LinearTransformation (or unit conversion) on the connection
+                factor, offset = s.linear[j_in]
+                value = f"{factor!r} * ({value}) + {offset!r}"
+            body.append(f"ib{i}[{j_in}] = {value}")
         def timed(call: str, column: int) -> list[str]:
             if timers is None:
                 return [call]
@@ -666,7 +681,11 @@ def interpreted_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str
     plan = []
     for i, s in enumerate(slots):
         # (input index, source already stepped this step (Gauss-Seidel), source column)
-        feeds = [(j, algorithm == "gauss-seidel" and src < position[id(s)], col) for j, src, col in s.feeds]
+        feeds = [(j, algorithm == "gauss-seidel" and src < position[id(s)], col) for j, src, col in s.feeds
+                 if j not in s.linear]
+        # transformed connections (SSP LinearTransformation, unit conversion): (..., factor, offset)
+        lin_feeds = [(j, algorithm == "gauss-seidel" and src < position[id(s)], col) + s.linear[j]
+                     for j, src, col in s.feeds if j in s.linear]
         before = after = None
         if s.ports is not None:
             before, after = s.ports.bind(ring, text, stride, algorithm == "gauss-seidel", direct, _Stop)
@@ -674,7 +693,7 @@ def interpreted_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str
             after = after if s.ports.outputs else None
         plan.append((i, s.inst, s.in_buf, ctypes.addressof(s.in_buf), ctypes.addressof(s.in_vr), len(s.in_names),
                      ctypes.addressof(s.out_vr), len(s.out_names), s.n_couple, s.col0 * ctypes.sizeof(c_double),
-                     feeds, before, after))
+                     feeds, lin_feeds, before, after))
     base = ring.ctypes.data
 
     def row(k: int) -> int:
@@ -688,7 +707,8 @@ def interpreted_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str
             o1, o0, om = row(k + 1), row(k), row(k - 1)
             sample = (k + 1) % stride == 0
             a1 = base + o1 * ctypes.sizeof(c_double)
-            for i, inst, buf, buf_addr, vr_in, n_in, vr_out, n_all, n_couple, offset, feeds, before, after in plan:
+            for i, inst, buf, buf_addr, vr_in, n_in, vr_out, n_all, n_couple, offset, feeds, lin_feeds, before, \
+                    after in plan:
                 for j, upstream, col in feeds:
                     latest, previous = (o1, o0) if upstream else (o0, om)
                     if linear:
@@ -696,6 +716,13 @@ def interpreted_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str
                         buf[j] = a * flat[latest + col] + (1.0 - a) * flat[previous + col]
                     else:
                         buf[j] = flat[latest + col]
+                for j, upstream, col, factor, shift in lin_feeds:
+                    latest, previous = (o1, o0) if upstream else (o0, om)
+                    if linear:
+                        a = 0.5 if upstream else 1.5
+                        buf[j] = factor * (a * flat[latest + col] + (1.0 - a) * flat[previous + col]) + shift
+                    else:
+                        buf[j] = factor * flat[latest + col] + shift
                 if before is not None:
                     before(k)
                 if n_in:
@@ -720,15 +747,17 @@ def interpreted_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str
         t = t0 + k * H
         o1, o0, om = row(k + 1), row(k), row(k - 1)
         a1 = base + o1 * ctypes.sizeof(c_double)
-        for i, inst, buf, buf_addr, vr_in, n_in, vr_out, n_all, n_couple, offset, feeds, before, after in plan[first:]:
+        for i, inst, buf, buf_addr, vr_in, n_in, vr_out, n_all, n_couple, offset, feeds, lin_feeds, before, \
+                after in plan[first:]:
             if i > first:  # the FMUs after the one that ended: their usual step
-                for j, upstream, col in feeds:
+                for j, upstream, col, *transform in feeds + lin_feeds:
                     latest, previous = (o1, o0) if upstream else (o0, om)
                     if linear:
                         a = 0.5 if upstream else 1.5
-                        buf[j] = a * flat[latest + col] + (1.0 - a) * flat[previous + col]
+                        value = a * flat[latest + col] + (1.0 - a) * flat[previous + col]
                     else:
-                        buf[j] = flat[latest + col]
+                        value = flat[latest + col]
+                    buf[j] = transform[0] * value + transform[1] if transform else value
                 if before is not None:
                     before(k)
                 if n_in:

@@ -31,7 +31,7 @@ from .fmu_folder import default_fmu_dir
 from .fmu_interface import FmuInterface, FmuVariable, read_fmu_interface
 from .graph import find_algebraic_loop, initialization_order, stepping_order
 from .roles import ComponentRole, declared_roles
-from .values import type_mismatch
+from .values import transformation_problem, type_mismatch
 
 #: causalities a scenario may give a value to
 SETTABLE_CAUSALITIES = ("parameter", "input")
@@ -102,6 +102,14 @@ class ResolvedSystem:
     def with_role(self, role: str) -> list[ComponentRole]:
         """The components declared with ``role``, in scenario order."""
         return [r for r in self.roles.values() if r.role == role]
+
+    def loop_transformation(self, con):
+        """What the step loop applies on connection ``con`` (:func:`orchestrator.cosim.values.numeric_transformation`)."""
+        from .values import numeric_transformation
+
+        return numeric_transformation(con.transformation, self.variable(con.source), self.variable(con.target),
+                                      self.interfaces[con.source.component].enumerations,
+                                      self.interfaces[con.target.component].enumerations)
 
     def variable(self, ref: VariableRef) -> FmuVariable:
         """Model-description entry of a ``component.variable`` reference."""
@@ -269,6 +277,10 @@ def resolve_system(
         a = _lookup(interfaces[con.source.component], con.source, f"connections[{i}].from", src, READABLE_CAUSALITIES, "an output")
         b = _lookup(interfaces[con.target.component], con.target, f"connections[{i}].to", src, ("input",), "an input")
         _same_type(a, b, f"connections[{i}]", str(con), src)
+        problem = transformation_problem(con.transformation, a, b, interfaces[con.source.component].enumerations,
+                                         interfaces[con.target.component].enumerations)
+        if problem is not None:
+            raise ScenarioError(f"connections[{i}].transformation", con.transformation.describe(), problem, src)
     for i, b in enumerate(scenario.initial):
         out = _lookup(interfaces[b.source.component], b.source, f"initial[{i}].from", src, READABLE_CAUSALITIES, "an output")
         var = _lookup(interfaces[b.target.component], b.target, f"initial[{i}].to", src, SETTABLE_CAUSALITIES, "a parameter or input")

@@ -22,10 +22,11 @@ same declared type): :func:`type_mismatch` says why two variables cannot be join
 from __future__ import annotations
 
 from ctypes import addressof, c_char_p, c_int
-from typing import Any, Callable, Sequence
+from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
+from ..inputs.transformations import LinearTransformation
 from .fmi_runtime import FmuInstance, value_references
 from .fmu_interface import FmuVariable
 
@@ -78,8 +79,10 @@ class TypedPorts:
     outputs : sequence of (name, type, column)
         Outputs read after every step; ``column`` is the column in the float row buffer
         (Integer, Enumeration, Boolean) or in the :class:`TextStore` (String).
-    inputs : sequence of (name, type, source slot, source column)
-        Connected inputs with the column of the output that drives them.
+    inputs : sequence of (name, type, source slot, source column[, table])
+        Connected inputs with the column of the output that drives them and, for a
+        mapping transformation on the connection, its int -> int table
+        (:func:`numeric_transformation`).
     """
 
     def __init__(self, slot: int, inst: FmuInstance, outputs: Sequence[tuple[str, str, int]],
@@ -87,7 +90,7 @@ class TypedPorts:
         self.slot = slot
         self.inst = inst
         self.outputs = list(outputs)
-        self.inputs = list(inputs)
+        self.inputs = [tuple(i) + (None,) * (5 - len(i)) for i in inputs]
         iface = inst.interface
         self._out_groups = []  # (getter, family, vr array, value buffer, columns)
         for family in ("Integer", "Boolean", "String"):
@@ -98,11 +101,11 @@ class TypedPorts:
                 self._out_groups.append((inst.typed_get[family], family, vr, buf(), [col for _, col in members]))
         self._in_groups = []  # (setter, family, vr array, value buffer, [(index, source slot, source column)])
         for family in ("Integer", "Boolean", "String"):
-            members = [(n, src, col) for n, t, src, col in self.inputs if FUNCTION_FAMILY[t] == family]
+            members = [(n, src, col, table) for n, t, src, col, table in self.inputs if FUNCTION_FAMILY[t] == family]
             if members:
-                vr = value_references(iface, [n for n, _, _ in members])
+                vr = value_references(iface, [m[0] for m in members])
                 buf = (c_char_p if family == "String" else c_int) * len(members)
-                feeds = [(j, src, col) for j, (_, src, col) in enumerate(members)]
+                feeds = [(j, src, col, table) for j, (_, src, col, table) in enumerate(members)]
                 self._in_groups.append((inst.typed_set[family], family, vr, buf(), feeds))
 
     @property
@@ -138,7 +141,7 @@ class TypedPorts:
             return k * n_cols if direct else (k % 3) * n_cols
 
         in_plan = [(setter, family, addressof(vr), len(feeds), buf, addressof(buf),
-                    [(j, gauss_seidel and src < slot, col) for j, src, col in feeds])
+                    [(j, gauss_seidel and src < slot, col, table) for j, src, col, table in feeds])
                    for setter, family, vr, buf, feeds in self._in_groups]
         out_plan = [(getter, family, addressof(vr), len(cols), buf, addressof(buf), cols)
                     for getter, family, vr, buf, cols in self._out_groups]
@@ -147,11 +150,12 @@ class TypedPorts:
             o_new, o_now = row(k + 1), row(k)
             for setter, family, vr, n, buf, addr, feeds in in_plan:
                 if family == "String":
-                    for j, upstream, col in feeds:
+                    for j, upstream, col, _ in feeds:
                         buf[j] = text.ring[(k + 1) % 3 if upstream else k % 3][col].encode("utf-8")
                 else:
-                    for j, upstream, col in feeds:
-                        buf[j] = int(flat[(o_new if upstream else o_now) + col])
+                    for j, upstream, col, table in feeds:
+                        value = int(flat[(o_new if upstream else o_now) + col])
+                        buf[j] = value if table is None else table.get(value, value)
                 st = setter(component, vr, n, addr)
                 if st > 1:
                     raise stop(slot, f"fmi2Set{family}", st, k)
@@ -199,3 +203,42 @@ def python_value(fmi_type: str, value: Any) -> Any:
     if fmi_type == "String":
         return str(value)
     return float(value)
+
+
+def transformation_problem(transformation, source: FmuVariable, target: FmuVariable,
+                           source_types: Mapping[str, Mapping[str, int]],
+                           target_types: Mapping[str, Mapping[str, int]]) -> str | None:
+    """Why a connection's transformation does not fit its variables' type, or None.
+
+    ``source_types`` and ``target_types`` are the two FMUs' Enumeration types
+    (:attr:`FmuInterface.enumerations`), for an Enumeration mapping's item names.
+    """
+    if transformation is None:
+        return None
+    if isinstance(transformation, LinearTransformation):
+        return None if target.type == "Real" else f"a Real connection for a linear transformation; {target.name} is {target.type}"
+    kinds = {"Boolean": ("Boolean",), "Integer": ("Integer", "Enumeration"), "Enumeration": ("Enumeration",)}
+    if target.type not in kinds[transformation.kind]:
+        return (f"a {' or '.join(kinds[transformation.kind])} connection for a {transformation.kind} mapping; "
+                f"{target.name} is {target.type}")
+    if transformation.kind == "Enumeration":
+        for var, types, side in ((source, source_types, 0), (target, target_types, 1)):
+            items = types.get(var.declared_type, {})
+            for entry in transformation.entries:
+                if entry[side] not in items:
+                    return (f"item names of {var.declared_type or 'the enumeration'} of {var.name} "
+                            f"({', '.join(items) or 'none'}); {entry[side]!r} is not one")
+    return None
+
+
+def numeric_transformation(transformation, source: FmuVariable, target: FmuVariable,
+                           source_types: Mapping[str, Mapping[str, int]],
+                           target_types: Mapping[str, Mapping[str, int]]):
+    """What the loop applies: a :class:`LinearTransformation`, an int -> int table (Booleans 0/1), or None."""
+    if transformation is None or isinstance(transformation, LinearTransformation):
+        return transformation
+    if transformation.kind == "Enumeration":
+        src = source_types[source.declared_type]
+        dst = target_types[target.declared_type]
+        return {src[a]: dst[b] for a, b in transformation.entries}
+    return {int(a): int(b) for a, b in transformation.entries}

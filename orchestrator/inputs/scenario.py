@@ -66,6 +66,7 @@ from .analysis_settings import AnalysisSettings, AnalysisTable
 from .files import find_input_file, packaged_files, read_toml
 from .load_events import EventTable, ScenarioEvent, check_events_in_run
 from .master_options import ALGORITHMS, EXTRAPOLATIONS
+from .transformations import Transformation
 from .schema import (
     NAME_PATTERN,
     ParameterValue,
@@ -174,10 +175,16 @@ class Component:
 
 @dataclass(frozen=True)
 class Connection:
-    """Output ``source`` drives input ``target`` at every communication step."""
+    """Output ``source`` drives input ``target`` at every communication step.
+
+    ``transformation`` (from an SSP connection: linear, or a Boolean/Integer/Enumeration
+    mapping; :mod:`orchestrator.inputs.transformations`) changes the value on the way;
+    the target receives, and records, the transformed value.
+    """
 
     source: VariableRef
     target: VariableRef
+    transformation: Transformation | None = None
 
     def __str__(self) -> str:
         return f"{self.source} -> {self.target}"
