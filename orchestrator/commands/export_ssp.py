@@ -36,11 +36,9 @@ def run(args: argparse.Namespace) -> int:
     from ..cosim.fmu_store import ensure_fmus, stale_project_fmus
     from ..cosim.master import CoSimulation
     from ..cosim.system import resolve_system
-    from ..inputs.scenario import find_scenario
     from ..interop.ssp import export_ssp
-    from ..run.runner import load_any
 
-    scenario = scenario_options.apply(load_any(find_scenario(args.scenario)), args, "export-ssp")
+    scenario = scenario_options.apply(scenario_options.load(args.scenario, args, "export-ssp"), args, "export-ssp")
     paths = ensure_fmus(scenario, args.fmu_dir, build=not args.no_build,
                         report=lambda m: print(m, file=sys.stderr))
     for warning in stale_project_fmus(paths):

@@ -259,6 +259,7 @@ def resolve_system(
             raise ScenarioError(f"components.{c.name}.fmu", str(paths[c.name]), problem, src)
     scenario, events = assign_events(scenario, interfaces)
 
+    scenario = _enumeration_items_as_values(scenario, interfaces)
     connected_inputs = {str(c.target) for c in scenario.connections}
     for comp in scenario.components:
         iface = interfaces[comp.name]
@@ -310,6 +311,25 @@ def resolve_system(
         events=events,
         roles=FrozenMap(declared_roles(scenario, interfaces)),
     )
+
+
+def _enumeration_items_as_values(scenario: Scenario, interfaces: Mapping[str, FmuInterface]) -> Scenario:
+    """Enumeration values given by item name (an SSP ``ssv:Enumeration``) as the item's integer value."""
+    for comp in scenario.components:
+        iface = interfaces[comp.name]
+        changed = {}
+        for pname, value in comp.parameters.items():
+            var = iface.variables.get(pname)
+            if var is not None and var.type == "Enumeration" and isinstance(value, str):
+                items = iface.enumerations.get(var.declared_type, {})
+                if value not in items:
+                    raise ScenarioError(f"components.{comp.name}.parameters.{pname}", value,
+                                        f"an item of {var.declared_type}: {', '.join(items) or 'none'}",
+                                        scenario.source)
+                changed[pname] = items[value]
+        if changed:
+            scenario = scenario.with_parameters(comp.name, **changed)
+    return scenario
 
 
 def _feedthrough(scenario: Scenario, interfaces: Mapping[str, FmuInterface]) -> dict[str, list[str]]:
