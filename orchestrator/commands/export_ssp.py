@@ -37,6 +37,7 @@ def run(args: argparse.Namespace) -> int:
     from ..cosim.master import CoSimulation
     from ..cosim.system import resolve_system
     from ..interop.ssp import export_ssp
+    from ..interop.ssp_export import stale_warnings
 
     scenario = scenario_options.apply(scenario_options.load(args.scenario, args, "export-ssp"), args, "export-ssp")
     paths = ensure_fmus(scenario, args.fmu_dir, build=not args.no_build,
@@ -46,6 +47,8 @@ def run(args: argparse.Namespace) -> int:
     system = resolve_system(scenario, fmu_paths=paths)
     initial = CoSimulation(system).initial_values() if scenario.initial else {}
     out = export_ssp(system, args.out, initial)
+    for warning in stale_warnings(system, initial):
+        print(f"dtcosim export-ssp: warning: {warning}", file=sys.stderr)
     print(f"{out}: {len(scenario.components)} components, {len(scenario.connections)} connections"
           + (f", initial values {', '.join(f'{k} = {v:.10g}' for k, v in initial.items())}" if initial else ""))
     return 0

@@ -42,7 +42,7 @@ from ..cosim.system import ResolvedSystem
 from ..errors import SspError
 from ..inputs.analysis_settings import AnalysisSettings
 from ..inputs.scenario import VariableRef
-from .ssp_xml import DTCOSIM_ANNOTATION, NS, OSP_ANNOTATION
+from .ssp_xml import COMPUTED_ANNOTATION, DTCOSIM_ANNOTATION, NS, OSP_ANNOTATION
 
 SSD_NAME = "SystemStructure.ssd"
 #: Name of every component's parameter set in an exported SSP.
@@ -70,8 +70,47 @@ def _connector(parent: ET.Element, name: str, kind: str, fmi_type: str, unit: st
         el.set("unit", unit)
 
 
-def _parameter(parent: ET.Element, name: str, fmi_type: str, value: Any) -> None:
+def computed_values(system: ResolvedSystem) -> dict[str, tuple[str, tuple[str, ...]]]:
+    """For each ``[[initial]]`` target: (its source, the components whose parameters decide the value).
+
+    The value an initial binding produces depends on the parameters of the source
+    component and of every component that feeds it, directly or through others, by
+    connections or initial bindings (the initialisation sweeps).
+    """
+    sc = system.scenario
+    feeders: dict[str, set[str]] = {name: set() for name in sc.component_names}
+    for link in list(sc.connections) + list(sc.initial):
+        feeders[link.target.component].add(link.source.component)
+    out = {}
+    for b in sc.initial:
+        seen, todo = set(), [b.source.component]
+        while todo:
+            comp = todo.pop()
+            if comp not in seen:
+                seen.add(comp)
+                todo += sorted(feeders[comp] - seen)
+        out[str(b.target)] = (str(b.source), tuple(n for n in sc.component_names if n in seen))
+    return out
+
+
+def stale_warnings(system: ResolvedSystem, initial_values: Mapping[str, Any]) -> list[str]:
+    """What ``dtcosim export-ssp`` warns: which exported values are computed and what makes them stale in another host."""
+    out = []
+    for target, (source, depends) in computed_values(system).items():
+        if target in initial_values:
+            out.append(f"{target} = {initial_values[target]:.10g} is computed by dtcosim's initialisation from "
+                       f"{source}; another host applies it as a fixed value, which goes stale when a parameter of "
+                       f"{', '.join(depends)} is changed there: export again (dtcosim export-ssp --set ...) instead")
+    return out
+
+
+def _parameter(parent: ET.Element, name: str, fmi_type: str, value: Any,
+               computed: tuple[str, tuple[str, ...]] | None = None) -> None:
     p = ET.SubElement(parent, _q("ssv:Parameter"), name=name)
+    if computed is not None:
+        source, depends = computed
+        p.set("description", f"computed by dtcosim's initialisation from {source}; stale once a parameter of "
+                             f"{', '.join(depends)} changes (export again)")
     if fmi_type == "Real":
         ET.SubElement(p, _q("ssv:Real"), value=_num(value))
     elif fmi_type in ("Integer", "Enumeration"):
@@ -80,6 +119,10 @@ def _parameter(parent: ET.Element, name: str, fmi_type: str, value: Any) -> None
         ET.SubElement(p, _q("ssv:Boolean"), value="true" if value else "false")
     else:
         ET.SubElement(p, _q("ssv:String"), value=str(value))
+    if computed is not None:
+        annotations = ET.SubElement(p, _q("ssv:Annotations"))
+        annotation = ET.SubElement(annotations, _q("ssc:Annotation"), type=COMPUTED_ANNOTATION)
+        ET.SubElement(annotation, _q("dtc:Computed"), source=computed[0], dependsOn=" ".join(computed[1]))
 
 
 def _resource_names(system: ResolvedSystem) -> dict[str, str]:
@@ -115,6 +158,7 @@ def system_structure(system: ResolvedSystem, initial_values: Mapping[str, float]
     sim = sc.simulation
     initial_values = dict(initial_values or {})
     resources = _resource_names(system)
+    computed = computed_values(system)
     root = ET.Element(_q("ssd:SystemStructureDescription"), name=sc.name, version="1.0")
     sysel = ET.SubElement(root, _q("ssd:System"), name=sc.name)
     if sc.description:
@@ -166,7 +210,8 @@ def system_structure(system: ResolvedSystem, initial_values: Mapping[str, float]
             pset = ET.SubElement(pvals, _q("ssv:ParameterSet"), version="1.0", name=PARAMETER_SET)
             params = ET.SubElement(pset, _q("ssv:Parameters"))
             for pname, value in values.items():
-                _parameter(params, pname, iface.variables[pname].type, value)
+                _parameter(params, pname, iface.variables[pname].type, value,
+                           computed.get(f"{comp.name}.{pname}") if f"{comp.name}.{pname}" in initial_values else None)
     if sc.connections:
         conns = ET.SubElement(sysel, _q("ssd:Connections"))
         for con in sc.connections:

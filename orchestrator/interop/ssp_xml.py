@@ -37,6 +37,8 @@ OSP_NAMESPACES = ("https://opensimulationplatform.com/SSP/OSPAnnotations",
                   "http://opensimulationplatform.com/SSP/OSPAnnotations")
 OSP_ANNOTATION = "com.opensimulationplatform"
 DTCOSIM_ANNOTATION = "org.dtcosim.scenario"
+#: a parameter value dtcosim's initialisation computed (an exported [[initial]] binding)
+COMPUTED_ANNOTATION = "org.dtcosim.computed"
 
 _TRANSFORMATIONS = {"ssc:LinearTransformation", "ssc:BooleanMappingTransformation",
                     "ssc:IntegerMappingTransformation", "ssc:EnumerationMappingTransformation"}
@@ -139,8 +141,10 @@ def check_supported(root, path: Path, notes: list[str]) -> None:
 
 
 def _known_annotation(parent: str, annotation) -> bool:
-    return parent == "ssd:Annotations" and annotation.getparent().getparent() is not None \
-        and tag(annotation.getparent().getparent()) == "ssd:DefaultExperiment" \
+    holder = annotation.getparent().getparent()
+    if parent == "ssv:Annotations" and holder is not None and tag(holder) == "ssv:Parameter":
+        return annotation.get("type") == COMPUTED_ANNOTATION  # the import restores the [[initial]] binding
+    return parent == "ssd:Annotations" and holder is not None and tag(holder) == "ssd:DefaultExperiment" \
         and annotation.get("type") in (OSP_ANNOTATION, DTCOSIM_ANNOTATION)
 
 
