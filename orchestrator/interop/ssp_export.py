@@ -125,6 +125,22 @@ def _parameter(parent: ET.Element, name: str, fmi_type: str, value: Any,
         ET.SubElement(annotation, _q("dtc:Computed"), source=computed[0], dependsOn=" ".join(computed[1]))
 
 
+def _transformation(parent: ET.Element, transformation) -> None:
+    """The ``ssc:`` element of a connection's transformation (nothing for None)."""
+    from ..inputs.transformations import MAPPING_KINDS, LinearTransformation
+
+    if transformation is None:
+        return
+    if isinstance(transformation, LinearTransformation):
+        ET.SubElement(parent, _q("ssc:LinearTransformation"), factor=_num(transformation.factor),
+                      offset=_num(transformation.offset))
+        return
+    el = ET.SubElement(parent, _q(MAPPING_KINDS[transformation.kind]))
+    for source, target in transformation.entries:
+        text = (lambda v: ("true" if v else "false") if isinstance(v, bool) else str(v))
+        ET.SubElement(el, _q("ssc:MapEntry"), source=text(source), target=text(target))
+
+
 def _resource_names(system: ResolvedSystem) -> dict[str, str]:
     """Archive path of each component's FMU (one copy per distinct file)."""
     by_sha: dict[str, str] = {}
@@ -215,9 +231,10 @@ def system_structure(system: ResolvedSystem, initial_values: Mapping[str, float]
     if sc.connections:
         conns = ET.SubElement(sysel, _q("ssd:Connections"))
         for con in sc.connections:
-            ET.SubElement(conns, _q("ssd:Connection"), startElement=con.source.component,
-                          startConnector=con.source.variable, endElement=con.target.component,
-                          endConnector=con.target.variable)
+            el = ET.SubElement(conns, _q("ssd:Connection"), startElement=con.source.component,
+                               startConnector=con.source.variable, endElement=con.target.component,
+                               endConnector=con.target.variable)
+            _transformation(el, con.transformation)
     if units:
         units_el = ET.SubElement(root, _q("ssd:Units"))
         for name, base in sorted(units.items()):

@@ -238,3 +238,14 @@ fail_at = 0.5
     assert not outcome.complete and outcome.ended_by is None
     assert "fmi2DoStep returned discard" in outcome.error
     assert "without progress in the step (last successful time 0.5 s)" in outcome.error
+
+
+@pytest.mark.parametrize("fmi_type", list(TYPED))
+def test_initial_bindings_of_every_type(fmi_type, tmp_path):
+    inp, out, value = TYPED[fmi_type]
+    text = feedthrough_pair(tmp_path, fmi_type).replace("[[connections]]", "[[initial]]")
+    system = resolve_system(load_scenario(write_scenario(tmp_path, text)))
+    outcome = CoSimulation(system).run(handle_sigint=False)
+    assert outcome.initial_values == {f"b.{inp}": value}
+    samples = outcome.column("b." + out)
+    assert (list(samples) == [value] * 11) if fmi_type == "String" else np.all(samples == float(value))

@@ -329,3 +329,18 @@ def test_mapping_transformations_on_connections(tmp_path, kind):
   </ssd:System>"""
     outcome = run(write_ssp(tmp_path, ssd(system)))
     assert np.all(outcome.column(f"b.{out}") == expected)
+
+
+def test_transformations_survive_export_and_import(tmp_path):
+    from orchestrator.interop.ssp import export_ssp
+
+    system = A_TO_B.format(
+        a=feedthrough("a", real("Float64_continuous_input", "input") + real("Float64_continuous_output", "output"),
+                      inline_values(("Float64_continuous_input", "Real", "5.0"))),
+        b=feedthrough("b", real("Float64_continuous_input", "input") + real("Float64_continuous_output", "output")),
+        transformation='<ssc:LinearTransformation factor="2" offset="3"/>')
+    scenario = import_ssp(write_ssp(tmp_path / "in", ssd(system)))
+    again = import_ssp(export_ssp(resolve_system(scenario), tmp_path / "out.ssp"))
+    assert again.connections == scenario.connections and again.connections[0].transformation is not None
+    outcome = CoSimulation(resolve_system(again)).run(handle_sigint=False)
+    assert np.all(outcome.column("b.Float64_continuous_output") == 13.0)
