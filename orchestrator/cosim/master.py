@@ -58,12 +58,23 @@ generated one is tested against) 2.3-3.2 us, in all four algorithm/extrapolation
 variants (``python benchmarks/bench_plumbing.py --repeat 7``, medians; the
 floor itself is ~12 us).
 
+Types
+-----
+Real variables are exchanged by the statements above; Integer, Enumeration,
+Boolean and String variables through :class:`~orchestrator.cosim.values.TypedPorts`
+(two more calls per step for an FMU that has such ports, none otherwise, so a
+Real-only system runs exactly the loop it always ran). Connection transformations
+(SSP) are applied where the value is exchanged: a linear one inside the Real
+statement of that coupling only.
+
 Stopping
 --------
 An FMU status worse than warning stops the run with an :class:`FmuStepError`
 message (FMU, function, time, status, the FMU's log); Ctrl-C (SIGINT) is caught
 between blocks of steps. Either way the samples recorded so far are returned with
-``complete = False``.
+``complete = False``. An FMU that ends the simulation itself (``fmi2Discard`` with
+``fmi2Terminated`` after progress, :mod:`orchestrator.cosim.termination`) ends the
+run normally: ``complete = True``, ``ended_by`` naming it.
 """
 
 from __future__ import annotations
