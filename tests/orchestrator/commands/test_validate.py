@@ -10,17 +10,18 @@ from tests.helpers.reference_fmus import NAMES, reference_fmu
 from tests.helpers.scenarios import dtcosim
 
 
-def validate(path, tmp_path):
-    proc = dtcosim("validate", str(path), cwd=tmp_path)
+def validate(paths, tmp_path):
+    proc = dtcosim("validate", *str(paths).split(" "), cwd=tmp_path)
     assert "Traceback" not in proc.stdout + proc.stderr
     return proc
 
 
-@pytest.mark.parametrize("name", NAMES)
-def test_every_reference_fmu_is_valid(name, tmp_path):
-    proc = validate(reference_fmu(name), tmp_path)
+def test_every_reference_fmu_is_valid(tmp_path):
+    proc = validate(" ".join(str(reference_fmu(name)) for name in NAMES), tmp_path)
     assert proc.returncode == 0, proc.stdout
-    assert f"{name}.fmu: ok (FMI 2.0 co-simulation, Reference FMUs" in proc.stdout and "linux64" in proc.stdout
+    for name in NAMES:
+        assert f"{name}.fmu: ok (FMI 2.0 co-simulation, Reference FMUs" in proc.stdout
+    assert proc.stdout.count("binaries for linux64") == len(NAMES)
 
 
 def _copy(source, target, change, rename=lambda name: name):
@@ -47,10 +48,13 @@ def test_broken_files_are_named_problems(tmp_path):
     cut.write_bytes(reference_fmu("Dahlquist").read_bytes()[:300])
     truncated = _copy(reference_fmu("Dahlquist"), tmp_path / "truncated.fmu", _truncated)
     missing = _copy(reference_fmu("Dahlquist"), tmp_path / "missing.fmu", _without_description)
-    for path, message in ((not_zip, "not a zip archive, so not an FMU"), (cut, "not a zip archive"),
-                          (truncated, "modelDescription.xml, line"), (missing, "has no modelDescription.xml")):
-        proc = validate(path, tmp_path)
-        assert proc.returncode == 1 and f"{path}: 1 problem(s)" in proc.stdout and message in proc.stdout, proc.stdout
+    cases = ((not_zip, "not a zip archive, so not an FMU"), (cut, "not a zip archive"),
+             (truncated, "modelDescription.xml, line"), (missing, "has no modelDescription.xml"))
+    proc = validate(" ".join(str(path) for path, _ in cases), tmp_path)
+    assert proc.returncode == 1
+    reports = proc.stdout.split(str(tmp_path))[1:]  # one block per file, in the order given
+    for (path, message), report in zip(cases, reports):
+        assert report.startswith(f"/{path.name}: 1 problem(s)") and message in report, proc.stdout
 
 
 def test_an_fmu_without_a_binary_for_this_platform_cannot_run_here(tmp_path):
