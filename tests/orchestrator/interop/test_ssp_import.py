@@ -344,3 +344,24 @@ def test_transformations_survive_export_and_import(tmp_path):
     assert again.connections == scenario.connections and again.connections[0].transformation is not None
     outcome = CoSimulation(resolve_system(again)).run(handle_sigint=False)
     assert np.all(outcome.column("b.Float64_continuous_output") == 13.0)
+
+
+def test_other_tools_annotations_are_reported_and_ssd_folder_and_archive_read_alike(tmp_path):
+    import zipfile
+
+    system = SYSTEM_PARAMETER.format(component_binding="", system_binding="").replace(
+        "</ssd:Elements>\n  </ssd:System>",
+        '</ssd:Elements>\n<ssd:Annotations><ssc:Annotation type="com.example.layout"><x xmlns="urn:x"/>'
+        "</ssc:Annotation></ssd:Annotations>\n  </ssd:System>")
+    folder = write_ssp(tmp_path / "folder", ssd(system))
+    notes: list[str] = []
+    from_folder = import_ssp(folder, report=notes.append)
+    assert len(notes) == 1 and "annotation of type 'com.example.layout' ignored" in notes[0] and "line" in notes[0]
+    archive = tmp_path / "system.ssp"
+    with zipfile.ZipFile(archive, "w") as zf:
+        for f in folder.rglob("*"):
+            if f.is_file():
+                zf.write(f, f.relative_to(folder).as_posix())
+    for other in (import_ssp(folder / "SystemStructure.ssd"), import_ssp(archive)):
+        assert [c.name for c in other.components] == [c.name for c in from_folder.components]
+        assert other.connections == from_folder.connections and other.simulation == from_folder.simulation
