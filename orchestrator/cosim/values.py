@@ -22,7 +22,7 @@ same declared type): :func:`type_mismatch` says why two variables cannot be join
 from __future__ import annotations
 
 from ctypes import addressof, c_char_p, c_int
-from typing import Any, Callable, Mapping, Sequence
+from typing import Callable, Mapping, Sequence
 
 import numpy as np
 
@@ -30,8 +30,6 @@ from ..inputs.transformations import LinearTransformation
 from .fmi_runtime import FmuInstance, value_references
 from .fmu_interface import FmuVariable
 
-#: FMI 2.0 variable types
-FMI_TYPES = ("Real", "Integer", "Boolean", "String", "Enumeration")
 #: the fmi2Get/Set function family of each non-Real type
 FUNCTION_FAMILY = {"Integer": "Integer", "Enumeration": "Integer", "Boolean": "Boolean", "String": "String"}
 
@@ -192,17 +190,6 @@ class TypedPorts:
                 text.rows[0, col] = value
             else:
                 row0[col] = float(value)
-
-
-def python_value(fmi_type: str, value: Any) -> Any:
-    """A recorded float (or string) as the Python value of its FMI type (int, bool, float or str)."""
-    if fmi_type in ("Integer", "Enumeration"):
-        return int(value)
-    if fmi_type == "Boolean":
-        return bool(value)
-    if fmi_type == "String":
-        return str(value)
-    return float(value)
 
 
 def transformation_problem(transformation, source: FmuVariable, target: FmuVariable,
