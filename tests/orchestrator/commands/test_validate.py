@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import zipfile
 
-
 from tests.helpers.reference_fmus import NAMES, reference_fmu
 from tests.helpers.scenarios import dtcosim
 
