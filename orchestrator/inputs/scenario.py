@@ -26,8 +26,10 @@ TOML format (units SI; see ``docs/orchestrator.md`` for the full reference)::
 
     [components.gearbox]
     fmu = "Gearbox.fmu"                   # relative to the scenario file or the FMU directory
+    # no_feedthrough = ["y"]              # outputs not depending directly on inputs (FMU does not say)
     [components.gearbox.parameters]
-    "stage1.k0" = 1.58e10                 # dotted names quoted, or as nested tables
+    "stage1.k0" = 1.58e10                 # dotted names quoted, or as nested tables; also start values
+                                          # of variables with initial="exact"/"approx" (states)
 
     [[connections]]
     from = "wind.omega"                   # an output
