@@ -1,4 +1,8 @@
-"""Validation of built FMUs: ``fmpy.validation`` plus dtcosim's own conventions."""
+"""Validation of FMUs: ``fmpy.validation`` for any FMU, plus dtcosim's own conventions for the FMUs dtcosim built.
+
+A file that is not a zip archive or whose ``modelDescription.xml`` is missing or
+truncated is one problem with a message, never a traceback.
+"""
 
 from __future__ import annotations
 
@@ -49,12 +53,41 @@ def runtime_declaration_problems(fmu_path: Path | str) -> list[str]:
     return problems
 
 
+RECORD_MEMBER = "resources/dtcosim.json"
+
+
+def archive_problem(fmu_path: Path | str) -> str | None:
+    """Why the file cannot be an FMU archive at all (not a zip, no modelDescription.xml), or None."""
+    try:
+        with zipfile.ZipFile(fmu_path) as archive:
+            names = set(archive.namelist())
+    except zipfile.BadZipFile as exc:
+        return f"not a zip archive, so not an FMU ({exc})"
+    except OSError as exc:
+        return f"cannot be read ({exc})"
+    if "modelDescription.xml" not in names:
+        return "the archive has no modelDescription.xml"
+    return None
+
+
+def is_dtcosim_fmu(fmu_path: Path | str) -> bool:
+    """True for an FMU dtcosim built (it carries the record ``resources/dtcosim.json``)."""
+    with zipfile.ZipFile(fmu_path) as archive:
+        return RECORD_MEMBER in archive.namelist()
+
+
 def check_fmu(fmu_path: Path | str) -> list[str]:
-    """All problems of one FMU (empty if it is valid)."""
-    problems = validate_fmu(str(fmu_path))
+    """All problems of one FMU (empty if it is valid): fmpy's validation, and dtcosim's conventions for its own FMUs."""
+    problem = archive_problem(fmu_path)
+    if problem is not None:
+        return [problem]
+    try:
+        problems = validate_fmu(str(fmu_path))
+    except Exception as exc:  # fmpy raises on XML it cannot parse at all
+        return [f"modelDescription.xml cannot be read ({exc})"]
     if problems:
         return list(problems)
-    return convention_problems(fmu_path)
+    return convention_problems(fmu_path) if is_dtcosim_fmu(fmu_path) else []
 
 
 def fmu_files(paths: Iterable[Path | str]) -> list[Path]:

@@ -77,19 +77,20 @@ class AlgebraicLoopError(ScenarioError):
     lists the variables on the cycle.
     """
 
-    def __init__(self, cycle: list[str], source: str | None = None) -> None:
+    def __init__(self, cycle: list[str], source: str | None = None, hint: str = "") -> None:
         self.cycle = list(cycle)
+        self.hint = hint
         ScenarioError.__init__(
             self,
             "connections",
             " -> ".join(self.cycle),
             "no algebraic loop: every cycle of connections must pass through an output that does not "
-            "depend directly on the FMU's inputs (ModelStructure dependencies)",
+            "depend directly on the FMU's inputs (ModelStructure dependencies)" + (f"; {hint}" if hint else ""),
             source,
         )
 
     def __reduce__(self):
-        return (type(self), (self.cycle, self.source))
+        return (type(self), (self.cycle, self.source, self.hint))
 
 
 class InitializationError(DtcosimError, RuntimeError):

@@ -29,13 +29,40 @@ def versions() -> dict[str, str]:
     return out
 
 
-def write_series_csv(path: str | Path, header: list[str], time_s: np.ndarray, values: np.ndarray) -> Path:
-    """CSV of ``time_s`` (N,) and ``values`` (N, M) under ``header`` (M + 1 fields), 17 significant digits."""
+def write_series_csv(path: str | Path, header: list[str], time_s: np.ndarray, values: np.ndarray,
+                     types: list[str] | None = None, text: Mapping[int, np.ndarray] | None = None) -> Path:
+    """CSV of ``time_s`` (N,) and ``values`` (N, M) under ``header`` (M + 1 fields), 17 significant digits.
+
+    ``types`` (M FMI type names) formats the non-Real columns: Integer and Enumeration
+    as integers, Boolean as 0/1, String (from ``text``: column index -> N strings)
+    quoted with doubled inner quotes. Without it every column is Real.
+    """
     path = Path(path)
+    if types is not None and any(t != "Real" for t in types):
+        return _write_typed_csv(path, header, time_s, values, types, dict(text or {}))
     table = np.column_stack([time_s, values]) if values.size else np.asarray(time_s)[:, None]
     with open(path, "w", encoding="utf-8", newline="\n") as fh:
         fh.write(",".join(_csv_field(h) for h in header) + "\n")
         np.savetxt(fh, table, delimiter=",", fmt="%.17g")
+    return path
+
+
+def _write_typed_csv(path: Path, header: list[str], time_s: np.ndarray, values: np.ndarray, types: list[str],
+                     text: dict[int, np.ndarray]) -> Path:
+    def fmt(typ: str, j: int):
+        if typ == "String":
+            column = text[j]
+            return lambda i: '"' + str(column[i]).replace('"', '""') + '"'
+        column = values[:, j]
+        if typ in ("Integer", "Enumeration", "Boolean"):
+            return lambda i: "%d" % column[i]
+        return lambda i: "%.17g" % column[i]
+
+    formats = [fmt(t, j) for j, t in enumerate(types)]
+    with open(path, "w", encoding="utf-8", newline="\n") as fh:
+        fh.write(",".join(_csv_field(h) for h in header) + "\n")
+        for i, t in enumerate(time_s):
+            fh.write(",".join(["%.17g" % t] + [f(i) for f in formats]) + "\n")
     return path
 
 

@@ -36,11 +36,10 @@ def run(args: argparse.Namespace) -> int:
     from ..cosim.fmu_store import ensure_fmus, stale_project_fmus
     from ..cosim.master import CoSimulation
     from ..cosim.system import resolve_system
-    from ..inputs.scenario import find_scenario
     from ..interop.ssp import export_ssp
-    from ..run.runner import load_any
+    from ..interop.ssp_export import stale_warnings
 
-    scenario = scenario_options.apply(load_any(find_scenario(args.scenario)), args, "export-ssp")
+    scenario = scenario_options.apply(scenario_options.load(args.scenario, args, "export-ssp"), args, "export-ssp")
     paths = ensure_fmus(scenario, args.fmu_dir, build=not args.no_build,
                         report=lambda m: print(m, file=sys.stderr))
     for warning in stale_project_fmus(paths):
@@ -48,6 +47,8 @@ def run(args: argparse.Namespace) -> int:
     system = resolve_system(scenario, fmu_paths=paths)
     initial = CoSimulation(system).initial_values() if scenario.initial else {}
     out = export_ssp(system, args.out, initial)
+    for warning in stale_warnings(system, initial):
+        print(f"dtcosim export-ssp: warning: {warning}", file=sys.stderr)
     print(f"{out}: {len(scenario.components)} components, {len(scenario.connections)} connections"
           + (f", initial values {', '.join(f'{k} = {v:.10g}' for k, v in initial.items())}" if initial else ""))
     return 0

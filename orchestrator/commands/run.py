@@ -68,13 +68,12 @@ def run(args: argparse.Namespace) -> int:
     """Run the scenario; write results; print a summary."""
     from ..cosim.fmu_store import ensure_fmus, stale_project_fmus
     from ..cosim.system import resolve_system
-    from ..inputs.scenario import find_scenario
     from ..run.analyses import format_analyses
-    from ..run.runner import load_any, run_scenario
+    from ..run.runner import run_scenario
 
     quiet = args.quiet
     say = (lambda msg: None) if quiet else (lambda msg: print(msg, file=sys.stderr))
-    scenario = scenario_options.apply(load_any(find_scenario(args.scenario)), args, "run")
+    scenario = scenario_options.apply(scenario_options.load(args.scenario, args, "run"), args, "run")
     paths = ensure_fmus(scenario, args.fmu_dir, build=not args.no_build, report=say)
     for warning in stale_project_fmus(paths):
         print(f"dtcosim run: warning: {warning}", file=sys.stderr)

@@ -24,6 +24,17 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="override a parameter value, e.g. --set wind.seed=7 (repeatable)")
 
 
+def load(spec, args: argparse.Namespace, command: str):
+    """The scenario ``spec`` names (TOML, SSP or packaged name), read with ``--step``/``--stop`` for an SSP that lacks them."""
+    from ..inputs.scenario import find_scenario
+    from ..run.runner import load_any
+
+    def note(message: str) -> None:
+        print(f"dtcosim {command}: note: {message}", file=sys.stderr)
+
+    return load_any(find_scenario(spec), step_s=args.step, stop_s=args.stop, report=note)
+
+
 def apply(scenario, args: argparse.Namespace, command: str):
     """The scenario with the options applied; notes of what else changed go to stderr as warnings."""
     from ..inputs.overrides import (

@@ -1,12 +1,14 @@
-"""``dtcosim validate``: check built FMUs, and whether this environment (or a fresh one) can run them.
+"""``dtcosim validate``: check FMUs (any FMU, not only dtcosim's), and whether this environment can run them.
 
-For every FMU: fmpy's validation and dtcosim's conventions (units, descriptions,
-state handling, ``documentation/index.html`` and ``resources/requirements.txt``
-present), then the FMU's declared requirements against this interpreter
-(what is missing stops the FMU from starting and fails the check; a version
-outside the tested range is a warning). ``--host`` also runs each FMU once in a
-fresh virtual environment holding only its declared requirements and fmpy
-(:mod:`fmus.selftest`).
+For every FMU: fmpy's validation; what dtcosim's master needs (FMI 2.0,
+co-simulation, a binary for this platform); for an FMU dtcosim built also its
+conventions (units, descriptions, state handling, ``documentation/index.html``
+and ``resources/requirements.txt`` present) and its declared requirements against
+this interpreter (what is missing stops the FMU from starting and fails the
+check; a version outside the tested range is a warning). A file that is not a
+zip or has a broken ``modelDescription.xml`` is reported as such, without a
+traceback. ``--host`` also runs each valid dtcosim FMU once in a fresh virtual
+environment holding only its declared requirements and fmpy (:mod:`fmus.selftest`).
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ import argparse
 from pathlib import Path
 
 from fmus.requirements import check_environment, read_from_fmu
-from fmus.validation import check_fmu, fmu_files
+from fmus.validation import check_fmu, fmu_files, is_dtcosim_fmu
 
 from ..cosim.fmu_folder import default_fmu_dir
 
@@ -47,6 +49,30 @@ def _environment_lines(path: Path) -> tuple[list[str], list[str]]:
     return [f"this environment cannot run it: {m}" for m in check.missing], list(check.warnings)
 
 
+def _host_problems(path: Path) -> list[str]:
+    """What dtcosim's master needs of any FMU: FMI 2.0 co-simulation with a binary for this platform."""
+    from ..cosim.fmu_interface import read_fmu_interface
+    from ..cosim.system import platform_problem
+    from ..errors import ScenarioError
+
+    try:
+        iface = read_fmu_interface(path, "fmu")
+    except ScenarioError as exc:
+        return [f"dtcosim cannot run it: expected {exc.expected}"]
+    problem = platform_problem(iface)
+    return [] if problem is None else [f"dtcosim cannot run it here: expected {problem}"]
+
+
+def _describe(path: Path) -> str:
+    from ..cosim.fmu_interface import read_fmu_interface
+
+    iface = read_fmu_interface(path, "fmu")
+    req = read_from_fmu(path)
+    what = f"FMI {iface.fmi_version} co-simulation, {iface.generation_tool or 'unknown tool'}, binaries for " \
+           f"{', '.join(iface.platforms)}"
+    return what + (f"; requires {req.summary()}; this environment has it" if req is not None else "")
+
+
 def run(args: argparse.Namespace) -> int:
     """Validate and print the problems; 0 if every FMU is valid and can run here, 1 otherwise."""
     files = fmu_files(args.paths)
@@ -63,6 +89,8 @@ def run(args: argparse.Namespace) -> int:
         problems = check_fmu(path)
         warnings: list[str] = []
         if not problems:
+            problems = _host_problems(path)
+        if not problems:
             problems, warnings = _environment_lines(path)
         if problems:
             failed += 1
@@ -70,9 +98,9 @@ def run(args: argparse.Namespace) -> int:
             for problem in problems:
                 print(f"  - {problem}")
         else:
-            req = read_from_fmu(path)
-            print(f"{path}: ok (requires {req.summary()}; this environment has it)")
-            valid.append(path)
+            print(f"{path}: ok ({_describe(path)})")
+            if is_dtcosim_fmu(path):
+                valid.append(path)
         for warning in warnings:
             print(f"  warning: {warning}")
     if args.host and valid:

@@ -139,6 +139,11 @@ class FmuInstance:
         self.do_step = DO_STEP(cast(getattr(dll, "fmi2DoStep"), c_void_p).value)
         self.set_real = REAL_VALUES(cast(getattr(dll, "fmi2SetReal"), c_void_p).value)
         self.get_real = REAL_VALUES(cast(getattr(dll, "fmi2GetReal"), c_void_p).value)
+        #: fmi2Get/SetInteger, -Boolean, -String by FMI type (same argument layout: pointers to arrays)
+        self.typed_get = {typ: REAL_VALUES(cast(getattr(dll, f"fmi2Get{typ}"), c_void_p).value)
+                          for typ in ("Integer", "Boolean", "String")}
+        self.typed_set = {typ: REAL_VALUES(cast(getattr(dll, f"fmi2Set{typ}"), c_void_p).value)
+                          for typ in ("Integer", "Boolean", "String")}
         self.component: Any = None
 
     # ----------------------------------------------------------------- checks
@@ -213,6 +218,39 @@ class FmuInstance:
         vals = (c_double * len(names))()
         self._check(self.get_real(self.component, addressof(vrs), len(names), addressof(vals)), "fmi2GetReal", time_s)
         return list(vals)
+
+    def get_values(self, names: Iterable[str], time_s: float) -> list[Any]:
+        """Values of any FMI type by variable name (Real float, Integer/Enumeration int, Boolean bool, String str)."""
+        getters = {"Real": self.slave.getReal, "Integer": self.slave.getInteger, "Enumeration": self.slave.getInteger,
+                   "Boolean": self.slave.getBoolean, "String": self.slave.getString}
+        out = []
+        for name in names:
+            var = self.interface.variables[name]
+            box: list = []
+            self._call(f"fmi2Get{'Integer' if var.type == 'Enumeration' else var.type}", time_s,
+                       lambda: box.extend(getters[var.type]([var.value_reference])))
+            value = box[0]
+            out.append(value.decode("utf-8", "replace") if isinstance(value, bytes) else
+                       bool(value) if var.type == "Boolean" else value)
+        return out
+
+    def termination_status(self) -> tuple[bool, float | None]:
+        """After fmi2DoStep returned fmi2Discard: (fmi2Terminated, fmi2LastSuccessfulTime or None).
+
+        Uses ``fmi2GetBooleanStatus`` and ``fmi2GetRealStatus``; an FMU that cannot tell
+        (the call fails) counts as not terminated.
+        """
+        from fmpy.fmi2 import fmi2LastSuccessfulTime, fmi2Terminated
+
+        try:
+            terminated = bool(self.slave.getBooleanStatus(fmi2Terminated))
+        except Exception:
+            return False, None
+        try:
+            last = float(self.slave.getRealStatus(fmi2LastSuccessfulTime))
+        except Exception:
+            last = None
+        return terminated, last
 
     def set_reals(self, values: dict[str, float], time_s: float) -> None:
         """Real values by variable name."""

@@ -41,6 +41,11 @@ class FmuVariable:
     description : str
     start : Any
         Start value as declared (None when absent).
+    initial : str
+        ``exact``, ``approx``, ``calculated`` or "" (FMI 2: ``initial`` attribute, the
+        default of its causality and variability when absent; "" where none applies).
+    declared_type : str
+        Name of the variable's ``declaredType`` ("" when none; an Enumeration's type).
     """
 
     name: str
@@ -51,6 +56,8 @@ class FmuVariable:
     unit: str = ""
     description: str = ""
     start: Any = None
+    initial: str = ""
+    declared_type: str = ""
 
 
 @dataclass(frozen=True)
@@ -79,6 +86,13 @@ class FmuInterface:
     record : mapping or None
         The dtcosim record of an FMU dtcosim built (``role``, ``source``, ``model``,
         ``signals``); None for any other FMU.
+    platforms : tuple of str
+        Platforms the archive has a co-simulation binary for (``binaries/<platform>/<modelIdentifier>.<ext>``,
+        e.g. ``("linux64", "win64")``).
+    default_start_s, default_stop_s : float or None
+        DefaultExperiment startTime and stopTime.
+    enumerations : mapping of str -> mapping of str -> int
+        Enumeration types (TypeDefinitions): type name -> item name -> value.
     """
 
     path: Path
@@ -95,6 +109,10 @@ class FmuInterface:
     default_step_s: float | None = None
     unit_definitions: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
     record: Mapping[str, Any] | None = field(default=None, repr=False)
+    platforms: tuple[str, ...] = ()
+    default_start_s: float | None = None
+    default_stop_s: float | None = None
+    enumerations: Mapping[str, Mapping[str, int]] = field(default_factory=dict)
     _inputs: tuple[str, ...] = field(default=(), repr=False)
 
     def variable(self, name: str) -> FmuVariable:
@@ -134,6 +152,34 @@ def _typed_start(type_: str, start: Any) -> Any:
     except ValueError:
         return start
     return str(start)
+
+
+#: shared-library extension of each FMI 2.0 platform folder
+PLATFORM_EXTENSIONS = {"linux64": ".so", "linux32": ".so", "win64": ".dll", "win32": ".dll", "darwin64": ".dylib"}
+
+
+def binary_platforms(path: Path, model_identifier: str) -> tuple[str, ...]:
+    """Platforms whose ``binaries/<platform>/<modelIdentifier><ext>`` the FMU archive holds (sorted)."""
+    try:
+        with zipfile.ZipFile(path) as archive:
+            names = set(archive.namelist())
+    except (OSError, zipfile.BadZipFile):
+        return ()
+    return tuple(sorted(platform for platform, ext in PLATFORM_EXTENSIONS.items()
+                        if f"binaries/{platform}/{model_identifier}{ext}" in names))
+
+
+def _initial(v) -> str:
+    """The FMI 2.0 ``initial`` of a variable, with the standard's default when absent (Table in 2.2.7)."""
+    if v.initial:
+        return str(v.initial)
+    causality = v.causality or "local"
+    variability = v.variability or ("continuous" if v.type == "Real" else "discrete")
+    if variability == "constant" or causality == "parameter":
+        return "exact"
+    if causality in ("calculatedParameter", "output", "local"):
+        return "calculated"
+    return ""
 
 
 def read_record(path: Path, key: str) -> dict[str, Any] | None:
@@ -215,6 +261,8 @@ def read_fmu_interface(path: str | Path, key: str = "fmu") -> FmuInterface:
             unit=unit or "",
             description=v.description or "",
             start=_typed_start(str(v.type), v.start),
+            initial=_initial(v),
+            declared_type=str(v.declaredType.name) if v.declaredType is not None else "",
         )
     inputs = tuple(n for n, v in variables.items() if v.causality == "input")
     deps: dict[str, tuple[str, ...] | None] = {}
@@ -225,9 +273,12 @@ def read_fmu_interface(path: str | Path, key: str = "fmu") -> FmuInterface:
         if v.causality == "output" and name not in deps:
             deps[name] = None
     cs = md.coSimulation
-    default_step = None
-    if md.defaultExperiment is not None and md.defaultExperiment.stepSize:
-        default_step = float(md.defaultExperiment.stepSize)
+    default_step = default_start = default_stop = None
+    if md.defaultExperiment is not None:
+        de = md.defaultExperiment
+        default_step = float(de.stepSize) if de.stepSize else None
+        default_start = float(de.startTime) if de.startTime is not None else None
+        default_stop = float(de.stopTime) if de.stopTime is not None else None
     units: dict[str, dict[str, float]] = {}
     for u in md.unitDefinitions or ():
         b = u.baseUnit
@@ -254,6 +305,11 @@ def read_fmu_interface(path: str | Path, key: str = "fmu") -> FmuInterface:
         default_step_s=default_step,
         unit_definitions=FrozenMap(units),
         record=read_record(p, key),
+        platforms=binary_platforms(p, cs.modelIdentifier),
+        default_start_s=default_start,
+        default_stop_s=default_stop,
+        enumerations=FrozenMap({t.name: FrozenMap({i.name: int(i.value) for i in t.items})
+                                for t in md.typeDefinitions or () if t.type == "Enumeration"}),
         _inputs=inputs,
     )
     _CACHE[cache_key] = iface

@@ -1,12 +1,17 @@
 """A scenario checked against its FMUs' model descriptions.
 
 :func:`resolve_system` locates every FMU, reads its ``modelDescription.xml``
-(nothing is instantiated) and checks every name the scenario uses: parameters
-exist, are settable and have the right type; connections join a Real output to a
-Real input; initial bindings join a Real output to a Real parameter or input;
-record patterns match variables; no algebraic loop. The first problem raises
-:class:`~orchestrator.errors.ScenarioError` naming the scenario key. The result,
-a :class:`ResolvedSystem`, is what the master runs.
+(nothing is instantiated) and checks what the master needs and every name the
+scenario uses: each FMU is FMI 2.0 co-simulation with a binary for this platform;
+parameters and start values exist, may be set before initialisation (FMI 2.0:
+parameters, inputs and variables with ``initial="exact"`` or ``"approx"``) and have
+the right type; connections join an output to an input of the same type (Real,
+Integer, Boolean, String, or Enumeration of the same declared type); initial
+bindings join an output to a parameter or input of the same type; record
+patterns match variables (any type); no algebraic loop (with the scenario's
+``no_feedthrough`` declarations for FMUs that omit their output dependencies).
+The first problem raises :class:`~orchestrator.errors.ScenarioError` naming the
+scenario key. The result, a :class:`ResolvedSystem`, is what the master runs.
 """
 
 from __future__ import annotations
@@ -26,6 +31,7 @@ from .fmu_folder import default_fmu_dir
 from .fmu_interface import FmuInterface, FmuVariable, read_fmu_interface
 from .graph import find_algebraic_loop, initialization_order, stepping_order
 from .roles import ComponentRole, declared_roles
+from .values import transformation_problem, type_mismatch
 
 #: causalities a scenario may give a value to
 SETTABLE_CAUSALITIES = ("parameter", "input")
@@ -43,12 +49,15 @@ class RecordedVariable:
     value_reference : int
     unit : str
         Unit declared by the FMU ("" if none).
+    type : str
+        FMI type: ``Real``, ``Integer``, ``Boolean``, ``String`` or ``Enumeration``.
     """
 
     component: str
     variable: str
     value_reference: int
     unit: str
+    type: str = "Real"
 
     @property
     def column(self) -> str:
@@ -94,6 +103,14 @@ class ResolvedSystem:
         """The components declared with ``role``, in scenario order."""
         return [r for r in self.roles.values() if r.role == role]
 
+    def loop_transformation(self, con):
+        """What the step loop applies on connection ``con`` (:func:`orchestrator.cosim.values.numeric_transformation`)."""
+        from .values import numeric_transformation
+
+        return numeric_transformation(con.transformation, self.variable(con.source), self.variable(con.target),
+                                      self.interfaces[con.source.component].enumerations,
+                                      self.interfaces[con.target.component].enumerations)
+
     def variable(self, ref: VariableRef) -> FmuVariable:
         """Model-description entry of a ``component.variable`` reference."""
         return self.interfaces[ref.component].variables[ref.variable]
@@ -130,18 +147,34 @@ def resolve_fmu_paths(scenario: Scenario, fmu_dir: str | Path | None = None) -> 
     return out
 
 
+#: FMI 2.0 (section 2.2.7, fmi2SetXXX before fmi2EnterInitializationMode): who may take a start value
+START_VALUE_RULE = ('FMI 2.0 allows a start value before initialisation only for a variable that is not a constant '
+                    'and has initial="exact" or initial="approx" (parameters, inputs, states such as '
+                    'BouncingBall h)')
+
+
+def takes_start_value(var: FmuVariable) -> bool:
+    """True if FMI 2.0 lets a host set ``var`` before initialisation (parameter, input, exact/approx start)."""
+    if var.variability == "constant" or var.causality == "independent":
+        return False
+    return var.causality in SETTABLE_CAUSALITIES or var.initial in ("exact", "approx")
+
+
 def parameter_problem(iface: FmuInterface, pname: str) -> str | None:
     """What a value for variable ``pname`` of an FMU would have to be, or None if it may be set.
 
     A scenario or a study may give values to parameters and inputs that are not
-    constants; an unknown name gets the closest settable names as a suggestion.
+    constants, and start values to the other variables FMI 2.0 lets a host set
+    before initialisation (``initial="exact"`` or ``"approx"``, e.g. the states of
+    BouncingBall); an unknown name gets the closest settable names as a suggestion.
     """
     var = iface.variables.get(pname)
     if var is None:
-        settable = [n for n, v in iface.variables.items() if v.causality in SETTABLE_CAUSALITIES]
-        return f"a parameter of {iface.model_name} ({iface.path.name}){suggestion(pname, settable)}"
-    if var.causality not in SETTABLE_CAUSALITIES or var.variability == "constant":
-        return f"a settable parameter or input; {pname} has causality {var.causality}, variability {var.variability}"
+        settable = [n for n, v in iface.variables.items() if takes_start_value(v)]
+        return f"a parameter or start value of {iface.model_name} ({iface.path.name}){suggestion(pname, settable)}"
+    if not takes_start_value(var):
+        return (f"a variable that can take a start value; {pname} has causality {var.causality}, variability "
+                f"{var.variability}, initial {var.initial or '(none)'}: {START_VALUE_RULE}")
     return None
 
 
@@ -168,9 +201,30 @@ def _lookup(iface: FmuInterface, ref: VariableRef, key: str, source: str | None,
         raise ScenarioError(key, str(ref), f"{role} of {iface.model_name} ({iface.path.name}){suggestion(ref.variable, names)}", source)
     if var.causality not in causalities:
         raise ScenarioError(key, str(ref), f"{role} (causality {' or '.join(causalities)}); {ref.variable} has causality {var.causality}", source)
-    if var.type != "Real":
-        raise ScenarioError(key, str(ref), f"a Real variable; {ref.variable} is {var.type}", source)
     return var
+
+
+def _same_type(source: FmuVariable, target: FmuVariable, key: str, link: str, src: str | None) -> None:
+    problem = type_mismatch(source, target)
+    if problem is not None:
+        raise ScenarioError(key, link, f"variables of the same type at both ends; {problem}", src)
+
+
+def platform_problem(iface: FmuInterface) -> str | None:
+    """Why this machine cannot load the FMU's binary (FMI 2.0 ``binaries/<platform>/``), or None."""
+    from fmpy import platform
+
+    if platform in iface.platforms:
+        return None
+    has = ", ".join(iface.platforms) if iface.platforms else "none"
+    return (f"an FMU with a co-simulation binary for this platform ({platform}: binaries/{platform}/"
+            f"{iface.model_identifier}{_extension()}); it has binaries for: {has}")
+
+
+def _extension() -> str:
+    from fmpy import sharedLibraryExtension
+
+    return sharedLibraryExtension
 
 
 def resolve_system(
@@ -199,8 +253,13 @@ def resolve_system(
     src = scenario.source
     paths = dict(fmu_paths) if fmu_paths is not None else resolve_fmu_paths(scenario, fmu_dir)
     interfaces = {c.name: read_fmu_interface(paths[c.name], f"components.{c.name}.fmu") for c in scenario.components}
+    for c in scenario.components:
+        problem = platform_problem(interfaces[c.name])
+        if problem is not None:
+            raise ScenarioError(f"components.{c.name}.fmu", str(paths[c.name]), problem, src)
     scenario, events = assign_events(scenario, interfaces)
 
+    scenario = _enumeration_items_as_values(scenario, interfaces)
     connected_inputs = {str(c.target) for c in scenario.connections}
     for comp in scenario.components:
         iface = interfaces[comp.name]
@@ -216,24 +275,26 @@ def resolve_system(
                 raise ScenarioError(key, value, f"a {var.type} value for {pname}", src)
 
     for i, con in enumerate(scenario.connections):
-        _lookup(interfaces[con.source.component], con.source, f"connections[{i}].from", src, READABLE_CAUSALITIES, "an output")
-        _lookup(interfaces[con.target.component], con.target, f"connections[{i}].to", src, ("input",), "an input")
+        a = _lookup(interfaces[con.source.component], con.source, f"connections[{i}].from", src, READABLE_CAUSALITIES, "an output")
+        b = _lookup(interfaces[con.target.component], con.target, f"connections[{i}].to", src, ("input",), "an input")
+        _same_type(a, b, f"connections[{i}]", str(con), src)
+        problem = transformation_problem(con.transformation, a, b, interfaces[con.source.component].enumerations,
+                                         interfaces[con.target.component].enumerations)
+        if problem is not None:
+            raise ScenarioError(f"connections[{i}].transformation", con.transformation.describe(), problem, src)
     for i, b in enumerate(scenario.initial):
-        _lookup(interfaces[b.source.component], b.source, f"initial[{i}].from", src, READABLE_CAUSALITIES, "an output")
+        out = _lookup(interfaces[b.source.component], b.source, f"initial[{i}].from", src, READABLE_CAUSALITIES, "an output")
         var = _lookup(interfaces[b.target.component], b.target, f"initial[{i}].to", src, SETTABLE_CAUSALITIES, "a parameter or input")
         if var.variability == "constant":
             raise ScenarioError(f"initial[{i}].to", str(b.target), "a settable (fixed or tunable) parameter", src)
+        _same_type(out, var, f"initial[{i}]", str(b), src)
 
     recorded = _resolve_record(scenario, interfaces)
 
-    feedthrough: dict[str, list[str]] = {}
-    for name, iface in interfaces.items():
-        for out in iface.outputs:
-            for inp in iface.direct_inputs_of(out):
-                feedthrough.setdefault(f"{name}.{inp}", []).append(f"{name}.{out}")
+    feedthrough = _feedthrough(scenario, interfaces)
     loop = find_algebraic_loop(((str(c.source), str(c.target)) for c in scenario.connections), feedthrough)
     if loop is not None:
-        raise AlgebraicLoopError(loop, src)
+        raise AlgebraicLoopError(loop, src, _loop_hint(loop, interfaces))
 
     names = scenario.component_names
     edges = [(c.source.component, c.target.component) for c in scenario.connections]
@@ -252,6 +313,65 @@ def resolve_system(
     )
 
 
+def _enumeration_items_as_values(scenario: Scenario, interfaces: Mapping[str, FmuInterface]) -> Scenario:
+    """Enumeration values given by item name (an SSP ``ssv:Enumeration``) as the item's integer value."""
+    for comp in scenario.components:
+        iface = interfaces[comp.name]
+        changed = {}
+        for pname, value in comp.parameters.items():
+            var = iface.variables.get(pname)
+            if var is not None and var.type == "Enumeration" and isinstance(value, str):
+                items = iface.enumerations.get(var.declared_type, {})
+                if value not in items:
+                    raise ScenarioError(f"components.{comp.name}.parameters.{pname}", value,
+                                        f"an item of {var.declared_type}: {', '.join(items) or 'none'}",
+                                        scenario.source)
+                changed[pname] = items[value]
+        if changed:
+            scenario = scenario.with_parameters(comp.name, **changed)
+    return scenario
+
+
+def _feedthrough(scenario: Scenario, interfaces: Mapping[str, FmuInterface]) -> dict[str, list[str]]:
+    """``"comp.input" -> ["comp.output", ...]`` direct dependencies, less the scenario's ``no_feedthrough``."""
+    src = scenario.source
+    feedthrough: dict[str, list[str]] = {}
+    for comp in scenario.components:
+        iface = interfaces[comp.name]
+        for i, out in enumerate(comp.no_feedthrough):
+            key = f"components.{comp.name}.no_feedthrough[{i}]"
+            var = iface.variables.get(out)
+            if var is None or var.causality != "output":
+                raise ScenarioError(key, out, f"an output of {iface.model_name}{suggestion(out, iface.outputs)}", src)
+            declared = iface.output_dependencies.get(out)
+            if declared:
+                raise ScenarioError(key, out, f"an output whose model description does not declare direct "
+                                    f"dependencies; {out} depends on {', '.join(declared)}", src)
+        for out in iface.outputs:
+            if out in comp.no_feedthrough:
+                continue
+            for inp in iface.direct_inputs_of(out):
+                feedthrough.setdefault(f"{comp.name}.{inp}", []).append(f"{comp.name}.{out}")
+    return feedthrough
+
+
+def _loop_hint(cycle: list[str], interfaces: Mapping[str, FmuInterface]) -> str:
+    """How to state that an output on the loop does not feed through, for FMUs that do not say."""
+    undeclared = []
+    for name in cycle:
+        comp, _, var = name.partition(".")
+        iface = interfaces[comp]
+        if var in iface.outputs and iface.output_dependencies.get(var) is None and name not in undeclared:
+            undeclared.append(name)
+    if not undeclared:
+        return ""
+    tables = "; ".join(f'[components.{n.partition(".")[0]}] no_feedthrough = ["{n.partition(".")[2]}"]'
+                       for n in undeclared)
+    return (f"{', '.join(undeclared)} {'has' if len(undeclared) == 1 else 'have'} no declared dependencies, which "
+            f"FMI 2 reads as depending directly on every input; if an output does not, say so in the scenario: "
+            f"{tables}")
+
+
 def _resolve_record(scenario: Scenario, interfaces: Mapping[str, FmuInterface]) -> tuple[RecordedVariable, ...]:
     src = scenario.source
     out: list[RecordedVariable] = []
@@ -260,14 +380,12 @@ def _resolve_record(scenario: Scenario, interfaces: Mapping[str, FmuInterface]) 
     def add(comp: str, var: FmuVariable) -> None:
         if (comp, var.name) not in seen:
             seen.add((comp, var.name))
-            out.append(RecordedVariable(comp, var.name, var.value_reference, var.unit))
+            out.append(RecordedVariable(comp, var.name, var.value_reference, var.unit, var.type))
 
     if not scenario.record:
         for comp in scenario.component_names:
             for name in interfaces[comp].outputs:
-                var = interfaces[comp].variables[name]
-                if var.type == "Real":
-                    add(comp, var)
+                add(comp, interfaces[comp].variables[name])
         return tuple(out)
     for i, pattern in enumerate(scenario.record):
         key = f"record.variables[{i}]"
@@ -282,14 +400,10 @@ def _resolve_record(scenario: Scenario, interfaces: Mapping[str, FmuInterface]) 
             exact = iface.variables.get(ref.variable)
             candidates = [exact] if exact is not None else [v for n, v in iface.variables.items() if var_rx.match(n)]
             for var in candidates:
-                if var.type != "Real":
-                    if exact is not None:
-                        raise ScenarioError(key, pattern, f"a Real variable; {var.name} is {var.type}", src)
-                    continue
                 add(comp, var)
                 matched += 1
         if not matched:
             comp = ref.component if ref.component in interfaces else None
             hint = suggestion(ref.variable, interfaces[comp].variables) if comp else ""
-            raise ScenarioError(key, pattern, f"a name or pattern matching at least one Real variable{hint}", src)
+            raise ScenarioError(key, pattern, f"a name or pattern matching at least one variable{hint}", src)
     return tuple(out)

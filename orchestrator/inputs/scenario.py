@@ -26,8 +26,10 @@ TOML format (units SI; see ``docs/orchestrator.md`` for the full reference)::
 
     [components.gearbox]
     fmu = "Gearbox.fmu"                   # relative to the scenario file or the FMU directory
+    # no_feedthrough = ["y"]              # outputs not depending directly on inputs (FMU does not say)
     [components.gearbox.parameters]
-    "stage1.k0" = 1.58e10                 # dotted names quoted, or as nested tables
+    "stage1.k0" = 1.58e10                 # dotted names quoted, or as nested tables; also start values
+                                          # of variables with initial="exact"/"approx" (states)
 
     [[connections]]
     from = "wind.omega"                   # an output
@@ -67,6 +69,7 @@ from .drivetrain_file import DrivetrainSpec, find_drivetrain, load_drivetrain_fi
 from .files import find_input_file, packaged_files, read_toml
 from .load_events import EventTable, ScenarioEvent, check_events_in_run
 from .master_options import ALGORITHMS, EXTRAPOLATIONS
+from .transformations import Transformation
 from .schema import (
     NAME_PATTERN,
     ParameterValue,
@@ -148,6 +151,10 @@ class Component:
         The drivetrain file this project FMU (``Gearbox.fmu`` or ``GeneratorRotor.fmu``) is
         built from (:mod:`orchestrator.inputs.drivetrain_file`); the FMU lives in a folder
         of the FMU directory keyed by the file's content (:meth:`Scenario.fmu_candidates`).
+    no_feedthrough : tuple of str
+        Outputs that do not depend directly on any input, for an FMU whose model
+        description does not say (no ``dependencies`` attribute: FMI 2 then means
+        "depends on all inputs"); a loop through them is not algebraic.
     """
 
     name: str
@@ -156,6 +163,7 @@ class Component:
     role: str | None = None
     signals: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
     drivetrain: DrivetrainSpec | None = None
+    no_feedthrough: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         from fmus.slaves.record import ROLES
@@ -182,14 +190,25 @@ class Component:
             raise ScenarioError(f"components.{self.name}.drivetrain", self.drivetrain.name,
                                 "a drivetrain file only for a project FMU built from it: fmu = "
                                 + " or ".join(f'"{f}"' for f in DRIVETRAIN_FMU_FILES) + f" (not {str(self.fmu)!r})")
+        outputs = (self.no_feedthrough,) if isinstance(self.no_feedthrough, str) else self.no_feedthrough
+        if not isinstance(outputs, (list, tuple)) or not all(isinstance(n, str) and n for n in outputs):
+            raise ScenarioError(f"components.{self.name}.no_feedthrough", self.no_feedthrough,
+                                "a list of output names")
+        object.__setattr__(self, "no_feedthrough", tuple(outputs))
 
 
 @dataclass(frozen=True)
 class Connection:
-    """Output ``source`` drives input ``target`` at every communication step."""
+    """Output ``source`` drives input ``target`` at every communication step.
+
+    ``transformation`` (from an SSP connection: linear, or a Boolean/Integer/Enumeration
+    mapping; :mod:`orchestrator.inputs.transformations`) changes the value on the way;
+    the target receives, and records, the transformed value.
+    """
 
     source: VariableRef
     target: VariableRef
+    transformation: Transformation | None = None
 
     def __str__(self) -> str:
         return f"{self.source} -> {self.target}"
@@ -459,6 +478,8 @@ class _ComponentTable(Table):
     signals: dict[str, Any] = Field(default_factory=dict, description="a table of signal kind = output name(s)")
     drivetrain: str | None = Field(None, description="a drivetrain file (path relative to this file, or a packaged "
                                    "name such as grc-like)")
+    no_feedthrough: list[str] = Field(default_factory=list,
+                                      description="a list of outputs that do not depend directly on any input")
 
 
 class _LinkTable(Table):
@@ -541,7 +562,8 @@ def scenario_from_dict(data: Mapping[str, Any], name: str | None = None, base_di
         if spec is None and inherited is not None and ctab.fmu == GENERATOR_FMU_FILE:
             spec = inherited  # the generator of a drivetrain file's gearbox takes its defaults from the same file
         try:
-            components.append(Component(cname, Path(ctab.fmu), params, ctab.role, ctab.signals, spec))
+            components.append(Component(cname, Path(ctab.fmu), params, ctab.role, ctab.signals, spec,
+                                        tuple(ctab.no_feedthrough)))
         except ScenarioError as exc:
             raise _rekeyed(exc, path if exc.key == "components" else None, source) from None
 

@@ -63,15 +63,20 @@ class LibcosimRun:
         Wall time of ``simulate_until`` alone [s].
     total_wall_time_s : float
         Child process wall time including loading the SSP [s].
+    last : dict of str -> float, int, bool or str
+        Values at the stop time of the ``last`` variables (any type, e.g. parameters
+        the SSP set: what libcosim applied).
     """
 
     time_s: np.ndarray
     values: dict[str, np.ndarray]
     simulation_wall_time_s: float
     total_wall_time_s: float
+    last: dict = None
 
 
-def run_ssp_in_libcosim(ssp: str | Path, stop_s: float, variables: list[str], timeout_s: float = 600.0) -> LibcosimRun:
+def run_ssp_in_libcosim(ssp: str | Path, stop_s: float, variables: list[str], timeout_s: float = 600.0,
+                        last: list[str] = ()) -> LibcosimRun:
     """Simulate an SSP with libcosim in a child process and return the sampled variables.
 
     Parameters
@@ -84,6 +89,8 @@ def run_ssp_in_libcosim(ssp: str | Path, stop_s: float, variables: list[str], ti
         ``component.variable`` names (Real) to sample at every step.
     timeout_s : float
         Child process timeout [s].
+    last : list of str
+        ``component.variable`` names (any type) whose values at the stop time are returned.
     """
     from .ssp import import_ssp
 
@@ -95,6 +102,8 @@ def run_ssp_in_libcosim(ssp: str | Path, stop_s: float, variables: list[str], ti
                "--samples", str(n_steps + 1), "--out", str(out)]
         for v in variables:
             cmd += ["--var", v]
+        for v in last:
+            cmd += ["--last", v]
         env = dict(os.environ)
         env["LD_PRELOAD"] = (libpython_path() + " " + env.get("LD_PRELOAD", "")).strip()
         t0 = time.perf_counter()
@@ -109,6 +118,7 @@ def run_ssp_in_libcosim(ssp: str | Path, stop_s: float, variables: list[str], ti
             values={v: data[f"v{i}"] for i, v in enumerate(variables)},
             simulation_wall_time_s=float(meta["simulation_wall_time_s"]),
             total_wall_time_s=total,
+            last=dict(meta.get("last", {})),
         )
 
 
@@ -152,6 +162,7 @@ def _child(argv: list[str] | None = None) -> int:
     parser.add_argument("--stop", type=float, required=True)
     parser.add_argument("--samples", type=int, required=True)
     parser.add_argument("--var", action="append", default=[])
+    parser.add_argument("--last", action="append", default=[])
     parser.add_argument("--out", required=True)
     args = parser.parse_args(argv)
 
@@ -165,20 +176,27 @@ def _child(argv: list[str] | None = None) -> int:
         print(f"libcosim could not load {args.ssp}: {_last_error()}", file=sys.stderr)
         return 2
     slaves = {info.name.decode(): info.index for info in execution.slave_infos()}
-    refs = []
-    for v in args.var:
+
+    def lookup(v: str):
         comp, _, name = v.partition(".")
         if comp not in slaves:
-            print(f"no component {comp!r} in the SSP (have {', '.join(slaves)})", file=sys.stderr)
-            return 2
+            raise LibcosimError(f"no component {comp!r} in the SSP (have {', '.join(slaves)})")
         idx = slaves[comp]
-        vr = next((d.reference for d in execution.slave_variables(idx) if d.name.decode() == name), None)
-        if vr is None:
-            print(f"no variable {name!r} in component {comp!r}", file=sys.stderr)
-            return 2
-        refs.append((idx, vr))
+        found = next((d for d in execution.slave_variables(idx) if d.name.decode() == name), None)
+        if found is None:
+            raise LibcosimError(f"no variable {name!r} in component {comp!r}")
+        return idx, found.reference, found.type
+
+    try:
+        refs = [lookup(v)[:2] for v in args.var]
+        last_refs = [lookup(v) for v in args.last]
+    except LibcosimError as exc:
+        print(exc, file=sys.stderr)
+        return 2
     observer = CosimObserver.create_time_series(buffer_size=args.samples)
     execution.add_observer(observer)
+    last_observer = CosimObserver.create_last_value()
+    execution.add_observer(last_observer)
     for idx, vr in refs:
         observer.start_time_series(idx, vr, CosimVariableType.REAL)
     t0 = time.perf_counter()
@@ -194,8 +212,16 @@ def _child(argv: list[str] | None = None) -> int:
         arrays[f"v{i}"] = values
         if time_s is None:
             time_s = times
+    readers = {CosimVariableType.REAL.value: last_observer.last_real_values,
+               CosimVariableType.INTEGER.value: last_observer.last_integer_values,
+               CosimVariableType.BOOLEAN.value: last_observer.last_boolean_values,
+               CosimVariableType.STRING.value: last_observer.last_string_values}
+    last = {}
+    for v, (idx, vr, typ) in zip(args.last, last_refs):
+        value = readers[typ](idx, [vr])[0]
+        last[v] = value.decode() if isinstance(value, bytes) else value
     np.savez(args.out, time_s=time_s if time_s is not None else np.zeros(0),
-             meta=json.dumps({"simulation_wall_time_s": wall}), **arrays)
+             meta=json.dumps({"simulation_wall_time_s": wall, "last": last}), **arrays)
     return 0
 
 

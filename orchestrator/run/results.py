@@ -32,20 +32,27 @@ TIMESERIES_FILE = "timeseries.csv"
 SUMMARY_FILE = "summary.json"
 
 
-def column_header(component: str, variable: str, unit: str) -> str:
-    """CSV header of a column: ``component.variable [unit]``."""
-    return f"{component}.{variable} [{unit or '-'}]"
+#: CSV header tag of the non-Real columns that have no unit
+TYPE_TAGS = {"Boolean": "Boolean 0/1", "String": "String"}
+
+
+def column_header(component: str, variable: str, unit: str, fmi_type: str = "Real") -> str:
+    """CSV header of a column: ``component.variable [unit]`` (``[Boolean 0/1]``, ``[String]`` for those types)."""
+    return f"{component}.{variable} [{TYPE_TAGS.get(fmi_type) or unit or '-'}]"
 
 
 def write_timeseries(path: str | Path, outcome: RunOutcome) -> Path:
-    """Write the sampled time series as CSV (full double precision, 17 significant digits)."""
-    header = ["time [s]"] + [column_header(c.component, c.variable, c.unit) for c in outcome.columns]
-    return write_series_csv(path, header, outcome.time_s, outcome.values)
+    """Write the sampled time series as CSV (Reals with 17 significant digits; other types as they are)."""
+    header = ["time [s]"] + [column_header(c.component, c.variable, c.unit, c.type) for c in outcome.columns]
+    types = [c.type for c in outcome.columns]
+    text = {j: outcome.text[c.column] for j, c in enumerate(outcome.columns) if c.column in outcome.text}
+    return write_series_csv(path, header, outcome.time_s, outcome.values, types, text)
 
 
 def statistics(outcome: RunOutcome, window: tuple[float, float]) -> dict[str, dict[str, float]]:
     """Mean, std, min, max of every recorded variable over ``window`` [s]."""
-    return {c.column: window_statistics(outcome.time_s, outcome.values[:, i], window) for i, c in enumerate(outcome.columns)}
+    return {c.column: window_statistics(outcome.time_s, outcome.values[:, i], window)
+            for i, c in enumerate(outcome.columns) if c.type != "String"}
 
 
 def build_summary(system: ResolvedSystem, outcome: RunOutcome, *, wall_time_s: float,
@@ -60,6 +67,9 @@ def build_summary(system: ResolvedSystem, outcome: RunOutcome, *, wall_time_s: f
         "scenario_file": sc.source,
         "complete": bool(outcome.complete),
     }
+    if outcome.ended_by is not None:
+        summary["ended_by"] = outcome.ended_by
+        summary["stopped_at"] = outcome.stopped_at_s
     if not outcome.complete:
         summary["stopped_at"] = outcome.stopped_at_s
         summary["error"] = outcome.error

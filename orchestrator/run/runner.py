@@ -23,13 +23,18 @@ from .plots import plot_run
 from .results import SUMMARY_FILE, TIMESERIES_FILE, build_summary, write_timeseries
 
 
-def load_any(path: str | Path) -> Scenario:
-    """A scenario from a TOML file or an SSP (``.ssp`` archive, ``.ssd`` file or SSP directory)."""
+def load_any(path: str | Path, step_s: float | None = None, stop_s: float | None = None,
+             report: Callable[[str], None] | None = None) -> Scenario:
+    """A scenario from a TOML file or an SSP (``.ssp`` archive, ``.ssd`` file or SSP directory).
+
+    ``step_s``, ``stop_s`` (``--step``, ``--stop``) are what an SSP without them uses;
+    ``report`` receives the SSP import's notes (:func:`orchestrator.interop.ssp.import_ssp`).
+    """
     p = Path(path)
     if p.suffix in (".ssp", ".ssd") or (p.is_dir() and (p / "SystemStructure.ssd").is_file()):
         from ..interop.ssp import import_ssp
 
-        return import_ssp(p)
+        return import_ssp(p, step_s=step_s, stop_s=stop_s, report=report)
     return load_scenario(p)
 
 

@@ -15,6 +15,7 @@ ToyMassA       mass on a wall spring, input force F; outputs x, v (exact step fo
 ToyMassB       mass coupled to A by a spring-damper, inputs xa, va; outputs F (force on A), x, v
 ToyFailer      output y = t; fails at t >= fail_at (mode 0: discard, 1: exception, 2: NaN output)
 ToyInit        parameter p0 (initial value); output y = p0 + u_start; input u
+ToyTyped       no inputs; outputs n (Integer: steps done), odd (Boolean: n odd), label (String "step n, ...")
 ToyGenerator   a third-party generator rotor: input shaft_torque; outputs omega, phi and a force-named
                output F_x (= shaft_torque / 1 m); parameters inertia, counter_torque, initial_speed
 """
@@ -217,6 +218,22 @@ class ToyGenerator(Fmi2Slave):
         self.phi += self.omega * h + 0.5 * alpha * h * h
         self.omega += alpha * h
         self.F_x = self.shaft_torque / 1.0
+        return True
+""",
+    "ToyTyped": """
+class ToyTyped(Fmi2Slave):
+    def __init__(self, **kw):
+        super().__init__(**kw)
+        self.n = 0
+        self.odd = False
+        self.label = "step 0"
+        self.register_variable(Integer("n", causality=Fmi2Causality.output))
+        self.register_variable(Boolean("odd", causality=Fmi2Causality.output))
+        self.register_variable(String("label", causality=Fmi2Causality.output))
+    def do_step(self, t, h):
+        self.n += 1
+        self.odd = self.n % 2 == 1
+        self.label = f'step {self.n}, "quoted", comma'
         return True
 """,
 }

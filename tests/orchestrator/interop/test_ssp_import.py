@@ -1,0 +1,367 @@
+"""SSP 1.0 files as other tools write them, written here from the standard's text, with values computed by hand.
+
+The FMUs are the Reference-FMUs: Feedthrough (every output equals its input of
+the same type, no state) and Dahlquist (x' = -k x with x(0) = 1, forward Euler
+with its own fixed internal step of 0.1 s: x(t) = (1 - 0.1 k)^(t / 0.1) at communication
+points that are multiples of 0.1 s).
+"""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from orchestrator.cosim.master import CoSimulation
+from orchestrator.cosim.system import resolve_system
+from orchestrator.errors import ScenarioError, SspError
+from orchestrator.interop.ssp import import_ssp
+from tests.helpers.reference_fmus import reference_fmu
+from tests.helpers.scenarios import dtcosim
+
+SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"
+SSC = "http://ssp-standard.org/SSP1/SystemStructureCommon"
+SSV = "http://ssp-standard.org/SSP1/SystemStructureParameterValues"
+SSM = "http://ssp-standard.org/SSP1/SystemStructureParameterMapping"
+OSP_HTTPS = "https://opensimulationplatform.com/SSP/OSPAnnotations"
+OSP_HTTP = "http://opensimulationplatform.com/SSP/OSPAnnotations"
+
+
+def osp_experiment(step: float = 0.1, stop: float = 1.0, namespace: str = OSP_HTTPS) -> str:
+    return f"""
+  <ssd:DefaultExperiment startTime="0" stopTime="{stop}">
+    <ssd:Annotations>
+      <ssc:Annotation type="com.opensimulationplatform">
+        <osp:Algorithm xmlns:osp="{namespace}">
+          <osp:FixedStepAlgorithm baseStepSize="{step}"/>
+        </osp:Algorithm>
+      </ssc:Annotation>
+    </ssd:Annotations>
+  </ssd:DefaultExperiment>"""
+
+
+def ssd(system: str, experiment: str | None = None, extra: str = "") -> str:
+    return f"""<?xml version="1.0" encoding="UTF-8"?>
+<ssd:SystemStructureDescription xmlns:ssd="{SSD}" xmlns:ssc="{SSC}" xmlns:ssv="{SSV}" xmlns:ssm="{SSM}"
+    name="test" version="1.0">
+{system}
+{extra}
+{osp_experiment() if experiment is None else experiment}
+</ssd:SystemStructureDescription>
+"""
+
+
+def real(name: str, kind: str, unit: str = "") -> str:
+    unit_attr = f' unit="{unit}"' if unit else ""
+    return f'<ssd:Connector name="{name}" kind="{kind}"><ssc:Real{unit_attr}/></ssd:Connector>'
+
+
+def feedthrough(name: str, connectors: str, bindings: str = "") -> str:
+    return f"""
+    <ssd:Component name="{name}" source="resources/Feedthrough.fmu">
+      <ssd:Connectors>{connectors}</ssd:Connectors>{bindings}
+    </ssd:Component>"""
+
+
+def inline_values(*params: tuple[str, str, str], prefix: str = "") -> str:
+    body = "".join(f'<ssv:Parameter name="{n}"><ssv:{t} value="{v}"/></ssv:Parameter>' for n, t, v in params)
+    prefix_attr = f' prefix="{prefix}"' if prefix else ""
+    return f"""
+      <ssd:ParameterBindings>
+        <ssd:ParameterBinding{prefix_attr}>
+          <ssd:ParameterValues>
+            <ssv:ParameterSet version="1.0" name="set"><ssv:Parameters>{body}</ssv:Parameters></ssv:ParameterSet>
+          </ssd:ParameterValues>
+        </ssd:ParameterBinding>
+      </ssd:ParameterBindings>"""
+
+
+def write_ssp(folder: Path, text: str, files: dict[str, str] | None = None) -> Path:
+    (folder / "resources").mkdir(parents=True, exist_ok=True)
+    for name in ("Feedthrough", "Dahlquist"):
+        shutil.copy(reference_fmu(name), folder / "resources" / f"{name}.fmu")
+    (folder / "SystemStructure.ssd").write_text(text)
+    for name, content in (files or {}).items():
+        (folder / name).write_text(content)
+    return folder
+
+
+def run(folder: Path, **kwargs):
+    outcome = CoSimulation(resolve_system(import_ssp(folder, **kwargs))).run(handle_sigint=False)
+    assert outcome.complete, outcome.error
+    return outcome
+
+
+A_TO_B = """
+  <ssd:System name="top">
+    <ssd:Elements>{a}{b}
+    </ssd:Elements>
+    <ssd:Connections>
+      <ssd:Connection startElement="a" startConnector="Float64_continuous_output" endElement="b"
+                      endConnector="Float64_continuous_input">{transformation}</ssd:Connection>
+    </ssd:Connections>
+  </ssd:System>"""
+
+
+def test_a_linear_transformation_on_a_connection_gives_factor_times_value_plus_offset(tmp_path):
+    system = A_TO_B.format(
+        a=feedthrough("a", real("Float64_continuous_input", "input") + real("Float64_continuous_output", "output"),
+                      inline_values(("Float64_continuous_input", "Real", "5.0"))),
+        b=feedthrough("b", real("Float64_continuous_input", "input") + real("Float64_continuous_output", "output")),
+        transformation='<ssc:LinearTransformation factor="2" offset="3"/>')
+    outcome = run(write_ssp(tmp_path, ssd(system)))
+    assert np.all(outcome.column("a.Float64_continuous_output") == 5.0)
+    assert np.all(outcome.column("b.Float64_continuous_output") == 2 * 5.0 + 3)  # what the receiver saw
+
+
+SSV_FILE = f"""<?xml version="1.0" encoding="UTF-8"?>
+<ssv:ParameterSet xmlns:ssv="{SSV}" xmlns:ssc="{SSC}" version="1.0" name="from-file">
+  <ssv:Parameters>
+    <ssv:Parameter name="gain_in"><ssv:Real value="4.0" unit="km"/></ssv:Parameter>
+    <ssv:Parameter name="count"><ssv:Integer value="3"/></ssv:Parameter>
+    <ssv:Parameter name="Boolean_input"><ssv:Boolean value="true"/></ssv:Parameter>
+    <ssv:Parameter name="Enumeration_input"><ssv:Enumeration value="Option 2"/></ssv:Parameter>
+  </ssv:Parameters>
+  <ssv:Units>
+    <ssc:Unit name="km"><ssc:BaseUnit m="1" factor="1000"/></ssc:Unit>
+  </ssv:Units>
+</ssv:ParameterSet>
+"""
+SSM_FILE = f"""<?xml version="1.0" encoding="UTF-8"?>
+<ssm:ParameterMapping xmlns:ssm="{SSM}" xmlns:ssc="{SSC}" version="1.0">
+  <ssm:MappingEntry source="gain_in" target="Float64_continuous_input">
+    <ssc:LinearTransformation factor="10" offset="0.5"/>
+  </ssm:MappingEntry>
+  <ssm:MappingEntry source="count" target="Int32_input">
+    <ssc:IntegerMappingTransformation>
+      <ssc:MapEntry source="3" target="30"/>
+    </ssc:IntegerMappingTransformation>
+  </ssm:MappingEntry>
+</ssm:ParameterMapping>
+"""
+
+
+def test_an_ssv_file_with_an_ssm_mapping_and_its_transformations(tmp_path):
+    connectors = (real("Float64_continuous_input", "input", "m") + real("Float64_continuous_output", "output", "m")
+                  + '<ssd:Connector name="Int32_output" kind="output"><ssc:Integer/></ssd:Connector>'
+                  + '<ssd:Connector name="Boolean_output" kind="output"><ssc:Boolean/></ssd:Connector>'
+                  + '<ssd:Connector name="Enumeration_output" kind="output"><ssc:Enumeration name="Option"/>'
+                    '</ssd:Connector>')
+    binding = """
+      <ssd:ParameterBindings>
+        <ssd:ParameterBinding source="params/values.ssv">
+          <ssd:ParameterMapping source="params/mapping.ssm"/>
+        </ssd:ParameterBinding>
+      </ssd:ParameterBindings>"""
+    system = f'<ssd:System name="top"><ssd:Elements>{feedthrough("a", connectors, binding)}</ssd:Elements></ssd:System>'
+    units = '<ssd:Units><ssc:Unit name="m"><ssc:BaseUnit m="1"/></ssc:Unit></ssd:Units>'
+    folder = write_ssp(tmp_path, ssd(system, extra=units))
+    (folder / "params").mkdir()
+    (folder / "params" / "values.ssv").write_text(SSV_FILE)
+    (folder / "params" / "mapping.ssm").write_text(SSM_FILE)
+    outcome = run(folder)
+    # 4 km = 4000 m (the connector's unit), then 10 x + 0.5 (SSP: conversion before the transformation)
+    assert np.all(outcome.column("a.Float64_continuous_output") == 10 * 4000.0 + 0.5)
+    assert np.all(outcome.column("a.Int32_output") == 30)  # 3 mapped to 30
+    assert np.all(outcome.column("a.Boolean_output") == 1.0)  # unmapped names are used as they are
+    assert np.all(outcome.column("a.Enumeration_output") == 2)  # "Option 2" of the Feedthrough's type Option
+
+
+NESTED = """
+  <ssd:System name="top">
+    <ssd:Elements>
+      <ssd:System name="inner">
+        <ssd:Connectors>{inner_out}</ssd:Connectors>
+        <ssd:Elements>{source}</ssd:Elements>
+        <ssd:Connections>
+          <ssd:Connection startElement="src" startConnector="Float64_continuous_output" endConnector="out"/>
+        </ssd:Connections>
+      </ssd:System>{sink}
+    </ssd:Elements>
+    <ssd:Connections>
+      <ssd:Connection startElement="inner" startConnector="out" endElement="sink" endConnector="Float64_continuous_input">
+        <ssc:LinearTransformation factor="-1"/>
+      </ssd:Connection>
+    </ssd:Connections>
+  </ssd:System>"""
+
+
+def test_a_nested_system_is_flattened_with_its_path_and_connected_through_its_connector(tmp_path):
+    system = NESTED.format(
+        inner_out=real("out", "output"),
+        source=feedthrough("src", real("Float64_continuous_input", "input") + real("Float64_continuous_output", "output"),
+                           inline_values(("Float64_continuous_input", "Real", "1.25"))),
+        sink=feedthrough("sink", real("Float64_continuous_input", "input") + real("Float64_continuous_output", "output")))
+    folder = write_ssp(tmp_path, ssd(system))
+    scenario = import_ssp(folder)
+    assert scenario.component_names == ["inner-src", "sink"]
+    assert [str(c) for c in scenario.connections] == ["inner-src.Float64_continuous_output -> "
+                                                      "sink.Float64_continuous_input"]
+    outcome = run(folder)
+    assert np.all(outcome.column("sink.Float64_continuous_output") == -1.25)
+
+
+SYSTEM_PARAMETER = """
+  <ssd:System name="top">
+    <ssd:Elements>
+      <ssd:System name="plant">
+        <ssd:Connectors><ssd:Connector name="rate" kind="parameter"><ssc:Real/></ssd:Connector></ssd:Connectors>
+        <ssd:Elements>
+          <ssd:Component name="decay" source="resources/Dahlquist.fmu">
+            <ssd:Connectors>
+              <ssd:Connector name="k" kind="parameter"><ssc:Real/></ssd:Connector>
+              <ssd:Connector name="x" kind="output"><ssc:Real/></ssd:Connector>
+            </ssd:Connectors>{component_binding}
+          </ssd:Component>
+        </ssd:Elements>
+        <ssd:Connections>
+          <ssd:Connection startConnector="rate" endElement="decay" endConnector="k"/>
+        </ssd:Connections>
+      </ssd:System>
+    </ssd:Elements>{system_binding}
+  </ssd:System>"""
+
+
+@pytest.mark.parametrize("name, prefix", [("plant.rate", ""), ("rate", "plant.")])
+def test_a_system_level_binding_on_a_system_connector_wins_over_the_component_level_one(tmp_path, name, prefix):
+    system = SYSTEM_PARAMETER.format(component_binding=inline_values(("k", "Real", "1.5")),
+                                     system_binding=inline_values((name, "Real", "2.0"), prefix=prefix))
+    outcome = run(write_ssp(tmp_path, ssd(system)))
+    n = np.arange(len(outcome.time_s))
+    np.testing.assert_allclose(outcome.time_s, 0.1 * n)
+    # forward Euler with k = 2 (the system's value; SSP: higher levels take precedence), h = 0.1
+    np.testing.assert_allclose(outcome.column("plant-decay.x"), (1 - 2.0 * 0.1) ** n, rtol=1e-12)
+
+
+def test_a_later_binding_at_one_level_wins(tmp_path):
+    two = inline_values(("k", "Real", "1.5")).replace("</ssd:ParameterBindings>", "") \
+        + inline_values(("k", "Real", "3.0")).replace("<ssd:ParameterBindings>", "")
+    system = SYSTEM_PARAMETER.format(component_binding=two, system_binding="")
+    outcome = run(write_ssp(tmp_path, ssd(system)))
+    n = np.arange(len(outcome.time_s))
+    np.testing.assert_allclose(outcome.column("plant-decay.x"), (1 - 3.0 * 0.1) ** n, rtol=1e-12)
+
+
+def test_the_osp_annotation_under_the_http_namespace_gives_the_step(tmp_path):
+    system = SYSTEM_PARAMETER.format(component_binding="", system_binding="")
+    outcome = run(write_ssp(tmp_path, ssd(system, osp_experiment(step=0.2, stop=1.0, namespace=OSP_HTTP))))
+    np.testing.assert_allclose(outcome.time_s, [0.0, 0.2, 0.4, 0.6, 0.8, 1.0], rtol=0, atol=1e-15)
+    np.testing.assert_allclose(outcome.column("plant-decay.x"), 0.9 ** (2 * np.arange(6)), rtol=1e-12)  # k = 1
+
+
+def test_without_an_annotation_the_step_comes_from_the_command_line(tmp_path):
+    folder = write_ssp(tmp_path / "ssp", ssd(SYSTEM_PARAMETER.format(component_binding="", system_binding=""),
+                                             '<ssd:DefaultExperiment startTime="0" stopTime="1.0"/>'))
+    proc = dtcosim("run", str(folder), "--step", "0.2", "--no-plots", "--quiet", "--out", str(tmp_path / "out"),
+                   cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    rows = (tmp_path / "out" / "timeseries.csv").read_text().splitlines()
+    assert len(rows) == 1 + 6 and float(rows[-1].split(",")[1]) == pytest.approx(0.9 ** 10, rel=1e-12)
+    # Dahlquist's own DefaultExperiment stepSize (0.1) is the fallback without --step
+    assert import_ssp(folder).simulation.step_s == 0.1
+
+
+def test_without_any_step_the_error_says_which_option_to_give(tmp_path):
+    folder = write_ssp(tmp_path, ssd(SYSTEM_PARAMETER.format(component_binding="", system_binding=""),
+                                     "<ssd:DefaultExperiment/>"))
+    shutil.copy(reference_fmu("Feedthrough"), folder / "resources" / "Dahlquist.fmu")  # no stepSize, stopTime 2
+    with pytest.raises(ScenarioError, match=r"simulation\.step.*give it on the command line: --step H"):
+        import_ssp(folder)
+    assert import_ssp(folder, step_s=0.5).simulation.stop_s == 2.0  # the FMU's DefaultExperiment stopTime
+
+
+@pytest.mark.parametrize("element, text", [
+    ("ssd:SignalDictionaries", "<ssd:SignalDictionaries/>"),
+    ("ssc:Binary", '<ssd:Connector name="bin" kind="input"><ssc:Binary/></ssd:Connector>'),
+])
+def test_an_unsupported_element_is_refused_naming_it_and_its_line(tmp_path, element, text):
+    system = SYSTEM_PARAMETER.format(component_binding="", system_binding="")
+    if element == "ssd:SignalDictionaries":
+        system = system.replace("</ssd:Elements>\n  </ssd:System>", "</ssd:Elements>\n" + text + "\n  </ssd:System>")
+    else:
+        system = system.replace('<ssd:Connector name="x" kind="output">', text + '<ssd:Connector name="x" kind="output">')
+    document = ssd(system)
+    line = next(i for i, row in enumerate(document.splitlines(), 1) if text.split(">")[0].split()[0] in row
+                and (element != "ssc:Binary" or "ssc:Binary" in row))
+    folder = write_ssp(tmp_path, document)
+    with pytest.raises(SspError, match=rf"SystemStructure\.ssd, line {line}: <{element}> is not supported by dtcosim"):
+        import_ssp(folder)
+
+
+def test_a_component_of_another_kind_and_an_unknown_parameter_name_are_refused(tmp_path):
+    system = SYSTEM_PARAMETER.format(component_binding="", system_binding=inline_values(("plant.nothing", "Real", "1")))
+    with pytest.raises(SspError, match=r"line \d+: parameter 'plant.nothing' reaches no variable"):
+        import_ssp(write_ssp(tmp_path, ssd(system)))
+    nested_ssp = SYSTEM_PARAMETER.format(component_binding="", system_binding="").replace(
+        'source="resources/Dahlquist.fmu"', 'source="resources/Other.ssp" type="application/x-ssp-package"')
+    with pytest.raises(SspError, match=r"<ssd:Component> type 'application/x-ssp-package' is not supported"):
+        import_ssp(write_ssp(tmp_path, ssd(nested_ssp)))
+
+
+MAPPINGS = {
+    "Boolean": ("Boolean_output", "Boolean_input", "Boolean", "true",
+                '<ssc:BooleanMappingTransformation><ssc:MapEntry source="true" target="false"/>'
+                '</ssc:BooleanMappingTransformation>', 0.0),
+    "Integer": ("Int32_output", "Int32_input", "Integer", "1",
+                '<ssc:IntegerMappingTransformation><ssc:MapEntry source="1" target="5"/>'
+                '</ssc:IntegerMappingTransformation>', 5.0),
+    "Enumeration": ("Enumeration_output", "Enumeration_input", "Enumeration", "Option 1",
+                    '<ssc:EnumerationMappingTransformation><ssc:MapEntry source="Option 1" target="Option 2"/>'
+                    '</ssc:EnumerationMappingTransformation>', 2.0),
+}
+
+
+@pytest.mark.parametrize("kind", list(MAPPINGS))
+def test_mapping_transformations_on_connections(tmp_path, kind):
+    out, inp, ssc_type, value, mapping, expected = MAPPINGS[kind]
+    ssc_el = f"<ssc:{ssc_type}/>" if kind != "Enumeration" else '<ssc:Enumeration name="Option"/>'
+    conn = lambda n, k: f'<ssd:Connector name="{n}" kind="{k}">{ssc_el}</ssd:Connector>'  # noqa: E731
+    system = f"""
+  <ssd:System name="top">
+    <ssd:Elements>{feedthrough("a", conn(inp, "input") + conn(out, "output"), inline_values((inp, ssc_type, value)))}
+      {feedthrough("b", conn(inp, "input") + conn(out, "output"))}
+    </ssd:Elements>
+    <ssd:Connections>
+      <ssd:Connection startElement="a" startConnector="{out}" endElement="b" endConnector="{inp}">{mapping}</ssd:Connection>
+    </ssd:Connections>
+  </ssd:System>"""
+    outcome = run(write_ssp(tmp_path, ssd(system)))
+    assert np.all(outcome.column(f"b.{out}") == expected)
+
+
+def test_transformations_survive_export_and_import(tmp_path):
+    from orchestrator.interop.ssp import export_ssp
+
+    system = A_TO_B.format(
+        a=feedthrough("a", real("Float64_continuous_input", "input") + real("Float64_continuous_output", "output"),
+                      inline_values(("Float64_continuous_input", "Real", "5.0"))),
+        b=feedthrough("b", real("Float64_continuous_input", "input") + real("Float64_continuous_output", "output")),
+        transformation='<ssc:LinearTransformation factor="2" offset="3"/>')
+    scenario = import_ssp(write_ssp(tmp_path / "in", ssd(system)))
+    again = import_ssp(export_ssp(resolve_system(scenario), tmp_path / "out.ssp"))
+    assert again.connections == scenario.connections and again.connections[0].transformation is not None
+    outcome = CoSimulation(resolve_system(again)).run(handle_sigint=False)
+    assert np.all(outcome.column("b.Float64_continuous_output") == 13.0)
+
+
+def test_other_tools_annotations_are_reported_and_ssd_folder_and_archive_read_alike(tmp_path):
+    import zipfile
+
+    system = SYSTEM_PARAMETER.format(component_binding="", system_binding="").replace(
+        "</ssd:Elements>\n  </ssd:System>",
+        '</ssd:Elements>\n<ssd:Annotations><ssc:Annotation type="com.example.layout"><x xmlns="urn:x"/>'
+        "</ssc:Annotation></ssd:Annotations>\n  </ssd:System>")
+    folder = write_ssp(tmp_path / "folder", ssd(system))
+    notes: list[str] = []
+    from_folder = import_ssp(folder, report=notes.append)
+    assert len(notes) == 1 and "annotation of type 'com.example.layout' ignored" in notes[0] and "line" in notes[0]
+    archive = tmp_path / "system.ssp"
+    with zipfile.ZipFile(archive, "w") as zf:
+        for f in folder.rglob("*"):
+            if f.is_file():
+                zf.write(f, f.relative_to(folder).as_posix())
+    for other in (import_ssp(folder / "SystemStructure.ssd"), import_ssp(archive)):
+        assert [c.name for c in other.components] == [c.name for c in from_folder.components]
+        assert other.connections == from_folder.connections and other.simulation == from_folder.simulation
