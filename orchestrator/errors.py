@@ -131,3 +131,49 @@ class FmuStepError(DtcosimError, RuntimeError):
 
 class SspError(DtcosimError, ValueError):
     """An SSP file cannot be read or written (names the file and the problem)."""
+
+
+def signal_name(signum: int) -> str:
+    """``2`` -> ``"SIGINT"``."""
+    import signal
+
+    try:
+        return signal.Signals(signum).name
+    except ValueError:
+        return f"signal {signum}"
+
+
+def reason_of(signum: int) -> str:
+    """Why a run stopped, as a summary and the command line say it: ``"interrupted by SIGTERM"``."""
+    import signal
+
+    if signum == signal.SIGINT:
+        return "interrupted by the user (Ctrl-C)"
+    return f"interrupted by {signal_name(signum)}"
+
+
+class RunInterrupted(KeyboardInterrupt):
+    """A stop signal (SIGINT, SIGTERM, SIGHUP) ended a command before it could finish its current stage.
+
+    A KeyboardInterrupt, so nothing that catches ``Exception`` swallows it; the
+    command line turns it into one line and the exit status ``128 + signum``.
+
+    Parameters
+    ----------
+    signum : int
+        The signal.
+    stage : str
+        What was going on (``"instantiation"``, ``"initialisation"``, ...).
+    time_s : float, optional
+        Simulation time reached [s].
+    """
+
+    def __init__(self, signum: int, stage: str, time_s: float | None = None) -> None:
+        self.signum = int(signum)
+        self.stage = stage
+        self.time_s = time_s
+        at = f" at t = {time_s:.6g} s" if time_s is not None else ""
+        super().__init__(f"{reason_of(self.signum)} during {stage}{at}")
+
+    def __reduce__(self):
+        return (type(self), (self.signum, self.stage, self.time_s))

@@ -1,7 +1,9 @@
 """``dtcosim run``: run a co-simulation scenario and write its results.
 
-Exit status: 0 complete, 1 error (bad scenario, FMU failure: partial results
-written), 130 interrupted by Ctrl-C (partial results written).
+Exit status: 0 complete, 1 error (bad scenario, FMU failure, initialisation
+failure, a results file that could not be written: ``summary.json`` says what
+is there), ``128 + signal`` when stopped by a signal: 130 Ctrl-C (SIGINT), 143
+SIGTERM, 129 SIGHUP (partial results written).
 """
 
 from __future__ import annotations
@@ -27,7 +29,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("scenario", nargs="?", default=None, metavar="SCENARIO",
                    help="scenario TOML/SSP file or packaged scenario name (default: paper-60s)")
-    p.add_argument("--out", type=Path, default=None, help="output directory (default: results/<scenario name>)")
+    p.add_argument("--out", type=Path, default=None,
+                   help="output directory (default: results/<scenario name>, or results/<scenario name>-<id> "
+                        "with --stop/--step/--output-interval/--algorithm/--extrapolation/--set; the files of a "
+                        "previous run in it are replaced)")
     p.add_argument("--fmu-dir", type=Path, default=None,
                    help="directory searched for FMUs after the scenario's own (default: $DTCOSIM_FMU_DIR or the project's fmus/)")
     p.add_argument("--compare-reference", action="store_true",
@@ -72,9 +77,14 @@ def run(args: argparse.Namespace) -> int:
     from ..run.analyses import format_analyses
     from ..run.runner import load_any, run_scenario
 
+    from ..run.run_folder import RunFolder
+
     quiet = args.quiet
     say = (lambda msg: None) if quiet else (lambda msg: print(msg, file=sys.stderr))
     scenario = scenario_options.apply(load_any(find_scenario(args.scenario)), args, "run")
+    out_dir = args.out if args.out is not None else scenario_options.default_out_dir(scenario, args, "run")
+    if not args.check:
+        RunFolder.check(out_dir)
     paths = ensure_fmus(scenario, args.fmu_dir, build=not args.no_build, report=say)
     for warning in stale_project_fmus(paths):
         print(f"dtcosim run: warning: {warning}", file=sys.stderr)
@@ -84,7 +94,9 @@ def run(args: argparse.Namespace) -> int:
               f"{len(system.recorded)} recorded variables, {len(system.events)} load event(s); stepping order {', '.join(system.order)}; "
               f"initialisation order {', '.join(system.init_order)})")
         return 0
-    out_dir = args.out if args.out is not None else Path("results") / scenario.name
+    previous = scenario_options.previous_run(out_dir)
+    if previous:
+        print(f"dtcosim run: note: replacing the previous run in {out_dir}/ ({previous})", file=sys.stderr)
     sim = scenario.simulation
     say(f"{scenario.name}: {len(scenario.components)} FMUs, {sim.algorithm}/{sim.extrapolation}, "
         f"H = {sim.step_s:g} s, {sim.start_s:g}-{sim.stop_s:g} s ({sim.n_steps} steps), order {', '.join(system.order)}")
@@ -98,6 +110,10 @@ def run(args: argparse.Namespace) -> int:
             bar.close()
     outcome = report.outcome
     s = report.summary
+    if not outcome.time_s.size:  # stopped before the first sample: nothing to show
+        print(f"dtcosim run: {outcome.error}; nothing was simulated ({out_dir / 'summary.json'} says so)",
+              file=sys.stderr)
+        return report.exit_status
     if not quiet:
         print(f"{scenario.name}: {'complete' if outcome.complete else 'INCOMPLETE'}, {outcome.steps} steps, "
               f"wall time {s['wall_time_s']:.2f} s (stepping {outcome.loop_time_s:.2f} s, "
@@ -129,7 +145,11 @@ def run(args: argparse.Namespace) -> int:
         if report.comparison_text:
             print(report.comparison_text)
         print(f"results in {Path(out_dir)}/: " + ", ".join(p.name for p in report.files.values()))
+    for problem in report.problems:
+        print(f"dtcosim run: error: {problem}", file=sys.stderr)
+    post = s.get("post_processing")
+    if post:
+        print(f"dtcosim run: {post['stopped']}; not done: {', '.join(post['not_done'])}", file=sys.stderr)
     if not outcome.complete:
         print(f"dtcosim run: {outcome.error}; partial results written to {out_dir}", file=sys.stderr)
-        return 130 if outcome.interrupted else 1
-    return 0
+    return report.exit_status

@@ -45,10 +45,11 @@ Per FMU and step the loop makes one ``fmi2SetReal`` (if the FMU has connected
 inputs), one ``fmi2DoStep`` and one ``fmi2GetReal`` that reads the coupling
 outputs and, on sampling steps, the recorded variables, calling the C functions
 through this project's own prototypes with pre-built value-reference arrays
-(:mod:`orchestrator.cosim.fmi_runtime`). ``fmi2GetReal`` writes straight into the
-preallocated numpy result array (or, when not every step is sampled, into a
-three-row ring buffer copied into the results on sampling steps), and the coupled
-inputs are read from there: no per-step Python objects, no copies. The loop is
+(:mod:`orchestrator.cosim.fmi_runtime`). ``fmi2GetReal`` writes straight into a
+block buffer of :data:`BLOCK_STEPS` + 2 rows (or, when not every step is sampled,
+into a three-row ring buffer copied into the block's sample rows on sampling
+steps), and the coupled inputs are read from there: no per-step Python objects,
+no copies. The loop is
 generated and compiled per system (:func:`compile_step_loop`), with every FMI
 function, array and column offset bound to a name, so each coupling is one
 statement. That pays: above the floor of the bare FMI calls, the generated loop
@@ -58,12 +59,22 @@ generated one is tested against) 2.3-3.2 us, in all four algorithm/extrapolation
 variants (``python benchmarks/bench_plumbing.py --repeat 7``, medians; the
 floor itself is ~12 us).
 
+Results
+-------
+After each block of steps its finished rows go to the run's sink (a
+:class:`RowSink`, e.g. a results file writer of :mod:`orchestrator.run.writers`)
+and, unless ``keep_values`` is off, into the outcome's arrays; the block buffer
+is then reused, so the master's own memory does not grow with the run.
+
 Stopping
 --------
 An FMU status worse than warning stops the run with an :class:`FmuStepError`
-message (FMU, function, time, status, the FMU's log); Ctrl-C (SIGINT) is caught
-between blocks of steps. Either way the samples recorded so far are returned with
-``complete = False``.
+message (FMU, function, time, status, the FMU's log); SIGINT (Ctrl-C), SIGTERM
+and SIGHUP set a flag (:class:`~orchestrator.cosim.stop_requests.StopRequests`)
+that is checked after each FMU is instantiated and between blocks of steps; a
+sink that cannot write (``OSError``: a full disk) stops the run too. Either way
+the samples recorded so far are returned with ``complete = False``; a stop
+request before the first step raises :class:`~orchestrator.errors.RunInterrupted`.
 """
 
 from __future__ import annotations
@@ -75,17 +86,19 @@ import threading
 import time
 from ctypes import c_double
 from dataclasses import dataclass, field
-from typing import Callable
+from typing import Callable, Protocol
 
 import numpy as np
 
-from ..errors import FmuStepError, InitializationError
+from ..atomic_files import describe_os_error
+from ..errors import FmuStepError, InitializationError, RunInterrupted
 from .fmi_runtime import FmuInstance, value_references
+from .stop_requests import StopRequests
 from .system import RecordedVariable, ResolvedSystem
 
 #: stepping-loop implementations (see :func:`compile_step_loop`)
 STEP_LOOPS = ("generated", "interpreted")
-#: steps between checks for Ctrl-C and progress updates
+#: steps between checks for stop requests, progress updates and hand-overs of rows to the sink
 BLOCK_STEPS = 250
 #: maximum initialisation sweeps beyond the number of components
 EXTRA_INIT_SWEEPS = 2
@@ -109,9 +122,14 @@ class RunOutcome:
     stopped_at_s : float
         Time of the last completed communication point [s].
     error : str or None
-        Why the run stopped early (FMU failure or interruption).
+        Why the run stopped early (FMU failure, interruption, a results file that could not be written).
     interrupted : bool
-        True if stopped by Ctrl-C.
+        True if stopped by a signal (Ctrl-C, SIGTERM, SIGHUP).
+    stop_signal : str or None
+        Name of that signal (``"SIGINT"``, ...).
+    stage : str
+        Where the run ended: ``"stepping"`` (also when complete), ``"writing"`` (the sink failed),
+        or, for outcomes built by a caller after an exception, ``"instantiation"``/``"initialisation"``.
     wall_time_s : float
         Whole run: instantiation, initialisation, stepping, cleanup [s].
     loop_time_s : float
@@ -138,6 +156,17 @@ class RunOutcome:
     initial_values: dict[str, float] = field(default_factory=dict)
     fmu_log: dict[str, list[str]] = field(default_factory=dict)
     profile: dict[str, dict[str, float]] | None = None
+    stop_signal: str | None = None
+    stage: str = "stepping"
+
+    @classmethod
+    def empty(cls, columns: tuple[RecordedVariable, ...], start_s: float, error: str, stage: str,
+              interrupted: bool = False, stop_signal: str | None = None,
+              fmu_log: dict[str, list[str]] | None = None) -> "RunOutcome":
+        """The outcome of a run that stopped before its first sample (instantiation or initialisation)."""
+        return cls(time_s=np.empty(0), values=np.empty((0, len(columns))), columns=tuple(columns), complete=False,
+                   steps=0, stopped_at_s=start_s, error=error, interrupted=interrupted, stop_signal=stop_signal,
+                   stage=stage, fmu_log=dict(fmu_log or {}))
 
     def column(self, name: str) -> np.ndarray:
         """Samples of ``"component.variable"``."""
@@ -150,6 +179,13 @@ class RunOutcome:
     def names(self) -> list[str]:
         """Recorded column names."""
         return [c.column for c in self.columns]
+
+
+class RowSink(Protocol):
+    """Where the master hands each finished block of rows (e.g. :class:`orchestrator.run.writers.CsvWriter`)."""
+
+    def append(self, time_s: np.ndarray, values: np.ndarray) -> None:
+        """Rows at ``time_s`` (n,), ``values`` (n, m) in the order of ``system.recorded``; may raise OSError."""
 
 
 class _Stop(Exception):
@@ -204,7 +240,8 @@ class CoSimulation:
 
     # ------------------------------------------------------------------ run
     def run(self, progress: Callable[[int, int], None] | None = None, handle_sigint: bool = True,
-            wall_time_limit_s: float | None = None) -> RunOutcome:
+            wall_time_limit_s: float | None = None, *, sink: RowSink | None = None, keep_values: bool = True,
+            stop: StopRequests | None = None) -> RunOutcome:
         """Instantiate, initialise, step to the stop time and free the FMUs.
 
         Parameters
@@ -212,59 +249,90 @@ class CoSimulation:
         progress : callable(done_steps, total_steps), optional
             Called every :data:`BLOCK_STEPS` steps.
         handle_sigint : bool
-            Catch Ctrl-C between blocks of steps (main thread only) and return
-            the partial results instead of raising KeyboardInterrupt.
+            Without ``stop``: catch SIGINT, SIGTERM and SIGHUP for the duration of
+            the run (main thread only) and return the partial results instead of
+            dying; False: leave the process's signal handling alone.
         wall_time_limit_s : float, optional
             Stop stepping (between blocks of steps) once the run has taken this
             much wall-clock time [s]; the outcome is then incomplete, with an error
             naming the limit and the time reached. None or 0: no limit.
+        sink : RowSink, optional
+            Receives every finished block of rows as the run goes (row 0, at the
+            start time, first).
+        keep_values : bool
+            Also keep every row in the outcome's ``time_s``/``values`` (default;
+            memory grows with the rows recorded so far). False: the outcome holds
+            no rows (the sink has them).
+        stop : StopRequests, optional
+            A caller's active stop requests (the caller installed the handlers,
+            e.g. for a whole run with its result files); checked after each FMU
+            is instantiated and between blocks of steps.
 
         Returns
         -------
         RunOutcome
-            Also when an FMU fails or the run is interrupted (``complete`` False).
+            Also when an FMU fails, the sink cannot write or the run is
+            interrupted while stepping (``complete`` False).
 
         Raises
         ------
         FmuStepError, InitializationError
             If instantiation or initialisation fails (nothing to record yet).
+        RunInterrupted
+            If a stop was requested before the first step.
         """
+        if stop is None:
+            with StopRequests(enabled=handle_sigint) as own:
+                return self._run(progress, wall_time_limit_s, sink, keep_values, own)
+        return self._run(progress, wall_time_limit_s, sink, keep_values, stop)
+
+    def _run(self, progress, wall_time_limit_s, sink, keep_values, stop: StopRequests) -> RunOutcome:
         wall0 = time.perf_counter()
         sim = self.settings
         n_steps = sim.n_steps
         stride = sim.output_stride
         n_rows = n_steps // stride + 1
+        timers = slots = None
         try:
-            self._instantiate()
+            self._instantiate(stop)
             initial_values = self._initialize()
+            stop.raise_if_requested("initialisation", sim.start_s)
             slots, columns = self._build_slots()
+            keys = [(c.component, c.variable) for c in columns]
+            order = np.array([keys.index((rv.component, rv.variable)) for rv in self.system.recorded], dtype=np.intp)
             n_cols = max(1, len(columns))
-            data = np.full((n_rows, n_cols), np.nan)
-            ring = data if stride == 1 else np.full((3, n_cols), np.nan)
+            if stride == 1:  # rows k_start - 1 and k_start of each block, then one row per step
+                block = np.full((BLOCK_STEPS + 2, n_cols), np.nan)
+                ring = block
+            else:  # the block's sample rows; outputs go to a three-row ring buffer
+                block = np.full((BLOCK_STEPS // stride + 2, n_cols), np.nan)
+                ring = np.full((3, n_cols), np.nan)
             # row 0: every output at t0, after initialisation
+            first = np.full(n_cols, np.nan)
             for s in slots:
                 if s.out_names:
                     values = s.inst.get_reals(s.out_names, sim.start_s)
-                    data[0, s.col0:s.col0 + len(values)] = values
-            if ring is not data:
-                ring[:] = data[0]
+                    first[s.col0:s.col0 + len(values)] = values
+            ring[:] = first
+            rows = _Rows(sim.start_s, sim.step_s * stride, order, n_rows if keep_values else 0, sink)
+            error = rows.deliver(first[None, :])
             timers = np.zeros((len(slots), 3)) if self.profile else None
             make_loop = compile_step_loop if self.step_loop == "generated" else interpreted_step_loop
-            advance = make_loop(slots, sim.algorithm, sim.extrapolation, stride, data, ring, timers)
+            advance = make_loop(slots, sim.algorithm, sim.extrapolation, stride, block, ring, timers)
             loop0 = time.perf_counter()
             deadline = wall0 + wall_time_limit_s if wall_time_limit_s else math.inf
-            k_done, error, interrupted = self._loop(advance, slots, data, n_steps, stride, progress, handle_sigint,
-                                                    deadline, wall_time_limit_s)
+            if error is None:
+                k_done, error, stage = self._loop(advance, slots, block, ring is block, rows, n_steps, stride,
+                                                  progress, stop, deadline, wall_time_limit_s)
+            else:
+                k_done, stage = 0, "writing"
             loop_time = time.perf_counter() - loop0
         finally:
             self._close()
-        rows = k_done // stride + 1
-        keys = [(c.component, c.variable) for c in columns]
-        order = [keys.index((rv.component, rv.variable)) for rv in self.system.recorded]
-        times = sim.start_s + sim.step_s * stride * np.arange(rows, dtype=float)
+        interrupted = stage == "interrupted"
         return RunOutcome(
-            time_s=times,
-            values=np.ascontiguousarray(data[:rows][:, order]),
+            time_s=rows.time_s(),
+            values=rows.values(),
             columns=tuple(self.system.recorded),
             complete=error is None,
             steps=k_done,
@@ -279,6 +347,8 @@ class CoSimulation:
                 s.name: dict(zip(("fmi2SetReal", "fmi2DoStep", "fmi2GetReal"), map(float, row)))
                 for s, row in zip(slots, timers)
             },
+            stop_signal=stop.signal_name if interrupted else None,
+            stage="stepping" if interrupted else stage,
         )
 
     def initial_values(self) -> dict[str, float]:
@@ -296,10 +366,12 @@ class CoSimulation:
             self._close()
 
     # ----------------------------------------------------------- lifecycle
-    def _instantiate(self) -> None:
+    def _instantiate(self, stop: StopRequests | None = None) -> None:
         sim = self.settings
         sc = self.system.scenario
         for name in self.system.init_order:
+            if stop is not None:
+                stop.raise_if_requested("instantiation", sim.start_s)
             inst = FmuInstance(name, self.system.interfaces[name])
             self.instances[name] = inst
             inst.instantiate(sim.start_s, sim.stop_s)
@@ -307,6 +379,8 @@ class CoSimulation:
             if params:
                 inst.set_values(params, sim.start_s)
             inst.enter_initialization(sim.start_s)
+        if stop is not None:
+            stop.raise_if_requested("instantiation", sim.start_s)
 
     def _initialize(self) -> dict[str, float]:
         """Sweeps in dependency order until the transferred values are a fixed point."""
@@ -385,63 +459,118 @@ class CoSimulation:
         return slots, columns
 
     # ----------------------------------------------------------------- loop
-    def _loop(self, advance, slots, data, n_steps, stride, progress, handle_sigint, deadline=math.inf,
-              wall_time_limit_s=None) -> tuple[int, str | None, bool]:
-        """Step until the stop time, an FMU failure, Ctrl-C or the ``time.perf_counter()`` deadline.
+    def _loop(self, advance, slots, block, direct, rows: "_Rows", n_steps, stride, progress, stop: StopRequests,
+              deadline=math.inf, wall_time_limit_s=None) -> tuple[int, str | None, str]:
+        """Step block by block until the stop time, an FMU failure, a stop request, a sink error or the deadline.
 
-        Returns (communication steps completed, error message or None, interrupted).
+        After each block its finished rows go to ``rows`` and the block buffer is
+        rewound. Returns (communication steps completed, error message or None,
+        stage: ``"stepping"``, ``"interrupted"`` or ``"writing"``).
         """
         t0, H = self.settings.start_s, self.settings.step_s
-        stop_flag = {"stop": False}
-        previous_handler = None
-        if handle_sigint and threading.current_thread() is threading.main_thread():
-            def on_sigint(signum, frame):
-                stop_flag["stop"] = True
-                signal.signal(signal.SIGINT, signal.default_int_handler)  # a second Ctrl-C aborts at once
-
-            previous_handler = signal.signal(signal.SIGINT, on_sigint)
         k = 0
         error = None
-        interrupted = False
+        stage = "stepping"
         try:
             while k < n_steps:
-                if stop_flag["stop"]:
-                    interrupted = True
-                    error = f"interrupted by the user (Ctrl-C) at t = {t0 + k * H:.6g} s"
-                    break
+                if stop.requested:
+                    return k, f"{stop.reason} at t = {t0 + k * H:.6g} s", "interrupted"
+                k_start = k
                 k_end = min(n_steps, k + BLOCK_STEPS)
                 try:
                     k = advance(k, k_end, t0, H)
-                except _Stop as stop:
-                    s = slots[stop.slot]
-                    s.inst.mark_failed(stop.status)
-                    error = str(FmuStepError(s.name, stop.function, t0 + stop.k * H, stop.status, list(s.inst.log)))
-                    k = stop.k
-                    break
+                except _Stop as failed:
+                    s = slots[failed.slot]
+                    s.inst.mark_failed(failed.status)
+                    error = str(FmuStepError(s.name, failed.function, t0 + failed.k * H, failed.status, list(s.inst.log)))
+                    k = failed.k
+                # the block's finished rows: samples at t_{k_start + 1} ... t_k
+                if direct:
+                    done = block[2:k - k_start + 2]
+                else:
+                    done = block[:k // stride - k_start // stride]
+                write_error = rows.deliver(done)
+                if write_error is not None:
+                    return k, f"{write_error} at t = {t0 + k * H:.6g} s", "writing"
+                if error is not None:
+                    return k, error, stage
+                if direct:  # rows t_{k-1}, t_k start the next block
+                    block[0:2] = block[k - k_start:k - k_start + 2]
                 if progress is not None:
                     progress(k, n_steps)
                 if k < n_steps and time.perf_counter() > deadline:
-                    error = f"wall-time limit of {wall_time_limit_s:g} s reached at t = {t0 + k * H:.6g} s"
-                    break
-        except KeyboardInterrupt:  # a second Ctrl-C, or no handler outside the main thread
-            interrupted = True
-            error = f"interrupted by the user (Ctrl-C) at t = {t0 + k * H:.6g} s"
-        finally:
-            if previous_handler is not None:
-                signal.signal(signal.SIGINT, previous_handler)
-        return k, error, error is not None and interrupted
+                    return k, f"wall-time limit of {wall_time_limit_s:g} s reached at t = {t0 + k * H:.6g} s", stage
+        except KeyboardInterrupt:  # a second signal, or no handler outside the main thread
+            return k, f"{stop.reason} at t = {t0 + k * H:.6g} s", "interrupted"
+        return k, error, stage
+
+
+class _Rows:
+    """The rows a run has finished: handed to the sink and, optionally, kept for the outcome.
+
+    Parameters
+    ----------
+    start_s, interval_s : float
+        Time of row 0 and between rows [s].
+    order : ndarray of int
+        Block-buffer column of each recorded variable (``system.recorded`` order).
+    capacity : int
+        Rows to keep (0: keep none). The array is allocated uninitialised, so the
+        memory is taken as rows arrive.
+    sink : RowSink, optional
+    """
+
+    def __init__(self, start_s: float, interval_s: float, order: np.ndarray, capacity: int,
+                 sink: RowSink | None) -> None:
+        self.start_s, self.interval_s = start_s, interval_s
+        self.order = order
+        self.sink = sink
+        self.count = 0
+        self.kept = np.empty((capacity, len(order))) if capacity else None
+
+    def deliver(self, rows: np.ndarray) -> str | None:
+        """Hand over ``rows`` (block-buffer columns); the sink's write error as text, else None."""
+        n = len(rows)
+        if n == 0:
+            return None
+        values = rows[:, self.order]
+        index = self.count + np.arange(n)
+        if self.kept is not None:
+            self.kept[self.count:self.count + n] = values
+        self.count += n
+        if self.sink is not None:
+            try:
+                self.sink.append(self.start_s + self.interval_s * index, values)
+            except OSError as exc:
+                self.sink = None  # nothing more goes to a sink that failed
+                return f"results not written: {describe_os_error(exc)}"
+        return None
+
+    def time_s(self) -> np.ndarray:
+        n = self.count if self.kept is not None else 0
+        return self.start_s + self.interval_s * np.arange(n, dtype=float)
+
+    def values(self) -> np.ndarray:
+        if self.kept is None:
+            return np.empty((0, len(self.order)))
+        return self.kept[:self.count]
 
 
 def compile_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str, stride: int,
                       data: np.ndarray, ring: np.ndarray, timers: np.ndarray | None = None) -> Callable:
     """Generate the stepping loop of one system, unrolled over its FMUs and couplings.
 
-    Outputs at ``t_{k+1}`` are written by ``fmi2GetReal`` into row ``k + 1`` of
-    ``ring`` (``ring is data`` when every step is sampled) or, with a three-row
-    ring buffer, into row ``(k + 1) % 3``, which is copied to ``data`` on sampling
-    steps. An input reads its source's column in the row of the sample it needs:
-    ``k + 1`` for a source already stepped in this step (Gauss-Seidel), ``k``
-    otherwise, and one row earlier for the second sample of ``linear``.
+    The loop runs over one block of steps ``k_start <= k < k_end`` at a time.
+    With every step sampled (``ring is data``), ``data`` is the block buffer: row
+    ``k - k_start + 1`` holds the outputs at ``t_k``, so rows 0 and 1 hold
+    ``t_{k_start - 1}`` and ``t_{k_start}`` on entry (the caller carries them over
+    from the previous block; both are the initial row before the first block) and
+    ``fmi2GetReal`` writes the outputs at ``t_{k+1}`` into row ``k - k_start + 2``.
+    Otherwise the outputs go to row ``(k + 1) % 3`` of the three-row ``ring``, which
+    is copied to row ``(k + 1) // stride - (k_start // stride + 1)`` of ``data`` on
+    sampling steps. An input reads its source's column in the row of the sample it
+    needs: ``t_{k+1}`` for a source already stepped in this step (Gauss-Seidel),
+    ``t_k`` otherwise, and one row earlier for the second sample of ``linear``.
 
     Parameters
     ----------
@@ -452,9 +581,9 @@ def compile_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str, st
     stride : int
         Steps per sample.
     data : ndarray, shape (n_rows, n_cols)
-        Sampled results; row 0 filled.
+        The block buffer (see above).
     ring : ndarray
-        ``data`` itself (stride 1) or a (3, n_cols) ring buffer holding row 0.
+        ``data`` itself (stride 1) or a (3, n_cols) ring buffer holding the latest rows.
     timers : ndarray, shape (n_slots, 3), optional
         If given, the loop adds the wall time of each FMU's fmi2SetReal, fmi2DoStep
         and fmi2GetReal calls to its row (profiling; costs ~1 us per call).
@@ -481,15 +610,15 @@ def compile_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str, st
     linear = extrapolation == "linear"
     direct = ring is data
 
-    def row_expr(offset: int) -> str:
-        """Element offset of row k + offset."""
-        if direct:
-            return f"(k + {offset}) * {n_cols}" if offset >= 0 else f"max(k + {offset}, 0) * {n_cols}"
-        return f"((k + {offset}) % 3) * {n_cols}"
-
-    body = ["t = t0 + k * H", f"o1 = {row_expr(1)}", f"o0 = {row_expr(0)}", f"a1 = BASE + o1 * {dsize}"]
-    if linear:
-        body.append(f"om = {row_expr(-1)}")
+    if direct:  # rows of t_{k-1}, t_k, t_{k+1} in the block buffer
+        body = ["t = t0 + k * H", f"o0 = (k + c) * {n_cols}", f"o1 = o0 + {n_cols}", f"a1 = BASE + o1 * {dsize}"]
+        if linear:
+            body.append(f"om = o0 - {n_cols}")
+    else:
+        body = ["t = t0 + k * H", f"o1 = ((k + 1) % 3) * {n_cols}", f"o0 = (k % 3) * {n_cols}",
+                f"a1 = BASE + o1 * {dsize}"]
+        if linear:
+            body.append(f"om = ((k - 1) % 3) * {n_cols}")
     if stride > 1:
         body.append(f"sample = (k + 1) % {stride} == 0")
     for i, s in enumerate(slots):
@@ -530,8 +659,10 @@ def compile_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str, st
             body.append(f"if st > 1: raise _Stop({i}, 'fmi2GetReal', st, k)")
     if not direct:
         body.append("if sample:")
-        body.append(f"    data[(k + 1) // {stride}] = ring[(k + 1) % 3]")
-    lines = ["def advance(k_start, k_end, t0, H):", "    for k in range(k_start, k_end):"]
+        body.append(f"    data[(k + 1) // {stride} - r0] = ring[(k + 1) % 3]")
+    lines = ["def advance(k_start, k_end, t0, H):",
+             "    c = 1 - k_start" if direct else f"    r0 = k_start // {stride} + 1",
+             "    for k in range(k_start, k_end):"]
     lines += ["        " + b for b in body]
     lines.append("    return k_end")
     source = "\n".join(lines) + "\n"
@@ -566,15 +697,15 @@ def interpreted_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str
                      feeds))
     base = ring.ctypes.data
 
-    def row(k: int) -> int:
-        if direct:
-            return max(k, 0) * n_cols
-        return (k % 3) * n_cols
-
     def advance(k_start: int, k_end: int, t0: float, H: float) -> int:
+        r0 = k_start // stride + 1
         for k in range(k_start, k_end):
             t = t0 + k * H
-            o1, o0, om = row(k + 1), row(k), row(k - 1)
+            if direct:  # block buffer: row k - k_start + 1 holds t_k
+                o0 = (k - k_start + 1) * n_cols
+                o1, om = o0 + n_cols, o0 - n_cols
+            else:
+                o1, o0, om = ((k + 1) % 3) * n_cols, (k % 3) * n_cols, ((k - 1) % 3) * n_cols
             sample = (k + 1) % stride == 0
             a1 = base + o1 * ctypes.sizeof(c_double)
             for i, inst, buf, buf_addr, vr_in, n_in, vr_out, n_all, n_couple, offset, feeds in plan:
@@ -598,7 +729,7 @@ def interpreted_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str
                     if st > 1:
                         raise _Stop(i, "fmi2GetReal", st, k)
             if not direct and sample:
-                data[(k + 1) // stride] = ring[(k + 1) % 3]
+                data[(k + 1) // stride - r0] = ring[(k + 1) % 3]
         return k_end
 
     return advance

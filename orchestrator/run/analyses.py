@@ -46,10 +46,19 @@ from components.analysis.fatigue import fatigue_report, write_del_csv, write_ldd
 from components.analysis.spectrum import amplitude_spectrum
 from components.errors import DtcosimError
 
+from ..atomic_files import atomic_path
 from ..cosim.master import RunOutcome
 from ..cosim.physics_view import PhysicsUnavailable, gearbox_drivetrain, wind_parameters
 from ..cosim.roles import GEARBOX, GENERATOR, WIND_SOURCE
 from ..cosim.system import ResolvedSystem
+
+
+def _atomic(write, path: Path, *args) -> Path:
+    """``write(path, *args)`` through a temporary file and rename (the file is whole or not there)."""
+    with atomic_path(path) as tmp:
+        write(tmp, *args)
+    return path
+
 
 CONTACT_LOSS_FILE = "contact_loss.csv"
 DEL_FILE = "fatigue_del.csv"
@@ -224,7 +233,7 @@ def analyse_run(system: ResolvedSystem, outcome: RunOutcome, out_dir: str | Path
                 "meshes_with_contact_loss": [n for n, s in stats.items() if s.separations > 0],
                 "meshes": meshes,
             }
-            result.files["contact_loss"] = write_contact_loss_csv(out / CONTACT_LOSS_FILE, stats)
+            result.files["contact_loss"] = _atomic(write_contact_loss_csv, out / CONTACT_LOSS_FILE, stats)
 
     loads = forces + torques
     if not loads:
@@ -240,9 +249,9 @@ def analyse_run(system: ResolvedSystem, outcome: RunOutcome, out_dir: str | Path
             fat["revolution_speeds"] = speeds
             fat["shaft_torques"] = list(torques)
             result.summary["fatigue"] = fat
-            result.files["fatigue_del"] = write_del_csv(out / DEL_FILE, report)
+            result.files["fatigue_del"] = _atomic(write_del_csv, out / DEL_FILE, report)
             if report.ldd:
-                result.files["fatigue_ldd"] = write_ldd_csv(out / LDD_FILE, report)
+                result.files["fatigue_ldd"] = _atomic(write_ldd_csv, out / LDD_FILE, report)
                 if plots:
                     from .analysis_plots import plot_load_duration
 

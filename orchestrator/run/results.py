@@ -3,8 +3,10 @@
 ``timeseries.csv``
     One row per sample: ``time [s]`` and every recorded variable, header
     ``component.variable [unit]`` with the unit the FMU declares (``[-]`` when it
-    declares none), e.g. ``gearbox.stage1.F_sp[1] [N]``. Written also for an
-    incomplete run (the samples up to where it stopped).
+    declares none), e.g. ``gearbox.stage1.F_sp[1] [N]``. Streamed while the run
+    steps (``timeseries.csv.partial``, :mod:`orchestrator.run.writers`) and renamed
+    when the co-simulation ends, also for an incomplete run (the samples up to
+    where it stopped).
 
 ``summary.json``
     ``scenario``, ``complete``, ``statistics`` (``{"component.variable": {"mean",
@@ -15,6 +17,14 @@
     model name, GUID per component), ``stopped_at`` and ``error`` for an
     incomplete run, ``comparison`` with ``--compare-reference``. Non-finite
     numbers are written as ``null``.
+
+    How the run ended: ``status`` (``complete``, ``stopped`` by a signal,
+    ``failed``; ``running`` while it runs, see :mod:`orchestrator.run.run_folder`),
+    ``stage`` (``instantiation``, ``initialisation``, ``stepping``, ``writing``),
+    ``signal`` when a signal stopped it, ``problems`` (files that could not be
+    written), ``post_processing`` when analyses or plots were not done. ``files``
+    lists the whole files by role, ``files_incomplete`` those that are there but
+    not whole (with the reason and the rows they hold).
 """
 
 from __future__ import annotations
@@ -48,22 +58,42 @@ def statistics(outcome: RunOutcome, window: tuple[float, float]) -> dict[str, di
     return {c.column: window_statistics(outcome.time_s, outcome.values[:, i], window) for i, c in enumerate(outcome.columns)}
 
 
+def run_status(outcome: RunOutcome, problems: list[str] | None = None) -> str:
+    """``complete``, ``stopped`` (a signal) or ``failed``."""
+    if outcome.interrupted:
+        return "stopped"
+    return "complete" if outcome.complete and not problems else "failed"
+
+
 def build_summary(system: ResolvedSystem, outcome: RunOutcome, *, wall_time_s: float,
                   derived: Mapping[str, Any] | None = None, comparison: Mapping[str, Any] | None = None,
-                  files: Mapping[str, str] | None = None) -> dict[str, Any]:
-    """The ``summary.json`` content of a run (see the module docstring)."""
+                  files: Mapping[str, str] | None = None, listing: Mapping[str, Any] | None = None,
+                  header: Mapping[str, Any] | None = None, problems: list[str] | None = None) -> dict[str, Any]:
+    """The ``summary.json`` content of a run (see the module docstring).
+
+    ``files`` (role -> name) or ``listing`` (``{"files": ..., "files_incomplete": ...}``
+    of :meth:`~orchestrator.run.run_folder.RunFolder.listing`) say what the folder holds.
+    """
     sc = system.scenario
     sim = sc.simulation
-    summary: dict[str, Any] = {
+    summary: dict[str, Any] = dict(header or {})
+    summary.update({
         "scenario": sc.name,
         "description": sc.description,
         "scenario_file": sc.source,
+        "status": run_status(outcome, problems),
         "complete": bool(outcome.complete),
-    }
+        "stage": outcome.stage,
+    })
     if not outcome.complete:
         summary["stopped_at"] = outcome.stopped_at_s
         summary["error"] = outcome.error
         summary["interrupted"] = outcome.interrupted
+        if outcome.stop_signal:
+            summary["signal"] = outcome.stop_signal
+    if problems:
+        summary["problems"] = list(problems)
+    summary["samples"] = int(outcome.time_s.size)
     summary.update({
         "window_s": list(sim.window_s),
         "statistics": statistics(outcome, sim.window_s),
@@ -98,6 +128,8 @@ def build_summary(system: ResolvedSystem, outcome: RunOutcome, *, wall_time_s: f
         summary["profile"] = {"seconds_per_fmi_function": outcome.profile, "loop_time_s": outcome.loop_time_s}
     if files:
         summary["files"] = dict(files)
+    if listing:
+        summary.update(dict(listing))
     if comparison is not None:
         summary["comparison"] = comparison
     warnings = {name: [m for m in log if m.startswith(("[warning]", "[discard]", "[error]", "[fatal]"))]
