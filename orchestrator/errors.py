@@ -96,6 +96,10 @@ class InitializationError(DtcosimError, RuntimeError):
     """The initial values could not be propagated (FMI call failed or no fixed point)."""
 
 
+#: what pythonfmu 0.7's C wrapper logs after any Python exception in a slave ("... PyObject_CallMethod unknown error")
+_WRAPPER_NOISE = "Fatal py exception encountered"
+
+
 class FmuStepError(DtcosimError, RuntimeError):
     """An FMU returned a status worse than fmi2Warning during the run.
 
@@ -119,7 +123,9 @@ class FmuStepError(DtcosimError, RuntimeError):
         self.time_s = float(time_s)
         self.status = int(status)
         self.log = list(log or [])
-        detail = ("; FMU log: " + " | ".join(self.log[-5:])) if self.log else ""
+        # pythonfmu adds its own line after an exception the slave already explained: show the explanation
+        shown = [m for m in self.log if _WRAPPER_NOISE not in m] or self.log
+        detail = ("; FMU log: " + " | ".join(shown[-5:])) if shown else ""
         super().__init__(
             f"FMU {component!r}: {function} returned {status_label(self.status)} (status {self.status}) "
             f"at t = {self.time_s:.6g} s{detail}"

@@ -86,7 +86,7 @@ def fmu_parameter_names(names: Mapping[str, str]) -> Iterator[None]:
         fmu_name = names.get(exc.name)
         if fmu_name is None:
             raise
-        raise ParameterError(fmu_name, exc.value, exc.expected) from exc
+        raise ParameterError(fmu_name, exc.value, exc.expected, exc.bounds) from exc
 
 
 class FmuError(Exception):

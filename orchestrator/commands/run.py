@@ -148,7 +148,7 @@ def run(args: argparse.Namespace) -> int:
     for problem in report.problems:
         print(f"dtcosim run: error: {problem}", file=sys.stderr)
     post = s.get("post_processing")
-    if post:
+    if post and not outcome.interrupted:  # a signal during stepping is told once, below
         print(f"dtcosim run: {post['stopped']}; not done: {', '.join(post['not_done'])}", file=sys.stderr)
     if not outcome.complete:
         print(f"dtcosim run: {outcome.error}; partial results written to {out_dir}", file=sys.stderr)

@@ -41,6 +41,8 @@ class FmuVariable:
     description : str
     start : Any
         Start value as declared (None when absent).
+    minimum, maximum : float or int or None
+        The ``min`` and ``max`` attributes (None when absent).
     """
 
     name: str
@@ -51,6 +53,8 @@ class FmuVariable:
     unit: str = ""
     description: str = ""
     start: Any = None
+    minimum: float | int | None = None
+    maximum: float | int | None = None
 
 
 @dataclass(frozen=True)
@@ -136,6 +140,12 @@ def _typed_start(type_: str, start: Any) -> Any:
     return str(start)
 
 
+def _bound(type_: str, text: Any) -> float | int | None:
+    """A ``min``/``max`` attribute as a number (None when absent or not a number)."""
+    value = _typed_start(type_, text) if type_ in ("Real", "Integer", "Enumeration") else None
+    return value if isinstance(value, (int, float)) and not isinstance(value, bool) else None
+
+
 def read_record(path: Path, key: str) -> dict[str, Any] | None:
     """The dtcosim record in an FMU archive, None if it has none.
 
@@ -215,6 +225,8 @@ def read_fmu_interface(path: str | Path, key: str = "fmu") -> FmuInterface:
             unit=unit or "",
             description=v.description or "",
             start=_typed_start(str(v.type), v.start),
+            minimum=_bound(str(v.type), getattr(v, "min", None)),
+            maximum=_bound(str(v.type), getattr(v, "max", None)),
         )
     inputs = tuple(n for n, v in variables.items() if v.causality == "input")
     deps: dict[str, tuple[str, ...] | None] = {}

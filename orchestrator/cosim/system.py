@@ -4,7 +4,10 @@
 (nothing is instantiated) and checks every name the scenario uses: parameters
 exist, are settable and have the right type; connections join a Real output to a
 Real input; initial bindings join a Real output to a Real parameter or input;
-record patterns match variables; no algebraic loop. The first problem raises
+record patterns match variables; no algebraic loop; every value within what
+the FMU accepts (FMI Integer range, declared bounds, a dtcosim model's own
+validation: :mod:`orchestrator.cosim.parameter_checks`); the results within the
+size limits (:func:`check_sizes`). The first problem raises
 :class:`~orchestrator.errors.ScenarioError` naming the scenario key. The result,
 a :class:`ResolvedSystem`, is what the master runs.
 """
@@ -20,11 +23,13 @@ from components.validation import is_number
 
 from ..errors import AlgebraicLoopError, ScenarioError, suggestion
 from ..frozen_map import FrozenMap
+from ..inputs.limits import MAX_RESULT_VALUES
 from ..inputs.scenario import Scenario, VariableRef
 from .event_slots import AssignedEvent, assign_events
 from .fmu_folder import default_fmu_dir
 from .fmu_interface import FmuInterface, FmuVariable, read_fmu_interface
 from .graph import find_algebraic_loop, initialization_order, stepping_order
+from .parameter_checks import model_problem, value_problem
 from .roles import ComponentRole, declared_roles
 
 #: causalities a scenario may give a value to
@@ -214,6 +219,9 @@ def resolve_system(
                 raise ScenarioError(key, value, "no value for an input that a connection drives", src)
             if not _value_matches(var, value):
                 raise ScenarioError(key, value, f"a {var.type} value for {pname}", src)
+            problem = value_problem(iface, var, value)
+            if problem is not None:
+                raise ScenarioError(key, value, problem, src)
 
     for i, con in enumerate(scenario.connections):
         _lookup(interfaces[con.source.component], con.source, f"connections[{i}].from", src, READABLE_CAUSALITIES, "an output")
@@ -240,7 +248,7 @@ def resolve_system(
     order = tuple(scenario.simulation.order) if scenario.simulation.order else tuple(stepping_order(names, edges))
     init_edges = edges + [(b.source.component, b.target.component) for b in scenario.initial]
     init_order = tuple(initialization_order(names, init_edges))
-    return ResolvedSystem(
+    system = ResolvedSystem(
         scenario=scenario,
         fmu_paths=paths,
         interfaces=interfaces,
@@ -250,6 +258,30 @@ def resolve_system(
         events=events,
         roles=FrozenMap(declared_roles(scenario, interfaces)),
     )
+    problem = model_problem(system)
+    if problem is not None:
+        raise ScenarioError(*problem, src)
+    check_sizes(system)
+    return system
+
+
+def check_sizes(system: ResolvedSystem) -> None:
+    """Refuse a run whose results would exceed :data:`~orchestrator.inputs.limits.MAX_RESULT_VALUES`.
+
+    Raises
+    ------
+    ScenarioError
+        Naming ``simulation.output_interval``, the number of samples and columns and the limit.
+    """
+    sim = system.scenario.simulation
+    rows = sim.n_steps // sim.output_stride + 1
+    columns = len(system.recorded) + 1
+    if rows * columns > MAX_RESULT_VALUES:
+        raise ScenarioError(
+            "simulation.output_interval", sim.output_interval_s,
+            f"an interval giving at most {MAX_RESULT_VALUES:,} recorded values per run; this one gives {rows:,} "
+            f"samples x {columns} columns (time and {len(system.recorded)} variables) = {rows * columns:,}: raise the "
+            "output interval, shorten the run or record fewer variables", system.scenario.source)
 
 
 def _resolve_record(scenario: Scenario, interfaces: Mapping[str, FmuInterface]) -> tuple[RecordedVariable, ...]:
