@@ -9,6 +9,7 @@ from typing import Iterable
 from fmpy import read_model_description
 from fmpy.validation import validate_fmu
 
+from .archive_checks import archive_problems
 from .requirements import ARCHIVE_MEMBER, read_from_fmu
 from .runtime_guard import RequirementsFormatError
 
@@ -50,11 +51,18 @@ def runtime_declaration_problems(fmu_path: Path | str) -> list[str]:
 
 
 def check_fmu(fmu_path: Path | str) -> list[str]:
-    """All problems of one FMU (empty if it is valid)."""
-    problems = validate_fmu(str(fmu_path))
+    """All problems of one FMU (empty if it is valid): a readable archive that this platform can load first."""
+    if not zipfile.is_zipfile(fmu_path):
+        return [f"{fmu_path} is not an FMU: not a zip archive"]
+    try:
+        problems = validate_fmu(str(fmu_path))
+    except Exception as exc:  # noqa: BLE001 - fmpy raises plain exceptions for broken archives and XML
+        return [f"the archive or its modelDescription.xml cannot be read ({exc})"]
     if problems:
         return list(problems)
-    return convention_problems(fmu_path)
+    md = read_model_description(str(fmu_path), validate=False)
+    identifier = md.coSimulation.modelIdentifier if md.coSimulation is not None else None
+    return archive_problems(fmu_path, identifier, md.generationTool or "") + convention_problems(fmu_path)
 
 
 def fmu_files(paths: Iterable[Path | str]) -> list[Path]:

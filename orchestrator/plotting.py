@@ -85,6 +85,16 @@ def new_figure(rows: int = 1, height: float = 4.0, sharex: bool = True, width: f
     return fig, axes
 
 
+def new_grid(rows: int, columns: int, height: float, width: float, sharex: str | bool = "col"):
+    """A headless figure of ``rows`` x ``columns`` axes: (figure, 2-D axes array)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(width, height), dpi=110, layout="constrained")
+    FigureCanvasAgg(fig)
+    return fig, fig.subplots(rows, columns, sharex=sharex, squeeze=False)
+
+
 def save_figure(fig, path: Path) -> Path:
     """Write the figure as PNG (temporary file and rename); returns ``path``."""
     with atomic_path(path) as tmp:

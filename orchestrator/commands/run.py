@@ -115,36 +115,39 @@ def run(args: argparse.Namespace) -> int:
               file=sys.stderr)
         return report.exit_status
     if not quiet:
-        print(f"{scenario.name}: {'complete' if outcome.complete else 'INCOMPLETE'}, {outcome.steps} steps, "
-              f"wall time {s['wall_time_s']:.2f} s (stepping {outcome.loop_time_s:.2f} s, "
-              f"{1e6 * outcome.loop_time_s / max(outcome.steps, 1):.1f} us/step)")
+        import textwrap
+
+        print(textwrap.fill(f"{scenario.name}: {'complete' if outcome.complete else 'INCOMPLETE'}, {outcome.steps} "
+                            f"steps in {s['wall_time_s']:.2f} s (stepping {outcome.loop_time_s:.2f} s, "
+                            f"{1e6 * outcome.loop_time_s / max(outcome.steps, 1):.1f} us/step)", width=80,
+                            subsequent_indent="  "))
+        from ..run.text_tables import fit_table, number
+
         w0, w1 = sim.window_s
         print(f"statistics over [{w0:g}, {w1:g}] s:")
-        print(f"  {'variable':<32}{'mean':>14}{'std':>14}{'min':>14}{'max':>14}")
-        for name, st in s["statistics"].items():
-            vals = [st[k] for k in ("mean", "std", "min", "max")]
-            print(f"  {name:<32}" + "".join(f"{v:14.6g}" if v is not None else f"{'-':>14}" for v in vals))
+        rows = [[name, *(number(st[k]) for k in ("mean", "std", "min", "max"))] for name, st in s["statistics"].items()]
+        print("\n".join(fit_table(["variable", "mean", "std", "min", "max"], rows)))
         fig16 = s.get("generator_vs_ideal")
         if fig16:
             dev = fig16["relative_deviation"]
             if dev.get("max_abs") is not None:
-                print(f"generator vs {fig16['ratio']:.6g} x rotor speed: mean {dev['mean']:+.2e}, "
-                      f"max |deviation| {dev['max_abs']:.2e} (relative)")
+                print(f"generator vs {fig16['ratio']:.6g} x rotor speed (relative): mean {dev['mean']:+.2e}, "
+                      f"max |dev| {dev['max_abs']:.2e}")
         analyses = format_analyses(s)
         if analyses:
             print(analyses)
         if outcome.profile:
             steps = max(outcome.steps, 1)
             print("time per communication step in FMI calls [us]:")
-            print(f"  {'component':<16}{'fmi2SetReal':>13}{'fmi2DoStep':>13}{'fmi2GetReal':>13}")
-            fmi_total = 0.0
-            for comp, times in outcome.profile.items():
-                fmi_total += sum(times.values())
-                print(f"  {comp:<16}" + "".join(f"{1e6 * times[f] / steps:13.1f}" for f in ("fmi2SetReal", "fmi2DoStep", "fmi2GetReal")))
+            functions = ("fmi2SetReal", "fmi2DoStep", "fmi2GetReal")
+            fmi_total = sum(sum(times.values()) for times in outcome.profile.values())
+            rows = [[comp, *(f"{1e6 * times[f] / steps:.1f}" for f in functions)] for comp, times in outcome.profile.items()]
+            print("\n".join(fit_table(["component", *functions], rows)))
             print(f"  master (loop minus FMI calls): {1e6 * (outcome.loop_time_s - fmi_total) / steps:.1f} us/step")
         if report.comparison_text:
             print(report.comparison_text)
-        print(f"results in {Path(out_dir)}/: " + ", ".join(p.name for p in report.files.values()))
+        print(textwrap.fill(f"results in {Path(out_dir)}/: " + ", ".join(p.name for p in report.files.values()),
+                            width=80, subsequent_indent="  ", break_on_hyphens=False, break_long_words=False))
     for problem in report.problems:
         print(f"dtcosim run: error: {problem}", file=sys.stderr)
     post = s.get("post_processing")

@@ -193,7 +193,9 @@ def read_fmu_interface(path: str | Path, key: str = "fmu") -> FmuInterface:
     Raises
     ------
     ScenarioError
-        If the file is missing, unreadable, not FMI 2.0 or not co-simulation.
+        If the file is missing, unreadable, not FMI 2.0 or not co-simulation, or it
+        cannot be loaded here (no binary for this platform, a PythonFMU or dtcosim
+        FMU without its resources: :func:`fmus.archive_checks.archive_problems`).
     """
     from fmpy import read_model_description
 
@@ -213,6 +215,11 @@ def read_fmu_interface(path: str | Path, key: str = "fmu") -> FmuInterface:
         raise ScenarioError(key, str(path), f"an FMI 2.0 FMU (this is FMI {md.fmiVersion})")
     if md.coSimulation is None:
         raise ScenarioError(key, str(path), "a co-simulation FMU")
+    from fmus.archive_checks import archive_problems
+
+    problems = archive_problems(p, md.coSimulation.modelIdentifier, md.generationTool or "")
+    if problems:
+        raise ScenarioError(key, str(path), f"an FMU this host can load ({'; '.join(problems)})")
     variables: dict[str, FmuVariable] = {}
     for v in md.modelVariables:
         unit = v.unit or (v.declaredType.unit if v.declaredType is not None and getattr(v.declaredType, "unit", None) else "")

@@ -47,6 +47,7 @@ from components.analysis.spectrum import amplitude_spectrum
 from components.errors import DtcosimError
 
 from ..atomic_files import atomic_path
+from .text_tables import fit_table, number
 from ..cosim.master import RunOutcome
 from ..cosim.physics_view import PhysicsUnavailable, gearbox_drivetrain, wind_parameters
 from ..cosim.roles import GEARBOX, GENERATOR, WIND_SOURCE
@@ -383,13 +384,13 @@ def format_analyses(summary: dict[str, Any]) -> str:
         if not lost and not any(m["time_in_backlash_s"] > 0 for m in cl["meshes"].values()):
             lines.append(head + f"none ({len(cl['meshes'])} meshes)")
         else:
-            lines.append(head + f"{len(lost)} of {len(cl['meshes'])} meshes separate, {cl['total_separations']} "
-                         f"separations, {cl['total_flank_changes']} flank changes")
-            for name, m in cl["meshes"].items():
-                if m["separations"] or m["time_in_backlash_s"] > 0:
-                    lines.append(f"  {name:<32}{m['separations']:>3} separations {m['flank_changes']:>3} flank changes "
-                                 f"{1e3 * m['time_in_backlash_s']:9.2f} ms inside the backlash "
-                                 f"(longest {1e3 * m['longest_episode_s']:.2f} ms)")
+            lines.append(head.rstrip())
+            lines.append(f"  {len(lost)} of {len(cl['meshes'])} meshes separate, {cl['total_separations']} "
+                         f"separations, {cl['total_flank_changes']} flank changes (times in ms)")
+            rows = [[name, str(m["separations"]), str(m["flank_changes"]), f"{1e3 * m['time_in_backlash_s']:.2f}",
+                     f"{1e3 * m['longest_episode_s']:.2f}"]
+                    for name, m in cl["meshes"].items() if m["separations"] or m["time_in_backlash_s"] > 0]
+            lines += fit_table(["mesh", "separations", "flank changes", "in backlash", "longest"], rows)
     fat = summary.get("fatigue")
     if fat:
         exps = [f"m={m:g}" for m in fat["wohler_exponents"]]
@@ -397,6 +398,6 @@ def format_analyses(summary: dict[str, Any]) -> str:
         if shafts:
             lines.append(f"damage-equivalent loads (N_ref = {fat['reference_frequency_hz'] or 0:g} Hz x T) [N m]: "
                          + ", ".join(exps))
-            for n, d in shafts.items():
-                lines.append(f"  {n:<32}" + "".join(f"{d['del'][e]:14.6g}" for e in exps))
+            lines += fit_table(["shaft", *exps], [[n, *(number(d["del"][e], ".6g") for e in exps)]
+                                                  for n, d in shafts.items()])
     return "\n".join(lines)

@@ -91,8 +91,8 @@ class ResultWriter(Protocol):
 
 
 def csv_field(text: str) -> str:
-    """A CSV header field, quoted if it holds a comma or a quote."""
-    return '"' + text.replace('"', '""') + '"' if ("," in text or '"' in text) else text
+    """A CSV header field, quoted if it holds a comma, a quote or a line break (RFC 4180)."""
+    return '"' + text.replace('"', '""') + '"' if any(c in text for c in ',"\r\n') else text
 
 
 class CsvWriter:
