@@ -2,7 +2,7 @@
 
 Exit status: 0 every point has a result (``ok`` or ``failed``: failed points
 are results, listed in the table); 1 invalid study, or points that hit an
-infrastructure error (re-tried by the next run); 130 interrupted by Ctrl-C
+infrastructure error (re-tried by the next run); 130 interrupted by Ctrl-C (143 SIGTERM, 129 SIGHUP)
 (finished points are kept; run the same command again to continue).
 """
 
@@ -162,5 +162,5 @@ def run(args: argparse.Namespace) -> int:
     if report.interrupted:
         print(f"dtcosim sweep: interrupted; {report.ok + report.failed + report.errors} finished points kept in "
               f"{out_dir / JOURNAL_FILE}; run the same command again to continue", file=sys.stderr)
-        return 130
+        return 128 + (report.signal or 2)
     return 1 if counts["error"] or counts["pending"] else 0

@@ -35,6 +35,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
 
+from ..cosim.stop_requests import STOP_SIGNALS
 from ..inputs.study import StudyError
 from .engine import FAILED, OK, PointTask, run_point
 from .journal import JOURNAL_FILE, Journal, latest_by_key, read_journal
@@ -62,7 +63,9 @@ class SweepReport:
         Outcomes of the submitted points that finished (``failed``: the point
         itself failed; ``errors``: infrastructure or unexpected errors).
     interrupted : bool
-        Stopped by Ctrl-C (finished points are journaled).
+        Stopped by a signal: Ctrl-C, SIGTERM or SIGHUP (finished points are journaled).
+    signal : int
+        That signal's number (0 if none).
     wall_time_s : float
         The whole call [s] (cluster start-up and output files included).
     compute_time_s : float
@@ -81,6 +84,7 @@ class SweepReport:
     failed: int = 0
     errors: int = 0
     interrupted: bool = False
+    signal: int = 0
     wall_time_s: float = 0.0
     compute_time_s: float = 0.0
     workers: int = 0
@@ -100,23 +104,26 @@ def pending_points(prepared: PreparedStudy, records: list[dict], retry_failed: b
 
 
 class _Interrupts:
-    """SIGINT handling that never splits a journal write: Ctrl-C during a write is raised after it."""
+    """SIGINT, SIGTERM and SIGHUP handling that never splits a journal write: a signal during a write is raised after it."""
 
     def __init__(self) -> None:
         self.critical = False
         self.pending = False
-        self.previous = None
+        self.previous: dict[int, object] = {}
+        self.signum: int | None = None
 
     def __enter__(self) -> "_Interrupts":
         if threading.current_thread() is threading.main_thread():
-            self.previous = signal.signal(signal.SIGINT, self._handler)
+            for signum in STOP_SIGNALS:
+                self.previous[signum] = signal.signal(signum, self._handler)
         return self
 
     def __exit__(self, *exc) -> None:
-        if self.previous is not None:
-            signal.signal(signal.SIGINT, self.previous)
+        for signum, handler in self.previous.items():
+            signal.signal(signum, handler)
 
     def _handler(self, signum, frame) -> None:
+        self.signum = self.signum or signum
         if self.critical:
             self.pending = True
         else:
@@ -293,6 +300,7 @@ def _execute(prepared: PreparedStudy, todo: list[int], journal: Journal, report:
                     progress(record)
         except KeyboardInterrupt:
             report.interrupted = True
+            report.signal = interrupts.signum or signal.SIGINT
             if client is not None:
                 with contextlib.suppress(Exception):
                     client.cancel(list(futures))
