@@ -82,9 +82,7 @@ def run(args: argparse.Namespace) -> int:
     quiet = args.quiet
     say = (lambda msg: None) if quiet else (lambda msg: print(msg, file=sys.stderr))
     scenario = scenario_options.apply(load_any(find_scenario(args.scenario)), args, "run")
-    out_dir = args.out if args.out is not None else scenario_options.default_out_dir(scenario, args, "run")
-    if not args.check:
-        RunFolder.check(out_dir)
+    out_dir, out_note = (args.out, "") if args.out is not None else scenario_options.default_out_dir(scenario, args)
     paths = ensure_fmus(scenario, args.fmu_dir, build=not args.no_build, report=say)
     for warning in stale_project_fmus(paths):
         print(f"dtcosim run: warning: {warning}", file=sys.stderr)
@@ -94,6 +92,9 @@ def run(args: argparse.Namespace) -> int:
               f"{len(system.recorded)} recorded variables, {len(system.events)} load event(s); stepping order {', '.join(system.order)}; "
               f"initialisation order {', '.join(system.init_order)})")
         return 0
+    RunFolder.check(out_dir)  # a file or an unwritable folder: refused before anything is instantiated
+    if out_note:
+        print(f"dtcosim run: note: {out_note}", file=sys.stderr)
     previous = scenario_options.previous_run(out_dir)
     if previous:
         print(f"dtcosim run: note: replacing the previous run in {out_dir}/ ({previous})", file=sys.stderr)

@@ -54,21 +54,21 @@ def given_overrides(args: argparse.Namespace) -> list[str]:
     return out
 
 
-def default_out_dir(scenario, args: argparse.Namespace, command: str) -> Path:
-    """``results/<scenario>``; with overrides ``results/<scenario>-<8 hex digits of the overrides>``.
+def default_out_dir(scenario, args: argparse.Namespace) -> tuple[Path, str]:
+    """``results/<scenario>``; with overrides ``results/<scenario>-<8 hex digits of the overrides>``, and a note.
 
     A run with changed settings never replaces the scenario's own results: the
-    same overrides always go to the same folder, and the choice is printed.
+    same overrides always go to the same folder, and the note (printed by the
+    command) says where.
     """
     base = Path("results") / scenario.name
     overrides = given_overrides(args)
     if not overrides:
-        return base
+        return base, ""
     digest = hashlib.sha256(json.dumps(sorted(overrides)).encode()).hexdigest()[:8]
     out = Path("results") / f"{scenario.name}-{digest}"
-    print(f"dtcosim {command}: note: {', '.join(overrides)} change the scenario: results go to {out}/ "
-          f"({base}/ is for the scenario as written; --out chooses another folder)", file=sys.stderr)
-    return out
+    return out, (f"{', '.join(overrides)} change the scenario: results go to {out}/ ({base}/ is for the scenario "
+                 "as written; --out chooses another folder)")
 
 
 def previous_run(out_dir: Path) -> str:

@@ -91,7 +91,7 @@ def run(args: argparse.Namespace) -> int:
         try:
             study = replace(study, timeout_s=args.timeout)
         except StudyError as exc:
-            raise StudyError("--timeout", exc.value, exc.expected, exc.bounds) from None
+            raise StudyError("--timeout", exc.value, exc.expected) from None
     prepared = prepare_study(study, fmu_dir=args.fmu_dir, build=not args.no_build)
     for note in prepared.notes:
         print(f"dtcosim sweep: warning: {note}", file=sys.stderr)

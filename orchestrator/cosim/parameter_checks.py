@@ -54,8 +54,6 @@ def value_problem(iface: FmuInterface, var: FmuVariable, value: Any) -> str | No
     """What ``value`` of ``var`` would have to be, or None if the FMU accepts it (as far as checkable here)."""
     if var.type in INTEGER_TYPES and isinstance(value, int) and not INT32_MIN <= value <= INT32_MAX:
         return INTEGER_RANGE
-    if var.type == "Real" and isinstance(value, float) and not math.isfinite(value):
-        return "a finite number"
     bounds = declared_bounds(iface, var)
     if bounds is not None and not isinstance(value, (bool, str)):
         try:
