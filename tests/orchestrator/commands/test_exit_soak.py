@@ -21,7 +21,7 @@ from tests.helpers.scenarios import dtcosim
 
 pytestmark = pytest.mark.slow
 
-SOAK_RUNS = int(os.environ.get("DTCOSIM_SOAK_RUNS", "10"))
+SOAK_RUNS = int(os.environ.get("DTCOSIM_SOAK_RUNS", "6"))
 #: one failing run (a singular gearbox matrix: fmi2Discard at the first step) after every this many
 FAIL_EVERY = 10
 
