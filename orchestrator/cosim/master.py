@@ -81,8 +81,6 @@ from __future__ import annotations
 
 import ctypes
 import math
-import signal
-import threading
 import time
 from ctypes import c_double
 from dataclasses import dataclass, field
@@ -91,7 +89,7 @@ from typing import Callable, Protocol
 import numpy as np
 
 from ..atomic_files import describe_os_error
-from ..errors import FmuStepError, InitializationError, RunInterrupted
+from ..errors import FmuStepError, InitializationError
 from .fmi_runtime import FmuInstance, value_references
 from .stop_requests import StopRequests
 from .system import RecordedVariable, ResolvedSystem
@@ -292,7 +290,6 @@ class CoSimulation:
         n_steps = sim.n_steps
         stride = sim.output_stride
         n_rows = n_steps // stride + 1
-        timers = slots = None
         try:
             self._instantiate(stop)
             initial_values = self._initialize()

@@ -64,7 +64,7 @@ def value_problem(iface: FmuInterface, var: FmuVariable, value: Any) -> str | No
 
 
 def model_problem(system) -> tuple[str, Any, str] | None:
-    """(component, ParameterError) of the first dtcosim model that rejects the values, as (key, value, expected).
+    """``(scenario key, value, expectation)`` of the first dtcosim model that rejects the values, else None.
 
     Builds each dtcosim component's parameter set from its record and the
     effective parameter values (:mod:`orchestrator.cosim.physics_view`), exactly as

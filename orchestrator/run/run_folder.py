@@ -23,7 +23,6 @@ import os
 from pathlib import Path
 from typing import Any, Mapping
 
-from ..atomic_files import describe_os_error
 from ..errors import EntryError
 from ..result_files import write_summary
 from .writers import PARTIAL_SUFFIX
@@ -157,8 +156,3 @@ class RunFolder:
         if self.incomplete:
             out["files_incomplete"] = dict(self.incomplete)
         return out
-
-
-def write_error_text(exc: OSError) -> str:
-    """An ``OSError`` while writing results as one line naming the file."""
-    return describe_os_error(exc)

@@ -101,4 +101,4 @@ def connect(scheduler: str, timeout_s: float = 20.0):
 
 def is_authenticated(scheduler: str) -> bool:
     """False for a plain-TCP address (anyone who reaches it can run code on its workers)."""
-    return scheduler.startswith(("tls://", "ucx://")) is True
+    return scheduler.startswith(("tls://", "ucx://"))
