@@ -5,9 +5,10 @@ after the interpreter is finalised, which can abort the process with status 134
 after every result was written; the console script ends with ``os._exit``
 after the exit handlers (:func:`orchestrator.commands.cli.end_process`).
 
-CI runs a modest count; the 1,000-run soak is run by hand::
+CI runs a modest count, with plots (matplotlib's exit handlers too); the
+1,000-run soak is run by hand, without plots to keep it to about an hour::
 
-    DTCOSIM_SOAK_RUNS=1000 python -m pytest -q tests/orchestrator/commands/test_exit_soak.py
+    DTCOSIM_SOAK_RUNS=1000 DTCOSIM_SOAK_PLOTS=0 python -m pytest -q -s tests/orchestrator/commands/test_exit_soak.py
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from tests.helpers.scenarios import dtcosim
 pytestmark = pytest.mark.slow
 
 SOAK_RUNS = int(os.environ.get("DTCOSIM_SOAK_RUNS", "6"))
+PLOTS = os.environ.get("DTCOSIM_SOAK_PLOTS", "1") != "0"
 #: one failing run (a singular gearbox matrix: fmi2Discard at the first step) after every this many
 FAIL_EVERY = 10
 
@@ -31,7 +33,8 @@ def test_successful_runs_exit_0_and_failed_ones_1_every_time(fmu_dir, tmp_path):
     done = {"ok": 0, "failed": 0}
     for i in range(SOAK_RUNS):
         out = tmp_path / "soak"
-        proc = dtcosim("run", "--fmu-dir", str(fmu_dir), "--stop", "0.1", "-q", "--out", str(out), cwd=tmp_path)
+        proc = dtcosim("run", "--fmu-dir", str(fmu_dir), "--stop", "0.1", "-q", "--out", str(out),
+                       *(() if PLOTS else ("--no-plots",)), cwd=tmp_path)
         if proc.returncode != 0 or json.loads((out / "summary.json").read_text())["status"] != "complete":
             wrong.append((i, proc.returncode, proc.stderr[-400:]))
         done["ok"] += 1
