@@ -22,6 +22,7 @@ COMMAND_MODULES = (
     "orchestrator.commands.validate",
     "orchestrator.commands.modes",
     "orchestrator.commands.sweep",
+    "orchestrator.commands.loads",
 )
 
 
