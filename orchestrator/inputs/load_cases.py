@@ -570,7 +570,7 @@ def load_cases_from_dict(data: Mapping[str, Any], name: str | None = None, base_
     sim = SimulationOverrides(step_s=doc.simulation.step, output_interval_s=doc.simulation.output_interval,
                               algorithm=doc.simulation.algorithm, extrapolation=doc.simulation.extrapolation)
     return LoadCaseSet(
-        name=doc.name if doc.name is not None else name, base_scenario=doc.base.scenario, base_path=path,
+        name=doc.name if doc.name is not None else (name or "load-cases"), base_scenario=doc.base.scenario, base_path=path,
         base_parameters=params, simulation=sim, length_s=runs.length, transient_s=runs.transient, seeds=seeds,
         seed_parameter=runs.seed_parameter, wind=_wind(doc.wind, source), edges_m_s=_edges(doc.bins, source),
         law=_law(doc.operating_law, source), rows=tuple(_row(r, i, source) for i, r in enumerate(doc.operating_points)),

@@ -73,9 +73,11 @@ def plot_lrd(res: LifetimeResults, path: Path) -> Path:
         cl = res.channels[col]
         f, unit = _scale(cl.channel.unit)
         h = cl.ldd
-        for gear, revs in h.revolutions.items():
+        for k, (gear, revs) in enumerate(h.revolutions.items()):
             above = np.cumsum(revs[::-1])[::-1]  # revolutions at this level or higher
-            ax.step(np.maximum(above, 1e-3), h.upper * f, where="post", label=f"{gear}")
+            # the gears at the two ends of a shaft may turn alike: dashed over solid keeps both visible
+            ax.step(np.maximum(above, 1e-3), h.upper * f, where="post", label=f"{gear}",
+                    linestyle=("-", "--", ":")[k % 3], linewidth=2.0 - 0.6 * k)
         ax.set_xscale("log")
         ax.set_xlabel("revolutions at or above the level [-]")
         ax.set_ylabel(f"{col} [{unit}]", fontsize=8)
