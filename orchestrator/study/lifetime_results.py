@@ -438,7 +438,8 @@ def report_text(res: LifetimeResults) -> str:
         for rank, (b, share) in enumerate(ranked_bins(res, col), 1):
             lines.append(f"  {rank:2d}. {plc.bins[b].label:<16} {100 * share:7.2f} %  (probability "
                          f"{plc.bins[b].probability:.4f})")
-    return "\n".join(lines) + "\n"
+        lines.append("")
+    return "\n".join(lines)
 
 
 def summary(res: LifetimeResults) -> dict[str, Any]:

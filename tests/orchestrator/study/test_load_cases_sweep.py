@@ -12,7 +12,6 @@ import sys
 import time
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 from tests.helpers.scenarios import dtcosim
@@ -122,7 +121,6 @@ def _run_stats(out: Path) -> dict[int, dict]:
 
 
 def test_load_revolutions_equal_the_integral_of_the_speed_and_bin_times_sum_to_the_runs(killed_and_resumed):
-    from components.analysis.load_spectrum import merge_histograms
     from orchestrator.inputs.load_cases import load_load_cases
     from orchestrator.study.lifetime_results import read_run_file
 
@@ -159,3 +157,29 @@ def test_report_recomputes_after_a_changed_design_life_without_running(killed_an
              if r["wohler_exponent [-]"] == "5.0"}
     for channel, value in before.items():
         assert after[channel] == pytest.approx(value * 2 ** (1 / 5), rel=1e-12)
+
+
+def test_workers_publish_the_progress_of_each_running_case(tmp_path, fmu_dir):
+    from dataclasses import replace
+
+    from orchestrator.inputs.load_cases import load_cases_from_dict
+    from orchestrator.study.lifetime_results import store_run_data
+    from orchestrator.study.load_cases import prepare_load_cases
+    from orchestrator.study.sweep import run_sweep
+
+    lcs = load_cases_from_dict({"base": {"scenario": "paper-60s"}, "runs": {"length": 1.0, "transient": 0.5, "seeds": 2},
+                                "wind": {"distribution": "weibull", "k": 2.0, "A": 9.0},
+                                "bins": {"edges": [10.0, 12.0]}, "operating_law": {"rated_wind_speed": 11.0}})
+    plc = prepare_load_cases(lcs, fmu_dir=fmu_dir)
+    prepared = replace(plc.prepared, payload=replace(plc.prepared.payload, progress_topic="test-progress"))
+    events, records = [], []
+    report = run_sweep(prepared, tmp_path, workers=1, plots=False, progress=records.append,
+                       on_result=store_run_data(plc, tmp_path), case_progress=events.append)
+    assert report.ok == 2
+    steps = round(1.5 / plc.prepared.payload.system.scenario.simulation.step_s)
+    for case in plc.cases:
+        mine = [e for e in events if e["index"] == case.index]
+        # events arrive through the scheduler, apart from the results: the last ones may come after the sweep
+        assert mine and all(e["total"] == steps and 0 < e["done"] <= steps for e in mine)
+        assert [e["done"] for e in mine] == sorted(e["done"] for e in mine)
+    assert all(r["run_file"].startswith("runs/") for r in records)
