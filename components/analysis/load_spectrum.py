@@ -89,6 +89,22 @@ class LevelHistogram:
         """Sum of a gear's revolutions."""
         return float(self.revolutions[gear].sum())
 
+    def dense(self) -> tuple[np.ndarray, np.ndarray, dict[str, np.ndarray]]:
+        """Every cell from the lowest to the highest occupied one: ``(edges, time_s, revolutions)`` (zeros between)."""
+        if self.indices.size == 0:
+            return np.zeros(1), np.zeros(0), {g: np.zeros(0) for g in self.revolutions}
+        first = int(self.indices[0])
+        n = int(self.indices[-1]) - first + 1
+        pos = self.indices - first
+        edges = (first + np.arange(n + 1, dtype=float)) * self.width
+        time = np.zeros(n)
+        time[pos] = self.time_s
+        revs = {}
+        for g, r in self.revolutions.items():
+            revs[g] = np.zeros(n)
+            revs[g][pos] = r
+        return edges, time, revs
+
     def coarsened(self, exponent: int) -> "LevelHistogram":
         """The same distribution on the coarser lattice ``2^exponent`` (>= this one's)."""
         if exponent < self.exponent:

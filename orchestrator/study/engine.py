@@ -17,6 +17,11 @@ Engines
 ``cosim``
     The scenario's FMUs stepped by :class:`orchestrator.cosim.master.CoSimulation`.
 
+With a payload's ``run_data`` (a load-case set, :mod:`orchestrator.study.run_data`)
+a co-simulation point also returns the rainflow cycles and load levels of its load
+channels, extracted in the worker so the samples never travel; with a
+``progress_topic`` it publishes its progress while it runs.
+
 :func:`run_point` never raises for a failure of the point itself (a parameter
 the model rejects, a solver or FMU failure): it returns a record with
 ``status = "failed"`` and the error message. Anything else (a bug, a lost

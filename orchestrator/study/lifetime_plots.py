@@ -55,9 +55,8 @@ def plot_ldd(res: LifetimeResults, path: Path) -> Path:
     for ax, col in zip(axes, cols):
         cl = res.channels[col]
         f, unit = _scale(cl.channel.unit)
-        h = cl.ldd
-        edges = np.append(h.lower, h.upper[-1]) * f if h.indices.size else np.zeros(2)
-        ax.stairs(h.time_s / HOURS, edges, fill=True, alpha=0.6, label=col)
+        edges, time_s, _ = cl.ldd.dense()
+        ax.stairs(time_s / HOURS, edges * f, fill=True, alpha=0.6, label=col)
         ax.set_xlabel(f"{col} [{unit}]")
         ax.set_ylabel("time [h]")
         ax.legend(loc="upper left", fontsize=7)

@@ -52,6 +52,9 @@ def test_negative_loads_fall_in_floor_cells_and_round_trip_through_arrays():
     h = level_histogram(t, np.array([-3.0, -1.0, 0.0, 1.0, 3.0]), exponent=1)
     assert h.indices.tolist() == [-2, -1, 0, 1] and h.time_s.tolist() == [0.125, 0.25, 0.5, 0.125]  # 1 / 2 floors to cell 0
     assert h.coarsened(2).indices.tolist() == [-1, 0]
+    gappy = level_histogram(t, np.array([-3.0, -3.0, 5.0, 5.0, 5.0]), exponent=1)
+    edges, time, _ = gappy.dense()
+    assert edges.tolist() == [-4.0, -2.0, 0.0, 2.0, 4.0, 6.0] and time.tolist() == [0.375, 0.0, 0.0, 0.0, 0.625]
     again = LevelHistogram.from_arrays(h.as_arrays())
     assert again.exponent == 1 and np.array_equal(again.time_s, h.time_s)
     assert lattice_exponent(np.full(3, 5.0)) == math.floor(math.log2(5.0 / LATTICE_LEVELS))
