@@ -13,7 +13,7 @@ with both cores free). Before and after, it measures how many cores are free
 (:func:`bench_sweep.free_cores`: 2.0 = two idle cores); a speed-up can only be
 as large as that.
 
-Run: ``python benchmarks/bench_loads.py [--length 600] [--transient 10] [--step H]``
+Run: ``python benchmarks/bench_loads.py [--length 600] [--transient 10] [--step H] [--keep DIR]``
 """
 
 from __future__ import annotations
@@ -71,6 +71,7 @@ def main() -> None:
     parser.add_argument("--length", type=float, default=600.0, help="analysed length per run [s]")
     parser.add_argument("--transient", type=float, default=10.0, help="discarded transient per run [s]")
     parser.add_argument("--step", type=float, default=None, help="communication step [s] (default: the scenario's)")
+    parser.add_argument("--keep", type=Path, default=None, help="write the results here (default: a temporary folder)")
     args = parser.parse_args()
     lcs = load_cases_from_dict(reduced_set(args.length, args.transient, args.step), source="bench-loads")
     plc = prepare_load_cases(lcs)
@@ -80,8 +81,9 @@ def main() -> None:
     print(f"free cores before: {free_cores():.2f}")
     results = {}
     with tempfile.TemporaryDirectory(prefix="bench-loads-") as tmp:
+        root = args.keep or Path(tmp)
         for workers in (1, 2):
-            r = run_once(plc, workers, Path(tmp) / f"w{workers}")
+            r = run_once(plc, workers, root / f"w{workers}")
             results[workers] = r
             print(f"{workers} worker(s): sweep {r['sweep_s']:.1f} s (compute {r['compute_s']:.1f} s), "
                   f"{60.0 * n / r['sweep_s']:.2f} cases/min, post-processing {r['post_s']:.2f} s; per case: "
