@@ -34,7 +34,7 @@ import csv
 import io
 import json
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
@@ -251,9 +251,10 @@ def compute_lifetime(plc: PreparedLoadCases, out_dir: str | Path) -> LifetimeRes
     out = Path(out_dir)
     lcs = plc.load_cases
     done = finished_runs(plc, out)
-    runs = [read_run_file(out / done[c.index]["run_file"]) for c in plc.cases if c.index in done]
+    finished = [c for c in plc.cases if c.index in done]
+    runs = [replace(read_run_file(out / done[c.index]["run_file"]), case_index=c.index) for c in finished]
     missing = [c.index for c in plc.cases if c.index not in done]
-    run_bins = [plc.cases[r.case_index].bin for r in runs]
+    run_bins = [c.bin for c in finished]
     lengths = [r.analysed_time_s for r in runs]
     probs = [b.probability for b in plc.bins]
     weights = run_weights(run_bins, lengths, probs, lcs.life) if runs else np.zeros(0)

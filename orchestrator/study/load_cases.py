@@ -15,6 +15,12 @@ spectral level are the wind source's ``omega0``, ``sigma`` and ``a``
 generator's ``counter_torque``; the seed is the wind source's ``seed`` unless the
 set names another parameter.
 
+Seeds: every bin gets realisations of its own. The seed parameter of run ``s`` in
+bin ``b`` is ``s + SEED_STRIDE * b`` (:data:`SEED_STRIDE`), so bins at the same
+operating point (every region-3 bin under the law) are independent samples, not
+the same run counted twice; ``{seed}`` in a string parameter is the seed as
+listed (e.g. the record ``DLC1.2_{seed}.outb`` of the bin's own row).
+
 Channels
 --------
 Every load the gearbox declares (its record's signals): the ``rotor_torque``,
@@ -45,6 +51,8 @@ from ..inputs.study import Base, Study, StudyError
 from .prepare import PreparedStudy, point_key, prepare_study
 from .run_data import Channel, RunDataSpec
 
+#: the seed parameter of a run is its listed seed + SEED_STRIDE x its bin index (independent bins)
+SEED_STRIDE = 1000
 #: operating-point field -> (role, parameter of the dtcosim FMU of that role, load-case key)
 TARGETS = {
     "rotor_speed_rad_s": ("wind_source", "omega0", "rotor_speed_rpm"),
@@ -65,6 +73,7 @@ class Case:
     bin : int
         Wind-speed bin index.
     seed : int
+        The seed as listed in the set (the seed parameter gets ``seed + SEED_STRIDE * bin``).
     parameters : mapping
         ``component.parameter`` values of the run.
     """
@@ -233,7 +242,7 @@ def _cases(lcs: LoadCaseSet, bins, targets: Mapping[str, str], seed_parameter: s
             params: dict[str, Any] = dict(fixed)
             params.update({k: _with_seed(v, seed) for k, v in b.parameters.items()})
             if seed_parameter is not None:
-                params[seed_parameter] = seed
+                params[seed_parameter] = seed + SEED_STRIDE * b.index
             out.append(Case(len(out), b.index, seed, params))
     return tuple(out)
 
@@ -286,7 +295,9 @@ def prepare_load_cases(lcs: LoadCaseSet, fmu_dir: str | Path | None = None, buil
         raise LoadCaseError(exc.key, exc.value, exc.expected, src) from None
     spec = RunDataSpec(channels, lcs.time_grid().window_s, lcs.fatigue.gate_fraction, lcs.fatigue.residue)
     identity = {**prepared.identity, "load_cases": spec.identity()}
-    keys = tuple(point_key(identity, p) for p in prepared.points)
+    # a run's key names its bin too: two bins with the same parameters are still two runs
+    keys = tuple(point_key({**identity, "bin": [bins[c.bin].low_m_s, bins[c.bin].high_m_s]}, p)
+                 for c, p in zip(cases, prepared.points))
     payload = replace(prepared.payload, run_data=spec)
     prepared = replace(prepared, payload=payload, identity=identity, keys=keys)
     return PreparedLoadCases(lcs, bins, cases, channels, prepared, hss, meshes, tuple(prepared.notes))
