@@ -27,6 +27,7 @@ COMMAND_MODULES = (
     "orchestrator.commands.modes",
     "orchestrator.commands.drivetrain",
     "orchestrator.commands.sweep",
+    "orchestrator.commands.loads",
 )
 
 

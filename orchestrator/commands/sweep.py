@@ -14,6 +14,8 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
+from .cluster_options import add_cluster_arguments, check_cluster_arguments
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``sweep`` subcommand."""
@@ -28,14 +30,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         ),
     )
     p.add_argument("study", metavar="STUDY", help="study TOML file or packaged study name (e.g. paper-sensitivity)")
-    p.add_argument("--workers", type=int, default=None, metavar="N",
-                   help="workers of the LocalCluster: processes with one thread each (default: CPU count)")
-    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
-                   help="use an existing Dask cluster through its scheduler, e.g. tls://10.0.0.5:8786 (left running; "
-                        "TLS settings from the Dask configuration, see docs/studies.md)")
-    p.add_argument("--dashboard", nargs="?", const="127.0.0.1:8787", default=None, metavar="HOST:PORT",
-                   help="start the LocalCluster's Dask dashboard (default address 127.0.0.1:8787; without this "
-                        "option nothing listens on it)")
+    add_cluster_arguments(p)
     p.add_argument("--out", type=Path, default=None, help="output directory (default: results/<study name>)")
     p.add_argument("--fmu-dir", type=Path, default=None,
                    help="directory searched for the base scenario's FMUs (default: $DTCOSIM_FMU_DIR or the project's fmus/)")
@@ -110,15 +105,7 @@ def run(args: argparse.Namespace) -> int:
             print(f"{study.name}: {counts}; written " + ", ".join(p.name for p in files.values()))
         return 0
 
-    if args.scheduler:
-        from ..study.cluster import is_authenticated
-
-        if not is_authenticated(args.scheduler):
-            print(f"dtcosim sweep: warning: {args.scheduler} is not authenticated: any process that reaches it can "
-                  "run code on its workers (use a TLS cluster, see docs/studies.md)", file=sys.stderr)
-    if args.dashboard and args.scheduler:
-        raise StudyError("--dashboard", args.dashboard, "no dashboard option with --scheduler (the existing "
-                         "cluster has its own)")
+    check_cluster_arguments(args, "sweep")
     where = f"scheduler {args.scheduler}" if args.scheduler else f"a LocalCluster of {args.workers or os.cpu_count()} workers"
     bar = None
     progress = None

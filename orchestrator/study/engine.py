@@ -17,6 +17,11 @@ Engines
 ``cosim``
     The scenario's FMUs stepped by :class:`orchestrator.cosim.master.CoSimulation`.
 
+With a payload's ``run_data`` (a load-case set, :mod:`orchestrator.study.run_data`)
+a co-simulation point also returns the rainflow cycles and load levels of its load
+channels, extracted in the worker so the samples never travel; with a
+``progress_topic`` it publishes its progress while it runs.
+
 :func:`run_point` never raises for a failure of the point itself (a parameter
 the model rejects, a solver or FMU failure): it returns a record with
 ``status = "failed"`` and the error message. Anything else (a bug, a lost
@@ -81,6 +86,12 @@ class StudyPayload:
         (:mod:`orchestrator.study.drivetrain_variants`).
     variants : mapping of int -> PointVariant
         Point index -> its structure and the FMU parameter values that replace its file entries.
+    run_data : RunDataSpec or None
+        Co-simulation: also extract cycles and level histograms of these load channels
+        (:mod:`orchestrator.study.run_data`; a load-case set), returned as the record's ``data``.
+    progress_topic : str or None
+        Co-simulation in a Dask worker: publish ``{"key", "index", "done", "total"}`` (communication
+        steps) on this topic while a point runs (``Worker.log_event``, at most twice a second).
     """
 
     study: str
@@ -97,6 +108,8 @@ class StudyPayload:
     timeout_s: float | None = None
     structures: Mapping[str, Any] = field(default_factory=dict)
     variants: Mapping[int, Any] = field(default_factory=dict)
+    run_data: Any = None
+    progress_topic: str | None = None
 
 
 @dataclass(frozen=True)
@@ -188,7 +201,7 @@ def _point_system(payload: StudyPayload, task: PointTask, local_files: bool):
 
 
 # -------------------------------------------------------------------- engines
-def _monolithic(payload: StudyPayload, task: PointTask) -> dict[str, float]:
+def _monolithic(payload: StudyPayload, task: PointTask) -> tuple[dict[str, float], None]:
     from components.reference.acceleration import peak_output_acceleration
     from components.reference.solver import SolverSettings, simulate_monolithic
 
@@ -236,15 +249,38 @@ def _monolithic(payload: StudyPayload, task: PointTask) -> dict[str, float]:
         else:
             series = result.series[payload.series_names[m.variable]]
             out[m.name] = window_statistic(result.time_s, series, payload.window_s, m.statistic)
-    return out
+    return out, None
 
 
-def _cosim(payload: StudyPayload, task: PointTask) -> dict[str, float]:
+def _progress_publisher(topic: str | None, task: PointTask):
+    """A master progress callback publishing on ``topic`` from this Dask worker (None outside a worker)."""
+    if not topic:
+        return None
+    try:
+        from distributed import get_worker
+
+        worker = get_worker()
+    except (ImportError, ValueError):
+        return None
+    last = [0.0]
+
+    def publish(done: int, total: int) -> None:
+        now = time.monotonic()
+        if done < total and now - last[0] < 0.5:
+            return
+        last[0] = now
+        worker.log_event(topic, {"key": task.key, "index": task.index, "done": int(done), "total": int(total)})
+
+    return publish
+
+
+def _cosim(payload: StudyPayload, task: PointTask) -> tuple[dict[str, float], dict | None]:
     from ..cosim.master import CoSimulation
 
     system = _point_system(payload, task, local_files=True)
     cpu0 = time.process_time()
-    outcome = CoSimulation(system).run(handle_sigint=False, wall_time_limit_s=payload.timeout_s)
+    outcome = CoSimulation(system).run(progress=_progress_publisher(payload.progress_topic, task),
+                                       handle_sigint=False, wall_time_limit_s=payload.timeout_s)
     cpu = time.process_time() - cpu0
     if not outcome.complete:
         raise DtcosimError(outcome.error or "the co-simulation stopped early")
@@ -263,7 +299,12 @@ def _cosim(payload: StudyPayload, task: PointTask) -> dict[str, float]:
         else:
             values = outcome.column(m.variable)
             out[m.name] = window_statistic(outcome.time_s, values, system.scenario.simulation.window_s, m.statistic)
-    return out
+    data = None
+    if payload.run_data is not None:
+        from .run_data import collect_run_data
+
+        data = collect_run_data(payload.run_data, outcome.time_s, outcome.column)
+    return out, data
 
 
 def _clean(value: float) -> float | None:
@@ -283,14 +324,17 @@ def run_point(payload: StudyPayload, task: PointTask) -> dict[str, Any]:
     dict
         ``key``, ``index``, ``status`` (``"ok"`` or ``"failed"``), ``measures``
         (name -> value, non-finite as None), ``error`` (message or None),
-        ``error_type``, ``worker`` (``host:pid``), ``task_wall_time_s``.
+        ``error_type``, ``worker`` (``host:pid``), ``task_wall_time_s``; with a payload's
+        ``run_data`` also ``data`` (:func:`orchestrator.study.run_data.collect_run_data`).
     """
     wall0 = time.perf_counter()
     record: dict[str, Any] = {"key": task.key, "index": task.index, "status": OK, "measures": {}, "error": None,
                               "error_type": None}
     try:
-        values = _monolithic(payload, task) if payload.engine == "monolithic" else _cosim(payload, task)
+        values, data = _monolithic(payload, task) if payload.engine == "monolithic" else _cosim(payload, task)
         record["measures"] = {k: _clean(v) for k, v in values.items()}
+        if data is not None:
+            record["data"] = data
     except DtcosimError as exc:
         record["status"] = FAILED
         record["error"] = str(exc)

@@ -192,6 +192,8 @@ def run_sweep(
     on_start: Callable[[int, int], None] | None = None,
     plots: bool = True,
     dashboard: str | None = None,
+    on_result: Callable[[int, dict[str, Any]], dict[str, Any]] | None = None,
+    case_progress: Callable[[dict[str, Any]], None] | None = None,
 ) -> SweepReport:
     """Run the study's pending points on Dask and write the journal, the table and the plots.
 
@@ -217,6 +219,13 @@ def run_sweep(
     dashboard : str, optional
         ``host:port`` of the LocalCluster's Dask dashboard (default: none; see
         :mod:`orchestrator.study.cluster`).
+    on_result : callable(point index, worker result) -> dict, optional
+        Called with each point's result before its journal record is written (e.g. to
+        store the result's ``data`` in a file of its own); the fields it returns are
+        added to the record.
+    case_progress : callable(event), optional
+        Called with the progress events the workers publish while a point runs
+        (``{"key", "index", "done", "total"}``; the payload's ``progress_topic``).
 
     Returns
     -------
@@ -236,14 +245,16 @@ def run_sweep(
         if on_start is not None:
             on_start(len(todo), report.skipped)
         if todo:
-            _execute(prepared, todo, journal, report, workers, scheduler, progress, dashboard)
+            _execute(prepared, todo, journal, report, workers, scheduler, progress, dashboard, on_result,
+                     case_progress)
     report.files = write_outputs(prepared, out, report, plots=plots)
     report.wall_time_s = time.perf_counter() - wall0
     return report
 
 
 def _execute(prepared: PreparedStudy, todo: list[int], journal: Journal, report: SweepReport,
-             workers: int | None, scheduler: str | None, progress, dashboard: str | None = None) -> None:
+             workers: int | None, scheduler: str | None, progress, dashboard: str | None = None, on_result=None,
+             case_progress=None) -> None:
     from distributed import as_completed
 
     study = prepared.study
@@ -262,6 +273,9 @@ def _execute(prepared: PreparedStudy, todo: list[int], journal: Journal, report:
                     raise StudyError("--scheduler", scheduler, f"a cluster with at least one worker (none connected "
                                      f"within {WAIT_FOR_WORKERS_S:g} s)") from None
                 report.workers = _worker_count(client)
+            topic = prepared.payload.progress_topic
+            if case_progress is not None and topic:
+                client.subscribe_topic(topic, lambda event: case_progress(event[1]))
             payload = client.scatter([prepared.payload], hash=False)[0]
             t0 = time.perf_counter()
             run_id = uuid.uuid4().hex[:8]
@@ -288,6 +302,8 @@ def _execute(prepared: PreparedStudy, todo: list[int], journal: Journal, report:
                     "error_type": result.get("error_type"), "worker": result.get("worker"),
                     "task_wall_time_s": result.get("task_wall_time_s"), "code_version": code, "finished_at": _now(),
                 }
+                if on_result is not None and record["status"] == OK:
+                    record.update(on_result(i, result))
                 with interrupts.critical_section():
                     journal.append(record)
                 if record["status"] == OK:

@@ -1,0 +1,44 @@
+"""The Dask options every command that runs points on a cluster shares: ``--workers``, ``--scheduler``, ``--dashboard``.
+
+Used by ``dtcosim sweep`` and ``dtcosim loads``: one definition of what a
+LocalCluster exposes (:mod:`orchestrator.study.cluster`: TLS with temporary
+credentials, no dashboard unless asked) and of the checks on an existing cluster.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+
+def add_cluster_arguments(p: argparse.ArgumentParser) -> None:
+    """Add ``--workers``, ``--scheduler`` and ``--dashboard`` to a subcommand's parser."""
+    p.add_argument("--workers", type=int, default=None, metavar="N",
+                   help="workers of the LocalCluster: processes with one thread each (default: CPU count)")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="use an existing Dask cluster through its scheduler, e.g. tls://10.0.0.5:8786 (left running; "
+                        "TLS settings from the Dask configuration, see docs/studies.md)")
+    p.add_argument("--dashboard", nargs="?", const="127.0.0.1:8787", default=None, metavar="HOST:PORT",
+                   help="start the LocalCluster's Dask dashboard (default address 127.0.0.1:8787; without this "
+                        "option nothing listens on it)")
+
+
+def check_cluster_arguments(args: argparse.Namespace, command: str) -> None:
+    """Warn about an unauthenticated ``--scheduler``; refuse ``--dashboard`` with it (before anything runs).
+
+    Raises
+    ------
+    StudyError
+        ``--dashboard`` together with ``--scheduler``.
+    """
+    from ..inputs.study import StudyError
+
+    if args.scheduler:
+        from ..study.cluster import is_authenticated
+
+        if not is_authenticated(args.scheduler):
+            print(f"dtcosim {command}: warning: {args.scheduler} is not authenticated: any process that reaches it "
+                  "can run code on its workers (use a TLS cluster, see docs/studies.md)", file=sys.stderr)
+    if args.dashboard and args.scheduler:
+        raise StudyError("--dashboard", args.dashboard, "no dashboard option with --scheduler (the existing "
+                         "cluster has its own)")

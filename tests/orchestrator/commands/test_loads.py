@@ -1,0 +1,49 @@
+"""``dtcosim loads``: the packaged paper-turbine set runs and its report ranks the bins; errors are one line."""
+
+from __future__ import annotations
+
+import json
+import re
+
+import pytest
+
+from tests.helpers.scenarios import dtcosim
+
+
+def test_a_bad_set_is_one_error_line_without_traceback(tmp_path):
+    (tmp_path / "bad.toml").write_text('[base]\nscenario = "paper-60s"\n[wind]\ndistribution = "weibull"\nk = 2.0\n'
+                                       'A = 9.0\n[bins]\nedges = [4.0, 8.0]\n[runs]\nlenght = 60.0\n')
+    proc = dtcosim("loads", "bad.toml", cwd=tmp_path)
+    assert proc.returncode == 1
+    assert proc.stderr.strip().splitlines() == [
+        "dtcosim loads: error: bad.toml: invalid load-case set entry runs.lenght = 60.0: expected a known key here: "
+        "length, seed_parameter, seeds, transient (did you mean length?)"]
+
+
+def test_check_prints_the_plan(tmp_path, fmu_dir):
+    proc = dtcosim("loads", "paper-turbine", "--check", "--fmu-dir", str(fmu_dir), cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert "11 bins x 3 seeds = 33 runs of 10 + 600 s, 33 to run" in proc.stdout
+    assert "17 channels" in proc.stdout
+
+
+@pytest.mark.slow
+def test_the_packaged_paper_turbine_set_runs_and_ranks_the_bins_by_damage_share(tmp_path, fmu_dir):
+    out = tmp_path / "out"
+    proc = dtcosim("loads", "paper-turbine", "--length", "2", "--transient", "3", "--seeds", "1", "--workers", "2",
+                   "--out", str(out), "--fmu-dir", str(fmu_dir), cwd=tmp_path, timeout=900)
+    assert proc.returncode == 0, proc.stderr
+    report = (out / "lifetime_report.txt").read_text()
+    summary = json.loads((out / "lifetime.json").read_text())
+    assert summary["complete"] and summary["finished_runs"] == 11
+    labels = ["high-speed shaft", "stage1 sun_planet mesh", "stage1 ring_planet mesh", "stage2 sun_planet mesh",
+              "stage2 ring_planet mesh", "stage3 parallel mesh"]
+    assert list(summary["rankings"]) == labels
+    assert summary["rankings"]["high-speed shaft"]["channel"] == "gearbox.shaft3.torque"
+    for label in labels:
+        block = report.split(f"{label} (", 1)[1].split("\n\n")[0]
+        shares = [float(s) for s in re.findall(r"^\s+\d+\. \[[^)]+\) m/s\s+([\d.]+) %", block, re.M)]
+        assert len(shares) == 11 and shares == sorted(shares, reverse=True), label
+        assert sum(shares) == pytest.approx(100.0, abs=0.05), label
+        assert "lifetime damage" in block.splitlines()[0]  # the packaged set has S-N curves for all of them
+    assert (out / "damage_by_bin.png").stat().st_size > 10_000
