@@ -49,11 +49,21 @@ def _csv_field(text: str) -> str:
 
 
 def read_timeseries(path: str | Path) -> tuple[list[str], np.ndarray]:
-    """Read a ``timeseries.csv``: (header fields, array of shape (n_samples, n_columns)).
+    """Read a run's results file, CSV or binary: (header fields, array of shape (n_samples, n_columns)).
 
-    Also reads a file a killed run left (``timeseries.csv.partial``): a last line
-    without its line end (a chunk cut by the kill) is not a sample and is left out.
+    The header fields are ``time [s]``, ``component.variable [unit]``, ... for either
+    format. Reads ``timeseries.csv`` and ``timeseries.parquet``, and the files a
+    killed run left: ``timeseries.csv.partial`` (a last line without its line end, a
+    chunk cut by the kill, is not a sample and is left out) and
+    ``timeseries.parquet.partial`` (an Arrow IPC stream, read up to its last whole
+    batch). For the units and FMI types of a binary file column by column, and its
+    String columns, use :func:`orchestrator.columnar_files.read_columnar`.
     """
+    from .columnar_files import is_columnar, read_columnar
+
+    if is_columnar(path):
+        table = read_columnar(path)
+        return table.header, table.data
     import csv
     import io
 
@@ -65,6 +75,24 @@ def read_timeseries(path: str | Path) -> tuple[list[str], np.ndarray]:
     rest = fh.read()
     data = np.loadtxt(io.StringIO(rest), delimiter=",", ndmin=2) if rest.strip() else np.empty((0, len(header)))
     return header, data
+
+
+def find_timeseries(folder: str | Path) -> Path:
+    """The results file of a run in ``folder``: the one its ``summary.json`` lists, else
+    ``timeseries.csv`` or ``timeseries.parquet`` (whole, then ``.partial``), whichever is there."""
+    folder = Path(folder)
+    try:
+        summary = json.loads((folder / "summary.json").read_text(encoding="utf-8"))
+        listed = (summary.get("files") or {}).get("timeseries") or \
+            ((summary.get("files_incomplete") or {}).get("timeseries") or {}).get("file")
+    except (OSError, ValueError, AttributeError):
+        listed = None
+    names = ([listed] if isinstance(listed, str) else []) + ["timeseries.csv", "timeseries.parquet",
+                                                             "timeseries.csv.partial", "timeseries.parquet.partial"]
+    for name in names:
+        if (folder / name).is_file():
+            return folder / name
+    raise FileNotFoundError(f"{folder}: no results file (timeseries.csv or timeseries.parquet)")
 
 
 def jsonable(value: Any) -> Any:

@@ -13,6 +13,7 @@ import os
 import sys
 from pathlib import Path
 
+from ..inputs.results_format import RESULTS_FORMATS
 from . import scenario_options
 
 
@@ -23,7 +24,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="run a co-simulation scenario (default: the paper's 60 s scenario) and write results and plots",
         description=(
             "Run a co-simulation scenario through its FMUs with the fixed-step master and write "
-            "timeseries.csv, summary.json and PNG plots. SCENARIO is a TOML file, an .ssp/.ssd file, or the "
+            "timeseries.csv (or timeseries.parquet for long runs, see --results), summary.json and PNG plots. SCENARIO is a TOML file, an .ssp/.ssd file, or the "
             "name of a packaged scenario (default: paper-60s). Missing project FMUs are built first."
         ),
     )
@@ -42,6 +43,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--check", action="store_true",
                    help="only check the scenario against the FMUs' model descriptions (nothing is instantiated) and exit")
     p.add_argument("--no-plots", action="store_true", help="do not write the PNG plots")
+    p.add_argument("--results", choices=RESULTS_FORMATS, default=None,
+                   help="results file: csv (timeseries.csv), parquet (timeseries.parquet: binary, units as metadata; "
+                        "pandas.read_parquet, MATLAB parquetread) or auto, Parquet above 2 million values "
+                        "(samples x recorded variables) (default: the scenario's [record] format, else auto)")
     p.add_argument("--profile", action="store_true",
                    help="time every FMI call per FMU and report where the stepping time goes (adds ~1 us per call)")
     p.add_argument("--quiet", "-q", action="store_true", help="no progress bar and no statistics table")
@@ -103,7 +108,7 @@ def run(args: argparse.Namespace) -> int:
     bar, progress = _progress_bar(sim) if not quiet and sys.stderr.isatty() else (None, None)
     try:
         report = run_scenario(system, out_dir, compare_reference=args.compare_reference, plots=not args.no_plots,
-                              progress=progress, profile=args.profile)
+                              progress=progress, profile=args.profile, results_format=args.results)
     finally:
         if bar is not None:
             bar.close()

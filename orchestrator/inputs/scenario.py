@@ -41,6 +41,7 @@ TOML format (units SI; see ``docs/orchestrator.md`` for the full reference)::
 
     [record]
     variables = ["wind.omega", "gearbox.stage*.F_sp[1]"]  # names or * / ? patterns
+    format = "auto"                       # results file: "csv", "parquet" or "auto" (Parquet for long runs)
 
     [[events]]                            # generator load events (orchestrator.inputs.load_events)
     kind = "grid_fault"                   # torque_step | grid_fault | emergency_stop
@@ -70,6 +71,7 @@ from .files import find_input_file, packaged_files, read_toml
 from .limits import MIN_RELATIVE_STEP
 from .load_events import EventTable, ScenarioEvent, check_events_in_run
 from .master_options import ALGORITHMS, EXTRAPOLATIONS
+from .results_format import RESULTS_FORMATS
 from .schema import (
     NAME_PATTERN,
     ParameterValue,
@@ -358,6 +360,8 @@ class Scenario:
         Generator load events (``[[events]]``); each must start inside the run.
     analysis : AnalysisSettings
         Settings of the result analyses (``[analysis]``).
+    results_format : {"auto", "csv", "parquet"}
+        File the samples go to (``[record] format``, :mod:`orchestrator.inputs.results_format`).
     """
 
     name: str
@@ -371,6 +375,7 @@ class Scenario:
     source: str | None = None
     events: tuple[ScenarioEvent, ...] = ()
     analysis: AnalysisSettings = field(default_factory=AnalysisSettings)
+    results_format: str = "auto"
 
     def __post_init__(self) -> None:
         src = self.source
@@ -426,6 +431,8 @@ class Scenario:
         check_events_in_run(self.events, self.simulation.start_s, self.simulation.stop_s, names, src)
         if not isinstance(self.analysis, AnalysisSettings):
             raise ScenarioError("analysis", self.analysis, "an AnalysisSettings", src)
+        if self.results_format not in RESULTS_FORMATS:
+            raise ScenarioError("record.format", self.results_format, "one of " + ", ".join(RESULTS_FORMATS), src)
 
     # ------------------------------------------------------------------ access
     def component(self, name: str) -> Component:
@@ -506,6 +513,7 @@ class _LinkTable(Table):
 
 class _RecordTable(Table):
     variables: list[str] = Field(default_factory=list, description='a list of "component.variable" strings')
+    format: Literal[RESULTS_FORMATS] = "auto"
 
 
 class ScenarioFile(Table):
@@ -609,6 +617,7 @@ def scenario_from_dict(data: Mapping[str, Any], name: str | None = None, base_di
         record=tuple(doc.record.variables) if doc.record is not None else (),
         events=tuple(events),
         analysis=analysis,
+        results_format=doc.record.format if doc.record is not None else "auto",
         base_dir=base_dir,
         source=source,
     )

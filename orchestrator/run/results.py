@@ -1,7 +1,12 @@
 """Results of a run on disk: ``timeseries.csv`` and ``summary.json``.
 
-``timeseries.csv``
-    One row per sample: ``time [s]`` and every recorded variable, header
+``timeseries.csv`` or ``timeseries.parquet``
+    The format is the scenario's ``[record] format`` (or ``--results``): ``csv``,
+    ``parquet``, or ``auto``, Parquet for long runs
+    (:mod:`orchestrator.inputs.results_format`). The Parquet file has the same
+    columns, named ``component.variable`` with the unit and FMI type as metadata
+    (:mod:`orchestrator.columnar_files`); :func:`orchestrator.result_files.read_timeseries`
+    reads both. The CSV has one row per sample: ``time [s]`` and every recorded variable, header
     ``component.variable [unit]`` with the unit the FMU declares (``[-]`` when it
     declares none), e.g. ``gearbox.stage1.F_sp[1] [N]``. Streamed while the run
     steps (``timeseries.csv.partial``, :mod:`orchestrator.run.writers`) and renamed
@@ -36,11 +41,31 @@ from components.reference.results import window_statistics
 
 from ..cosim.master import RunOutcome
 from ..cosim.system import ResolvedSystem
+from ..inputs.results_format import RESULTS_FILES, concrete_format
 from ..result_files import jsonable, versions
-from .writers import Column, CsvWriter
+from .writers import Column, CsvWriter, ResultWriter
 
-TIMESERIES_FILE = "timeseries.csv"
+TIMESERIES_FILE = RESULTS_FILES["csv"]
+TIMESERIES_PARQUET = RESULTS_FILES["parquet"]
 SUMMARY_FILE = "summary.json"
+
+
+def results_writer(requested: str, out_dir: str | Path, sim=None, variables: int = 0) -> ResultWriter:
+    """The writer of a run's results file in ``out_dir``: ``requested`` is ``csv``, ``parquet`` or ``auto``.
+
+    ``auto`` needs ``sim`` (:class:`~orchestrator.inputs.scenario.SimulationSettings`) and the
+    number of recorded ``variables`` to count the values. The writer's ``format``
+    attribute says which it is.
+    """
+    samples = sim.n_steps // sim.output_stride + 1 if sim is not None else 0
+    fmt = concrete_format(requested, samples, variables)
+    if fmt == "parquet":
+        from .parquet_writer import ParquetWriter
+
+        writer: ResultWriter = ParquetWriter(Path(out_dir) / TIMESERIES_PARQUET)
+    else:
+        writer = CsvWriter(Path(out_dir) / TIMESERIES_FILE)
+    return writer
 
 
 def column_header(component: str, variable: str, unit: str, fmi_type: str = "Real") -> str:
@@ -53,13 +78,26 @@ def result_columns(columns) -> list[Column]:
     return [Column(c.column, c.unit, c.type) for c in columns]
 
 
-def write_timeseries(path: str | Path, outcome: RunOutcome) -> Path:
-    """Write an outcome's samples as ``timeseries.csv`` in one go (the same writer a run streams into)."""
-    writer = CsvWriter(path)
+def write_timeseries(path: str | Path, outcome: RunOutcome, chunk_rows: int | None = None) -> Path:
+    """Write an outcome's samples with the writer a run streams into: Parquet for a ``.parquet`` path, else CSV.
+
+    ``chunk_rows``: hand the rows over in chunks of that many (as a run does), default all at once.
+    """
+    path = Path(path)
+    if path.suffix == ".parquet":
+        from .parquet_writer import ParquetWriter
+
+        writer: ResultWriter = ParquetWriter(path)
+    else:
+        writer = CsvWriter(path)
     writer.open(result_columns(outcome.columns))
     try:
         text = {j: outcome.text[c.column] for j, c in enumerate(outcome.columns) if c.column in outcome.text}
-        writer.append(outcome.time_s, outcome.values, text or None)
+        n = len(outcome.time_s)
+        step = chunk_rows or max(n, 1)
+        for i in range(0, n, step):
+            part = {j: v[i:i + step] for j, v in text.items()}
+            writer.append(outcome.time_s[i:i + step], outcome.values[i:i + step], part or None)
     except BaseException:
         writer.abandon()
         raise

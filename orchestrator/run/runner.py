@@ -24,9 +24,9 @@ from .analyses import analyse_run
 from .comparison import compare, format_comparison, run_reference
 from .derived import Skipped, generator_vs_ideal
 from .plots import plot_run
-from .results import TIMESERIES_FILE, build_summary, result_columns
+from .results import build_summary, result_columns, results_writer
 from .run_folder import RunFolder
-from .writers import CsvWriter
+from .writers import ResultWriter
 
 
 def signal_number(name: str) -> int:
@@ -88,8 +88,8 @@ def _stage_of(exc: FmuStepError | InitializationError) -> str:
 
 def run_scenario(system: ResolvedSystem, out_dir: str | Path, *, compare_reference: bool = False, plots: bool = True,
                  progress: Callable[[int, int], None] | None = None, handle_sigint: bool = True,
-                 profile: bool = False) -> RunReport:
-    """Run a checked scenario and write ``timeseries.csv``, ``summary.json``, the analyses and the plots.
+                 profile: bool = False, results_format: str | None = None) -> RunReport:
+    """Run a checked scenario and write ``timeseries.csv`` (or ``.parquet``), ``summary.json``, the analyses, the plots.
 
     The analyses (:func:`orchestrator.run.analyses.analyse_run`: contact loss, fatigue
     loads, contact-force spectra) add ``contact_loss.csv``, ``fatigue_del.csv``,
@@ -126,6 +126,10 @@ def run_scenario(system: ResolvedSystem, out_dir: str | Path, *, compare_referen
         Stop cleanly on SIGINT, SIGTERM and SIGHUP (partial results, ``complete: false``).
     profile : bool
         Time every FMI call per FMU (``summary.json`` key ``profile``).
+    results_format : {"auto", "csv", "parquet"}, optional
+        The results file (:mod:`orchestrator.inputs.results_format`); default: the
+        scenario's ``[record] format``. ``summary.json`` says which
+        (``results_format``, ``files.timeseries``).
 
     Returns
     -------
@@ -143,7 +147,8 @@ def run_scenario(system: ResolvedSystem, out_dir: str | Path, *, compare_referen
     folder = RunFolder.prepare(out_dir, {"scenario": sc.name, "description": sc.description,
                                          "scenario_file": sc.source})
     out = folder.path
-    writer = CsvWriter(out / TIMESERIES_FILE)
+    writer = results_writer(results_format or sc.results_format, out, sim, len(system.recorded))
+    folder.header["results_format"] = writer.format
     problems: list[str] = []
     with StopRequests(enabled=handle_sigint) as stop:
         cosim = CoSimulation(system, profile=profile)
@@ -198,7 +203,7 @@ def run_scenario(system: ResolvedSystem, out_dir: str | Path, *, compare_referen
     return RunReport(outcome, summary, files, comparison_text, problems, list(folder.replaced), status)
 
 
-def _finish_timeseries(writer: CsvWriter, outcome: RunOutcome, folder: RunFolder, problems: list[str]) -> None:
+def _finish_timeseries(writer: ResultWriter, outcome: RunOutcome, folder: RunFolder, problems: list[str]) -> None:
     """Rename the streamed file when whole; otherwise say in the summary what it holds."""
     if outcome.stage == "writing":
         writer.abandon()

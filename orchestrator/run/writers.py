@@ -22,8 +22,10 @@ The life cycle is the same for every format:
     Stop without renaming (after a write error): what was written stays in
     ``<file>.partial``, readable up to its last complete chunk.
 
-:class:`CsvWriter` is the first format; a binary columnar format plugs in by
-implementing the same four methods (:class:`ResultWriter`).
+:class:`CsvWriter` is the text format; :class:`~orchestrator.run.parquet_writer.ParquetWriter`
+the binary columnar one. Both stream into their ``.partial`` file through
+:class:`StreamedFile` (all-or-nothing chunks, fsync and rename on close) and
+implement the same four methods (:class:`ResultWriter`).
 """
 
 from __future__ import annotations
@@ -37,6 +39,7 @@ from typing import Protocol, Sequence
 import numpy as np
 
 from ..atomic_files import fsync_directory
+from ..columnar_files import TYPE_TAGS, header_field
 
 #: suffix of a results file while it is being written
 PARTIAL_SUFFIX = ".partial"
@@ -44,8 +47,6 @@ PARTIAL_SUFFIX = ".partial"
 REAL_FORMAT = "%.17g"
 #: value format of each FMI 2.0 type (a Boolean is 0.0/1.0, an Integer an exact float, in the row arrays)
 TYPE_FORMATS = {"Real": REAL_FORMAT, "Integer": "%d", "Enumeration": "%d", "Boolean": "%d", "String": "%s"}
-#: header tag of the non-Real columns that have no unit
-TYPE_TAGS = {"Boolean": "Boolean 0/1", "String": "String"}
 
 
 @dataclass(frozen=True)
@@ -76,12 +77,14 @@ class Column:
     @property
     def header(self) -> str:
         """``component.variable [unit]`` (``[-]`` without a unit, ``[Boolean 0/1]``, ``[String]`` for those types)."""
-        return f"{self.name} [{TYPE_TAGS.get(self.fmi_type) or self.unit or '-'}]"
+        return header_field(self.name, self.unit, self.fmi_type)
 
 
 class ResultWriter(Protocol):
     """What a results format implements (see the module docstring)."""
 
+    #: the format's name (``csv``, ``parquet``: :data:`orchestrator.inputs.results_format.RESULTS_FORMATS`)
+    format: str
     path: Path
     rows_written: int
 
@@ -107,8 +110,12 @@ def csv_field(text: str) -> str:
     return '"' + text.replace('"', '""') + '"' if any(c in text for c in ',"\r\n') else text
 
 
-class CsvWriter:
-    """``timeseries.csv``: ``time [s]`` then one column per recorded variable, one line per sample.
+class StreamedFile:
+    """A results file written chunk by chunk into ``<path>.partial`` and renamed to ``path`` when whole.
+
+    The part every format shares: :meth:`_write` writes a chunk whole or cuts the
+    file back to the previous chunk and raises; :meth:`close` forces the file to
+    the disk and renames it; :meth:`abandon` leaves the partial file as it is.
 
     Parameters
     ----------
@@ -127,21 +134,15 @@ class CsvWriter:
         self.fsync_every_chunk = fsync_every_chunk
         self.rows_written = 0
         self._fh = None
-        self._row_format = ""
         self._size = 0
 
     @property
     def partial_path(self) -> Path:
         return self.path.with_name(self.path.name + PARTIAL_SUFFIX)
 
-    def open(self, columns: Sequence[Column]) -> None:
-        columns = [self.time_column, *columns]
-        self._row_format = ",".join(c.format for c in columns) + "\n"
-        self._n_values = len(columns) - 1
-        self._string_columns = [j for j, c in enumerate(columns[1:]) if c.fmi_type == "String"]
-        header = (",".join(csv_field(c.header) for c in columns) + "\n").encode("utf-8")
+    def _create(self) -> None:
         self._fh = open(self.partial_path, "wb", buffering=0)
-        self._write(header)
+        self._size = 0
 
     def _write(self, data: bytes) -> None:
         """Write all of ``data`` or cut the file back to where it was and raise."""
@@ -159,6 +160,53 @@ class CsvWriter:
                 exc.filename = str(self.partial_path)
             raise
         self._size += len(data)
+
+    def _close_partial(self) -> None:
+        """Force the partial file to the disk and close it."""
+        fh, self._fh = self._fh, None
+        try:
+            os.fsync(fh.fileno())
+        finally:
+            fh.close()
+
+    def close(self) -> Path:
+        self._close_partial()
+        os.replace(self.partial_path, self.path)
+        fsync_directory(self.path.parent)
+        return self.path
+
+    def abandon(self) -> None:
+        fh, self._fh = self._fh, None
+        if fh is not None:
+            with contextlib.suppress(OSError):
+                fh.close()
+
+
+class CsvWriter(StreamedFile):
+    """``timeseries.csv``: ``time [s]`` then one column per recorded variable, one line per sample.
+
+    Parameters
+    ----------
+    path : path
+        Final file name; written as ``<path>.partial`` until :meth:`close`.
+    fsync_every_chunk : bool
+        See :class:`StreamedFile`.
+    """
+
+    format = "csv"
+
+    def __init__(self, path: str | Path, fsync_every_chunk: bool = False) -> None:
+        super().__init__(path, fsync_every_chunk)
+        self._row_format = ""
+
+    def open(self, columns: Sequence[Column]) -> None:
+        columns = [self.time_column, *columns]
+        self._row_format = ",".join(c.format for c in columns) + "\n"
+        self._n_values = len(columns) - 1
+        self._string_columns = [j for j, c in enumerate(columns[1:]) if c.fmi_type == "String"]
+        header = (",".join(csv_field(c.header) for c in columns) + "\n").encode("utf-8")
+        self._create()
+        self._write(header)
 
     def append(self, time_s: np.ndarray, values: np.ndarray, text: dict[int, np.ndarray] | None = None) -> None:
         n = len(time_s)
@@ -187,19 +235,3 @@ class CsvWriter:
                 fields[j + 1] = '"' + str(text[j][i]).replace('"', '""') + '"'
             out.append(self._row_format % tuple(fields))
         return "".join(out)
-
-    def close(self) -> Path:
-        fh, self._fh = self._fh, None
-        try:
-            os.fsync(fh.fileno())
-        finally:
-            fh.close()
-        os.replace(self.partial_path, self.path)
-        fsync_directory(self.path.parent)
-        return self.path
-
-    def abandon(self) -> None:
-        fh, self._fh = self._fh, None
-        if fh is not None:
-            with contextlib.suppress(OSError):
-                fh.close()
