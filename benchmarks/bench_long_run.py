@@ -1,22 +1,32 @@
-"""Where the time and memory of a long run go: the paper scenario over 600 s (the IEC load-case length).
+"""What a long run costs: the paper scenario over 600 s (the IEC load-case length), H as the scenario's default.
 
-Runs the phases of ``dtcosim run`` (:func:`orchestrator.run.runner.run_scenario`) one by one in
-this process and prints, per phase, wall and CPU time, the peak resident memory during the
-phase (Linux: ``VmHWM``, reset before each phase through ``/proc/self/clear_refs``) and the
-resident memory after it; then the sizes of the files written, and, for comparison, what
-writing the same samples with ``np.save`` costs (the binary results file is issue 13's
-streaming writer, not measured here).
+Two parts:
 
-Targets (issue 14): <= 10 s wall including results and plots, <= 150 MB peak memory,
-results file <= 60 MB.
+1. **Whole runs** (default): ``run_scenario`` (what ``dtcosim run`` does: stream the samples
+   into the results file, analyses, plots, summary) in a fresh process per results format
+   (``csv``, ``parquet``) and per Gearbox kernel (``DTCOSIM_KERNEL`` = ``compiled``,
+   ``numpy``), printing wall and CPU time of the run, the peak resident memory of the
+   process (``ru_maxrss``: everything, imports and the FMUs included) and the size of the
+   results file, against the targets of issue 14: <= 10 s wall including writing results
+   and plots, <= 150 MB peak memory, results file <= 60 MB.
+2. **Phases** (``--phases``): the phases of a run one by one in this process, per phase wall
+   and CPU time, the peak resident memory during the phase (Linux: ``VmHWM``, reset before
+   each phase through ``/proc/self/clear_refs``) and the resident memory after it; the
+   results written in chunks of 250 rows as a run streams them, in both formats.
 
-Run: ``python benchmarks/bench_long_run.py [--stop 600] [--step H] [--out DIR]``.
+Run: ``python benchmarks/bench_long_run.py [--stop 600] [--step H] [--formats csv,parquet]
+[--kernels compiled,numpy] [--phases]``.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
+import os
 import re
+import resource
+import subprocess
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -64,12 +74,95 @@ class Phases:
         print(f"| total | {total:.2f} | {sum(r[2] for r in self.rows):.2f} | {max(r[3] for r in self.rows):.0f} | |")
 
 
+def _long_scenario(args):
+    from orchestrator.inputs.scenario import find_scenario, load_scenario
+
+    scenario = load_scenario(find_scenario("paper-60s")).with_simulation(stop_s=args.stop, window_s=(5.0, args.stop))
+    if args.step is not None:
+        scenario = scenario.with_simulation(step_s=args.step, output_interval_s=args.step)
+    return scenario
+
+
+def child_main(args) -> None:
+    """One whole run in this (fresh) process; prints one JSON line."""
+    wall0 = time.perf_counter()
+    from components.model.kernel import choose_kernel
+    from orchestrator.cosim.fmu_store import ensure_fmus
+    from orchestrator.cosim.system import resolve_system
+    from orchestrator.run.runner import run_scenario
+
+    scenario = _long_scenario(args)
+    system = resolve_system(scenario, fmu_paths=ensure_fmus(scenario, None))
+    prepared_s = time.perf_counter() - wall0
+    with tempfile.TemporaryDirectory(prefix="dtcosim-long-") as tmp:
+        wall, cpu = time.perf_counter(), time.process_time()
+        report = run_scenario(system, Path(tmp), handle_sigint=False, results_format=args.child)
+        wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
+        assert report.outcome.complete and not report.problems, (report.outcome.error, report.problems)
+        results = report.files["timeseries"]
+        print(json.dumps({
+            "format": args.child, "kernel": choose_kernel()[0], "wall_s": wall, "cpu_s": cpu,
+            "start_up_s": prepared_s, "cosimulation_s": report.outcome.wall_time_s,
+            "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
+            "results_file": results.name, "results_mb": results.stat().st_size / 1e6,
+            "samples": report.summary["samples"], "steps": report.outcome.steps,
+            "plots": sum(1 for k in report.files if k.startswith("plot:")),
+        }))
+
+
+def whole_runs_main(args) -> None:
+    """Whole runs, one fresh process per kernel and format; a table against the targets."""
+    print(f"paper-60s over 0-{args.stop:g} s, H = {'the scenario default' if args.step is None else args.step}; "
+          f"each run in a fresh process (peak RSS = the whole process)\n")
+    print("| kernel | results | wall [s] | CPU [s] | of which co-simulation wall [s] | peak RSS [MB] | "
+          "results file [MB] |")
+    print("|---|---|---|---|---|---|---|")
+    rows = []
+    for kernel in args.kernels.split(","):
+        for fmt in args.formats.split(","):
+            cmd = [sys.executable, __file__, "--child", fmt, "--stop", str(args.stop)]
+            if args.step is not None:
+                cmd += ["--step", str(args.step)]
+            proc = subprocess.run(cmd, capture_output=True, text=True, env={**os.environ, "DTCOSIM_KERNEL": kernel})
+            if proc.returncode != 0:
+                print(f"| {kernel} | {fmt} | failed: {proc.stderr.strip().splitlines()[-1:]} |")
+                continue
+            r = json.loads(proc.stdout.strip().splitlines()[-1])
+            rows.append(r)
+            print(f"| {r['kernel']} | {r['results_file']} | {r['wall_s']:.2f} | {r['cpu_s']:.2f} | "
+                  f"{r['cosimulation_s']:.2f} | {r['peak_rss_mb']:.0f} | {r['results_mb']:.1f} |", flush=True)
+    if rows:
+        r = rows[0]
+        print(f"\n{r['samples']} samples, {r['steps']} steps, {r['plots']} plots per run; targets: wall <= 10 s, "
+              "peak RSS <= 150 MB, results file <= 60 MB")
+        csv = {x["kernel"]: x for x in rows if x["format"] == "csv"}
+        for x in rows:
+            base = csv.get(x["kernel"])
+            if x["format"] != "csv" and base:
+                print(f"{x['kernel']}: {x['format']} / csv: wall {x['wall_s'] / base['wall_s']:.2f}, "
+                      f"CPU {x['cpu_s'] / base['cpu_s']:.2f}, peak RSS {x['peak_rss_mb'] / base['peak_rss_mb']:.2f}, "
+                      f"file {x['results_mb'] / base['results_mb']:.2f}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--stop", type=float, default=600.0, help="stop time [s] (default 600)")
     parser.add_argument("--step", type=float, default=None, help="communication step [s] (default: the scenario's)")
-    parser.add_argument("--out", type=Path, default=None, help="result directory (default: a temporary one)")
+    parser.add_argument("--out", type=Path, default=None, help="result directory of --phases (default: temporary)")
+    parser.add_argument("--formats", default="csv,parquet", help="results formats of the whole runs")
+    parser.add_argument("--kernels", default="compiled,numpy", help="Gearbox kernels of the whole runs")
+    parser.add_argument("--phases", action="store_true", help="time the phases of one run in this process instead")
+    parser.add_argument("--child", default=None, help=argparse.SUPPRESS)
     args = parser.parse_args()
+    if args.child:
+        child_main(args)
+    elif args.phases:
+        phases_main(args)
+    else:
+        whole_runs_main(args)
+
+
+def phases_main(args) -> None:
     start_rss = _memory_mb("VmRSS")
     phases = Phases()
 
@@ -84,18 +177,21 @@ def main() -> None:
     from orchestrator.cosim.fmu_store import ensure_fmus
     from orchestrator.cosim.master import CoSimulation
     from orchestrator.cosim.system import resolve_system
-    from orchestrator.inputs.scenario import find_scenario, load_scenario
     from orchestrator.run.analyses import analyse_run
     from orchestrator.run.derived import generator_vs_ideal
     from orchestrator.run.plots import plot_run
-    from orchestrator.run.results import SUMMARY_FILE, TIMESERIES_FILE, build_summary, write_timeseries
+    from orchestrator.cosim.master import BLOCK_STEPS
+    from orchestrator.run.results import (
+        SUMMARY_FILE,
+        TIMESERIES_FILE,
+        TIMESERIES_PARQUET,
+        build_summary,
+        write_timeseries,
+    )
     from orchestrator.result_files import write_summary
 
     def resolve():
-        scenario = load_scenario(find_scenario("paper-60s")).with_simulation(stop_s=args.stop,
-                                                                           window_s=(5.0, args.stop))
-        if args.step is not None:
-            scenario = scenario.with_simulation(step_s=args.step, output_interval_s=args.step)
+        scenario = _long_scenario(args)
         return resolve_system(scenario, fmu_paths=ensure_fmus(scenario, None))
 
     system = phases.run("scenario + FMU paths", resolve)
@@ -109,7 +205,11 @@ def main() -> None:
         outcome = phases.run("co-simulation (instantiate, step, free)",
                              lambda: CoSimulation(system).run(handle_sigint=False))
         assert outcome.complete, outcome.error
-        csv = phases.run("timeseries.csv", write_timeseries, out / TIMESERIES_FILE, outcome)
+        chunk = BLOCK_STEPS // sim.output_stride or 1
+        csv = phases.run(f"timeseries.csv (chunks of {chunk} rows)", write_timeseries, out / TIMESERIES_FILE,
+                         outcome, chunk)
+        parquet = phases.run(f"timeseries.parquet (chunks of {chunk} rows)", write_timeseries,
+                             out / TIMESERIES_PARQUET, outcome, chunk)
         npy = phases.run("(comparison: np.save of the same samples)", np.save, out / "timeseries.npy", outcome.values)
         fig16 = phases.run("generator vs ideal", generator_vs_ideal, system, outcome)
         analyses = phases.run("analyses + their plots", analyse_run, system, outcome, out, plots=True)
@@ -126,7 +226,8 @@ def main() -> None:
         phases.print()
         sizes = {p.name: p.stat().st_size for p in out.iterdir() if p.is_file()}
         print()
-        print(f"files: timeseries.csv {sizes[csv.name] / 1e6:.1f} MB, np.save of the same samples "
+        print(f"files: timeseries.csv {sizes[csv.name] / 1e6:.1f} MB, timeseries.parquet "
+              f"{sizes[parquet.name] / 1e6:.1f} MB, np.save of the same samples "
               f"{sizes[Path(str(npy)).name if npy else 'timeseries.npy'] / 1e6:.1f} MB, plots "
               f"{sum(v for k, v in sizes.items() if k.endswith('.png')) / 1e6:.1f} MB "
               f"({len(plots) + sum(1 for k in analyses.files if 'plot' in k)} PNG), everything "
@@ -134,7 +235,8 @@ def main() -> None:
         wall = sum(r[1] for r in phases.rows if not r[0].startswith("(")) - phases.rows[0][1]
         peak = max(r[3] for r in phases.rows)
         print(f"targets: wall without imports {wall:.1f} s (<= 10 s), peak RSS {peak:.0f} MB (<= 150 MB), "
-              f"results file {sizes[csv.name] / 1e6:.1f} MB as CSV (<= 60 MB)")
+              f"results file {sizes[csv.name] / 1e6:.1f} MB as CSV, {sizes[parquet.name] / 1e6:.1f} MB as Parquet "
+              "(<= 60 MB); both formats written here, a run writes one")
 
 
 if __name__ == "__main__":
