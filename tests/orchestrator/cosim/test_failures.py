@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from orchestrator.inputs.scenario import find_scenario, load_scenario
-from orchestrator.result_files import read_timeseries
+from orchestrator.result_files import find_timeseries, read_timeseries
 from tests.helpers.scenarios import TOY_SCENARIO, dtcosim
 
 pytestmark = pytest.mark.slow
@@ -75,6 +75,8 @@ def test_ctrl_c_stops_the_run_and_writes_partial_results(fmu_dir, tmp_path):
     assert summary["complete"] is False and summary["interrupted"] is True
     assert 0.0 < summary["stopped_at"] < 600.0
     assert "interrupted" in summary["error"]
-    header, data = read_timeseries(out / "timeseries.csv")
+    # 600 001 samples x 22 variables: the binary results file by default (orchestrator.inputs.results_format)
+    assert summary["files"]["timeseries"] == "timeseries.parquet" == find_timeseries(out).name
+    header, data = read_timeseries(find_timeseries(out))
     assert data.shape[0] == round(summary["stopped_at"] / 1e-3) + 1
     assert np.all(np.isfinite(data))
