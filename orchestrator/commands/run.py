@@ -113,6 +113,11 @@ def run(args: argparse.Namespace) -> int:
             if dev.get("max_abs") is not None:
                 print(f"generator vs {fig16['ratio']:.6g} x rotor speed: mean {dev['mean']:+.2e}, "
                       f"max |deviation| {dev['max_abs']:.2e} (relative)")
+        for row in s.get("recorded_comparison", []):
+            print(f"simulated {row['simulated']} vs recorded {row['recorded']} over [{w0:g}, {w1:g}] s: "
+                  f"RMS difference {row['rms_difference']:.4g} ({100 * row['rms_difference_relative']:.3g} % of the "
+                  f"record's RMS), max {row['max_difference']:.4g} ({100 * row['max_difference_relative']:.3g} %), "
+                  f"mean {row['mean_difference']:+.4g}")
         analyses = format_analyses(s)
         if analyses:
             print(analyses)

@@ -20,6 +20,7 @@ from .analyses import analyse_run
 from .comparison import compare, format_comparison, run_reference
 from .derived import Skipped, generator_vs_ideal
 from .plots import plot_run
+from .recorded import compare_recorded, plot_recorded
 from .results import SUMMARY_FILE, TIMESERIES_FILE, build_summary, write_timeseries
 
 
@@ -104,6 +105,9 @@ def run_scenario(system: ResolvedSystem, out_dir: str | Path, *, compare_referen
     if system.events:
         derived["events"] = [a.as_dict() for a in system.events]
     derived["analysis_settings"] = system.scenario.analysis.as_dict()
+    recorded = compare_recorded(system, outcome)
+    if recorded:  # simulated against recorded channels (a TimeSeriesSource playing a record)
+        derived["recorded_comparison"] = recorded
     analyses = analyse_run(system, outcome, out, plots=plots)
     derived.update(analyses.summary)
     if analyses.notes:
@@ -128,6 +132,9 @@ def run_scenario(system: ResolvedSystem, out_dir: str | Path, *, compare_referen
     if plots:
         for p in plot_run(system, outcome, out, skipped):
             files[f"plot:{p.stem}"] = p
+        recorded_plot = plot_recorded(system, outcome, out)
+        if recorded_plot is not None:
+            files[f"plot:{recorded_plot.stem}"] = recorded_plot
     derived["analyses_skipped"] = skipped
     summary = build_summary(
         system, outcome, wall_time_s=time.perf_counter() - wall0, derived=derived, comparison=comparison,
