@@ -93,3 +93,31 @@ def plot_recorded(system: ResolvedSystem, outcome: RunOutcome, out_dir: str | Pa
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
+
+
+def plot_contact_loss_counts(summary_contact_loss: dict, out_dir: str | Path, title: str) -> Path | None:
+    """``contact_loss_counts.png``: separations and flank changes per mesh (None without contact loss)."""
+    meshes = summary_contact_loss.get("meshes", {}) if summary_contact_loss else {}
+    if not meshes or not summary_contact_loss.get("total_separations"):
+        return None
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    names = list(meshes)
+    x = np.arange(len(names))
+    fig, ax = plt.subplots(figsize=(max(6.0, 0.7 * len(names) + 2.0), 4.2))
+    ax.bar(x - 0.2, [meshes[n]["separations"] for n in names], 0.4, label="separations (contact -> no contact)")
+    ax.bar(x + 0.2, [meshes[n]["flank_changes"] for n in names], 0.4, label="flank changes")
+    ax.set_xticks(x, [n.split(".", 1)[1] for n in names], rotation=60, ha="right", fontsize=8)
+    ax.set_ylabel("count [-]")
+    w0, w1 = summary_contact_loss["window_s"]
+    ax.set_title(f"{title}: contact loss per mesh over [{w0:g}, {w1:g}] s")
+    ax.legend(loc="best", fontsize=8)
+    ax.grid(axis="y", alpha=0.3)
+    fig.tight_layout()
+    path = Path(out_dir) / "contact_loss_counts.png"
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

@@ -20,7 +20,7 @@ from .analyses import analyse_run
 from .comparison import compare, format_comparison, run_reference
 from .derived import Skipped, generator_vs_ideal
 from .plots import plot_run
-from .recorded import compare_recorded, plot_recorded
+from .recorded import compare_recorded, plot_contact_loss_counts, plot_recorded
 from .results import SUMMARY_FILE, TIMESERIES_FILE, build_summary, write_timeseries
 
 
@@ -135,6 +135,9 @@ def run_scenario(system: ResolvedSystem, out_dir: str | Path, *, compare_referen
         recorded_plot = plot_recorded(system, outcome, out)
         if recorded_plot is not None:
             files[f"plot:{recorded_plot.stem}"] = recorded_plot
+        counts_plot = plot_contact_loss_counts(derived.get("contact_loss"), out, system.scenario.name)
+        if counts_plot is not None:
+            files[f"plot:{counts_plot.stem}"] = counts_plot
     derived["analyses_skipped"] = skipped
     summary = build_summary(
         system, outcome, wall_time_s=time.perf_counter() - wall0, derived=derived, comparison=comparison,
