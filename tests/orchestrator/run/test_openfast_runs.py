@@ -158,3 +158,21 @@ interpolation = "linear"
     f = Interpolant(t, speed * rpm, "pchip")
     assert fine["w"] == pytest.approx([f.value(x) for x in fine["time"]], rel=1e-13)
     assert fine["phi"] == pytest.approx([f.integral(x) for x in fine["time"]], rel=1e-12, abs=1e-14)
+
+
+def test_build_validate_and_export_ssp_with_the_new_fmus(fmu_home, tmp_path, capsys):
+    import zipfile
+
+    from orchestrator.commands.cli import main as dtcosim
+
+    openfast_file("DLC1.1_0_NREL5MW_OC3_spar_2.outb")
+    assert dtcosim(["build", "--scenario", "openfast-dlc11-torque", "--out", str(fmu_home)]) == 0
+    built = sorted(fmu_home.rglob("*.fmu"))
+    assert {p.name for p in built} >= {"TimeSeriesSource.fmu", "Rotor.fmu", "TorqueController.fmu"}
+    assert dtcosim(["validate", *map(str, built)]) == 0
+    ssp = tmp_path / "torque.ssp"
+    assert dtcosim(["export-ssp", "openfast-dlc11-torque", "--fmu-dir", str(fmu_home), "--out", str(ssp)]) == 0
+    with zipfile.ZipFile(ssp) as zf:
+        assert {"resources/TimeSeriesSource.fmu", "resources/Rotor.fmu", "resources/TorqueController.fmu"} <= set(zf.namelist())
+    capsys.readouterr()
+    assert dtcosim(["run", str(ssp), "--stop", "0.2", "--out", str(tmp_path / "ssp-run"), "--no-plots"]) == 0
