@@ -25,16 +25,20 @@ class ParameterError(DtcosimError, ValueError):
         The rejected value.
     expected : str
         Human-readable description of what is admissible, e.g. ``"> 0"``.
+    bounds : components.validation.Bounds, optional
+        The admissible range as numbers, when it is a simple one (the validators
+        of :mod:`components.validation` attach it; FMU builds publish it).
     """
 
-    def __init__(self, name: str, value: Any, expected: str) -> None:
+    def __init__(self, name: str, value: Any, expected: str, bounds: Any = None) -> None:
         self.name = name
         self.value = value
         self.expected = expected
+        self.bounds = bounds
         super().__init__(f"invalid parameter {name} = {value!r}: expected {expected}")
 
     def __reduce__(self):  # keep the exception picklable (Dask ships it between processes)
-        return (type(self), (self.name, self.value, self.expected))
+        return (type(self), (self.name, self.value, self.expected, self.bounds))
 
 
 class SolverError(DtcosimError, RuntimeError):

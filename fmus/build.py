@@ -16,8 +16,10 @@ Each FMU is self-contained and collision-free:
   host process): it only subclasses the slave with the build id;
 * ``resources/dtcosim.json`` is the FMU's record (:mod:`fmus.slaves.record`):
   the parameter set it is built from (a drivetrain preset's structure and
-  defaults; wind and generator parameter sets), its declared role and the
-  signals of its outputs. The slave builds its interface from that record at
+  defaults; wind and generator parameter sets), its declared role, the
+  signals of its outputs and the bounds of its parameters (probed from the
+  slave's own validation, :func:`fmus.parameter_ranges.parameter_bounds`; also
+  written as FMI ``min``/``max``). The slave builds its interface from that record at
   instantiation, and hosts read it instead of guessing what the FMU is.
 
 Two FMUs built from different code therefore run their own code in one
@@ -50,6 +52,7 @@ from components.model.presets import PRESETS, cosim_preset
 from components.model.wind import WindParameters
 
 from . import model_description, runtime_files
+from .parameter_ranges import parameter_bounds
 from .records import full_record, model_of
 from .slaves import base as slave_base
 from .slaves.record import RECORD_FILE
@@ -340,11 +343,12 @@ def build_fmu(name: str, out_dir: Path | str, preset: str = "table6", source: So
             role = slave_class.role
         finally:
             _forget_modules([package, script.stem], [str(script.parent)])
-    record = full_record(name, role, model, origin, variables)
+    bounds = parameter_bounds(name, model)
+    record = full_record(name, role, model, origin, variables, bounds)
     xml = model_description.finalize(
         model_description.read_member(fmu_path), variables, build_id,
         f"dtcosim {components.__version__} with PythonFMU {pythonfmu.__version__}",
-        role=role, record_file=f"resources/{RECORD_FILE}",
+        role=role, record_file=f"resources/{RECORD_FILE}", bounds=bounds,
     )
     xml = runtime_files.describe(xml, runtime.requirements)
     model_description.rewrite_archive(fmu_path, {model_description.MODEL_DESCRIPTION: xml,

@@ -11,7 +11,10 @@ pythonfmu emits neither units nor ``InitialUnknowns``; this module adds
   feedthrough: outputs change only in ``doStep``);
 * a deterministic GUID derived from the build hash and the generation tool;
 * ``VendorAnnotations`` with the dtcosim tool entry: the component's declared
-  role and where its record is (``resources/dtcosim.json``).
+  role and where its record is (``resources/dtcosim.json``);
+* ``min`` and ``max`` of every parameter whose validation has a simple range
+  (:class:`components.validation.Bounds`; FMI bounds are inclusive like these),
+  so any host can check a value before it instantiates the FMU.
 """
 
 from __future__ import annotations
@@ -20,7 +23,7 @@ import io
 import uuid
 import zipfile
 from pathlib import Path
-from typing import Iterable
+from typing import Any, Iterable, Mapping
 from xml.etree import ElementTree as ET
 
 from .slaves.interface import OUTPUT, REAL, UNITS, Variable
@@ -61,7 +64,7 @@ def unit_definitions(unit_names: Iterable[str]) -> ET.Element:
 
 
 def finalize(xml: bytes, variables: tuple[Variable, ...], build_id: str, generation_tool: str,
-             role: str = "", record_file: str = "") -> bytes:
+             role: str = "", record_file: str = "", bounds: Mapping[str, Any] | None = None) -> bytes:
     """Add units, InitialUnknowns, output dependencies, a deterministic GUID and the vendor annotation.
 
     Parameters
@@ -78,6 +81,8 @@ def finalize(xml: bytes, variables: tuple[Variable, ...], build_id: str, generat
         The component's role and its record's path in the archive, written as
         ``<VendorAnnotations><Tool name="dtcosim"><Component role=... record=.../></Tool>``
         (omitted when empty).
+    bounds : mapping of str -> Bounds, optional
+        Parameter ranges, written as the ``min``/``max`` attributes of their type element.
 
     Returns
     -------
@@ -97,6 +102,12 @@ def finalize(xml: bytes, variables: tuple[Variable, ...], build_id: str, generat
             real.set("unit", var.unit)
             if var.start is not None:  # exact round trip (pythonfmu writes 16 significant digits)
                 real.set("start", _format_real(var.start))
+        b = (bounds or {}).get(var.name)
+        if b is not None and var.type in (REAL, "Integer"):
+            element = node.find(var.type)
+            text = _format_real if var.type == REAL else (lambda x: str(int(x)))
+            element.set("min", text(b.minimum))
+            element.set("max", text(b.maximum))
 
     root.set("guid", "{" + str(uuid.uuid5(_GUID_NAMESPACE, f"{root.get('modelName')}:{build_id}:{generation_tool}")) + "}")
     root.set("generationTool", generation_tool)

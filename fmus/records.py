@@ -57,9 +57,13 @@ def signals_of(variables: Iterable[Variable]) -> dict[str, dict[str, str]]:
 
 
 def full_record(name: str, role: str, model: Mapping[str, Any], source: str,
-                variables: Iterable[Variable] = ()) -> dict[str, Any]:
-    """The complete record of FMU ``name`` (format :data:`~fmus.slaves.record.RECORD_FORMAT`)."""
-    return {
+                variables: Iterable[Variable] = (), bounds: Mapping[str, Any] | None = None) -> dict[str, Any]:
+    """The complete record of FMU ``name`` (format :data:`~fmus.slaves.record.RECORD_FORMAT`).
+
+    ``bounds`` (parameter -> :class:`components.validation.Bounds`) become the record's
+    ``bounds``: what a host checks a value against before it instantiates the FMU.
+    """
+    record = {
         "format": RECORD_FORMAT,
         "fmu": name,
         "role": role,
@@ -68,3 +72,6 @@ def full_record(name: str, role: str, model: Mapping[str, Any], source: str,
         "model": dict(model),
         "signals": signals_of(variables),
     }
+    if bounds:
+        record["bounds"] = {var: b.as_dict() for var, b in bounds.items()}
+    return record

@@ -13,6 +13,7 @@ from typing import Iterable
 from fmpy import read_model_description
 from fmpy.validation import validate_fmu
 
+from .archive_checks import RECORD_MEMBER, archive_problems
 from .requirements import ARCHIVE_MEMBER, read_from_fmu
 from .runtime_guard import RequirementsFormatError
 
@@ -53,7 +54,6 @@ def runtime_declaration_problems(fmu_path: Path | str) -> list[str]:
     return problems
 
 
-RECORD_MEMBER = "resources/dtcosim.json"
 
 
 def archive_problem(fmu_path: Path | str) -> str | None:
@@ -77,17 +77,21 @@ def is_dtcosim_fmu(fmu_path: Path | str) -> bool:
 
 
 def check_fmu(fmu_path: Path | str) -> list[str]:
-    """All problems of one FMU (empty if it is valid): fmpy's validation, and dtcosim's conventions for its own FMUs."""
+    """All problems of one FMU (empty if it is valid): a readable archive this platform can load, fmpy's validation,
+    and dtcosim's conventions for its own FMUs."""
     problem = archive_problem(fmu_path)
     if problem is not None:
         return [problem]
     try:
         problems = validate_fmu(str(fmu_path))
-    except Exception as exc:  # fmpy raises on XML it cannot parse at all
+    except Exception as exc:  # noqa: BLE001 - fmpy raises plain exceptions for XML it cannot parse at all
         return [f"modelDescription.xml cannot be read ({exc})"]
     if problems:
         return list(problems)
-    return convention_problems(fmu_path) if is_dtcosim_fmu(fmu_path) else []
+    md = read_model_description(str(fmu_path), validate=False)
+    identifier = md.coSimulation.modelIdentifier if md.coSimulation is not None else None
+    problems = archive_problems(fmu_path, identifier, md.generationTool or "")
+    return problems + (convention_problems(fmu_path) if is_dtcosim_fmu(fmu_path) else [])
 
 
 def fmu_files(paths: Iterable[Path | str]) -> list[Path]:

@@ -97,6 +97,10 @@ class InitializationError(DtcosimError, RuntimeError):
     """The initial values could not be propagated (FMI call failed or no fixed point)."""
 
 
+#: what pythonfmu 0.7's C wrapper logs after any Python exception in a slave ("... PyObject_CallMethod unknown error")
+_WRAPPER_NOISE = "Fatal py exception encountered"
+
+
 class FmuStepError(DtcosimError, RuntimeError):
     """An FMU returned a status worse than fmi2Warning during the run.
 
@@ -120,7 +124,9 @@ class FmuStepError(DtcosimError, RuntimeError):
         self.time_s = float(time_s)
         self.status = int(status)
         self.log = list(log or [])
-        detail = ("; FMU log: " + " | ".join(self.log[-5:])) if self.log else ""
+        # pythonfmu adds its own line after an exception the slave already explained: show the explanation
+        shown = [m for m in self.log if _WRAPPER_NOISE not in m] or self.log
+        detail = ("; FMU log: " + " | ".join(shown[-5:])) if shown else ""
         super().__init__(
             f"FMU {component!r}: {function} returned {status_label(self.status)} (status {self.status}) "
             f"at t = {self.time_s:.6g} s{detail}"
@@ -132,3 +138,49 @@ class FmuStepError(DtcosimError, RuntimeError):
 
 class SspError(DtcosimError, ValueError):
     """An SSP file cannot be read or written (names the file and the problem)."""
+
+
+def signal_name(signum: int) -> str:
+    """``2`` -> ``"SIGINT"``."""
+    import signal
+
+    try:
+        return signal.Signals(signum).name
+    except ValueError:
+        return f"signal {signum}"
+
+
+def reason_of(signum: int) -> str:
+    """Why a run stopped, as a summary and the command line say it: ``"interrupted by SIGTERM"``."""
+    import signal
+
+    if signum == signal.SIGINT:
+        return "interrupted by the user (Ctrl-C)"
+    return f"interrupted by {signal_name(signum)}"
+
+
+class RunInterrupted(KeyboardInterrupt):
+    """A stop signal (SIGINT, SIGTERM, SIGHUP) ended a command before it could finish its current stage.
+
+    A KeyboardInterrupt, so nothing that catches ``Exception`` swallows it; the
+    command line turns it into one line and the exit status ``128 + signum``.
+
+    Parameters
+    ----------
+    signum : int
+        The signal.
+    stage : str
+        What was going on (``"instantiation"``, ``"initialisation"``, ...).
+    time_s : float, optional
+        Simulation time reached [s].
+    """
+
+    def __init__(self, signum: int, stage: str, time_s: float | None = None) -> None:
+        self.signum = int(signum)
+        self.stage = stage
+        self.time_s = time_s
+        at = f" at t = {time_s:.6g} s" if time_s is not None else ""
+        super().__init__(f"{reason_of(self.signum)} during {stage}{at}")
+
+    def __reduce__(self):
+        return (type(self), (self.signum, self.stage, self.time_s))

@@ -14,6 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .atomic_files import atomic_path
+
 RPM_PER_RAD_S = 60.0 / (2.0 * math.pi)
 
 
@@ -83,9 +85,20 @@ def new_figure(rows: int = 1, height: float = 4.0, sharex: bool = True, width: f
     return fig, axes
 
 
+def new_grid(rows: int, columns: int, height: float, width: float, sharex: str | bool = "col"):
+    """A headless figure of ``rows`` x ``columns`` axes: (figure, 2-D axes array)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(width, height), dpi=110, layout="constrained")
+    FigureCanvasAgg(fig)
+    return fig, fig.subplots(rows, columns, sharex=sharex, squeeze=False)
+
+
 def save_figure(fig, path: Path) -> Path:
-    """Write the figure as PNG; returns ``path``."""
-    fig.savefig(path)
+    """Write the figure as PNG (temporary file and rename); returns ``path``."""
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp)
     return path
 
 
@@ -93,8 +106,11 @@ def close_figure(fig, path: str | Path) -> Path:
     """Write a pyplot figure as PNG (tight bounding box, 120 dpi), close it and return ``path``."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120, bbox_inches="tight")
     import matplotlib.pyplot as plt
 
-    plt.close(fig)
+    try:
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=120, bbox_inches="tight")
+    finally:
+        plt.close(fig)
     return path

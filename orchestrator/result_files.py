@@ -15,6 +15,8 @@ from typing import Any, Mapping
 
 import numpy as np
 
+from .atomic_files import atomic_path, write_text_atomic
+
 _PACKAGES = ("dtcosim", "numpy", "scipy", "fmpy", "pythonfmu", "matplotlib")
 
 
@@ -29,40 +31,16 @@ def versions() -> dict[str, str]:
     return out
 
 
-def write_series_csv(path: str | Path, header: list[str], time_s: np.ndarray, values: np.ndarray,
-                     types: list[str] | None = None, text: Mapping[int, np.ndarray] | None = None) -> Path:
+def write_series_csv(path: str | Path, header: list[str], time_s: np.ndarray, values: np.ndarray) -> Path:
     """CSV of ``time_s`` (N,) and ``values`` (N, M) under ``header`` (M + 1 fields), 17 significant digits.
 
-    ``types`` (M FMI type names) formats the non-Real columns: Integer and Enumeration
-    as integers, Boolean as 0/1, String (from ``text``: column index -> N strings)
-    quoted with doubled inner quotes. Without it every column is Real.
+    Written by temporary file and rename: ``path`` is whole or not there.
     """
     path = Path(path)
-    if types is not None and any(t != "Real" for t in types):
-        return _write_typed_csv(path, header, time_s, values, types, dict(text or {}))
     table = np.column_stack([time_s, values]) if values.size else np.asarray(time_s)[:, None]
-    with open(path, "w", encoding="utf-8", newline="\n") as fh:
+    with atomic_path(path) as tmp, open(tmp, "w", encoding="utf-8", newline="\n") as fh:
         fh.write(",".join(_csv_field(h) for h in header) + "\n")
         np.savetxt(fh, table, delimiter=",", fmt="%.17g")
-    return path
-
-
-def _write_typed_csv(path: Path, header: list[str], time_s: np.ndarray, values: np.ndarray, types: list[str],
-                     text: dict[int, np.ndarray]) -> Path:
-    def fmt(typ: str, j: int):
-        if typ == "String":
-            column = text[j]
-            return lambda i: '"' + str(column[i]).replace('"', '""') + '"'
-        column = values[:, j]
-        if typ in ("Integer", "Enumeration", "Boolean"):
-            return lambda i: "%d" % column[i]
-        return lambda i: "%.17g" % column[i]
-
-    formats = [fmt(t, j) for j, t in enumerate(types)]
-    with open(path, "w", encoding="utf-8", newline="\n") as fh:
-        fh.write(",".join(_csv_field(h) for h in header) + "\n")
-        for i, t in enumerate(time_s):
-            fh.write(",".join(["%.17g" % t] + [f(i) for f in formats]) + "\n")
     return path
 
 
@@ -71,12 +49,21 @@ def _csv_field(text: str) -> str:
 
 
 def read_timeseries(path: str | Path) -> tuple[list[str], np.ndarray]:
-    """Read a ``timeseries.csv``: (header fields, array of shape (n_samples, n_columns))."""
-    import csv
+    """Read a ``timeseries.csv``: (header fields, array of shape (n_samples, n_columns)).
 
-    with open(path, encoding="utf-8") as fh:
-        header = next(csv.reader(fh))
-        data = np.loadtxt(fh, delimiter=",", ndmin=2)
+    Also reads a file a killed run left (``timeseries.csv.partial``): a last line
+    without its line end (a chunk cut by the kill) is not a sample and is left out.
+    """
+    import csv
+    import io
+
+    text = Path(path).read_text(encoding="utf-8")
+    if text and not text.endswith("\n"):
+        text = text[:text.rfind("\n") + 1]
+    fh = io.StringIO(text)
+    header = next(csv.reader(fh))
+    rest = fh.read()
+    data = np.loadtxt(io.StringIO(rest), delimiter=",", ndmin=2) if rest.strip() else np.empty((0, len(header)))
     return header, data
 
 
@@ -95,7 +82,5 @@ def jsonable(value: Any) -> Any:
 
 
 def write_summary(path: str | Path, summary: Mapping[str, Any]) -> Path:
-    """Write ``summary.json`` (indented, NaN/inf as null)."""
-    path = Path(path)
-    path.write_text(json.dumps(jsonable(summary), indent=2, allow_nan=False) + "\n", encoding="utf-8")
-    return path
+    """Write ``summary.json`` (indented, NaN/inf as null) by temporary file and rename."""
+    return write_text_atomic(path, json.dumps(jsonable(summary), indent=2, allow_nan=False) + "\n")

@@ -48,6 +48,7 @@ from dataclasses import replace
 from typing import Mapping
 
 from ..errors import ParameterError
+from ..validation import choice_bounds
 from .contact import CONTACT_LAWS, MeshContact
 from .drivetrain import Drivetrain
 from .generator import EVENT_KINDS, GeneratorParameters, LoadEvent
@@ -166,7 +167,7 @@ def _mesh_from(prefix: str, mesh: MeshContact, values: Mapping[str, float]) -> M
         code = values[key]
         if not (isinstance(code, (int, float)) and not isinstance(code, bool) and float(code).is_integer()
                 and 0 <= int(code) < len(CONTACT_LAWS)):
-            raise ParameterError(key, code, "0 (CFS) or 1 (impact)")
+            raise ParameterError(key, code, "0 (CFS) or 1 (impact)", choice_bounds(CONTACT_LAWS, "0 (CFS) or 1 (impact)"))
         changes["law"] = CONTACT_LAWS[int(code)]
     key = f"{prefix}.impact_damping"
     if key in values:
@@ -176,7 +177,7 @@ def _mesh_from(prefix: str, mesh: MeshContact, values: Mapping[str, float]) -> M
         return replace(mesh, **changes)
     except ParameterError as exc:  # re-raise under the flat name
         flat = next((f"{prefix}.{k}" for k, f in _MESH_FIELDS.items() if exc.name in (f, k)), f"{prefix}.{exc.name}")
-        raise ParameterError(flat, exc.value, exc.expected) from None
+        raise ParameterError(flat, exc.value, exc.expected, exc.bounds) from None
 
 
 def unflatten(template: Drivetrain, values: Mapping[str, float]) -> Drivetrain:
@@ -209,7 +210,7 @@ def unflatten(template: Drivetrain, values: Mapping[str, float]) -> Drivetrain:
         except ParameterError as exc:
             local = exc.name.split(".", 1)[-1]
             flat = next((f"{st.name}.{k}" for k, f in fields.items() if f == local), exc.name)
-            raise ParameterError(flat, exc.value, exc.expected) from None
+            raise ParameterError(flat, exc.value, exc.expected, exc.bounds) from None
 
     def shaft(sh: Shaft) -> Shaft:
         try:
@@ -219,7 +220,7 @@ def unflatten(template: Drivetrain, values: Mapping[str, float]) -> Drivetrain:
                 values.get(f"{sh.name}.damping", sh.damping_nms_per_rad),
             )
         except ParameterError as exc:
-            raise ParameterError(exc.name.replace("_nm_per_rad", "").replace("_nms_per_rad", ""), exc.value, exc.expected) from None
+            raise ParameterError(exc.name.replace("_nm_per_rad", "").replace("_nms_per_rad", ""), exc.value, exc.expected, exc.bounds) from None
 
     shafts = tuple(shaft(sh) for sh in template.shafts)
     if template.generator is not None:
@@ -238,7 +239,8 @@ def unflatten(template: Drivetrain, values: Mapping[str, float]) -> Drivetrain:
 def _integer_code(name: str, value, choices: tuple[str, ...]) -> int:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not float(value).is_integer() \
             or not 0 <= int(value) < len(choices):
-        raise ParameterError(name, value, ", ".join(f"{i} = {c}" for i, c in enumerate(choices)))
+        text = ", ".join(f"{i} = {c}" for i, c in enumerate(choices))
+        raise ParameterError(name, value, text, choice_bounds(choices, text))
     return int(value)
 
 
@@ -257,7 +259,7 @@ def wind_from_values(values: Mapping[str, float | int], template: WindParameters
     try:
         return replace(template, **changes)
     except ParameterError as exc:  # WindParameters names them wind.<flat name>
-        raise ParameterError(exc.name.removeprefix("wind."), exc.value, exc.expected) from None
+        raise ParameterError(exc.name.removeprefix("wind."), exc.value, exc.expected, exc.bounds) from None
 
 
 def generator_values(params: GeneratorParameters, n_slots: int = N_EVENT_SLOTS) -> dict[str, float | int]:
@@ -295,7 +297,7 @@ def events_from_slots(values: Mapping[str, float | int], n_slots: int = N_EVENT_
         except ParameterError as exc:  # LoadEvent names them event.<field>
             local = exc.name.removeprefix("event.")
             flat = next((k for k, f in _SLOT_FIELDS.items() if f == local), local)
-            raise ParameterError(f"event{i}.{flat}", exc.value, exc.expected) from None
+            raise ParameterError(f"event{i}.{flat}", exc.value, exc.expected, exc.bounds) from None
     return tuple(events)
 
 
@@ -314,4 +316,4 @@ def generator_from_values(values: Mapping[str, float | int], template: Generator
     except ParameterError as exc:  # GeneratorParameters names them generator.<field>
         local = exc.name.removeprefix("generator.")
         flat = next((k for k, f in GENERATOR_FIELDS.items() if f == local), local)
-        raise ParameterError(flat, exc.value, exc.expected) from None
+        raise ParameterError(flat, exc.value, exc.expected, exc.bounds) from None

@@ -15,7 +15,8 @@ the two-inertia system (evaluated with a scaled Taylor series, numpy only).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from typing import Mapping
 
 import numpy as np
 
@@ -58,6 +59,22 @@ class RotorParameters:
     @property
     def has_shaft(self) -> bool:
         return self.shaft_stiffness_nm_rad > 0.0
+
+
+#: flat (FMU) parameter name -> field of :class:`RotorParameters`
+ROTOR_FIELDS = {"inertia": "inertia_kgm2", "shaft_stiffness": "shaft_stiffness_nm_rad",
+                "shaft_damping": "shaft_damping_nms_rad", "carrier_inertia": "carrier_inertia_kgm2"}
+
+
+def rotor_from_values(values: Mapping[str, float], template: RotorParameters) -> RotorParameters:
+    """``template`` with the flat values that ``values`` has (:data:`ROTOR_FIELDS`); errors name the flat parameter.
+
+    Used by the Rotor FMU and by the host's checks before running.
+    """
+    try:
+        return replace(template, **{f: values[k] for k, f in ROTOR_FIELDS.items() if k in values})
+    except ParameterError as exc:  # RotorParameters names them rotor.<flat name>
+        raise ParameterError(exc.name.removeprefix("rotor."), exc.value, exc.expected, exc.bounds) from None
 
 
 def _expm(a: np.ndarray) -> np.ndarray:

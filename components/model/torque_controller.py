@@ -19,12 +19,20 @@ exactly for a speed held over a step.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from typing import Mapping
 
 from ..errors import ParameterError
-from ..validation import finite, non_negative, one_of, positive, set_fields
+from ..validation import choice_bounds, finite, is_number, non_negative, one_of, positive, set_fields
 
 REGION3_MODES = ("constant_power", "constant_torque")
+#: flat (FMU) parameter name -> field of :class:`TorqueLawParameters` (``region3_mode`` is an Integer code)
+CONTROLLER_FIELDS = {
+    "cut_in_speed": "cut_in_speed_rad_s", "region2_start": "region2_start_rad_s", "optimal_gain": "optimal_gain_nm_s2",
+    "rated_speed": "rated_speed_rad_s", "rated_power": "rated_power_w", "slip_percent": "slip_percent",
+    "rated_torque": "rated_torque_nm", "region3_min_pitch": "region3_min_pitch_rad", "max_torque": "max_torque_nm",
+    "max_rate": "max_rate_nm_s", "filter_corner": "filter_corner_rad_s",
+}
 
 
 @dataclass(frozen=True)
@@ -53,9 +61,9 @@ class TorqueLawParameters:
     max_torque_nm : float
         ``VS_MaxTq`` = 47402.91 N m.
     max_rate_nm_s : float
-        ``VS_MaxRat`` = 15000 N m/s (``inf``: no limit).
+        ``VS_MaxRat`` = 15000 N m/s (at most 1e30: a huge value means no limit).
     filter_corner_rad_s : float
-        ``CornerFreq`` = 1.570796 rad/s (``inf``: no filter).
+        ``CornerFreq`` = 1.570796 rad/s (at most 1e30: a huge value means no filter).
     """
 
     cut_in_speed_rad_s: float = 70.16224
@@ -119,6 +127,24 @@ class TorqueLawParameters:
         if k == 0.0:
             return sy
         return (s - math.sqrt(s * (s - 4.0 * k * sy))) / (2.0 * k)
+
+
+def controller_from_values(values: Mapping[str, float | int], template: TorqueLawParameters) -> TorqueLawParameters:
+    """``template`` with the flat values that ``values`` has (:data:`CONTROLLER_FIELDS`, ``region3_mode`` code).
+
+    Used by the TorqueController FMU and by the host's checks before running; errors name the flat parameter.
+    """
+    changes = {f: values[k] for k, f in CONTROLLER_FIELDS.items() if k in values}
+    if "region3_mode" in values:
+        code = values["region3_mode"]
+        text = ", ".join(f"{i} = {m}" for i, m in enumerate(REGION3_MODES))
+        if not (is_number(code) and float(code).is_integer() and 0 <= int(code) < len(REGION3_MODES)):
+            raise ParameterError("region3_mode", code, text, choice_bounds(REGION3_MODES, text))
+        changes["region3_mode"] = REGION3_MODES[int(code)]
+    try:
+        return replace(template, **changes)
+    except ParameterError as exc:  # TorqueLawParameters names them controller.<flat name>
+        raise ParameterError(exc.name.removeprefix("controller."), exc.value, exc.expected, exc.bounds) from None
 
 
 def region_of(p: TorqueLawParameters, speed_rad_s: float, pitch_rad: float = 0.0) -> str:

@@ -38,6 +38,8 @@ from ..validation import (
 )
 
 AMPLITUDE_CONVENTIONS = ("variance", "paper")
+#: most harmonics a rotor-speed process may have (each evaluation sums all of them; the paper's use 256)
+MAX_HARMONICS = 100_000
 
 
 @dataclass(frozen=True)
@@ -53,11 +55,13 @@ class WindParameters:
     sigma_rad_s : float
         Fluctuation intensity sigma [rad/s] (paper: 0.12 rpm).
     n_harmonics : int
-        Number of harmonics N (>= 1).
+        Number of harmonics N (1 to :data:`MAX_HARMONICS`).
     f_min_rad_s, f_max_rad_s : float
         Frequency range [rad/s] of the harmonics.
     seed : int
-        Seed of the phase generator (numpy ``default_rng``).
+        Seed of the phase generator (numpy ``default_rng``), 0 to 2147483647: an FMI
+        Integer is 32 bits, so a larger seed could not reach the FMU; 2^31 seeds give as
+        many independent phase sets as any study needs.
     amplitude : {"variance", "paper"}
         Amplitude convention, see module docstring.
     """
@@ -77,7 +81,7 @@ class WindParameters:
             mean_speed_rad_s=finite("wind.omega0", self.mean_speed_rad_s),
             spectrum_level=non_negative("wind.a", self.spectrum_level),
             sigma_rad_s=positive("wind.sigma", self.sigma_rad_s),
-            n_harmonics=integer_at_least("wind.n_harmonics", self.n_harmonics, 1),
+            n_harmonics=integer_at_least("wind.n_harmonics", self.n_harmonics, 1, MAX_HARMONICS),
             f_min_rad_s=non_negative("wind.f_min", self.f_min_rad_s),
             f_max_rad_s=positive("wind.f_max", self.f_max_rad_s),
             seed=integer_at_least("wind.seed", self.seed, 0),

@@ -21,7 +21,10 @@ How errors reach the host (pythonfmu 0.7 C wrapper)
   ``loggingOn = fmi2True`` (or called ``fmi2SetDebugLogging``). Errors are
   therefore also echoed to ``sys.stderr`` (see :attr:`echo_errors_to_stderr`).
 * ``do_step`` returning ``False`` gives ``fmi2Discard``: used for solver
-  failures and bad inputs; the component state is left at the last
+  failures, arithmetic failures of a step (division by zero, overflow, a
+  singular matrix: :func:`plain_reason`, never the Python exception's text),
+  bad inputs and a communication point or step that is not a finite number
+  (a step must also be > 0); the component state is left at the last
   communication point.
 * There is no way to return ``fmi2Error`` from Python: a Python exception
   becomes ``fmi2Fatal`` and its text is lost ("unknown error"), so the message
@@ -38,6 +41,7 @@ from __future__ import annotations
 
 import ctypes
 import json
+import math
 import sys
 from abc import abstractmethod
 from contextlib import contextmanager
@@ -87,7 +91,31 @@ def fmu_parameter_names(names: Mapping[str, str]) -> Iterator[None]:
         fmu_name = names.get(exc.name)
         if fmu_name is None:
             raise
-        raise ParameterError(fmu_name, exc.value, exc.expected) from exc
+        raise ParameterError(fmu_name, exc.value, exc.expected, exc.bounds) from exc
+
+
+#: exception types that are arithmetic failures of the model (solver discard while stepping)
+_ARITHMETIC = (ArithmeticError,)
+
+
+def is_arithmetic_failure(exc: BaseException) -> bool:
+    """Division by zero, overflow, a floating-point error or a singular matrix (numpy's LinAlgError)."""
+    return isinstance(exc, _ARITHMETIC) or type(exc).__name__ == "LinAlgError"
+
+
+def plain_reason(exc: BaseException) -> str:
+    """What went wrong, in words a user of the FMU can act on (no Python exception text for model failures)."""
+    if isinstance(exc, DtcosimError):
+        return str(exc)
+    if type(exc).__name__ == "LinAlgError":
+        return "the model's equations have a singular matrix with these parameter and input values"
+    if isinstance(exc, ZeroDivisionError):
+        return "a division by zero in the model with these parameter and input values"
+    if isinstance(exc, (OverflowError, FloatingPointError)):
+        return "a number in the model grew beyond the floating-point range with these parameter and input values"
+    if isinstance(exc, MemoryError):
+        return "not enough memory for the model with these parameter values"
+    return f"{type(exc).__name__}: {exc}"  # a defect, not a user's input: the text helps to find it
 
 
 class FmuError(Exception):
@@ -245,11 +273,8 @@ class DtcosimSlave(Fmi2Slave):
             print(f"[{type(self).__name__} {self.instance_name!r}] {message}", file=sys.stderr, flush=True)
 
     def _fail(self, context: str, exc: BaseException) -> None:
-        """Log ``exc`` and raise it to the wrapper (the host gets ``fmi2Fatal``)."""
-        if isinstance(exc, DtcosimError):
-            message = f"{context}: {exc}"
-        else:
-            message = f"{context}: {type(exc).__name__}: {exc}"
+        """Log ``exc`` (:func:`plain_reason`) and raise it to the wrapper (the host gets ``fmi2Fatal``)."""
+        message = f"{context}: {plain_reason(exc)}"
         self._report(message, Fmi2Status.error)
         _balance_wrapper_release(self)
         raise FmuError(message) from None
@@ -291,14 +316,18 @@ class DtcosimSlave(Fmi2Slave):
         if self._phase != STEPPING:
             self._report(f"doStep at t = {current_time:g} s called in phase {self._phase!r} (call exitInitializationMode first)")
             return False
+        if not (math.isfinite(current_time) and math.isfinite(step_size) and step_size > 0.0):
+            self._report(f"doStep refused: communication point {current_time!r} s and step {step_size!r} s must be "
+                         "finite numbers, the step > 0; state kept")
+            return False
         try:
             self._step(current_time, step_size)
-        except DtcosimError as exc:
-            self._report(f"doStep from t = {current_time:.9g} s, h = {step_size:.3g} s failed: {exc}; "
+        except Exception as exc:  # noqa: BLE001
+            if not (isinstance(exc, DtcosimError) or is_arithmetic_failure(exc)):
+                self._fail(f"doStep from t = {current_time:.9g} s", exc)
+            self._report(f"doStep from t = {current_time:.9g} s, h = {step_size:.3g} s failed: {plain_reason(exc)}; "
                          "state kept at the start of the step")
             return False
-        except Exception as exc:  # noqa: BLE001
-            self._fail(f"doStep from t = {current_time:.9g} s", exc)
         self._time = current_time + step_size
         for group in self._eager_groups:
             self._refresh(group)

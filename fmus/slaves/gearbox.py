@@ -30,6 +30,7 @@ from components.model.description import build
 from components.model.drivetrain import Drivetrain
 from components.model.gearbox_model import SHAFT_TORQUE_MODES, GearboxModel
 from components.model.integrators import StepControl
+from components.validation import choice_bounds
 
 from .base import DtcosimSlave
 from .gearbox_parameters import (
@@ -146,7 +147,8 @@ class Gearbox(DtcosimSlave):
     def _configure(self) -> None:
         mode = self.value("shaft_torque_mode")
         if not 0 <= mode < len(SHAFT_TORQUE_MODES):
-            raise ParameterError("shaft_torque_mode", mode, enumeration_text(SHAFT_TORQUE_MODES))
+            text = enumeration_text(SHAFT_TORQUE_MODES)
+            raise ParameterError("shaft_torque_mode", mode, text, choice_bounds(SHAFT_TORQUE_MODES, text))
         drivetrain = drivetrain_from_values(self._template, self.value)
         control = control_from_values(self.value)
         self.model = GearboxModel(drivetrain, control, SHAFT_TORQUE_MODES[mode], bool(self.value("extrapolate_inputs")))

@@ -13,16 +13,13 @@ from typing import Any, Hashable, Iterable, Mapping
 
 from components.errors import ParameterError, SolverError
 from components.model.description import build
+from components.model.rotor import ROTOR_FIELDS
 from components.model.rotor import Rotor as RotorComponent
-from components.model.rotor import RotorParameters
+from components.model.rotor import rotor_from_values
 
 from .base import DtcosimSlave
 from .interface import Variable, real_input, real_output, real_parameter
 from .record import ROTOR
-
-_FIELDS = {"inertia": "inertia_kgm2", "shaft_stiffness": "shaft_stiffness_nm_rad",
-           "shaft_damping": "shaft_damping_nms_rad", "carrier_inertia": "carrier_inertia_kgm2"}
-
 
 class Rotor(DtcosimSlave):
     """``J_r omega' = T_aero - T_gearbox`` (rigid) or the rotor and main shaft, as an FMU."""
@@ -54,7 +51,7 @@ class Rotor(DtcosimSlave):
         return "motion"
 
     def _configure(self) -> None:
-        self.params = RotorParameters(**{f: self.value(k) for k, f in _FIELDS.items()})
+        self.params = rotor_from_values({k: self.value(k) for k in ROTOR_FIELDS}, build(self.model["rotor"], "model.rotor"))
         self._new_rotor()
 
     def _new_rotor(self) -> None:

@@ -11,7 +11,6 @@ inputs. Only numpy is imported at run time; no file outside the FMU is read.
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 from typing import Any, Hashable, Iterable, Mapping
 
@@ -19,6 +18,7 @@ import numpy as np
 
 from components.errors import DtcosimError, ParameterError, SolverError
 from components.model.time_series import OUT_OF_RECORD, ChannelSpec, TimeSeriesPlayer
+from components.validation import choice_bounds, finite
 
 from .base import DtcosimSlave
 from .interface import Variable, enumeration_text, integer_parameter, real_output, real_parameter
@@ -63,15 +63,12 @@ class TimeSeriesSource(DtcosimSlave):
         series = self.model["series"]
         policy = self.value("out_of_record")
         if not 0 <= policy < len(OUT_OF_RECORD):
-            raise ParameterError("out_of_record", policy, enumeration_text(OUT_OF_RECORD))
-        offset = self.value("time_offset")
-        if not math.isfinite(offset):
-            raise ParameterError("time_offset", offset, "a finite number [s]")
+            text = enumeration_text(OUT_OF_RECORD)
+            raise ParameterError("out_of_record", policy, text, choice_bounds(OUT_OF_RECORD, text))
+        offset = finite("time_offset", self.value("time_offset"))
         channels = []
         for ch in series["outputs"]:
-            initial = float(self.value(f"{ch['output']}.initial")) if ch["integral_of"] else 0.0
-            if not math.isfinite(initial):
-                raise ParameterError(f"{ch['output']}.initial", initial, "finite")
+            initial = finite(f"{ch['output']}.initial", self.value(f"{ch['output']}.initial")) if ch["integral_of"] else 0.0
             channels.append(ChannelSpec(ch["output"], int(ch["column"]), ch["interpolation"], bool(ch["integral_of"]),
                                         initial))
         path = Path(self.resources) / DATA_FILE

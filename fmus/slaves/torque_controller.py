@@ -15,7 +15,7 @@ from typing import Any, Hashable, Iterable, Mapping
 from components.errors import ParameterError, SolverError
 from components.model.description import build
 from components.model.torque_controller import REGION3_MODES, TorqueController as ControllerComponent
-from components.model.torque_controller import TorqueLawParameters
+from components.model.torque_controller import CONTROLLER_FIELDS, controller_from_values
 
 from .base import DtcosimSlave
 from .interface import Variable, enumeration_text, integer_parameter, real_input, real_output, real_parameter
@@ -62,15 +62,9 @@ class TorqueController(DtcosimSlave):
         return "torque"
 
     def _configure(self) -> None:
-        mode = self.value("region3_mode")
-        if not 0 <= mode < len(REGION3_MODES):
-            raise ParameterError("region3_mode", mode, enumeration_text(REGION3_MODES))
-        values = {f: self.value(name) for name, (f, _, _) in PARAMETERS.items()}
-        try:
-            self.params = TorqueLawParameters(region3_mode=REGION3_MODES[mode], **values)
-        except ParameterError as exc:
-            local = exc.name.removeprefix("controller.")
-            raise ParameterError(local, exc.value, exc.expected) from None
+        names = (*CONTROLLER_FIELDS, "region3_mode")
+        self.params = controller_from_values({n: self.value(n) for n in names},
+                                             build(self.model["controller"], "model.controller"))
         self._new()
 
     def _new(self) -> None:

@@ -17,7 +17,12 @@ from typing import Any, Hashable, Iterable, Mapping
 from components.errors import ParameterError
 from components.model.description import build
 from components.model.parameter_map import WIND_FIELDS, wind_from_values
-from components.model.wind import AMPLITUDE_CONVENTIONS, PhasorStepper, RotorSpeedProcess
+from components.model.wind import (
+    AMPLITUDE_CONVENTIONS,
+    MAX_HARMONICS,
+    PhasorStepper,
+    RotorSpeedProcess,
+)
 
 from .base import DtcosimSlave
 from .interface import (
@@ -46,10 +51,10 @@ class WindSource(DtcosimSlave):
             real_parameter("a", d.spectrum_level, "rad/s",
                            "spectral level a of S(f) = a exp(-a f / sigma^2) (eq. 14; paper: 0.02 in rpm units)"),
             real_parameter("sigma", d.sigma_rad_s, "rad/s", "fluctuation intensity sigma (eq. 14; paper: 0.12 rpm)"),
-            integer_parameter("n_harmonics", d.n_harmonics, "number of harmonics N (>= 1)"),
+            integer_parameter("n_harmonics", d.n_harmonics, f"number of harmonics N (1 to {MAX_HARMONICS})"),
             real_parameter("f_min", d.f_min_rad_s, "rad/s", "lowest angular frequency of the harmonics"),
             real_parameter("f_max", d.f_max_rad_s, "rad/s", "highest angular frequency of the harmonics"),
-            integer_parameter("seed", d.seed, "seed of the random phases (numpy default_rng, >= 0)"),
+            integer_parameter("seed", d.seed, "seed of the random phases (numpy default_rng, 0 to 2147483647)"),
             integer_parameter("amplitude", AMPLITUDE_CONVENTIONS.index(d.amplitude),
                               f"amplitude convention: {amplitude} (W_k = sqrt(2 S df) or the paper's S df)"),
             real_output("omega", "rad/s", "rotor speed omega(t) (eq. 13)", "rotor_speed"),

@@ -8,8 +8,12 @@ and returns the process exit code.
 from __future__ import annotations
 
 import argparse
+import atexit
 import importlib
+import os
+import signal
 import sys
+import threading
 
 from components.errors import DtcosimError
 
@@ -58,22 +62,83 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _raise_interrupt(signum, frame) -> None:
+    from ..errors import RunInterrupted
+
+    raise RunInterrupted(signum, "the command")
+
+
 def main(argv: list[str] | None = None) -> int:
-    """Entry point of the ``dtcosim`` console script."""
+    """Run one ``dtcosim`` command; returns its exit status.
+
+    SIGTERM and SIGHUP end a command like Ctrl-C does (the run command stops
+    cleanly, see :mod:`orchestrator.cosim.stop_requests`): one line on stderr and
+    the status ``128 + signal`` (130 for Ctrl-C), at any stage.
+    """
     parser = build_parser()
     args = parser.parse_args(argv)
     if not getattr(args, "func", None):
         parser.print_help()
         return 2
+    previous = {}
+    if threading.current_thread() is threading.main_thread():
+        for name in ("SIGTERM", "SIGHUP"):
+            if hasattr(signal, name):
+                previous[getattr(signal, name)] = signal.signal(getattr(signal, name), _raise_interrupt)
     try:
         return int(args.func(args) or 0)
     except DtcosimError as exc:
         print(f"dtcosim {args.command}: error: {exc}", file=sys.stderr)
         return 1
-    except KeyboardInterrupt:
-        print(f"dtcosim {args.command}: interrupted", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:
+        signum = getattr(exc, "signum", signal.SIGINT)
+        text = str(exc) if getattr(exc, "signum", None) is not None else "interrupted by the user (Ctrl-C)"
+        print(f"dtcosim {args.command}: {text}", file=sys.stderr)
+        return 128 + int(signum)
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
+
+
+def end_process(status: int) -> None:
+    """Leave the process with ``status`` once everything is written, without the interpreter's teardown.
+
+    pythonfmu 0.7's shared library (loaded into this process for every FMU and
+    never unloaded) releases Python objects from its C++ static destructors,
+    which run after the interpreter has been finalised: glibc then sometimes
+    aborts with "corrupted double-linked list" (exit status 134) although every
+    result was written. So the console script runs the Python exit handlers
+    itself (``atexit``: temporary folders of extracted FMUs, logging, weakref
+    finalizers), flushes stdout and stderr and ends with ``os._exit``, which
+    skips the interpreter's finalisation and the C++ destructors. Nothing is
+    lost: every file was already written and closed (by temporary file and
+    rename) and every FMU instance freed by then.
+    """
+    try:
+        atexit._run_exitfuncs()
+    finally:
+        for stream in (sys.stdout, sys.stderr):
+            try:
+                stream.flush()
+            except Exception:  # noqa: BLE001 - a closed pipe must not change the status
+                pass
+        os._exit(status)
+
+
+def console_main() -> None:
+    """Entry point of the ``dtcosim`` console script: :func:`main`, then :func:`end_process`."""
+    try:
+        status = main()
+    except SystemExit as exc:  # argparse errors and --help, --version
+        code = exc.code
+        status = code if isinstance(code, int) else (0 if code is None else 1)
+        if not isinstance(code, (int, type(None))):
+            print(code, file=sys.stderr)
+    except KeyboardInterrupt:  # a signal before main's handlers were in place
+        print("dtcosim: interrupted", file=sys.stderr)
+        status = 130
+    end_process(status)
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    console_main()

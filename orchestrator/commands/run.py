@@ -1,7 +1,9 @@
 """``dtcosim run``: run a co-simulation scenario and write its results.
 
-Exit status: 0 complete, 1 error (bad scenario, FMU failure: partial results
-written), 130 interrupted by Ctrl-C (partial results written).
+Exit status: 0 complete, 1 error (bad scenario, FMU failure, initialisation
+failure, a results file that could not be written: ``summary.json`` says what
+is there), ``128 + signal`` when stopped by a signal: 130 Ctrl-C (SIGINT), 143
+SIGTERM, 129 SIGHUP (partial results written).
 """
 
 from __future__ import annotations
@@ -27,7 +29,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("scenario", nargs="?", default=None, metavar="SCENARIO",
                    help="scenario TOML/SSP file or packaged scenario name (default: paper-60s)")
-    p.add_argument("--out", type=Path, default=None, help="output directory (default: results/<scenario name>)")
+    p.add_argument("--out", type=Path, default=None,
+                   help="output directory (default: results/<scenario name>, or results/<scenario name>-<id> "
+                        "with --stop/--step/--output-interval/--algorithm/--extrapolation/--set; the files of a "
+                        "previous run in it are replaced)")
     p.add_argument("--fmu-dir", type=Path, default=None,
                    help="directory searched for FMUs after the scenario's own (default: $DTCOSIM_FMU_DIR or the project's fmus/)")
     p.add_argument("--compare-reference", action="store_true",
@@ -69,11 +74,13 @@ def run(args: argparse.Namespace) -> int:
     from ..cosim.fmu_store import ensure_fmus, stale_project_fmus
     from ..cosim.system import resolve_system
     from ..run.analyses import format_analyses
+    from ..run.run_folder import RunFolder
     from ..run.runner import run_scenario
 
     quiet = args.quiet
     say = (lambda msg: None) if quiet else (lambda msg: print(msg, file=sys.stderr))
     scenario = scenario_options.apply(scenario_options.load(args.scenario, args, "run"), args, "run")
+    out_dir, out_note = (args.out, "") if args.out is not None else scenario_options.default_out_dir(scenario, args)
     paths = ensure_fmus(scenario, args.fmu_dir, build=not args.no_build, report=say)
     for warning in stale_project_fmus(paths):
         print(f"dtcosim run: warning: {warning}", file=sys.stderr)
@@ -83,7 +90,12 @@ def run(args: argparse.Namespace) -> int:
               f"{len(system.recorded)} recorded variables, {len(system.events)} load event(s); stepping order {', '.join(system.order)}; "
               f"initialisation order {', '.join(system.init_order)})")
         return 0
-    out_dir = args.out if args.out is not None else Path("results") / scenario.name
+    RunFolder.check(out_dir)  # a file or an unwritable folder: refused before anything is instantiated
+    if out_note:
+        print(f"dtcosim run: note: {out_note}", file=sys.stderr)
+    previous = scenario_options.previous_run(out_dir)
+    if previous:
+        print(f"dtcosim run: note: replacing the previous run in {out_dir}/ ({previous})", file=sys.stderr)
     sim = scenario.simulation
     say(f"{scenario.name}: {len(scenario.components)} FMUs, {sim.algorithm}/{sim.extrapolation}, "
         f"H = {sim.step_s:g} s, {sim.start_s:g}-{sim.stop_s:g} s ({sim.n_steps} steps), order {', '.join(system.order)}")
@@ -97,43 +109,68 @@ def run(args: argparse.Namespace) -> int:
             bar.close()
     outcome = report.outcome
     s = report.summary
+    if not outcome.time_s.size:  # stopped before the first sample: nothing to show
+        print(f"dtcosim run: {outcome.error}; nothing was simulated ({out_dir / 'summary.json'} says so)",
+              file=sys.stderr)
+        return report.exit_status
     if not quiet:
-        print(f"{scenario.name}: {'complete' if outcome.complete else 'INCOMPLETE'}, {outcome.steps} steps, "
-              f"wall time {s['wall_time_s']:.2f} s (stepping {outcome.loop_time_s:.2f} s, "
-              f"{1e6 * outcome.loop_time_s / max(outcome.steps, 1):.1f} us/step)")
+        import textwrap
+
+        print(textwrap.fill(f"{scenario.name}: {'complete' if outcome.complete else 'INCOMPLETE'}, {outcome.steps} "
+                            f"steps in {s['wall_time_s']:.2f} s (stepping {outcome.loop_time_s:.2f} s, "
+                            f"{1e6 * outcome.loop_time_s / max(outcome.steps, 1):.1f} us/step)", width=80,
+                            subsequent_indent="  "))
+        from ..run.text_tables import fit_table, number
+
         w0, w1 = sim.window_s
         print(f"statistics over [{w0:g}, {w1:g}] s:")
-        print(f"  {'variable':<32}{'mean':>14}{'std':>14}{'min':>14}{'max':>14}")
-        for name, st in s["statistics"].items():
-            vals = [st[k] for k in ("mean", "std", "min", "max")]
-            print(f"  {name:<32}" + "".join(f"{v:14.6g}" if v is not None else f"{'-':>14}" for v in vals))
+        rows = [[name, *(number(st[k]) for k in ("mean", "std", "min", "max"))] for name, st in s["statistics"].items()]
+        print("\n".join(fit_table(["variable", "mean", "std", "min", "max"], rows)))
         fig16 = s.get("generator_vs_ideal")
         if fig16:
             dev = fig16["relative_deviation"]
             if dev.get("max_abs") is not None:
-                print(f"generator vs {fig16['ratio']:.6g} x rotor speed: mean {dev['mean']:+.2e}, "
-                      f"max |deviation| {dev['max_abs']:.2e} (relative)")
+                print(f"generator vs {fig16['ratio']:.6g} x rotor speed (relative): mean {dev['mean']:+.2e}, "
+                      f"max |dev| {dev['max_abs']:.2e}")
         for row in s.get("recorded_comparison", []):
-            print(f"simulated {row['simulated']} vs recorded {row['recorded']} over [{w0:g}, {w1:g}] s: "
-                  f"RMS difference {row['rms_difference']:.4g} ({100 * row['rms_difference_relative']:.3g} % of the "
-                  f"record's RMS), max {row['max_difference']:.4g} ({100 * row['max_difference_relative']:.3g} %), "
-                  f"mean {row['mean_difference']:+.4g}")
+            print(textwrap.fill(
+                f"simulated {row['simulated']} vs recorded {row['recorded']} over [{w0:g}, {w1:g}] s: "
+                f"RMS difference {row['rms_difference']:.4g} ({100 * row['rms_difference_relative']:.3g} % of the "
+                f"record's RMS), max {row['max_difference']:.4g} ({100 * row['max_difference_relative']:.3g} %), "
+                f"mean {row['mean_difference']:+.4g}", width=80, subsequent_indent="  "))
         analyses = format_analyses(s)
         if analyses:
             print(analyses)
         if outcome.profile:
             steps = max(outcome.steps, 1)
             print("time per communication step in FMI calls [us]:")
-            print(f"  {'component':<16}{'fmi2SetReal':>13}{'fmi2DoStep':>13}{'fmi2GetReal':>13}")
-            fmi_total = 0.0
-            for comp, times in outcome.profile.items():
-                fmi_total += sum(times.values())
-                print(f"  {comp:<16}" + "".join(f"{1e6 * times[f] / steps:13.1f}" for f in ("fmi2SetReal", "fmi2DoStep", "fmi2GetReal")))
+            functions = ("fmi2SetReal", "fmi2DoStep", "fmi2GetReal")
+            fmi_total = sum(sum(times.values()) for times in outcome.profile.values())
+            rows = [[comp, *(f"{1e6 * times[f] / steps:.1f}" for f in functions)] for comp, times in outcome.profile.items()]
+            print("\n".join(fit_table(["component", *functions], rows)))
             print(f"  master (loop minus FMI calls): {1e6 * (outcome.loop_time_s - fmi_total) / steps:.1f} us/step")
         if report.comparison_text:
             print(report.comparison_text)
-        print(f"results in {Path(out_dir)}/: " + ", ".join(p.name for p in report.files.values()))
+        print(textwrap.fill(f"results in {Path(out_dir)}/: " + ", ".join(p.name for p in report.files.values()),
+                            width=80, subsequent_indent="  ", break_on_hyphens=False, break_long_words=False))
+    for problem in report.problems:
+        print(f"dtcosim run: error: {problem}", file=sys.stderr)
+    post = s.get("post_processing")
+    if post and not outcome.interrupted:  # a signal during stepping is told once, below
+        print(f"dtcosim run: {post['stopped']}; not done: {', '.join(post['not_done'])}", file=sys.stderr)
     if not outcome.complete:
         print(f"dtcosim run: {outcome.error}; partial results written to {out_dir}", file=sys.stderr)
-        return 130 if outcome.interrupted else 1
-    return 0
+    elif report.exit_status > 128 and not post:  # a signal after every result was written
+        print(f"dtcosim run: interrupted ({signal_name(report.exit_status - 128)}) after every result was written: "
+              f"{out_dir} holds the whole run", file=sys.stderr)
+    return report.exit_status
+
+
+def signal_name(signum: int) -> str:
+    """``SIGINT`` for 2 (the number itself when unknown)."""
+    import signal
+
+    try:
+        return signal.Signals(signum).name
+    except ValueError:
+        return str(signum)

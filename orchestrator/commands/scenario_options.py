@@ -7,7 +7,10 @@ The rules are those of :mod:`orchestrator.inputs.overrides` (the same a study's
 from __future__ import annotations
 
 import argparse
+import hashlib
+import json
 import sys
+from pathlib import Path
 
 from ..inputs.master_options import ALGORITHMS, EXTRAPOLATIONS
 
@@ -49,3 +52,44 @@ def apply(scenario, args: argparse.Namespace, command: str):
     for note in notes:
         print(f"dtcosim {command}: warning: {note}", file=sys.stderr)
     return apply_parameters(scenario, dict(parse_assignment(item) for item in args.set))
+
+
+def given_overrides(args: argparse.Namespace) -> list[str]:
+    """The scenario-changing options on the command line, as typed (``["--stop 3", "--set wind.seed=7"]``)."""
+    out = []
+    for option, value in (("--stop", args.stop), ("--step", args.step), ("--output-interval", args.output_interval),
+                          ("--algorithm", args.algorithm), ("--extrapolation", args.extrapolation)):
+        if value is not None:
+            out.append(f"{option} {value:g}" if isinstance(value, float) else f"{option} {value}")
+    out += [f"--set {item.strip()}" for item in args.set]
+    return out
+
+
+def default_out_dir(scenario, args: argparse.Namespace) -> tuple[Path, str]:
+    """``results/<scenario>``; with overrides ``results/<scenario>-<8 hex digits of the overrides>``, and a note.
+
+    A run with changed settings never replaces the scenario's own results: the
+    same overrides always go to the same folder, and the note (printed by the
+    command) says where.
+    """
+    base = Path("results") / scenario.name
+    overrides = given_overrides(args)
+    if not overrides:
+        return base, ""
+    digest = hashlib.sha256(json.dumps(sorted(overrides)).encode()).hexdigest()[:8]
+    out = Path("results") / f"{scenario.name}-{digest}"
+    return out, (f"{', '.join(overrides)} change the scenario: results go to {out}/ ({base}/ is for the scenario "
+                 "as written; --out chooses another folder)")
+
+
+def previous_run(out_dir: Path) -> str:
+    """What a previous run left in ``out_dir`` (``"paper-60s, complete, started 2026-..."``), "" if nothing."""
+    try:
+        summary = json.loads((Path(out_dir) / "summary.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return ""
+    if not isinstance(summary, dict) or "scenario" not in summary:
+        return ""
+    state = summary.get("status") or ("complete" if summary.get("complete") else "incomplete")
+    started = f", started {summary['started_at']}" if summary.get("started_at") else ""
+    return f"scenario {summary.get('scenario')}, {state}{started}"

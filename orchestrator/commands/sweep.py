@@ -2,7 +2,7 @@
 
 Exit status: 0 every point has a result (``ok`` or ``failed``: failed points
 are results, listed in the table); 1 invalid study, or points that hit an
-infrastructure error (re-tried by the next run); 130 interrupted by Ctrl-C
+infrastructure error (re-tried by the next run); 130 interrupted by Ctrl-C (143 SIGTERM, 129 SIGHUP)
 (finished points are kept; run the same command again to continue).
 """
 
@@ -31,7 +31,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--workers", type=int, default=None, metavar="N",
                    help="workers of the LocalCluster: processes with one thread each (default: CPU count)")
     p.add_argument("--scheduler", default=None, metavar="ADDRESS",
-                   help="use an existing Dask cluster through its scheduler, e.g. tcp://10.0.0.5:8786 (left running)")
+                   help="use an existing Dask cluster through its scheduler, e.g. tls://10.0.0.5:8786 (left running; "
+                        "TLS settings from the Dask configuration, see docs/studies.md)")
+    p.add_argument("--dashboard", nargs="?", const="127.0.0.1:8787", default=None, metavar="HOST:PORT",
+                   help="start the LocalCluster's Dask dashboard (default address 127.0.0.1:8787; without this "
+                        "option nothing listens on it)")
     p.add_argument("--out", type=Path, default=None, help="output directory (default: results/<study name>)")
     p.add_argument("--fmu-dir", type=Path, default=None,
                    help="directory searched for the base scenario's FMUs (default: $DTCOSIM_FMU_DIR or the project's fmus/)")
@@ -106,6 +110,15 @@ def run(args: argparse.Namespace) -> int:
             print(f"{study.name}: {counts}; written " + ", ".join(p.name for p in files.values()))
         return 0
 
+    if args.scheduler:
+        from ..study.cluster import is_authenticated
+
+        if not is_authenticated(args.scheduler):
+            print(f"dtcosim sweep: warning: {args.scheduler} is not authenticated: any process that reaches it can "
+                  "run code on its workers (use a TLS cluster, see docs/studies.md)", file=sys.stderr)
+    if args.dashboard and args.scheduler:
+        raise StudyError("--dashboard", args.dashboard, "no dashboard option with --scheduler (the existing "
+                         "cluster has its own)")
     where = f"scheduler {args.scheduler}" if args.scheduler else f"a LocalCluster of {args.workers or os.cpu_count()} workers"
     bar = None
     progress = None
@@ -125,7 +138,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         report = run_sweep(prepared, out_dir, workers=args.workers, scheduler=args.scheduler,
                            retry_failed=args.retry_failed, progress=forward, on_start=on_start,
-                           plots=not args.no_plots)
+                           plots=not args.no_plots, dashboard=args.dashboard)
     finally:
         if bar is not None:
             bar.close()
@@ -149,5 +162,5 @@ def run(args: argparse.Namespace) -> int:
     if report.interrupted:
         print(f"dtcosim sweep: interrupted; {report.ok + report.failed + report.errors} finished points kept in "
               f"{out_dir / JOURNAL_FILE}; run the same command again to continue", file=sys.stderr)
-        return 130
+        return 128 + (report.signal or 2)
     return 1 if counts["error"] or counts["pending"] else 0

@@ -46,6 +46,8 @@ class FmuVariable:
         default of its causality and variability when absent; "" where none applies).
     declared_type : str
         Name of the variable's ``declaredType`` ("" when none; an Enumeration's type).
+    minimum, maximum : float or int or None
+        The ``min`` and ``max`` attributes (None when absent).
     """
 
     name: str
@@ -58,6 +60,8 @@ class FmuVariable:
     start: Any = None
     initial: str = ""
     declared_type: str = ""
+    minimum: float | int | None = None
+    maximum: float | int | None = None
 
 
 @dataclass(frozen=True)
@@ -154,21 +158,6 @@ def _typed_start(type_: str, start: Any) -> Any:
     return str(start)
 
 
-#: shared-library extension of each FMI 2.0 platform folder
-PLATFORM_EXTENSIONS = {"linux64": ".so", "linux32": ".so", "win64": ".dll", "win32": ".dll", "darwin64": ".dylib"}
-
-
-def binary_platforms(path: Path, model_identifier: str) -> tuple[str, ...]:
-    """Platforms whose ``binaries/<platform>/<modelIdentifier><ext>`` the FMU archive holds (sorted)."""
-    try:
-        with zipfile.ZipFile(path) as archive:
-            names = set(archive.namelist())
-    except (OSError, zipfile.BadZipFile):
-        return ()
-    return tuple(sorted(platform for platform, ext in PLATFORM_EXTENSIONS.items()
-                        if f"binaries/{platform}/{model_identifier}{ext}" in names))
-
-
 def _initial(v) -> str:
     """The FMI 2.0 ``initial`` of a variable, with the standard's default when absent (Table in 2.2.7)."""
     if v.initial:
@@ -180,6 +169,12 @@ def _initial(v) -> str:
     if causality in ("calculatedParameter", "output", "local"):
         return "calculated"
     return ""
+
+
+def _bound(type_: str, text: Any) -> float | int | None:
+    """A ``min``/``max`` attribute as a number (None when absent or not a number)."""
+    value = _typed_start(type_, text) if type_ in ("Real", "Integer", "Enumeration") else None
+    return value if isinstance(value, (int, float)) and not isinstance(value, bool) else None
 
 
 def read_record(path: Path, key: str) -> dict[str, Any] | None:
@@ -229,7 +224,9 @@ def read_fmu_interface(path: str | Path, key: str = "fmu") -> FmuInterface:
     Raises
     ------
     ScenarioError
-        If the file is missing, unreadable, not FMI 2.0 or not co-simulation.
+        If the file is missing, unreadable, not FMI 2.0 or not co-simulation, or it
+        cannot be loaded here (no binary for this platform, a PythonFMU or dtcosim
+        FMU without its resources: :func:`fmus.archive_checks.archive_problems`).
     """
     from fmpy import read_model_description
 
@@ -249,6 +246,11 @@ def read_fmu_interface(path: str | Path, key: str = "fmu") -> FmuInterface:
         raise ScenarioError(key, str(path), f"an FMI 2.0 FMU (this is FMI {md.fmiVersion})")
     if md.coSimulation is None:
         raise ScenarioError(key, str(path), "a co-simulation FMU")
+    from fmus.archive_checks import archive_problems, binary_platforms
+
+    problems = archive_problems(p, md.coSimulation.modelIdentifier, md.generationTool or "")
+    if problems:
+        raise ScenarioError(key, str(path), f"an FMU this host can load ({'; '.join(problems)})")
     variables: dict[str, FmuVariable] = {}
     for v in md.modelVariables:
         unit = v.unit or (v.declaredType.unit if v.declaredType is not None and getattr(v.declaredType, "unit", None) else "")
@@ -263,6 +265,8 @@ def read_fmu_interface(path: str | Path, key: str = "fmu") -> FmuInterface:
             start=_typed_start(str(v.type), v.start),
             initial=_initial(v),
             declared_type=str(v.declaredType.name) if v.declaredType is not None else "",
+            minimum=_bound(str(v.type), getattr(v, "min", None)),
+            maximum=_bound(str(v.type), getattr(v, "max", None)),
         )
     inputs = tuple(n for n, v in variables.items() if v.causality == "input")
     deps: dict[str, tuple[str, ...] | None] = {}

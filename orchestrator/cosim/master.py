@@ -45,10 +45,11 @@ Per FMU and step the loop makes one ``fmi2SetReal`` (if the FMU has connected
 inputs), one ``fmi2DoStep`` and one ``fmi2GetReal`` that reads the coupling
 outputs and, on sampling steps, the recorded variables, calling the C functions
 through this project's own prototypes with pre-built value-reference arrays
-(:mod:`orchestrator.cosim.fmi_runtime`). ``fmi2GetReal`` writes straight into the
-preallocated numpy result array (or, when not every step is sampled, into a
-three-row ring buffer copied into the results on sampling steps), and the coupled
-inputs are read from there: no per-step Python objects, no copies. The loop is
+(:mod:`orchestrator.cosim.fmi_runtime`). ``fmi2GetReal`` writes straight into a
+block buffer of :data:`BLOCK_STEPS` + 2 rows (or, when not every step is sampled,
+into a three-row ring buffer copied into the block's sample rows on sampling
+steps), and the coupled inputs are read from there: no per-step Python objects,
+no copies. The loop is
 generated and compiled per system (:func:`compile_step_loop`), with every FMI
 function, array and column offset bound to a name, so each coupling is one
 statement. That pays: above the floor of the bare FMI calls, the generated loop
@@ -65,40 +66,54 @@ Boolean and String variables through :class:`~orchestrator.cosim.values.TypedPor
 (two more calls per step for an FMU that has such ports, none otherwise, so a
 Real-only system runs exactly the loop it always ran). Connection transformations
 (SSP) are applied where the value is exchanged: a linear one inside the Real
-statement of that coupling only.
+statement of that coupling only. String samples are kept for the whole run
+(:class:`~orchestrator.cosim.values.TextStore`; only FMUs with String outputs
+have any).
+
+Results
+-------
+After each block of steps its finished rows go to the run's sink (a
+:class:`RowSink`, e.g. a results file writer of :mod:`orchestrator.run.writers`)
+and, unless ``keep_values`` is off, into the outcome's arrays; the block buffer
+is then reused, so the master's own memory does not grow with the run.
 
 Stopping
 --------
 An FMU status worse than warning stops the run with an :class:`FmuStepError`
-message (FMU, function, time, status, the FMU's log); Ctrl-C (SIGINT) is caught
-between blocks of steps. Either way the samples recorded so far are returned with
-``complete = False``. An FMU that ends the simulation itself (``fmi2Discard`` with
-``fmi2Terminated`` after progress, :mod:`orchestrator.cosim.termination`) ends the
-run normally: ``complete = True``, ``ended_by`` naming it.
+message (FMU, function, time, status, the FMU's log); SIGINT (Ctrl-C), SIGTERM
+and SIGHUP set a flag (:class:`~orchestrator.cosim.stop_requests.StopRequests`)
+that is checked after each FMU is instantiated and between blocks of steps; a
+sink that cannot write (``OSError``: a full disk) stops the run too. Either way
+the samples recorded so far are returned with ``complete = False``; a stop
+request before the first step raises :class:`~orchestrator.errors.RunInterrupted`.
+An FMU that ends the simulation itself (``fmi2Discard`` with ``fmi2Terminated``
+after progress, :mod:`orchestrator.cosim.termination`) ends the run normally:
+``complete = True``, ``ended_by`` naming it, its last sample kept (also off the
+output grid).
 """
 
 from __future__ import annotations
 
 import ctypes
 import math
-import signal
-import threading
 import time
 from ctypes import c_double
 from dataclasses import dataclass, field
-from typing import Callable
+from typing import Callable, Protocol
 
 import numpy as np
 
+from ..atomic_files import describe_os_error
 from ..errors import FmuStepError, InitializationError
 from .fmi_runtime import FmuInstance, value_references
+from .stop_requests import StopRequests
 from .system import RecordedVariable, ResolvedSystem
 from .termination import discard_status
 from .values import TextStore, TypedPorts
 
 #: stepping-loop implementations (see :func:`compile_step_loop`)
 STEP_LOOPS = ("generated", "interpreted")
-#: steps between checks for Ctrl-C and progress updates
+#: steps between checks for stop requests, progress updates and hand-overs of rows to the sink
 BLOCK_STEPS = 250
 #: maximum initialisation sweeps beyond the number of components
 EXTRA_INIT_SWEEPS = 2
@@ -122,9 +137,14 @@ class RunOutcome:
     stopped_at_s : float
         Time of the last completed communication point [s].
     error : str or None
-        Why the run stopped early (FMU failure or interruption).
+        Why the run stopped early (FMU failure, interruption, a results file that could not be written).
     interrupted : bool
-        True if stopped by Ctrl-C.
+        True if stopped by a signal (Ctrl-C, SIGTERM, SIGHUP).
+    stop_signal : str or None
+        Name of that signal (``"SIGINT"``, ...).
+    stage : str
+        Where the run ended: ``"stepping"`` (also when complete), ``"writing"`` (the sink failed),
+        or, for outcomes built by a caller after an exception, ``"instantiation"``/``"initialisation"``.
     wall_time_s : float
         Whole run: instantiation, initialisation, stepping, cleanup [s].
     loop_time_s : float
@@ -163,8 +183,19 @@ class RunOutcome:
     initial_values: dict[str, float] = field(default_factory=dict)
     fmu_log: dict[str, list[str]] = field(default_factory=dict)
     profile: dict[str, dict[str, float]] | None = None
+    stop_signal: str | None = None
+    stage: str = "stepping"
     text: dict[str, np.ndarray] = field(default_factory=dict)
     ended_by: str | None = None
+
+    @classmethod
+    def empty(cls, columns: tuple[RecordedVariable, ...], start_s: float, error: str, stage: str,
+              interrupted: bool = False, stop_signal: str | None = None,
+              fmu_log: dict[str, list[str]] | None = None) -> "RunOutcome":
+        """The outcome of a run that stopped before its first sample (instantiation or initialisation)."""
+        return cls(time_s=np.empty(0), values=np.empty((0, len(columns))), columns=tuple(columns), complete=False,
+                   steps=0, stopped_at_s=start_s, error=error, interrupted=interrupted, stop_signal=stop_signal,
+                   stage=stage, fmu_log=dict(fmu_log or {}))
 
     def column(self, name: str) -> np.ndarray:
         """Samples of ``"component.variable"`` (strings for a String variable)."""
@@ -179,6 +210,17 @@ class RunOutcome:
     def names(self) -> list[str]:
         """Recorded column names."""
         return [c.column for c in self.columns]
+
+
+class RowSink(Protocol):
+    """Where the master hands each finished block of rows (e.g. :class:`orchestrator.run.writers.CsvWriter`)."""
+
+    def append(self, time_s: np.ndarray, values: np.ndarray, text: dict[int, np.ndarray] | None = None) -> None:
+        """Rows at ``time_s`` (n,), ``values`` (n, m) in the order of ``system.recorded``; may raise OSError.
+
+        ``text`` (only when String variables are recorded): column index -> the n
+        strings of that column (its ``values`` column is NaN).
+        """
 
 
 class _Stop(Exception):
@@ -236,7 +278,8 @@ class CoSimulation:
 
     # ------------------------------------------------------------------ run
     def run(self, progress: Callable[[int, int], None] | None = None, handle_sigint: bool = True,
-            wall_time_limit_s: float | None = None) -> RunOutcome:
+            wall_time_limit_s: float | None = None, *, sink: RowSink | None = None, keep_values: bool = True,
+            stop: StopRequests | None = None) -> RunOutcome:
         """Instantiate, initialise, step to the stop time and free the FMUs.
 
         Parameters
@@ -244,23 +287,44 @@ class CoSimulation:
         progress : callable(done_steps, total_steps), optional
             Called every :data:`BLOCK_STEPS` steps.
         handle_sigint : bool
-            Catch Ctrl-C between blocks of steps (main thread only) and return
-            the partial results instead of raising KeyboardInterrupt.
+            Without ``stop``: catch SIGINT, SIGTERM and SIGHUP for the duration of
+            the run (main thread only) and return the partial results instead of
+            dying; False: leave the process's signal handling alone.
         wall_time_limit_s : float, optional
             Stop stepping (between blocks of steps) once the run has taken this
             much wall-clock time [s]; the outcome is then incomplete, with an error
             naming the limit and the time reached. None or 0: no limit.
+        sink : RowSink, optional
+            Receives every finished block of rows as the run goes (row 0, at the
+            start time, first).
+        keep_values : bool
+            Also keep every row in the outcome's ``time_s``/``values`` (default;
+            memory grows with the rows recorded so far). False: the outcome holds
+            no rows (the sink has them).
+        stop : StopRequests, optional
+            A caller's active stop requests (the caller installed the handlers,
+            e.g. for a whole run with its result files); checked after each FMU
+            is instantiated and between blocks of steps.
 
         Returns
         -------
         RunOutcome
-            Also when an FMU fails or the run is interrupted (``complete`` False).
+            Also when an FMU fails, the sink cannot write or the run is
+            interrupted while stepping (``complete`` False).
 
         Raises
         ------
         FmuStepError, InitializationError
             If instantiation or initialisation fails (nothing to record yet).
+        RunInterrupted
+            If a stop was requested before the first step.
         """
+        if stop is None:
+            with StopRequests(enabled=handle_sigint) as own:
+                return self._run(progress, wall_time_limit_s, sink, keep_values, own)
+        return self._run(progress, wall_time_limit_s, sink, keep_values, stop)
+
+    def _run(self, progress, wall_time_limit_s, sink, keep_values, stop: StopRequests) -> RunOutcome:
         wall0 = time.perf_counter()
         cpu0 = time.process_time()
         sim = self.settings
@@ -268,56 +332,59 @@ class CoSimulation:
         stride = sim.output_stride
         n_rows = n_steps // stride + 2  # + 1: a last sample off the output grid when an FMU ends the run
         self._ended = None
+        loop_cpu = 0.0
         try:
-            self._instantiate()
+            self._instantiate(stop)
             initial_values = self._initialize()
+            stop.raise_if_requested("initialisation", sim.start_s)
             slots, columns, n_text = self._build_slots()
+            keys = [(c.component, c.variable) for c in columns]
+            order = np.array([keys.index((rv.component, rv.variable)) for rv in self.system.recorded], dtype=np.intp)
             n_cols = max(1, len(columns))
-            data = np.full((n_rows, n_cols), np.nan)
-            ring = data if stride == 1 else np.full((3, n_cols), np.nan)
+            if stride == 1:  # rows k_start - 1 and k_start of each block, then one row per step
+                block = np.full((BLOCK_STEPS + 2, n_cols), np.nan)
+                ring = block
+            else:  # the block's sample rows; outputs go to a three-row ring buffer
+                block = np.full((BLOCK_STEPS // stride + 2, n_cols), np.nan)
+                ring = np.full((3, n_cols), np.nan)
             text = TextStore(n_rows, n_text)
             # row 0: every output at t0, after initialisation
+            first = np.full(n_cols, np.nan)
             for s in slots:
                 if s.out_names:
                     values = s.inst.get_reals(s.out_names, sim.start_s)
-                    data[0, s.col0:s.col0 + len(values)] = values
+                    first[s.col0:s.col0 + len(values)] = values
                 if s.ports is not None:
-                    s.ports.read_initial(data[0], text, sim.start_s)
-            if ring is not data:
-                ring[:] = data[0]
+                    s.ports.read_initial(first, text, sim.start_s)
+            ring[:] = first
+            text_columns = {j: col for j, col in enumerate(self._text_columns(slots)) if col >= 0}
+            rows = _Rows(sim.start_s, sim.step_s * stride, order, n_rows if keep_values else 0, sink,
+                         text=text, text_columns=text_columns)
+            error = rows.deliver(first[None, :])
             timers = np.zeros((len(slots), 3)) if self.profile else None
             make_loop = compile_step_loop if self.step_loop == "generated" else interpreted_step_loop
-            advance = make_loop(slots, sim.algorithm, sim.extrapolation, stride, data, ring, timers, text=text)
+            advance = make_loop(slots, sim.algorithm, sim.extrapolation, stride, block, ring, timers, text=text)
             loop0 = time.perf_counter()
             loop_cpu0 = time.process_time()
             deadline = wall0 + wall_time_limit_s if wall_time_limit_s else math.inf
-            k_done, error, interrupted = self._loop(advance, slots, data, n_steps, stride, progress, handle_sigint,
-                                                    deadline, wall_time_limit_s)
+            if error is None:
+                k_done, error, stage = self._loop(advance, slots, block, ring, text, rows, n_steps, stride,
+                                                  progress, stop, deadline, wall_time_limit_s)
+            else:
+                k_done, stage = 0, "writing"
             loop_time = time.perf_counter() - loop0
             loop_cpu = time.process_time() - loop_cpu0
         finally:
             self._close()
-        rows = k_done // stride + 1
-        times = sim.start_s + sim.step_s * stride * np.arange(rows, dtype=float)
-        stopped_at = sim.start_s + k_done * sim.step_s
-        if self._ended is not None and k_done % stride:  # the terminating FMU's last sample, off the grid
-            times = np.append(times, stopped_at)
-            rows += 1
-        keys = [(c.component, c.variable) for c in columns]
-        order = [keys.index((rv.component, rv.variable)) for rv in self.system.recorded]
-        text_columns = {}
-        for s in slots:
-            if s.ports is not None:
-                for name, typ, col in s.ports.outputs:
-                    if typ == "String":
-                        text_columns[f"{s.name}.{name}"] = text.rows[:rows, col].copy()
+        interrupted = stage == "interrupted"
+        kept = rows.count if rows.kept is not None else 0
         return RunOutcome(
-            time_s=times,
-            values=np.ascontiguousarray(data[:rows][:, order]),
+            time_s=rows.time_s(),
+            values=rows.values(),
             columns=tuple(self.system.recorded),
             complete=error is None,
             steps=k_done,
-            stopped_at_s=stopped_at,
+            stopped_at_s=sim.start_s + k_done * sim.step_s,
             error=error,
             interrupted=interrupted,
             wall_time_s=time.perf_counter() - wall0,
@@ -330,9 +397,21 @@ class CoSimulation:
                 s.name: dict(zip(("fmi2SetReal", "fmi2DoStep", "fmi2GetReal"), map(float, row)))
                 for s, row in zip(slots, timers)
             },
-            text={rv.column: text_columns[rv.column] for rv in self.system.recorded if rv.column in text_columns},
+            stop_signal=stop.signal_name if interrupted else None,
+            stage="stepping" if interrupted else stage,
+            text={self.system.recorded[j].column: text.rows[:kept, col].copy() for j, col in text_columns.items()},
             ended_by=None if self._ended is None else self._ended[0],
         )
+
+    def _text_columns(self, slots: list[_Slot]) -> list[int]:
+        """TextStore column of each recorded variable in ``system.recorded`` order (only String ones: -1 for others)."""
+        store = {}
+        for s in slots:
+            if s.ports is not None:
+                for name, typ, col in s.ports.outputs:
+                    if typ == "String":
+                        store[(s.name, name)] = col
+        return [store.get((rv.component, rv.variable), -1) for rv in self.system.recorded]
 
     def initial_values(self) -> dict[str, float]:
         """Instantiate and initialise the FMUs, return what the initial bindings set, free the FMUs.
@@ -349,10 +428,12 @@ class CoSimulation:
             self._close()
 
     # ----------------------------------------------------------- lifecycle
-    def _instantiate(self) -> None:
+    def _instantiate(self, stop: StopRequests | None = None) -> None:
         sim = self.settings
         sc = self.system.scenario
         for name in self.system.init_order:
+            if stop is not None:
+                stop.raise_if_requested("instantiation", sim.start_s)
             inst = FmuInstance(name, self.system.interfaces[name])
             self.instances[name] = inst
             inst.instantiate(sim.start_s, sim.stop_s)
@@ -360,6 +441,8 @@ class CoSimulation:
             if params:
                 inst.set_values(params, sim.start_s)
             inst.enter_initialization(sim.start_s)
+        if stop is not None:
+            stop.raise_if_requested("instantiation", sim.start_s)
 
     def _initialize(self) -> dict[str, float]:
         """Sweeps in dependency order until the transferred values are a fixed point."""
@@ -482,64 +565,149 @@ class CoSimulation:
         return slots, columns, n_text
 
     # ----------------------------------------------------------------- loop
-    def _loop(self, advance, slots, data, n_steps, stride, progress, handle_sigint, deadline=math.inf,
-              wall_time_limit_s=None) -> tuple[int, str | None, bool]:
-        """Step until the stop time, an FMU failure, Ctrl-C or the ``time.perf_counter()`` deadline.
+    def _loop(self, advance, slots, block, ring, text: TextStore, rows: "_Rows", n_steps, stride, progress,
+              stop: StopRequests, deadline=math.inf, wall_time_limit_s=None) -> tuple[int, str | None, str]:
+        """Step block by block until the stop time, an FMU failure or termination, a stop request, a sink error
+        or the deadline.
 
-        Returns (communication steps completed, error message or None, interrupted).
+        After each block its finished rows go to ``rows`` and the block buffer is
+        rewound. Returns (communication steps completed, error message or None,
+        stage: ``"stepping"``, ``"interrupted"`` or ``"writing"``).
         """
         t0, H = self.settings.start_s, self.settings.step_s
-        stop_flag = {"stop": False}
-        previous_handler = None
-        if handle_sigint and threading.current_thread() is threading.main_thread():
-            def on_sigint(signum, frame):
-                stop_flag["stop"] = True
-                signal.signal(signal.SIGINT, signal.default_int_handler)  # a second Ctrl-C aborts at once
-
-            previous_handler = signal.signal(signal.SIGINT, on_sigint)
+        direct = ring is block
         k = 0
         error = None
-        interrupted = False
+        stage = "stepping"
         try:
             while k < n_steps:
-                if stop_flag["stop"]:
-                    interrupted = True
-                    error = f"interrupted by the user (Ctrl-C) at t = {t0 + k * H:.6g} s"
-                    break
+                if stop.requested:
+                    return k, f"{stop.reason} at t = {t0 + k * H:.6g} s", "interrupted"
+                k_start = k
                 k_end = min(n_steps, k + BLOCK_STEPS)
                 try:
                     k = advance(k, k_end, t0, H)
-                except _Stop as stop:
-                    s = slots[stop.slot]
-                    discard = discard_status(s.inst, stop.function, stop.status, t0 + stop.k * H,
-                                             t0 + (stop.k + 1) * H)
-                    if discard is not None and discard.ends_run:  # the FMU ended the simulation
-                        try:
-                            k = advance.finish_step(stop.k, stop.slot, t0, H) if discard.reached_step_end else stop.k
-                        except _Stop as second:
-                            stop, discard = second, None
-                            s = slots[stop.slot]
-                        else:
-                            self._ended = (s.name, t0 + k * H)
-                            break
-                    s.inst.mark_failed(stop.status)
-                    error = str(FmuStepError(s.name, stop.function, t0 + stop.k * H, stop.status, list(s.inst.log)))
-                    if discard is not None:
-                        error += discard.note()
-                    k = stop.k
-                    break
+                except _Stop as failed:
+                    k, error = self._stopped(advance, slots, failed, k_start, t0, H)
+                # the block's finished rows: samples at t_{k_start + 1} ... t_k
+                last_time_s = None
+                if direct:
+                    done = block[2:k - k_start + 2]
+                else:
+                    n_done = k // stride - k_start // stride
+                    if self._ended is not None and k % stride:  # the terminating FMU's last sample, off the grid
+                        block[n_done] = ring[k % 3]
+                        text.sample(k // stride + 1, k, range(text.rows.shape[1]))
+                        n_done += 1
+                        last_time_s = t0 + k * H
+                    elif self._ended is not None and k > k_start:  # a finished last step on the grid
+                        block[n_done - 1] = ring[k % 3]
+                    done = block[:n_done]
+                write_error = rows.deliver(done, last_time_s)
+                if write_error is not None:
+                    return k, f"{write_error} at t = {t0 + k * H:.6g} s", "writing"
+                if error is not None or self._ended is not None:
+                    return k, error, stage
+                if direct:  # rows t_{k-1}, t_k start the next block
+                    block[0:2] = block[k - k_start:k - k_start + 2]
                 if progress is not None:
                     progress(k, n_steps)
                 if k < n_steps and time.perf_counter() > deadline:
-                    error = f"wall-time limit of {wall_time_limit_s:g} s reached at t = {t0 + k * H:.6g} s"
-                    break
-        except KeyboardInterrupt:  # a second Ctrl-C, or no handler outside the main thread
-            interrupted = True
-            error = f"interrupted by the user (Ctrl-C) at t = {t0 + k * H:.6g} s"
-        finally:
-            if previous_handler is not None:
-                signal.signal(signal.SIGINT, previous_handler)
-        return k, error, error is not None and interrupted
+                    return k, f"wall-time limit of {wall_time_limit_s:g} s reached at t = {t0 + k * H:.6g} s", stage
+        except KeyboardInterrupt:  # a second signal, or no handler outside the main thread
+            return k, f"{stop.reason} at t = {t0 + k * H:.6g} s", "interrupted"
+        return k, error, stage
+
+    def _stopped(self, advance, slots, failed: "_Stop", k_start: int, t0: float, H: float) -> tuple[int, str | None]:
+        """(steps completed, error or None) after a failing status; None and ``self._ended`` set when an FMU
+        ended the simulation (:mod:`orchestrator.cosim.termination`)."""
+        s = slots[failed.slot]
+        discard = discard_status(s.inst, failed.function, failed.status, t0 + failed.k * H, t0 + (failed.k + 1) * H)
+        if discard is not None and discard.ends_run:  # the FMU ended the simulation
+            try:
+                k = advance.finish_step(failed.k, failed.slot, t0, H, k_start) if discard.reached_step_end \
+                    else failed.k
+            except _Stop as second:
+                failed, discard = second, None
+                s = slots[failed.slot]
+            else:
+                self._ended = (s.name, t0 + k * H)
+                return k, None
+        s.inst.mark_failed(failed.status)
+        error = str(FmuStepError(s.name, failed.function, t0 + failed.k * H, failed.status, list(s.inst.log)))
+        if discard is not None:
+            error += discard.note()
+        return failed.k, error
+
+
+class _Rows:
+    """The rows a run has finished: handed to the sink and, optionally, kept for the outcome.
+
+    Parameters
+    ----------
+    start_s, interval_s : float
+        Time of row 0 and between rows [s].
+    order : ndarray of int
+        Block-buffer column of each recorded variable (``system.recorded`` order).
+    capacity : int
+        Rows to keep (0: keep none). The array is allocated uninitialised, so the
+        memory is taken as rows arrive.
+    sink : RowSink, optional
+    text : TextStore, optional
+        String samples of the run (rows by sample index).
+    text_columns : dict of int -> int, optional
+        Recorded column -> TextStore column of the recorded String variables.
+    """
+
+    def __init__(self, start_s: float, interval_s: float, order: np.ndarray, capacity: int,
+                 sink: RowSink | None, text: TextStore | None = None,
+                 text_columns: dict[int, int] | None = None) -> None:
+        self.start_s, self.interval_s = start_s, interval_s
+        self.order = order
+        self.sink = sink
+        self.count = 0
+        self.kept = np.empty((capacity, len(order))) if capacity else None
+        self.text = text
+        self.text_columns = dict(text_columns or {})
+        self.last_time_s: float | None = None  # a last row off the output grid (an FMU ended the run)
+
+    def deliver(self, rows: np.ndarray, last_time_s: float | None = None) -> str | None:
+        """Hand over ``rows`` (block-buffer columns), the last one at ``last_time_s`` if given (off the grid);
+        the sink's write error as text, else None."""
+        n = len(rows)
+        if n == 0:
+            return None
+        values = rows[:, self.order]
+        index = self.count + np.arange(n)
+        times = self.start_s + self.interval_s * index
+        if last_time_s is not None:
+            times[-1] = self.last_time_s = last_time_s
+        if self.kept is not None:
+            self.kept[self.count:self.count + n] = values
+        text = {j: self.text.rows[self.count:self.count + n, col] for j, col in self.text_columns.items()}
+        self.count += n
+        if self.sink is not None:
+            try:
+                if text:
+                    self.sink.append(times, values, text)
+                else:
+                    self.sink.append(times, values)
+            except OSError as exc:
+                self.sink = None  # nothing more goes to a sink that failed
+                return f"results not written: {describe_os_error(exc)}"
+        return None
+
+    def time_s(self) -> np.ndarray:
+        n = self.count if self.kept is not None else 0
+        times = self.start_s + self.interval_s * np.arange(n, dtype=float)
+        if n and self.last_time_s is not None:
+            times[-1] = self.last_time_s
+        return times
+
+    def values(self) -> np.ndarray:
+        if self.kept is None:
+            return np.empty((0, len(self.order)))
+        return self.kept[:self.count]
 
 
 def compile_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str, stride: int,
@@ -547,12 +715,17 @@ def compile_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str, st
                       text: TextStore | None = None) -> Callable:
     """Generate the stepping loop of one system, unrolled over its FMUs and couplings.
 
-    Outputs at ``t_{k+1}`` are written by ``fmi2GetReal`` into row ``k + 1`` of
-    ``ring`` (``ring is data`` when every step is sampled) or, with a three-row
-    ring buffer, into row ``(k + 1) % 3``, which is copied to ``data`` on sampling
-    steps. An input reads its source's column in the row of the sample it needs:
-    ``k + 1`` for a source already stepped in this step (Gauss-Seidel), ``k``
-    otherwise, and one row earlier for the second sample of ``linear``.
+    The loop runs over one block of steps ``k_start <= k < k_end`` at a time.
+    With every step sampled (``ring is data``), ``data`` is the block buffer: row
+    ``k - k_start + 1`` holds the outputs at ``t_k``, so rows 0 and 1 hold
+    ``t_{k_start - 1}`` and ``t_{k_start}`` on entry (the caller carries them over
+    from the previous block; both are the initial row before the first block) and
+    ``fmi2GetReal`` writes the outputs at ``t_{k+1}`` into row ``k - k_start + 2``.
+    Otherwise the outputs go to row ``(k + 1) % 3`` of the three-row ``ring``, which
+    is copied to row ``(k + 1) // stride - (k_start // stride + 1)`` of ``data`` on
+    sampling steps. An input reads its source's column in the row of the sample it
+    needs: ``t_{k+1}`` for a source already stepped in this step (Gauss-Seidel),
+    ``t_k`` otherwise, and one row earlier for the second sample of ``linear``.
 
     Parameters
     ----------
@@ -563,9 +736,9 @@ def compile_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str, st
     stride : int
         Steps per sample.
     data : ndarray, shape (n_rows, n_cols)
-        Sampled results; row 0 filled.
+        The block buffer (see above).
     ring : ndarray
-        ``data`` itself (stride 1) or a (3, n_cols) ring buffer holding row 0.
+        ``data`` itself (stride 1) or a (3, n_cols) ring buffer holding the latest rows.
     timers : ndarray, shape (n_slots, 3), optional
         If given, the loop adds the wall time of each FMU's fmi2SetReal, fmi2DoStep
         and fmi2GetReal calls to its row (profiling; costs ~1 us per call).
@@ -577,14 +750,15 @@ def compile_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str, st
     callable
         ``advance(k_start, k_end, t0, H) -> k_end``; raises ``_Stop(slot, function, status, k)``
         on a failing FMI status. Its generated source is in ``advance.source``;
-        ``advance.finish_step(k, slot, t0, H) -> k + 1`` completes step ``k`` after the FMU
-        in ``slot`` ended the simulation (see :func:`interpreted_step_loop`).
+        ``advance.finish_step(k, slot, t0, H, k_start) -> k + 1`` completes step ``k`` after the
+        FMU in ``slot`` ended the simulation (see :func:`interpreted_step_loop`).
 
     Notes
     -----
     An FMU with Integer, Enumeration, Boolean or String ports (:mod:`orchestrator.cosim.values`)
-    gets two more calls per step, ``before(k)`` ahead of its ``fmi2SetReal`` and
-    ``after(k)`` behind its ``fmi2GetReal``; a system of Real variables only has none.
+    gets two more calls per step, ``before(k, c)`` ahead of its ``fmi2SetReal`` and
+    ``after(k, c)`` behind its ``fmi2GetReal`` (``c``: the block's row offset); a system of
+    Real variables only has none.
     """
     n_cols = ring.shape[1]
     dsize = ctypes.sizeof(c_double)
@@ -602,15 +776,15 @@ def compile_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str, st
     linear = extrapolation == "linear"
     direct = ring is data
 
-    def row_expr(offset: int) -> str:
-        """Element offset of row k + offset."""
-        if direct:
-            return f"(k + {offset}) * {n_cols}" if offset >= 0 else f"max(k + {offset}, 0) * {n_cols}"
-        return f"((k + {offset}) % 3) * {n_cols}"
-
-    body = ["t = t0 + k * H", f"o1 = {row_expr(1)}", f"o0 = {row_expr(0)}", f"a1 = BASE + o1 * {dsize}"]
-    if linear:
-        body.append(f"om = {row_expr(-1)}")
+    if direct:  # rows of t_{k-1}, t_k, t_{k+1} in the block buffer
+        body = ["t = t0 + k * H", f"o0 = (k + c) * {n_cols}", f"o1 = o0 + {n_cols}", f"a1 = BASE + o1 * {dsize}"]
+        if linear:
+            body.append(f"om = o0 - {n_cols}")
+    else:
+        body = ["t = t0 + k * H", f"o1 = ((k + 1) % 3) * {n_cols}", f"o0 = (k % 3) * {n_cols}",
+                f"a1 = BASE + o1 * {dsize}"]
+        if linear:
+            body.append(f"om = ((k - 1) % 3) * {n_cols}")
     if stride > 1:
         body.append(f"sample = (k + 1) % {stride} == 0")
     for i, s in enumerate(slots):
@@ -642,8 +816,9 @@ def compile_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str, st
                 return [call]
             return ["c_ = clock()", call, f"T[{i}, {column}] += clock() - c_"]
 
+        row_offset = "c" if direct else "0"
         if typed_before:
-            body.append(f"tb{i}(k)")
+            body.append(f"tb{i}(k, {row_offset})")
         if s.in_names:
             body.extend(timed(f"st = set{i}(c{i}, VRI{i}, {len(s.in_names)}, IB{i})", 0))
             body.append(f"if st > 1: raise _Stop({i}, 'fmi2SetReal', st, k)")
@@ -660,11 +835,13 @@ def compile_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str, st
                               f"st = get{i}(c{i}, VRO{i}, {n_all}, {target}) if sample else 0", 2))
             body.append(f"if st > 1: raise _Stop({i}, 'fmi2GetReal', st, k)")
         if typed_after:
-            body.append(f"ta{i}(k)")
+            body.append(f"ta{i}(k, {row_offset})")
     if not direct:
         body.append("if sample:")
-        body.append(f"    data[(k + 1) // {stride}] = ring[(k + 1) % 3]")
-    lines = ["def advance(k_start, k_end, t0, H):", "    for k in range(k_start, k_end):"]
+        body.append(f"    data[(k + 1) // {stride} - r0] = ring[(k + 1) % 3]")
+    lines = ["def advance(k_start, k_end, t0, H):",
+             "    c = 1 - k_start" if direct else f"    r0 = k_start // {stride} + 1",
+             "    for k in range(k_start, k_end):"]
     lines += ["        " + b for b in body]
     lines.append("    return k_end")
     source = "\n".join(lines) + "\n"
@@ -686,11 +863,11 @@ def interpreted_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str
     tested against and as the baseline of ``benchmarks/bench_plumbing.py``
     (``timers`` is not supported: profiling uses the generated loop).
 
-    ``advance.finish_step(k, slot, t0, H)`` (used by both loops) completes
-    communication step ``k`` after the FMU in ``slot`` returned ``fmi2Discard`` with
-    ``fmi2Terminated`` at ``t_{k+1}``: it reads that FMU's outputs, steps the FMUs
-    after it in the stepping order as usual and samples row ``t_{k+1}``, also off
-    the output grid (the row after the last regular one). Returns ``k + 1``.
+    ``advance.finish_step(k, slot, t0, H, k_start)`` (used by both loops) completes
+    communication step ``k`` of the block that began at ``k_start`` after the FMU in
+    ``slot`` returned ``fmi2Discard`` with ``fmi2Terminated`` at ``t_{k+1}``: it reads
+    that FMU's outputs and steps the FMUs after it in the stepping order as usual
+    (the master then samples row ``t_{k+1}``, also off the output grid). Returns ``k + 1``.
     """
     if timers is not None:
         raise ValueError("profiling timers need the generated step loop")
@@ -717,15 +894,35 @@ def interpreted_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str
                      feeds, lin_feeds, before, after))
     base = ring.ctypes.data
 
-    def row(k: int) -> int:
-        if direct:
-            return max(k, 0) * n_cols
-        return (k % 3) * n_cols
+    def rows_of(k: int, k_start: int) -> tuple[int, int, int, int]:
+        """(offset of t_{k+1}, t_k, t_{k-1} in ``flat``, the block's row offset c)."""
+        if direct:  # block buffer: row k - k_start + 1 holds t_k
+            c = 1 - k_start
+            o0 = (k + c) * n_cols
+            return o0 + n_cols, o0, o0 - n_cols, c
+        return ((k + 1) % 3) * n_cols, (k % 3) * n_cols, ((k - 1) % 3) * n_cols, 0
+
+    def set_inputs(buf, feeds, lin_feeds, o1, o0, om) -> None:
+        for j, upstream, col in feeds:
+            latest, previous = (o1, o0) if upstream else (o0, om)
+            if linear:
+                a = 0.5 if upstream else 1.5
+                buf[j] = a * flat[latest + col] + (1.0 - a) * flat[previous + col]
+            else:
+                buf[j] = flat[latest + col]
+        for j, upstream, col, factor, shift in lin_feeds:
+            latest, previous = (o1, o0) if upstream else (o0, om)
+            if linear:
+                a = 0.5 if upstream else 1.5
+                buf[j] = factor * (a * flat[latest + col] + (1.0 - a) * flat[previous + col]) + shift
+            else:
+                buf[j] = factor * flat[latest + col] + shift
 
     def advance(k_start: int, k_end: int, t0: float, H: float) -> int:
+        r0 = k_start // stride + 1
         for k in range(k_start, k_end):
             t = t0 + k * H
-            o1, o0, om = row(k + 1), row(k), row(k - 1)
+            o1, o0, om, c = rows_of(k, k_start)
             sample = (k + 1) % stride == 0
             a1 = base + o1 * ctypes.sizeof(c_double)
             for i, inst, buf, buf_addr, vr_in, n_in, vr_out, n_all, n_couple, offset, feeds, lin_feeds, before, \
@@ -737,15 +934,10 @@ def interpreted_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str
                         buf[j] = a * flat[latest + col] + (1.0 - a) * flat[previous + col]
                     else:
                         buf[j] = flat[latest + col]
-                for j, upstream, col, factor, shift in lin_feeds:
-                    latest, previous = (o1, o0) if upstream else (o0, om)
-                    if linear:
-                        a = 0.5 if upstream else 1.5
-                        buf[j] = factor * (a * flat[latest + col] + (1.0 - a) * flat[previous + col]) + shift
-                    else:
-                        buf[j] = factor * flat[latest + col] + shift
+                if lin_feeds:
+                    set_inputs(buf, (), lin_feeds, o1, o0, om)
                 if before is not None:
-                    before(k)
+                    before(k, c)
                 if n_in:
                     st = inst.set_real(inst.component, vr_in, n_in, buf_addr)
                     if st > 1:
@@ -759,28 +951,21 @@ def interpreted_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str
                     if st > 1:
                         raise _Stop(i, "fmi2GetReal", st, k)
                 if after is not None:
-                    after(k)
+                    after(k, c)
             if not direct and sample:
-                data[(k + 1) // stride] = ring[(k + 1) % 3]
+                data[(k + 1) // stride - r0] = ring[(k + 1) % 3]
         return k_end
 
-    def finish_step(k: int, first: int, t0: float, H: float) -> int:
+    def finish_step(k: int, first: int, t0: float, H: float, k_start: int) -> int:
         t = t0 + k * H
-        o1, o0, om = row(k + 1), row(k), row(k - 1)
+        o1, o0, om, c = rows_of(k, k_start)
         a1 = base + o1 * ctypes.sizeof(c_double)
         for i, inst, buf, buf_addr, vr_in, n_in, vr_out, n_all, n_couple, offset, feeds, lin_feeds, before, \
                 after in plan[first:]:
             if i > first:  # the FMUs after the one that ended: their usual step
-                for j, upstream, col, *transform in feeds + lin_feeds:
-                    latest, previous = (o1, o0) if upstream else (o0, om)
-                    if linear:
-                        a = 0.5 if upstream else 1.5
-                        value = a * flat[latest + col] + (1.0 - a) * flat[previous + col]
-                    else:
-                        value = flat[latest + col]
-                    buf[j] = transform[0] * value + transform[1] if transform else value
+                set_inputs(buf, feeds, lin_feeds, o1, o0, om)
                 if before is not None:
-                    before(k)
+                    before(k, c)
                 if n_in:
                     st = inst.set_real(inst.component, vr_in, n_in, buf_addr)
                     if st > 1:
@@ -793,12 +978,7 @@ def interpreted_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str
                 if st > 1:
                     raise _Stop(i, "fmi2GetReal", st, k)
             if after is not None:
-                after(k)
-        if not direct:
-            last_row = (k + 1) // stride + (1 if (k + 1) % stride else 0)
-            data[last_row] = ring[(k + 1) % 3]
-            if text is not None and text.rows.shape[1]:
-                text.sample(last_row, k + 1, range(text.rows.shape[1]))
+                after(k, c)
         return k + 1
 
     advance.finish_step = finish_step

@@ -9,9 +9,12 @@ the right type; connections join an output to an input of the same type (Real,
 Integer, Boolean, String, or Enumeration of the same declared type); initial
 bindings join an output to a parameter or input of the same type; record
 patterns match variables (any type); no algebraic loop (with the scenario's
-``no_feedthrough`` declarations for FMUs that omit their output dependencies).
-The first problem raises :class:`~orchestrator.errors.ScenarioError` naming the
-scenario key. The result, a :class:`ResolvedSystem`, is what the master runs.
+``no_feedthrough`` declarations for FMUs that omit their output dependencies);
+every value within what the FMU accepts (FMI Integer range, declared bounds, a
+dtcosim model's own validation: :mod:`orchestrator.cosim.parameter_checks`); the
+results within the size limits (:func:`check_sizes`). The first problem raises
+:class:`~orchestrator.errors.ScenarioError` naming the scenario key. The result,
+a :class:`ResolvedSystem`, is what the master runs.
 """
 
 from __future__ import annotations
@@ -25,11 +28,13 @@ from components.validation import is_number
 
 from ..errors import AlgebraicLoopError, ScenarioError, suggestion
 from ..frozen_map import FrozenMap
+from ..inputs.limits import MAX_RESULT_VALUES
 from ..inputs.scenario import Scenario, VariableRef
 from .event_slots import AssignedEvent, assign_events
 from .fmu_folder import default_fmu_dir
 from .fmu_interface import FmuInterface, FmuVariable, read_fmu_interface
 from .graph import find_algebraic_loop, initialization_order, stepping_order
+from .parameter_checks import model_problem, value_problem
 from .roles import ComponentRole, declared_roles
 from .values import transformation_problem, type_mismatch
 
@@ -210,23 +215,6 @@ def _same_type(source: FmuVariable, target: FmuVariable, key: str, link: str, sr
         raise ScenarioError(key, link, f"variables of the same type at both ends; {problem}", src)
 
 
-def platform_problem(iface: FmuInterface) -> str | None:
-    """Why this machine cannot load the FMU's binary (FMI 2.0 ``binaries/<platform>/``), or None."""
-    from fmpy import platform
-
-    if platform in iface.platforms:
-        return None
-    has = ", ".join(iface.platforms) if iface.platforms else "none"
-    return (f"an FMU with a co-simulation binary for this platform ({platform}: binaries/{platform}/"
-            f"{iface.model_identifier}{_extension()}); it has binaries for: {has}")
-
-
-def _extension() -> str:
-    from fmpy import sharedLibraryExtension
-
-    return sharedLibraryExtension
-
-
 def resolve_system(
     scenario: Scenario,
     fmu_dir: str | Path | None = None,
@@ -253,10 +241,6 @@ def resolve_system(
     src = scenario.source
     paths = dict(fmu_paths) if fmu_paths is not None else resolve_fmu_paths(scenario, fmu_dir)
     interfaces = {c.name: read_fmu_interface(paths[c.name], f"components.{c.name}.fmu") for c in scenario.components}
-    for c in scenario.components:
-        problem = platform_problem(interfaces[c.name])
-        if problem is not None:
-            raise ScenarioError(f"components.{c.name}.fmu", str(paths[c.name]), problem, src)
     scenario, events = assign_events(scenario, interfaces)
 
     scenario = _enumeration_items_as_values(scenario, interfaces)
@@ -273,6 +257,9 @@ def resolve_system(
                 raise ScenarioError(key, value, "no value for an input that a connection drives", src)
             if not _value_matches(var, value):
                 raise ScenarioError(key, value, f"a {var.type} value for {pname}", src)
+            problem = value_problem(iface, var, value)
+            if problem is not None:
+                raise ScenarioError(key, value, problem, src)
 
     for i, con in enumerate(scenario.connections):
         a = _lookup(interfaces[con.source.component], con.source, f"connections[{i}].from", src, READABLE_CAUSALITIES, "an output")
@@ -301,7 +288,7 @@ def resolve_system(
     order = tuple(scenario.simulation.order) if scenario.simulation.order else tuple(stepping_order(names, edges))
     init_edges = edges + [(b.source.component, b.target.component) for b in scenario.initial]
     init_order = tuple(initialization_order(names, init_edges))
-    return ResolvedSystem(
+    system = ResolvedSystem(
         scenario=scenario,
         fmu_paths=paths,
         interfaces=interfaces,
@@ -311,6 +298,30 @@ def resolve_system(
         events=events,
         roles=FrozenMap(declared_roles(scenario, interfaces)),
     )
+    problem = model_problem(system)
+    if problem is not None:
+        raise ScenarioError(*problem, src)
+    check_sizes(system)
+    return system
+
+
+def check_sizes(system: ResolvedSystem) -> None:
+    """Refuse a run whose results would exceed :data:`~orchestrator.inputs.limits.MAX_RESULT_VALUES`.
+
+    Raises
+    ------
+    ScenarioError
+        Naming ``simulation.output_interval``, the number of samples and columns and the limit.
+    """
+    sim = system.scenario.simulation
+    rows = sim.n_steps // sim.output_stride + 1
+    columns = len(system.recorded) + 1
+    if rows * columns > MAX_RESULT_VALUES:
+        raise ScenarioError(
+            "simulation.output_interval", sim.output_interval_s,
+            f"an interval giving at most {MAX_RESULT_VALUES:,} recorded values per run; this one gives {rows:,} "
+            f"samples x {columns} columns (time and {len(system.recorded)} variables) = {rows * columns:,}: raise the "
+            "output interval, shorten the run or record fewer variables", system.scenario.source)
 
 
 def _enumeration_items_as_values(scenario: Scenario, interfaces: Mapping[str, FmuInterface]) -> Scenario:

@@ -113,19 +113,22 @@ class TypedPorts:
 
     def bind(self, ring: np.ndarray, text: TextStore, stride: int, gauss_seidel: bool, direct: bool,
              stop: Callable[..., Exception]) -> tuple[Callable[[int], None], Callable[[int], None]]:
-        """The loop's two calls for this FMU: ``before(k)`` (set inputs) and ``after(k)`` (read outputs).
+        """The loop's two calls for this FMU: ``before(k, c)`` (set inputs) and ``after(k, c)`` (read outputs).
+
+        ``c`` is the row offset of the block buffer when every step is sampled (row
+        ``k + c`` holds ``t_k``, :mod:`orchestrator.cosim.master`); unused with the ring.
 
         Parameters
         ----------
         ring : ndarray
-            The float row buffer (the result array itself when every step is sampled).
+            The float row buffer (the master's block buffer when every step is sampled).
         text : TextStore
         stride : int
             Steps per sample.
         gauss_seidel : bool
             Inputs from FMUs stepped earlier in this step receive their new values.
         direct : bool
-            ``ring`` is the result array (rows ``k``) rather than a three-row ring (rows ``k % 3``).
+            ``ring`` is the block buffer (rows ``k + c``) rather than a three-row ring (rows ``k % 3``).
         stop : callable(slot, function, status, k) -> Exception
             Builds the exception raised on a status worse than fmi2Warning.
         """
@@ -135,8 +138,8 @@ class TypedPorts:
         slot = self.slot
         string_columns = self.string_columns
 
-        def row(k: int) -> int:
-            return k * n_cols if direct else (k % 3) * n_cols
+        def row(k: int, c: int) -> int:
+            return (k + c) * n_cols if direct else (k % 3) * n_cols
 
         in_plan = [(setter, family, addressof(vr), len(feeds), buf, addressof(buf),
                     [(j, gauss_seidel and src < slot, col, table) for j, src, col, table in feeds])
@@ -144,8 +147,8 @@ class TypedPorts:
         out_plan = [(getter, family, addressof(vr), len(cols), buf, addressof(buf), cols)
                     for getter, family, vr, buf, cols in self._out_groups]
 
-        def before(k: int) -> None:
-            o_new, o_now = row(k + 1), row(k)
+        def before(k: int, c: int = 0) -> None:
+            o_new, o_now = row(k + 1, c), row(k, c)
             for setter, family, vr, n, buf, addr, feeds in in_plan:
                 if family == "String":
                     for j, upstream, col, _ in feeds:
@@ -158,8 +161,8 @@ class TypedPorts:
                 if st > 1:
                     raise stop(slot, f"fmi2Set{family}", st, k)
 
-        def after(k: int) -> None:
-            o_new = row(k + 1)
+        def after(k: int, c: int = 0) -> None:
+            o_new = row(k + 1, c)
             for getter, family, vr, n, buf, addr, cols in out_plan:
                 st = getter(component, vr, n, addr)
                 if st > 1:

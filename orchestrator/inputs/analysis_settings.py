@@ -32,6 +32,7 @@ from components.model.contact import CONTACT_LOSS_THRESHOLD_N
 from components.validation import is_number
 
 from ..errors import ScenarioError
+from .limits import MAX_LDD_BINS
 from .schema import Table
 
 SPECTRUM_MODES = ("auto", "always", "never")
@@ -86,14 +87,16 @@ class AnalysisSettings:
         object.__setattr__(self, "reference_frequency_hz", float(self.reference_frequency_hz))
         bins = self.ldd_bins
         if isinstance(bins, int) and not isinstance(bins, bool):
-            if bins < 1:
-                raise ScenarioError("analysis.ldd_bins", bins, "a bin count >= 1 or a list of increasing edges [N m]")
+            if not 1 <= bins <= MAX_LDD_BINS:
+                raise ScenarioError("analysis.ldd_bins", bins, f"a bin count within [1, {MAX_LDD_BINS}] or a list of "
+                                    "increasing edges [N m]")
         else:
-            ok = (isinstance(bins, (list, tuple)) and len(bins) >= 2
+            ok = (isinstance(bins, (list, tuple)) and 2 <= len(bins) <= MAX_LDD_BINS + 1
                   and all(is_number(x) and math.isfinite(x) for x in bins)
                   and all(b > a for a, b in zip(bins[:-1], bins[1:])))
             if not ok:
-                raise ScenarioError("analysis.ldd_bins", bins, "a bin count >= 1 or a list of >= 2 increasing edges [N m]")
+                raise ScenarioError("analysis.ldd_bins", bins, f"a bin count >= 1 or a list of 2 to {MAX_LDD_BINS + 1} "
+                                    "increasing edges [N m]")
             object.__setattr__(self, "ldd_bins", tuple(float(x) for x in bins))
         if self.rainflow_residue not in RESIDUE_METHODS:
             raise ScenarioError("analysis.rainflow_residue", self.rainflow_residue,

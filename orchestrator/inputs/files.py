@@ -25,14 +25,18 @@ def read_toml(path: str | Path, error: type[EntryError]) -> dict[str, Any]:
     Raises
     ------
     EntryError
-        ``error`` with key ``(file)`` if the file cannot be read, ``(syntax)`` if it is
-        not valid TOML.
+        ``error`` with key ``(file)`` if the file cannot be read or is not UTF-8 text,
+        ``(syntax)`` if it is not valid TOML.
     """
     path = Path(path)
     try:
         text = path.read_text(encoding="utf-8")
     except OSError as exc:
         raise error("(file)", str(path), f"a readable {error.kind} file ({exc.strerror})") from None
+    except UnicodeDecodeError as exc:
+        line = exc.object[:exc.start].count(b"\n") + 1
+        raise error("(file)", str(path), f"a UTF-8 text file (byte 0x{exc.object[exc.start]:02x} on line {line} "
+                    "is not UTF-8)") from None
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

@@ -67,10 +67,10 @@ from ..frozen_map import FrozenMap
 from .analysis_settings import AnalysisSettings, AnalysisTable
 from .drivetrain_file import DrivetrainSpec, find_drivetrain, load_drivetrain_file
 from .files import find_input_file, packaged_files, read_toml
+from .limits import MIN_RELATIVE_STEP
 from .load_events import EventTable, ScenarioEvent, check_events_in_run
 from .master_options import ALGORITHMS, EXTRAPOLATIONS
 from .series_spec import SeriesSpec, SeriesTable, series_from_table
-from .transformations import Transformation
 from .schema import (
     NAME_PATTERN,
     ParameterValue,
@@ -78,6 +78,7 @@ from .schema import (
     flatten_parameters,
     read_document,
 )
+from .transformations import Transformation
 
 #: the project FMU files a drivetrain file is built into, and the generator's (which inherits the gearbox's file)
 DRIVETRAIN_FMU_FILES = ("Gearbox.fmu", "GeneratorRotor.fmu")
@@ -104,8 +105,10 @@ _MULTIPLE_RTOL = 1e-9
 
 
 def steps_between(duration_s: float, step_s: float) -> int | None:
-    """``duration / step`` if it is a whole number (relative tolerance 1e-9), else None."""
+    """``duration / step`` if it is a whole number (relative tolerance 1e-9), else None (also when not finite)."""
     ratio = duration_s / step_s
+    if not math.isfinite(ratio):
+        return None
     n = round(ratio)
     if n >= 0 and abs(ratio - n) <= _MULTIPLE_RTOL * max(1.0, abs(ratio)):
         return int(n)
@@ -286,11 +289,25 @@ class SimulationSettings:
             raise ScenarioError("simulation.step", self.step_s, "> 0 s")
         if not stop > start:
             raise ScenarioError("simulation.stop", self.stop_s, f"> simulation.start = {start:g} s")
-        if steps_between(stop - start, step) is None:
-            raise ScenarioError("simulation.step", self.step_s, f"a step that divides stop - start = {stop - start:g} s into whole steps")
+        length = stop - start
+        if not math.isfinite(length):
+            raise ScenarioError("simulation.stop", self.stop_s, f"a run whose length stop - start is a finite number "
+                                f"(start = {start:g} s)")
+        if step > length:
+            raise ScenarioError("simulation.step", self.step_s, f"a step no longer than the run, stop - start = {length:g} s")
+        finest = MIN_RELATIVE_STEP * max(abs(start), abs(stop))
+        if step < finest:
+            raise ScenarioError("simulation.step", self.step_s,
+                                f"a step of at least {MIN_RELATIVE_STEP:g} x max(|start|, |stop|) = {finest:g} s (finer "
+                                "communication points are not distinct in double precision)")
+        if steps_between(length, step) is None:
+            raise ScenarioError("simulation.step", self.step_s, f"a step that divides stop - start = {length:g} s into whole steps")
         out = step if self.output_interval_s is None else self.output_interval_s
         if not is_number(out) or not math.isfinite(out) or not out > 0:
             raise ScenarioError("simulation.output_interval", self.output_interval_s, "a number > 0 [s]")
+        if out > length * (1.0 + _MULTIPLE_RTOL):
+            raise ScenarioError("simulation.output_interval", self.output_interval_s,
+                                f"an interval no longer than the run, stop - start = {length:g} s")
         if steps_between(float(out), step) in (None, 0):
             raise ScenarioError("simulation.output_interval", self.output_interval_s, f"a whole multiple of the step {step:g} s")
         window = (start, stop) if self.window_s is None else self.window_s

@@ -30,7 +30,7 @@ from pydantic import BaseModel, ConfigDict, ValidationError
 from ..errors import EntryError, suggestion
 
 #: names of components, scenarios and studies: letters, digits, ``_`` and ``-``, starting with a letter or ``_``
-NAME_PATTERN = re.compile(r"^[A-Za-z_][A-Za-z0-9_\-]*$")
+NAME_PATTERN = re.compile(r"[A-Za-z_][A-Za-z0-9_\-]*\Z")  # \Z, not $: "$" also matches before a final newline
 
 #: parameter values an input file may give (FMI Real, Integer, Boolean, String)
 ParameterValue = Union[float, int, bool, str]

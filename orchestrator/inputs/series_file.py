@@ -32,6 +32,7 @@ from typing import Mapping
 import numpy as np
 
 from ..errors import EntryError, suggestion
+from .limits import MAX_RECORD_BYTES
 
 RECORD_SUFFIXES = (".outb", ".out", ".csv")
 
@@ -101,6 +102,10 @@ class Record:
 
 def _check_not_empty(path: Path) -> bytes:
     try:
+        size = path.stat().st_size
+        if size > MAX_RECORD_BYTES:  # refused before it is read
+            raise RecordError("(file)", str(path), f"a record of at most {MAX_RECORD_BYTES:,} bytes "
+                              f"({MAX_RECORD_BYTES / 2**20:.3g} MiB); the file has {size:,} bytes")
         data = path.read_bytes()
     except OSError as exc:
         raise RecordError("(file)", str(path), f"a readable record file ({exc.strerror or exc})") from None

@@ -48,6 +48,7 @@ from components.validation import is_number
 from ..errors import EntryError
 from ..frozen_map import FrozenMap
 from .files import find_input_file, packaged_files, read_toml
+from .limits import MAX_AXIS_VALUES, MAX_STUDY_POINTS
 from .master_options import ALGORITHMS, EXTRAPOLATIONS
 from .measures import Measure, MeasureError, parse_measure
 from .overrides import SimulationOverrides
@@ -315,6 +316,10 @@ class Study:
         for i, pt in enumerate(self.points):
             for p in pt:
                 claim(p, "points")
+        n_points = math.prod(self.shape)
+        if n_points > MAX_STUDY_POINTS:
+            raise StudyError("axes", " x ".join(str(n) for n in self.shape), f"a study of at most {MAX_STUDY_POINTS:,} "
+                             f"points (explicit points x axes x seeds); this one has {n_points:,}", src)
         if self.seeds:
             _check_parameter_name(self.seed_parameter, "seed_parameter", src)
             claim(self.seed_parameter, "seeds")
@@ -341,7 +346,7 @@ class Study:
     @property
     def n_points(self) -> int:
         """Number of runs."""
-        return int(np.prod(self.shape))
+        return math.prod(self.shape)
 
     def expand(self) -> list[Point]:
         """Every point, explicit points outermost, seeds innermost."""
@@ -421,7 +426,7 @@ class _AxisTable(Table):
                                      description="a non-empty list of finite numbers, booleans or strings")
     start: float | None = Field(None, description="a finite number")
     stop: float | None = Field(None, description="a finite number")
-    num: int | None = Field(None, ge=1, description="an integer >= 1")
+    num: int | None = Field(None, ge=1, le=MAX_AXIS_VALUES, description=f"an integer within [1, {MAX_AXIS_VALUES}]")
     spacing: Literal[SPACINGS] | None = None
     label: str = Field("", description="a string")
     unit: str = Field("", description="a string")

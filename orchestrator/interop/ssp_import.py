@@ -42,7 +42,15 @@ from lxml import etree
 
 from ..errors import ScenarioError, SspError
 from ..inputs.analysis_settings import AnalysisSettings
-from ..inputs.scenario import Component, Connection, InitialBinding, Scenario, SimulationSettings, VariableRef
+from ..inputs.limits import MAX_SSP_BYTES, MAX_SSP_MEMBERS, MAX_SSP_RATIO
+from ..inputs.scenario import (
+    Component,
+    Connection,
+    InitialBinding,
+    Scenario,
+    SimulationSettings,
+    VariableRef,
+)
 from .ssp_system import flatten
 from .ssp_xml import (
     DTCOSIM_ANNOTATION,
@@ -64,6 +72,20 @@ SSD_NAME = "SystemStructure.ssd"
 _EXTRACTED: dict[str, Path] = {}
 
 
+def _check_archive_size(path: Path, zf: zipfile.ZipFile) -> None:
+    """Refuse an archive that would expand beyond the limits of :mod:`orchestrator.inputs.limits` (a zip bomb)."""
+    infos = zf.infolist()
+    if len(infos) > MAX_SSP_MEMBERS:
+        raise SspError(f"{path}: {len(infos)} archive members, expected at most {MAX_SSP_MEMBERS}")
+    total = sum(i.file_size for i in infos)
+    if total > MAX_SSP_BYTES:
+        raise SspError(f"{path}: expands to {total / 2**20:.0f} MiB, expected at most {MAX_SSP_BYTES / 2**20:.0f} MiB")
+    for info in infos:
+        if info.file_size > MAX_SSP_RATIO * max(info.compress_size, 1) and info.file_size > 1 << 20:
+            raise SspError(f"{path}: archive member {info.filename!r} expands {info.file_size / max(info.compress_size, 1):.0f} "
+                           f"times ({info.compress_size} -> {info.file_size} bytes), expected at most {MAX_SSP_RATIO} times")
+
+
 def _extract_ssp(path: Path) -> Path:
     """Directory with the archive's content (extracted once per process and content)."""
     digest = hashlib.sha256(path.read_bytes()).hexdigest()
@@ -72,6 +94,7 @@ def _extract_ssp(path: Path) -> Path:
         atexit.register(shutil.rmtree, target, True)
         try:
             with zipfile.ZipFile(path) as zf:
+                _check_archive_size(path, zf)
                 for member in zf.namelist():
                     dest = (target / member).resolve()
                     if not str(dest).startswith(str(target.resolve())):

@@ -33,6 +33,7 @@ from components.analysis.modal_verification import (
 from components.analysis.modes import DrivetrainModalAnalysis, drivetrain_modes
 from components.model.drivetrain import Drivetrain
 
+from ..atomic_files import write_text_atomic
 from .modal_plots import plot_campbell, plot_mode_shapes
 
 
@@ -109,7 +110,7 @@ def modal_report(
         if checks is not None:
             summary["free_response_check"] = [c.as_dict() for c in checks]
         summary["campbell"] = {"load_law": law.as_dict(), "crossings": campbell.crossings(), "mesh_frequency": campbell.mesh_formula}
-        (out / "modes.json").write_text(json.dumps(summary, indent=2))
+        write_text_atomic(out / "modes.json", json.dumps(summary, indent=2))
         files["modes.json"] = out / "modes.json"
         files["modes.png"] = plot_mode_shapes(analysis, out / "modes.png", n_shapes)
         files["campbell.csv"] = write_rows_csv(out / "campbell.csv", campbell.rows())

@@ -46,10 +46,20 @@ from components.analysis.fatigue import fatigue_report, write_del_csv, write_ldd
 from components.analysis.spectrum import amplitude_spectrum
 from components.errors import DtcosimError
 
+from ..atomic_files import atomic_path
 from ..cosim.master import RunOutcome
 from ..cosim.physics_view import PhysicsUnavailable, gearbox_drivetrain, wind_parameters
 from ..cosim.roles import GEARBOX, GENERATOR, WIND_SOURCE
 from ..cosim.system import ResolvedSystem
+from .text_tables import fit_table, number
+
+
+def _atomic(write, path: Path, *args) -> Path:
+    """``write(path, *args)`` through a temporary file and rename (the file is whole or not there)."""
+    with atomic_path(path) as tmp:
+        write(tmp, *args)
+    return path
+
 
 CONTACT_LOSS_FILE = "contact_loss.csv"
 DEL_FILE = "fatigue_del.csv"
@@ -224,7 +234,7 @@ def analyse_run(system: ResolvedSystem, outcome: RunOutcome, out_dir: str | Path
                 "meshes_with_contact_loss": [n for n, s in stats.items() if s.separations > 0],
                 "meshes": meshes,
             }
-            result.files["contact_loss"] = write_contact_loss_csv(out / CONTACT_LOSS_FILE, stats)
+            result.files["contact_loss"] = _atomic(write_contact_loss_csv, out / CONTACT_LOSS_FILE, stats)
 
     loads = forces + torques
     if not loads:
@@ -240,9 +250,9 @@ def analyse_run(system: ResolvedSystem, outcome: RunOutcome, out_dir: str | Path
             fat["revolution_speeds"] = speeds
             fat["shaft_torques"] = list(torques)
             result.summary["fatigue"] = fat
-            result.files["fatigue_del"] = write_del_csv(out / DEL_FILE, report)
+            result.files["fatigue_del"] = _atomic(write_del_csv, out / DEL_FILE, report)
             if report.ldd:
-                result.files["fatigue_ldd"] = write_ldd_csv(out / LDD_FILE, report)
+                result.files["fatigue_ldd"] = _atomic(write_ldd_csv, out / LDD_FILE, report)
                 if plots:
                     from .analysis_plots import plot_load_duration
 
@@ -374,13 +384,13 @@ def format_analyses(summary: dict[str, Any]) -> str:
         if not lost and not any(m["time_in_backlash_s"] > 0 for m in cl["meshes"].values()):
             lines.append(head + f"none ({len(cl['meshes'])} meshes)")
         else:
-            lines.append(head + f"{len(lost)} of {len(cl['meshes'])} meshes separate, {cl['total_separations']} "
-                         f"separations, {cl['total_flank_changes']} flank changes")
-            for name, m in cl["meshes"].items():
-                if m["separations"] or m["time_in_backlash_s"] > 0:
-                    lines.append(f"  {name:<32}{m['separations']:>3} separations {m['flank_changes']:>3} flank changes "
-                                 f"{1e3 * m['time_in_backlash_s']:9.2f} ms inside the backlash "
-                                 f"(longest {1e3 * m['longest_episode_s']:.2f} ms)")
+            lines.append(head.rstrip())
+            lines.append(f"  {len(lost)} of {len(cl['meshes'])} meshes separate, {cl['total_separations']} "
+                         f"separations, {cl['total_flank_changes']} flank changes (times in ms)")
+            rows = [[name, str(m["separations"]), str(m["flank_changes"]), f"{1e3 * m['time_in_backlash_s']:.2f}",
+                     f"{1e3 * m['longest_episode_s']:.2f}"]
+                    for name, m in cl["meshes"].items() if m["separations"] or m["time_in_backlash_s"] > 0]
+            lines += fit_table(["mesh", "separations", "flank changes", "in backlash", "longest"], rows)
     fat = summary.get("fatigue")
     if fat:
         exps = [f"m={m:g}" for m in fat["wohler_exponents"]]
@@ -388,6 +398,6 @@ def format_analyses(summary: dict[str, Any]) -> str:
         if shafts:
             lines.append(f"damage-equivalent loads (N_ref = {fat['reference_frequency_hz'] or 0:g} Hz x T) [N m]: "
                          + ", ".join(exps))
-            for n, d in shafts.items():
-                lines.append(f"  {n:<32}" + "".join(f"{d['del'][e]:14.6g}" for e in exps))
+            lines += fit_table(["shaft", *exps], [[n, *(number(d["del"][e], ".6g") for e in exps)]
+                                                  for n, d in shafts.items()])
     return "\n".join(lines)

@@ -137,18 +137,24 @@ def compare(outcome: RunOutcome, reference: SimulationResult, system: ResolvedSy
 
 
 def format_comparison(report: Mapping[str, Any]) -> str:
-    """A plain-text table of :func:`compare`'s report."""
+    """A plain-text table of :func:`compare`'s report, 80 columns wide.
+
+    Shown: the co-simulation's mean and std, their differences to the monolithic
+    reference (mean relative to ``|monolithic mean|``, std to the monolithic std)
+    and the rms difference relative to the std; every number of both, min and
+    max too, is in ``summary.json`` (``comparison``).
+    """
+    from .text_tables import fit_table, number
+
     w0, w1 = report["window_s"]
-    lines = [f"co-simulation vs monolithic reference over [{w0:g}, {w1:g}] s (relative differences; mean/min/max "
-             "relative to |monolithic mean|, std to monolithic std)"]
-    head = f"{'variable':<30}{'mean co-sim':>14}{'mean mono':>14}{'d mean':>10}{'std co-sim':>13}{'std mono':>13}{'d std':>9}{'d min':>9}{'d max':>9}{'rms/std':>9}"
-    lines.append(head)
+    lines = [f"co-simulation vs monolithic reference over [{w0:g}, {w1:g}] s (d: relative difference;",
+             "all values of both in summary.json, comparison):"]
+    rows = []
     for name, e in report["variables"].items():
-        c, m, r = e["cosim"], e["monolithic"], e["relative_difference"]
-        lines.append(
-            f"{name:<30}{c['mean']:14.6g}{m['mean']:14.6g}{r['mean']:10.2e}{c['std']:13.5g}{m['std']:13.5g}"
-            f"{r['std']:9.2e}{r['min']:9.1e}{r['max']:9.1e}{e.get('rms_relative_to_std', float('nan')):9.2e}"
-        )
+        c, r = e["cosim"], e["relative_difference"]
+        rows.append([name, number(c["mean"], ".6g"), number(r["mean"], "+.2e"), number(c["std"], ".5g"),
+                     number(r["std"], "+.2e"), number(e.get("rms_relative_to_std"), ".2e")])
+    lines += fit_table(["variable", "mean co-sim", "d mean", "std co-sim", "d std", "rms/std"], rows, indent=0)
     for note in report.get("notes", []):
         lines.append(f"note: {note}")
     return "\n".join(lines)

@@ -3,7 +3,8 @@
 * ``rotor_speed.png`` - rotor speed over time, the wind description (paper Fig. 15);
 * ``generator_speed.png`` - generator speed against the ideal gearbox, ratio x rotor
   speed, with their relative difference below (Fig. 16);
-* ``contact_forces.png`` - every contact force, one panel per stage (Fig. 17).
+* ``contact_forces.png`` - every contact force, one row per stage: the whole run
+  and the analysis window alone; identical planet meshes drawn once (Fig. 17).
 
 The variables come from the components' declared roles and signals
 (:mod:`orchestrator.cosim.roles`); a plot whose signals are not declared or not
@@ -19,7 +20,7 @@ import numpy as np
 from ..cosim.master import RunOutcome
 from ..cosim.roles import GEARBOX, GENERATOR, WIND_SOURCE, ComponentRole
 from ..cosim.system import ResolvedSystem
-from ..plotting import RPM_PER_RAD_S, new_figure, plot_envelope, save_figure
+from ..plotting import RPM_PER_RAD_S, new_figure, new_grid, plot_envelope, save_figure
 from .derived import Skipped, generator_vs_ideal, single_role
 
 #: mesh kind (declared signal info) -> label and line style
@@ -89,34 +90,87 @@ def plot_generator_speed(outcome: RunOutcome, rotor_column: str, gen_column: str
     return save_figure(fig, path)
 
 
+def symmetric_groups(series: list[tuple[str, str, np.ndarray]]) -> list[tuple[str, str, np.ndarray, list[str]]]:
+    """Curves of one stage with identical ones merged: (variable, mesh kind, samples, the identical others).
+
+    The planets of a planetary stage are evenly spaced and share one set of
+    parameters, so their meshes carry the same force at every instant; a curve
+    equal (to 1e-12 of its range) to an earlier one of the same mesh kind is
+    drawn once, its label naming the others.
+    """
+    groups: list[tuple[str, str, np.ndarray, list[str]]] = []
+    for var, kind, y in series:
+        for first, first_kind, y0, same in groups:
+            span = float(np.nanmax(np.abs(y0))) if y0.size else 0.0
+            if first_kind == kind and y.shape == y0.shape and np.allclose(y, y0, rtol=0.0, atol=1e-12 * max(span, 1.0),
+                                                                            equal_nan=True):
+                same.append(var)
+                break
+        else:
+            groups.append((var, kind, y, []))
+    return groups
+
+
+def _scale_to_window(ax, t, curves, window) -> None:
+    sel = (t >= window[0]) & (t <= window[1])
+    if not sel.any():
+        return
+    lo = min(float(np.nanmin(c[sel])) for c in curves)
+    hi = max(float(np.nanmax(c[sel])) for c in curves)
+    pad = 0.08 * (hi - lo) if hi > lo else max(abs(hi), 1e-9) * 0.01
+    ax.set_xlim(max(window[0], t[0]), min(window[1], t[-1]))
+    ax.set_ylim(lo - pad, hi + pad)
+
+
 def plot_contact_forces(outcome: RunOutcome, gearbox: ComponentRole, window, path: Path,
                         title_suffix: str = "") -> Path | None:
-    """Every recorded contact force the gearbox declares [kN], one panel per stage (Fig. 17)."""
+    """Every recorded contact force the gearbox declares [kN], one row per stage (Fig. 17).
+
+    Left: the whole run (the analysis window shaded), where the start-up peak
+    sets the scale; right: the analysis window alone, scaled to it, where the
+    fluctuation the statistics describe is visible. Planet meshes that carry the
+    same force (by symmetry) are drawn once (:func:`symmetric_groups`).
+    """
     recorded = {c.column: i for i, c in enumerate(outcome.columns)}
-    stages: dict[str, list[tuple[str, str, int]]] = {}
+    stages: dict[str, list[tuple[str, str, np.ndarray]]] = {}
     for s in gearbox.of_kind("contact_force"):
         i = recorded.get(f"{gearbox.component}.{s.variable}")
         if i is not None:
-            stages.setdefault(s.info.get("stage", ""), []).append((s.variable, s.info.get("mesh", "parallel"), i))
+            stages.setdefault(s.info.get("stage", ""), []).append(
+                (s.variable, s.info.get("mesh", "parallel"), outcome.values[:, i] / 1e3))
     if not stages:
         return None
     names = list(stages)
-    fig, axes = new_figure(len(names), height=2.6 * len(names) + 0.8, width=12.5)
+    fig, axes = new_grid(len(names), 2, height=2.6 * len(names) + 1.0, width=15.0)
     t = outcome.time_s
-    for ax, stage in zip(axes, names):
-        _shade_window(ax, window)
-        for k, (var, kind, i) in enumerate(stages[stage]):
+    merged = False
+    for row, stage in zip(axes, names):
+        whole, zoom = row
+        _shade_window(whole, window)
+        groups = symmetric_groups(stages[stage])
+        for k, (var, kind, y, same) in enumerate(groups):
             label, style = _MESH_STYLE.get(kind, (kind, "-"))
-            plot_envelope(ax, t, outcome.values[:, i] / 1e3, lw=0.7, ls=style, color=f"C{k % 10}",
-                          label=f"{var} ({label})")
-        ax.set_ylabel("force [kN]")
-        ax.set_title(f"{gearbox.component}.{stage}", fontsize=10, loc="left")
-        ax.grid(True, lw=0.3)
+            text = f"{var} ({label})"
+            if same:
+                merged = True
+                text += " = " + ", ".join(v[v.rfind("["):] if v.endswith("]") else v for v in same)
+            for ax in (whole, zoom):
+                plot_envelope(ax, t, y, lw=0.7, ls=style, color=f"C{k % 10}", label=text if ax is zoom else None)
+        _scale_to_window(zoom, t, [y for _, _, y, _ in groups], window)
+        for ax in (whole, zoom):
+            ax.set_ylabel("force [kN]")
+            ax.grid(True, lw=0.3)
+        whole.set_title(f"{gearbox.component}.{stage}: whole run", fontsize=10, loc="left")
+        zoom.set_title(f"{gearbox.component}.{stage}: analysis window {window[0]:g}-{window[1]:g} s", fontsize=10,
+                       loc="left")
         # outside the axes: inside, it hid the peaks of load events and start-up swings
-        ax.legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), fontsize=7, ncol=1, borderaxespad=0.0)
-    axes[-1].set_xlabel("time [s]")
-    axes[-1].set_xlim(t[0], t[-1])
-    fig.suptitle("Gear contact forces of all stages (paper Fig. 17)" + title_suffix)
+        zoom.legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), fontsize=7, ncol=1, borderaxespad=0.0)
+    for ax in axes[-1]:
+        ax.set_xlabel("time [s]")
+    axes[-1][0].set_xlim(t[0], t[-1])
+    note = ("; the planets' meshes carry identical forces by symmetry (evenly spaced planets, one parameter set): "
+            "each drawn once") if merged else ""
+    fig.suptitle("Gear contact forces of all stages (paper Fig. 17)" + title_suffix + note, fontsize=10)
     return save_figure(fig, path)
 
 

@@ -3,8 +3,10 @@
 ``timeseries.csv``
     One row per sample: ``time [s]`` and every recorded variable, header
     ``component.variable [unit]`` with the unit the FMU declares (``[-]`` when it
-    declares none), e.g. ``gearbox.stage1.F_sp[1] [N]``. Written also for an
-    incomplete run (the samples up to where it stopped).
+    declares none), e.g. ``gearbox.stage1.F_sp[1] [N]``. Streamed while the run
+    steps (``timeseries.csv.partial``, :mod:`orchestrator.run.writers`) and renamed
+    when the co-simulation ends, also for an incomplete run (the samples up to
+    where it stopped).
 
 ``summary.json``
     ``scenario``, ``complete``, ``statistics`` (``{"component.variable": {"mean",
@@ -15,6 +17,14 @@
     model name, GUID per component), ``stopped_at`` and ``error`` for an
     incomplete run, ``comparison`` with ``--compare-reference``. Non-finite
     numbers are written as ``null``.
+
+    How the run ended: ``status`` (``complete``, ``stopped`` by a signal,
+    ``failed``; ``running`` while it runs, see :mod:`orchestrator.run.run_folder`),
+    ``stage`` (``instantiation``, ``initialisation``, ``stepping``, ``writing``),
+    ``signal`` when a signal stopped it, ``problems`` (files that could not be
+    written), ``post_processing`` when analyses or plots were not done. ``files``
+    lists the whole files by role, ``files_incomplete`` those that are there but
+    not whole (with the reason and the rows they hold).
 """
 
 from __future__ import annotations
@@ -26,27 +36,34 @@ from components.reference.results import window_statistics
 
 from ..cosim.master import RunOutcome
 from ..cosim.system import ResolvedSystem
-from ..result_files import jsonable, versions, write_series_csv
+from ..result_files import jsonable, versions
+from .writers import Column, CsvWriter
 
 TIMESERIES_FILE = "timeseries.csv"
 SUMMARY_FILE = "summary.json"
 
 
-#: CSV header tag of the non-Real columns that have no unit
-TYPE_TAGS = {"Boolean": "Boolean 0/1", "String": "String"}
-
-
 def column_header(component: str, variable: str, unit: str, fmi_type: str = "Real") -> str:
     """CSV header of a column: ``component.variable [unit]`` (``[Boolean 0/1]``, ``[String]`` for those types)."""
-    return f"{component}.{variable} [{TYPE_TAGS.get(fmi_type) or unit or '-'}]"
+    return Column(f"{component}.{variable}", unit, fmi_type).header
+
+
+def result_columns(columns) -> list[Column]:
+    """The results-file columns of recorded variables (:class:`~orchestrator.cosim.system.RecordedVariable`)."""
+    return [Column(c.column, c.unit, c.type) for c in columns]
 
 
 def write_timeseries(path: str | Path, outcome: RunOutcome) -> Path:
-    """Write the sampled time series as CSV (Reals with 17 significant digits; other types as they are)."""
-    header = ["time [s]"] + [column_header(c.component, c.variable, c.unit, c.type) for c in outcome.columns]
-    types = [c.type for c in outcome.columns]
-    text = {j: outcome.text[c.column] for j, c in enumerate(outcome.columns) if c.column in outcome.text}
-    return write_series_csv(path, header, outcome.time_s, outcome.values, types, text)
+    """Write an outcome's samples as ``timeseries.csv`` in one go (the same writer a run streams into)."""
+    writer = CsvWriter(path)
+    writer.open(result_columns(outcome.columns))
+    try:
+        text = {j: outcome.text[c.column] for j, c in enumerate(outcome.columns) if c.column in outcome.text}
+        writer.append(outcome.time_s, outcome.values, text or None)
+    except BaseException:
+        writer.abandon()
+        raise
+    return writer.close()
 
 
 def statistics(outcome: RunOutcome, window: tuple[float, float]) -> dict[str, dict[str, float]]:
@@ -55,18 +72,33 @@ def statistics(outcome: RunOutcome, window: tuple[float, float]) -> dict[str, di
             for i, c in enumerate(outcome.columns) if c.type != "String"}
 
 
+def run_status(outcome: RunOutcome, problems: list[str] | None = None) -> str:
+    """``complete``, ``stopped`` (a signal) or ``failed``."""
+    if outcome.interrupted:
+        return "stopped"
+    return "complete" if outcome.complete and not problems else "failed"
+
+
 def build_summary(system: ResolvedSystem, outcome: RunOutcome, *, wall_time_s: float,
                   derived: Mapping[str, Any] | None = None, comparison: Mapping[str, Any] | None = None,
-                  files: Mapping[str, str] | None = None) -> dict[str, Any]:
-    """The ``summary.json`` content of a run (see the module docstring)."""
+                  files: Mapping[str, str] | None = None, listing: Mapping[str, Any] | None = None,
+                  header: Mapping[str, Any] | None = None, problems: list[str] | None = None) -> dict[str, Any]:
+    """The ``summary.json`` content of a run (see the module docstring).
+
+    ``files`` (role -> name) or ``listing`` (``{"files": ..., "files_incomplete": ...}``
+    of :meth:`~orchestrator.run.run_folder.RunFolder.listing`) say what the folder holds.
+    """
     sc = system.scenario
     sim = sc.simulation
-    summary: dict[str, Any] = {
+    summary: dict[str, Any] = dict(header or {})
+    summary.update({
         "scenario": sc.name,
         "description": sc.description,
         "scenario_file": sc.source,
+        "status": run_status(outcome, problems),
         "complete": bool(outcome.complete),
-    }
+        "stage": outcome.stage,
+    })
     if outcome.ended_by is not None:
         summary["ended_by"] = outcome.ended_by
         summary["stopped_at"] = outcome.stopped_at_s
@@ -74,6 +106,11 @@ def build_summary(system: ResolvedSystem, outcome: RunOutcome, *, wall_time_s: f
         summary["stopped_at"] = outcome.stopped_at_s
         summary["error"] = outcome.error
         summary["interrupted"] = outcome.interrupted
+        if outcome.stop_signal:
+            summary["signal"] = outcome.stop_signal
+    if problems:
+        summary["problems"] = list(problems)
+    summary["samples"] = int(outcome.time_s.size)
     summary.update({
         "window_s": list(sim.window_s),
         "statistics": statistics(outcome, sim.window_s),
@@ -108,6 +145,8 @@ def build_summary(system: ResolvedSystem, outcome: RunOutcome, *, wall_time_s: f
         summary["profile"] = {"seconds_per_fmi_function": outcome.profile, "loop_time_s": outcome.loop_time_s}
     if files:
         summary["files"] = dict(files)
+    if listing:
+        summary.update(dict(listing))
     if comparison is not None:
         summary["comparison"] = comparison
     warnings = {name: [m for m in log if m.startswith(("[warning]", "[discard]", "[error]", "[fatal]"))]

@@ -6,22 +6,33 @@ output directory (default ``results/<scenario name>/``).
 
 from __future__ import annotations
 
+import contextlib
+import signal
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
 
+from ..atomic_files import describe_os_error
 from ..cosim.master import CoSimulation, RunOutcome
 from ..cosim.physics_view import PhysicsUnavailable, physics_view
+from ..cosim.stop_requests import StopRequests, exit_status
 from ..cosim.system import ResolvedSystem
+from ..errors import FmuStepError, InitializationError, RunInterrupted, signal_name
 from ..inputs.scenario import Scenario, load_scenario
-from ..result_files import write_summary
 from .analyses import analyse_run
 from .comparison import compare, format_comparison, run_reference
 from .derived import Skipped, generator_vs_ideal
 from .plots import plot_run
 from .recorded import compare_recorded, plot_contact_loss_counts, plot_recorded
-from .results import SUMMARY_FILE, TIMESERIES_FILE, build_summary, write_timeseries
+from .results import TIMESERIES_FILE, build_summary, result_columns
+from .run_folder import RunFolder
+from .writers import CsvWriter
+
+
+def signal_number(name: str) -> int:
+    """``"SIGTERM"`` -> 15."""
+    return int(signal.Signals[name])
 
 
 def load_any(path: str | Path, step_s: float | None = None, stop_s: float | None = None,
@@ -46,18 +57,34 @@ class RunReport:
     Attributes
     ----------
     outcome : RunOutcome
+        Also for a run that stopped before its first step (no rows, ``stage`` says where).
     summary : dict
         The content of ``summary.json``.
     files : dict of str -> pathlib.Path
-        Written files by role (``timeseries``, ``summary``, ``plot:<name>``).
+        Whole files written, by role (``timeseries``, ``summary``, ``plot:<name>``).
     comparison_text : str
         The co-simulation vs monolithic table ("" without ``compare_reference``).
+    problems : list of str
+        What went wrong after the co-simulation (a file that could not be written); empty if nothing.
+    replaced : list of str
+        Files of a previous run in the output folder that this run removed.
+    exit_status : int
+        0 complete, ``128 + signal`` when stopped by a signal, 1 otherwise.
     """
 
     outcome: RunOutcome
     summary: dict[str, Any]
     files: dict[str, Path] = field(default_factory=dict)
     comparison_text: str = ""
+    problems: list[str] = field(default_factory=list)
+    replaced: list[str] = field(default_factory=list)
+    exit_status: int = 0
+
+
+def _stage_of(exc: FmuStepError | InitializationError) -> str:
+    if isinstance(exc, FmuStepError) and exc.function in ("fmi2Instantiate", "fmi2SetupExperiment"):
+        return "instantiation"
+    return "initialisation"
 
 
 def run_scenario(system: ResolvedSystem, out_dir: str | Path, *, compare_reference: bool = False, plots: bool = True,
@@ -69,11 +96,26 @@ def run_scenario(system: ResolvedSystem, out_dir: str | Path, *, compare_referen
     loads, contact-force spectra) add ``contact_loss.csv``, ``fatigue_del.csv``,
     ``fatigue_ldd.csv`` and their plots.
 
+    What survives a stop
+    --------------------
+    The folder is checked and the previous run's files are removed first
+    (:class:`~orchestrator.run.run_folder.RunFolder`); ``summary.json`` says
+    ``"status": "running"`` from then on and lists each file once it is whole.
+    The samples are streamed into ``timeseries.csv.partial`` block by block and
+    renamed to ``timeseries.csv`` when the co-simulation ends. SIGINT, SIGTERM
+    and SIGHUP stop the run between blocks of steps (or before the next FMU is
+    instantiated, or before the next result file); an FMU failure, a failed
+    initialisation and a write error (full disk) stop it too. Every stop ends
+    with a ``summary.json`` saying ``complete: false``, the ``stage``, where
+    (``stopped_at``) and why (``error``), and which files are whole (``files``)
+    or not (``files_incomplete``). After SIGKILL the summary still says
+    ``running`` and ``timeseries.csv.partial`` is readable up to its last block.
+
     Parameters
     ----------
     system : ResolvedSystem
     out_dir : path
-        Created if missing; existing result files are overwritten.
+        Created if missing; the files of a previous run in it are removed.
     compare_reference : bool
         Also run the monolithic reference on the same scenario and report every
         statistic of both (``summary.json`` key ``comparison``).
@@ -82,7 +124,7 @@ def run_scenario(system: ResolvedSystem, out_dir: str | Path, *, compare_referen
     progress : callable(done, total), optional
         Progress callback (communication steps).
     handle_sigint : bool
-        Stop cleanly on Ctrl-C (partial results, ``complete: false``).
+        Stop cleanly on SIGINT, SIGTERM and SIGHUP (partial results, ``complete: false``).
     profile : bool
         Time every FMI call per FMU (``summary.json`` key ``profile``).
 
@@ -90,33 +132,142 @@ def run_scenario(system: ResolvedSystem, out_dir: str | Path, *, compare_referen
     -------
     RunReport
         Results are written also when the run stops early; ``outcome.complete`` tells.
+
+    Raises
+    ------
+    OutputFolderError
+        If ``out_dir`` is a file or cannot be written (before anything runs).
     """
     wall0 = time.perf_counter()
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    outcome = CoSimulation(system, profile=profile).run(progress=progress, handle_sigint=handle_sigint)
-    files: dict[str, Path] = {"timeseries": write_timeseries(out / TIMESERIES_FILE, outcome)}
-    derived: dict[str, Any] = {}
-    skipped: list[dict[str, str]] = []
+    sc = system.scenario
+    sim = sc.simulation
+    folder = RunFolder.prepare(out_dir, {"scenario": sc.name, "description": sc.description,
+                                         "scenario_file": sc.source})
+    out = folder.path
+    writer = CsvWriter(out / TIMESERIES_FILE)
+    problems: list[str] = []
+    with StopRequests(enabled=handle_sigint) as stop:
+        cosim = CoSimulation(system, profile=profile)
+        try:
+            writer.open(result_columns(system.recorded))
+            folder.mark_incomplete("timeseries", writer.partial_path, "being written by the run")
+        except OSError as exc:
+            writer.abandon()
+            problems.append(describe_os_error(exc))
+            outcome = RunOutcome.empty(system.recorded, sim.start_s, f"results not written: {problems[-1]}", "writing")
+        else:
+            try:
+                outcome = cosim.run(progress=progress, sink=writer, stop=stop)
+            except (FmuStepError, InitializationError) as exc:
+                outcome = RunOutcome.empty(system.recorded, sim.start_s, str(exc), _stage_of(exc),
+                                           fmu_log={n: list(i.log) for n, i in cosim.instances.items()})
+            except RunInterrupted as exc:
+                outcome = RunOutcome.empty(system.recorded, sim.start_s, str(exc), exc.stage, interrupted=True,
+                                           stop_signal=stop.signal_name or signal_name(exc.signum))
+            _finish_timeseries(writer, outcome, folder, problems)
+        derived: dict[str, Any] = {}
+        skipped: list[dict[str, str]] = []
+        comparison = None
+        comparison_text = ""
+        post = _PostProcessing(stop, folder)
+        if outcome.time_s.size and not problems:
+            try:
+                comparison, comparison_text = _post_process(system, outcome, out, post, derived, skipped,
+                                                            compare_reference, plots)
+            except OSError as exc:
+                problems.append(describe_os_error(exc))
+                post.stopped = f"stopped: {problems[-1]}"
+        if post.stopped:
+            derived["post_processing"] = {"stopped": post.stopped, "not_done": post.not_done}
+        derived["analyses_skipped"] = skipped
+        summary = build_summary(system, outcome, wall_time_s=time.perf_counter() - wall0, derived=derived,
+                                comparison=comparison, listing=folder.listing(), header=folder.header,
+                                problems=problems)
+        files = {role: out / name for role, name in folder.files.items()}
+        try:
+            files["summary"] = folder.save(summary)
+        except OSError as exc:
+            problems.append(f"summary not written: {describe_os_error(exc)}")
+        signum = stop.signum if stop.signum is not None else (
+            signal_number(outcome.stop_signal) if outcome.stop_signal else None)
+        if signum is not None:
+            status = exit_status(signum)
+        elif outcome.complete and not problems:
+            status = 0
+        else:
+            status = 1
+    return RunReport(outcome, summary, files, comparison_text, problems, list(folder.replaced), status)
+
+
+def _finish_timeseries(writer: CsvWriter, outcome: RunOutcome, folder: RunFolder, problems: list[str]) -> None:
+    """Rename the streamed file when whole; otherwise say in the summary what it holds."""
+    if outcome.stage == "writing":
+        writer.abandon()
+        folder.mark_incomplete("timeseries", writer.partial_path, outcome.error or "write error",
+                               rows=writer.rows_written)
+        problems.append(outcome.error or "results not written")
+        return
+    if writer.rows_written == 0:  # stopped before the first sample: no results file at all
+        writer.abandon()
+        with contextlib.suppress(OSError):
+            writer.partial_path.unlink()
+        folder.incomplete.pop("timeseries", None)
+        return
     try:
-        derived["generator_vs_ideal"] = generator_vs_ideal(system, outcome)
-    except Skipped as exc:
-        skipped.append({"analysis": "generator_vs_ideal", "reason": str(exc)})
+        folder.commit("timeseries", writer.close())
+    except OSError as exc:
+        writer.abandon()
+        problems.append(describe_os_error(exc))
+        folder.mark_incomplete("timeseries", writer.partial_path, problems[-1], rows=writer.rows_written)
+
+
+class _PostProcessing:
+    """Stages after the co-simulation; a stop request skips the ones not started."""
+
+    def __init__(self, stop: StopRequests, folder: RunFolder) -> None:
+        self.stop = stop
+        self.folder = folder
+        self.stopped = ""
+        self.not_done: list[str] = []
+
+    def go(self, stage: str) -> bool:
+        """True if ``stage`` may start."""
+        if self.stop.requested and not self.stopped:
+            self.stopped = f"{self.stop.reason}; the co-simulation's results are whole"
+        if self.stopped:
+            self.not_done.append(stage)
+            return False
+        return True
+
+    def commit(self, files: dict[str, Path]) -> None:
+        for role, path in files.items():
+            self.folder.commit(role, path)
+
+
+def _post_process(system, outcome, out, post: _PostProcessing, derived, skipped, compare_reference, plots):
+    """Derived quantities, analyses, the monolithic comparison and the plots, stage by stage."""
+    comparison = None
+    comparison_text = ""
+    if post.go("generator_vs_ideal"):
+        try:
+            derived["generator_vs_ideal"] = generator_vs_ideal(system, outcome)
+        except Skipped as exc:
+            skipped.append({"analysis": "generator_vs_ideal", "reason": str(exc)})
     if system.events:
         derived["events"] = [a.as_dict() for a in system.events]
     derived["analysis_settings"] = system.scenario.analysis.as_dict()
-    recorded = compare_recorded(system, outcome)
-    if recorded:  # simulated against recorded channels (a TimeSeriesSource playing a record)
-        derived["recorded_comparison"] = recorded
-    analyses = analyse_run(system, outcome, out, plots=plots)
-    derived.update(analyses.summary)
-    if analyses.notes:
-        derived["analysis_notes"] = analyses.notes
-    skipped += analyses.skipped
-    files.update(analyses.files)
-    comparison = None
-    comparison_text = ""
-    if compare_reference:
+    if post.go("recorded_comparison"):
+        recorded = compare_recorded(system, outcome)
+        if recorded:  # simulated against recorded channels (a TimeSeriesSource playing a record)
+            derived["recorded_comparison"] = recorded
+    if post.go("analyses"):
+        analyses = analyse_run(system, outcome, out, plots=plots)
+        derived.update(analyses.summary)
+        if analyses.notes:
+            derived["analysis_notes"] = analyses.notes
+        skipped += analyses.skipped
+        post.commit(analyses.files)
+    if compare_reference and post.go("comparison"):
         if not outcome.complete:
             comparison = {"skipped": "the co-simulation did not complete"}
         else:
@@ -129,19 +280,12 @@ def run_scenario(system: ResolvedSystem, out_dir: str | Path, *, compare_referen
                 comparison = {"skipped": f"no monolithic reference: {exc}"}
                 comparison_text = f"no monolithic comparison: {exc}"
                 skipped.append({"analysis": "comparison", "reason": str(exc)})
-    if plots:
-        for p in plot_run(system, outcome, out, skipped):
-            files[f"plot:{p.stem}"] = p
+    if plots and post.go("plots"):
+        post.commit({f"plot:{p.stem}": p for p in plot_run(system, outcome, out, skipped)})
         recorded_plot = plot_recorded(system, outcome, out)
         if recorded_plot is not None:
-            files[f"plot:{recorded_plot.stem}"] = recorded_plot
+            post.commit({f"plot:{recorded_plot.stem}": recorded_plot})
         counts_plot = plot_contact_loss_counts(derived.get("contact_loss"), out, system.scenario.name)
         if counts_plot is not None:
-            files[f"plot:{counts_plot.stem}"] = counts_plot
-    derived["analyses_skipped"] = skipped
-    summary = build_summary(
-        system, outcome, wall_time_s=time.perf_counter() - wall0, derived=derived, comparison=comparison,
-        files={k: p.name for k, p in files.items()} | {"summary": SUMMARY_FILE},
-    )
-    files["summary"] = write_summary(out / SUMMARY_FILE, summary)
-    return RunReport(outcome, summary, files, comparison_text)
+            post.commit({f"plot:{counts_plot.stem}": counts_plot})
+    return comparison, comparison_text

@@ -89,10 +89,16 @@ class Journal:
                 self._fh = None
 
 
+#: the statuses a journal record may have
+RECORD_STATUSES = ("ok", "failed", "error")
+
+
 def read_journal(path: str | Path) -> list[dict[str, Any]]:
     """Every complete record of a journal, in file order (empty if the file does not exist).
 
-    Lines that are not a JSON object with a ``key`` (a torn last line) are skipped.
+    Lines that are not a JSON object with a ``key`` and a known ``status`` (a torn
+    last line, a record edited by hand) are skipped: their points count as not
+    run yet, and the next sweep runs them again.
     """
     path = Path(path)
     if not path.is_file():
@@ -107,7 +113,8 @@ def read_journal(path: str | Path) -> list[dict[str, Any]]:
                 record = json.loads(line)
             except json.JSONDecodeError:
                 continue
-            if isinstance(record, dict) and isinstance(record.get("key"), str):
+            if isinstance(record, dict) and isinstance(record.get("key"), str) \
+                    and record.get("status") in RECORD_STATUSES:
                 out.append(record)
     return out
 

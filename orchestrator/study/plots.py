@@ -21,6 +21,7 @@ import numpy as np
 
 from components.validation import is_number
 
+from ..atomic_files import atomic_path
 from ..inputs.measures import wohler_exponent_of
 from ..inputs.study import PlotSpec
 
@@ -173,7 +174,8 @@ def heatmap(prepared, recs, spec: PlotSpec, path: Path) -> Path:
         bar.update_ticks()
     ax.set_title(_title(spec.title or f"{study.name}: {m.description}", _per_cell(study, spec.x, spec.y), width, m.name),
                  fontsize=10)
-    fig.savefig(path, dpi=130)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=130)
     plt.close(fig)
     return path
 
@@ -222,7 +224,8 @@ def line_plot(prepared, recs, spec: PlotSpec, path: Path) -> Path:
                  fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
-    fig.savefig(path, dpi=130)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=130)
     plt.close(fig)
     return path
 

@@ -146,7 +146,14 @@ def _study_key_of(exc: ScenarioError) -> str:
 
 
 def _check_value(system, name: str, value: Any, key: str, source: str | None) -> None:
-    """A varied scenario parameter exists, is settable, not connected, and the value has its type."""
+    """A varied scenario parameter exists, is settable, not connected, and the value has its type and range.
+
+    The range is what the FMU declares (an FMI Integer's 32 bits, a dtcosim FMU's
+    bounds, ``min``/``max``: :func:`orchestrator.cosim.parameter_checks.value_problem`),
+    with the FMU's own message; combinations of values are the model's to refuse
+    (that point fails).
+    """
+    from ..cosim.parameter_checks import value_problem
     from ..cosim.system import _value_matches, parameter_problem
 
     comp, param = split_parameter(name)
@@ -163,6 +170,9 @@ def _check_value(system, name: str, value: Any, key: str, source: str | None) ->
         raise StudyError(key, name, "a parameter the scenario does not set at initialisation (an [[initial]] binding)", source)
     if not _value_matches(var, value):
         raise StudyError(key, value, f"a {var.type} value for {name}", source)
+    problem = value_problem(iface, var, value)
+    if problem is not None:
+        raise StudyError(key, value, f"{problem} for {name}", source)
 
 
 def _solver_settings(study: Study):

@@ -2,8 +2,9 @@
 
 :func:`run_sweep` runs the points of a :class:`~orchestrator.study.prepare.PreparedStudy`
 that the output directory's journal does not already hold, on Dask workers: a
-``distributed.LocalCluster`` (processes, one thread each) by default, or an
-existing cluster given its scheduler address. What all points share (base
+``distributed.LocalCluster`` (processes, one thread each, TLS with temporary
+credentials, no dashboard unless asked: :mod:`orchestrator.study.cluster`) by
+default, or an existing cluster given its scheduler address. What all points share (base
 system, measures, FMU bytes) is scattered once; each task carries one point
 (:func:`orchestrator.study.engine.run_point`).
 
@@ -25,9 +26,7 @@ from __future__ import annotations
 
 import contextlib
 import datetime as _dt
-import logging
 import math
-import os
 import signal
 import threading
 import time
@@ -36,6 +35,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
 
+from ..cosim.stop_requests import STOP_SIGNALS
 from ..inputs.study import StudyError
 from .engine import FAILED, OK, PointTask, run_point
 from .journal import JOURNAL_FILE, Journal, latest_by_key, read_journal
@@ -63,7 +63,9 @@ class SweepReport:
         Outcomes of the submitted points that finished (``failed``: the point
         itself failed; ``errors``: infrastructure or unexpected errors).
     interrupted : bool
-        Stopped by Ctrl-C (finished points are journaled).
+        Stopped by a signal: Ctrl-C, SIGTERM or SIGHUP (finished points are journaled).
+    signal : int
+        That signal's number (0 if none).
     wall_time_s : float
         The whole call [s] (cluster start-up and output files included).
     compute_time_s : float
@@ -82,6 +84,7 @@ class SweepReport:
     failed: int = 0
     errors: int = 0
     interrupted: bool = False
+    signal: int = 0
     wall_time_s: float = 0.0
     compute_time_s: float = 0.0
     workers: int = 0
@@ -101,23 +104,26 @@ def pending_points(prepared: PreparedStudy, records: list[dict], retry_failed: b
 
 
 class _Interrupts:
-    """SIGINT handling that never splits a journal write: Ctrl-C during a write is raised after it."""
+    """SIGINT, SIGTERM and SIGHUP handling that never splits a journal write: a signal during a write is raised after it."""
 
     def __init__(self) -> None:
         self.critical = False
         self.pending = False
-        self.previous = None
+        self.previous: dict[int, object] = {}
+        self.signum: int | None = None
 
     def __enter__(self) -> "_Interrupts":
         if threading.current_thread() is threading.main_thread():
-            self.previous = signal.signal(signal.SIGINT, self._handler)
+            for signum in STOP_SIGNALS:
+                self.previous[signum] = signal.signal(signum, self._handler)
         return self
 
     def __exit__(self, *exc) -> None:
-        if self.previous is not None:
-            signal.signal(signal.SIGINT, self.previous)
+        for signum, handler in self.previous.items():
+            signal.signal(signum, handler)
 
     def _handler(self, signum, frame) -> None:
+        self.signum = self.signum or signum
         if self.critical:
             self.pending = True
         else:
@@ -145,28 +151,16 @@ def _json_value(value: Any) -> Any:
     return value
 
 
-def _open_client(workers: int | None, scheduler: str | None):
-    """(client, cluster or None): a new LocalCluster, or a client of an existing scheduler."""
-    from distributed import Client, LocalCluster
+def _open_client(workers: int | None, scheduler: str | None, dashboard: str | None = None):
+    """(client, cluster or None): a new locked-down LocalCluster, or a client of an existing scheduler."""
+    from distributed import Client
+
+    from .cluster import connect, locked_down_local_cluster
 
     if scheduler:
-        try:
-            return Client(scheduler, timeout="20s"), None
-        except OSError as exc:
-            raise StudyError("--scheduler", scheduler, f"the address of a running Dask scheduler ({exc})") from None
-    n = workers if workers else (os.cpu_count() or 1)
-    # Ctrl-C on a terminal signals the whole process group: the worker processes start with SIGINT ignored
-    # (an ignored signal stays ignored across exec), so only this process acts on it and closes the cluster
-    previous = None
-    if threading.current_thread() is threading.main_thread():
-        previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
-    try:
-        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                               silence_logs=logging.ERROR)
-    finally:
-        if previous is not None:
-            signal.signal(signal.SIGINT, previous)
-    return Client(cluster), cluster
+        return connect(scheduler), None
+    cluster = locked_down_local_cluster(workers, dashboard)
+    return Client(cluster, security=cluster.security), cluster
 
 
 def _worker_count(client) -> int:
@@ -197,6 +191,7 @@ def run_sweep(
     progress: Callable[[dict[str, Any]], None] | None = None,
     on_start: Callable[[int, int], None] | None = None,
     plots: bool = True,
+    dashboard: str | None = None,
 ) -> SweepReport:
     """Run the study's pending points on Dask and write the journal, the table and the plots.
 
@@ -219,6 +214,9 @@ def run_sweep(
         Called once before the cluster starts.
     plots : bool
         Write the PNG plots.
+    dashboard : str, optional
+        ``host:port`` of the LocalCluster's Dask dashboard (default: none; see
+        :mod:`orchestrator.study.cluster`).
 
     Returns
     -------
@@ -238,14 +236,14 @@ def run_sweep(
         if on_start is not None:
             on_start(len(todo), report.skipped)
         if todo:
-            _execute(prepared, todo, journal, report, workers, scheduler, progress)
+            _execute(prepared, todo, journal, report, workers, scheduler, progress, dashboard)
     report.files = write_outputs(prepared, out, report, plots=plots)
     report.wall_time_s = time.perf_counter() - wall0
     return report
 
 
 def _execute(prepared: PreparedStudy, todo: list[int], journal: Journal, report: SweepReport,
-             workers: int | None, scheduler: str | None, progress) -> None:
+             workers: int | None, scheduler: str | None, progress, dashboard: str | None = None) -> None:
     from distributed import as_completed
 
     study = prepared.study
@@ -255,7 +253,7 @@ def _execute(prepared: PreparedStudy, todo: list[int], journal: Journal, report:
     with _Interrupts() as interrupts:
         client = cluster = None
         try:
-            client, cluster = _open_client(workers, scheduler)
+            client, cluster = _open_client(workers, scheduler, dashboard)
             report.workers = _worker_count(client)
             if report.workers == 0:  # an existing cluster whose workers have not connected (yet)
                 try:
@@ -302,6 +300,7 @@ def _execute(prepared: PreparedStudy, todo: list[int], journal: Journal, report:
                     progress(record)
         except KeyboardInterrupt:
             report.interrupted = True
+            report.signal = interrupts.signum or signal.SIGINT
             if client is not None:
                 with contextlib.suppress(Exception):
                     client.cancel(list(futures))

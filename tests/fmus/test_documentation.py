@@ -59,16 +59,17 @@ def test_html_variable_table_matches_the_model_description(fmu_path, name):
 
 
 @pytest.mark.parametrize("name, variable, expected", [
-    ("WindSource", "sigma", "> 0"),
-    ("WindSource", "n_harmonics", "an integer >= 1"),
+    ("WindSource", "sigma", "> 0 (within [1e-30, 1e+30])"),
+    ("WindSource", "n_harmonics", "an integer within [1, 100000]"),
+    ("WindSource", "seed", "an integer >= 0 (at most 2147483647, an FMI Integer)"),
     ("WindSource", "amplitude", "0 = variance, 1 = paper"),
-    ("Gearbox", "stage1.k0", "> 0"),
+    ("Gearbox", "stage1.k0", "> 0 (within [1e-30, 1e+30])"),
     ("Gearbox", "stage2.exponent", "within [1, 3]"),
-    ("Gearbox", "shaft3.damping", ">= 0"),
+    ("Gearbox", "shaft3.damping", ">= 0 (at most 1e+30)"),
     ("Gearbox", "omega_rotor", INPUT_RANGE),
     ("Gearbox", "shaft_torque", OUTPUT_RANGE),
     ("Gearbox", "extrapolate_inputs", "false, true"),
-    ("GeneratorRotor", "inertia", "> 0"),
+    ("GeneratorRotor", "inertia", "> 0 (within [1e-30, 1e+30])"),
     ("GeneratorRotor", "event1.kind", "0 = none, 1 = torque_step, 2 = grid_fault, 3 = emergency_stop"),
 ])
 def test_ranges_are_what_the_validation_demands(fmu_path, name, variable, expected):

@@ -28,7 +28,7 @@ DISCARD = 2
 
 @pytest.mark.parametrize("name, values, message", [
     ("WindSource", {"sigma": -0.1}, "invalid parameter sigma = -0.1: expected > 0"),
-    ("WindSource", {"n_harmonics": 0}, "invalid parameter n_harmonics = 0: expected an integer >= 1"),
+    ("WindSource", {"n_harmonics": 0}, "invalid parameter n_harmonics = 0: expected an integer within [1, 100000]"),
     ("WindSource", {"f_min": 5.0, "f_max": 2.0}, "invalid parameter f_max = 2.0: expected > f_min"),
     ("WindSource", {"amplitude": 2}, "invalid parameter amplitude = 2: expected 0 = variance, 1 = paper"),
     ("Gearbox", {"stage1.k0": -1.0}, "invalid parameter stage1.k0 = -1.0: expected > 0"),

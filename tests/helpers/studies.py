@@ -34,7 +34,7 @@ points = [
 ]
 """ + SMALL_TABLES
 #: the error of the invalid point
-SMALL_FAILURE = "invalid parameter stage3.lambda = -600000.0: expected > 0"
+SMALL_FAILURE = "invalid parameter stage3.lambda = -600000.0: expected > 0 (within [1e-30, 1e+30])"
 #: quasi-static stage-3 mesh force of the 1 kN m output torque: T / (r cos 20 deg), r = 80 mm [N]
 STAGE3_FORCE_N = 1000.0 / (0.08 * 0.9396926207859084)
 

@@ -18,12 +18,17 @@ import pytest
 
 from components.errors import ParameterError, SolverError
 from components.model.assembly import Assembly
-from components.model.gearbox_model import GearboxModel
 from components.model.gearbox_kernel import contact_table, phasing_table
+from components.model.gearbox_model import GearboxModel
 from components.model.generator import GeneratorRotor
 from components.model.integrators import StepControl
 from components.model.kernel import ENVIRONMENT_VARIABLE, choose_kernel, compiled_module
-from components.model.presets import cosim_preset, sensitivity_variant, table5_planetary, with_stage
+from components.model.presets import (
+    cosim_preset,
+    sensitivity_variant,
+    table5_planetary,
+    with_stage,
+)
 from components.model.wind import RotorSpeedProcess, WindParameters
 
 ck, _reason = compiled_module()

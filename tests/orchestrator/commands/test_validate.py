@@ -60,5 +60,5 @@ def test_an_fmu_without_a_binary_for_this_platform_cannot_run_here(tmp_path):
                     lambda name: name.replace("binaries/linux64/Dahlquist.so", "binaries/win64/Dahlquist.dll"))
     proc = validate(foreign, tmp_path)
     assert proc.returncode == 1
-    assert "dtcosim cannot run it here: expected an FMU with a co-simulation binary for this platform (linux64" \
+    assert "no co-simulation binary for this platform (linux64: binaries/linux64/Dahlquist.so)" \
         in proc.stdout and "it has binaries for: win64" in proc.stdout

@@ -13,7 +13,6 @@ import numpy as np
 import pytest
 
 from orchestrator.inputs.scenario import find_scenario, load_scenario
-
 from orchestrator.result_files import read_timeseries
 from tests.helpers.scenarios import TOY_SCENARIO, dtcosim
 

@@ -12,7 +12,11 @@ import pytest
 from components import units
 from components.model.parameter_map import flatten
 from orchestrator.inputs.drivetrain_entries import with_entries
-from orchestrator.inputs.drivetrain_file import DrivetrainFileError, drivetrain_from_dict, load_drivetrain_file
+from orchestrator.inputs.drivetrain_file import (
+    DrivetrainFileError,
+    drivetrain_from_dict,
+    load_drivetrain_file,
+)
 
 #: a valid two-stage file (paper units for lengths and angles, SI otherwise)
 BASE = """

@@ -11,7 +11,11 @@ import pytest
 from components.model.parameter_map import flatten
 from components.model.presets import cosim_preset, preset
 from components.reference.cases import CASES, run_case, run_reference_case
-from orchestrator.inputs.drivetrain_file import find_drivetrain, load_drivetrain_file, packaged_drivetrains
+from orchestrator.inputs.drivetrain_file import (
+    find_drivetrain,
+    load_drivetrain_file,
+    packaged_drivetrains,
+)
 from tests.helpers.scenarios import dtcosim
 
 

@@ -137,3 +137,13 @@ def test_record_found_in_a_data_root(tmp_path, monkeypatch):
         load_scenario(scenario(tmp_path, "sub/r.csv"))
     monkeypatch.setenv("DTCOSIM_DATA", os.pathsep.join(["/nonexistent", str(root)]))
     assert load_scenario(scenario(tmp_path, "sub/r.csv")).component("loads").series.record == (root / "sub" / "r.csv")
+
+
+def test_a_record_above_the_size_limit_is_refused_before_it_is_read(tmp_path, monkeypatch):
+    from orchestrator.inputs import series_file
+
+    path = tmp_path / "big.csv"
+    path.write_text("Time [s],GenSpeed [rpm]\n" + "".join(f"{i * 0.1:g},{1000 + i}\n" for i in range(100)))
+    monkeypatch.setattr(series_file, "MAX_RECORD_BYTES", 512)
+    with pytest.raises(RecordError, match=r"a record of at most 512 bytes \(0\.000488 MiB\); the file has 904 bytes"):
+        read_record(path)

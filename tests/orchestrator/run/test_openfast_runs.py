@@ -19,6 +19,8 @@ from components.model.torque_controller import TorqueLawParameters, law_torque_n
 from orchestrator.cosim.fmu_store import ensure_fmus
 from orchestrator.cosim.series_fmus import ensure_series_fmu
 from orchestrator.cosim.system import resolve_system
+from orchestrator.errors import ScenarioError
+from orchestrator.inputs.overrides import apply_parameters
 from orchestrator.inputs.scenario import find_scenario, load_scenario
 from orchestrator.run.runner import run_scenario
 from tests.helpers.openfast_data import openfast_file
@@ -89,6 +91,47 @@ def test_dlc11_torque_rotor_speed_within_one_percent_and_controller_on_its_curve
     pitch = column(o, "loads.pitch")
     on_curve = [law_torque_nm(law, w, p) for w, p in zip(filtered, pitch)]
     assert demand == pytest.approx(on_curve, rel=1e-12)  # region 3 by pitch throughout: never rate limited here
+
+
+@pytest.fixture(scope="module")
+def torque_driven(fmu_home):
+    """openfast-dlc11-torque with the module's FMUs: ``resolve(values) -> resolved system`` (nothing instantiated)."""
+    openfast_file("DLC2.3_1.out")
+    base = load_scenario(find_scenario("openfast-dlc11-torque"))
+    paths = ensure_fmus(base, fmu_home)
+    return lambda values=None: resolve_system(apply_parameters(base, values or {}), fmu_paths=paths)
+
+
+def test_new_fmus_publish_the_bounds_of_their_own_validation(torque_driven):
+    system = torque_driven()
+    for comp, name, minimum in (("rotor", "inertia", 1e-30), ("controller", "max_rate", 1e-30),
+                                ("controller", "region3_mode", 0), ("loads", "out_of_record", 0),
+                                ("loads", "time_offset", -1e30)):
+        iface = system.interfaces[comp]
+        assert iface.record["bounds"][name]["min"] == minimum, (comp, name)
+        assert iface.variables[name].minimum == minimum, (comp, name)  # modelDescription min/max
+    assert system.interfaces["controller"].record["bounds"]["region3_mode"]["max"] == 1
+
+
+@pytest.mark.parametrize("values, key, expected", [
+    ({"rotor.inertia": -1.0}, "components.rotor.parameters.inertia", "> 0 (within [1e-30, 1e+30])"),
+    ({"rotor.shaft_damping": 1e300}, "components.rotor.parameters.shaft_damping", ">= 0 (at most 1e+30)"),
+    ({"controller.region3_mode": 2}, "components.controller.parameters.region3_mode",
+     "0 = constant_power, 1 = constant_torque"),
+    ({"controller.filter_corner": 0.0}, "components.controller.parameters.filter_corner", "> 0 (within"),
+    ({"loads.out_of_record": 2}, "components.loads.parameters.out_of_record", "0 = hold, 1 = error"),
+    ({"loads.time_offset": 1e300}, "components.loads.parameters.time_offset", "a finite real number"),
+    # coupled: within their bounds, refused by the model's own check on the host
+    ({"controller.region2_start": 200.0}, "components.controller.parameters.region2_start",
+     "cut_in_speed (70.1622) < region2_start < rated_speed"),
+    ({"rotor.shaft_stiffness": 1e9}, "components.rotor.parameters.carrier_inertia", "> 0 with a main shaft"),
+    ({"loads.time_offset": 1e5}, "components.loads.parameters.time_offset",
+     "an offset keeping the run [0, 10] s inside the record"),
+])
+def test_values_the_new_fmus_refuse_are_refused_before_instantiation(torque_driven, values, key, expected):
+    with pytest.raises(ScenarioError) as info:
+        torque_driven(values)
+    assert info.value.key == key and str(info.value.expected).startswith(expected), str(info.value)
 
 
 def test_controller_fmu_torque_lies_on_the_configured_curve(fmu_home, tmp_path):
