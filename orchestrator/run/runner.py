@@ -24,6 +24,7 @@ from .analyses import analyse_run
 from .comparison import compare, format_comparison, run_reference
 from .derived import Skipped, generator_vs_ideal
 from .plots import plot_run
+from .recorded import compare_recorded, plot_contact_loss_counts, plot_recorded
 from .results import TIMESERIES_FILE, build_summary, result_columns
 from .run_folder import RunFolder
 from .writers import CsvWriter
@@ -255,6 +256,10 @@ def _post_process(system, outcome, out, post: _PostProcessing, derived, skipped,
     if system.events:
         derived["events"] = [a.as_dict() for a in system.events]
     derived["analysis_settings"] = system.scenario.analysis.as_dict()
+    if post.go("recorded_comparison"):
+        recorded = compare_recorded(system, outcome)
+        if recorded:  # simulated against recorded channels (a TimeSeriesSource playing a record)
+            derived["recorded_comparison"] = recorded
     if post.go("analyses"):
         analyses = analyse_run(system, outcome, out, plots=plots)
         derived.update(analyses.summary)
@@ -277,4 +282,10 @@ def _post_process(system, outcome, out, post: _PostProcessing, derived, skipped,
                 skipped.append({"analysis": "comparison", "reason": str(exc)})
     if plots and post.go("plots"):
         post.commit({f"plot:{p.stem}": p for p in plot_run(system, outcome, out, skipped)})
+        recorded_plot = plot_recorded(system, outcome, out)
+        if recorded_plot is not None:
+            post.commit({f"plot:{recorded_plot.stem}": recorded_plot})
+        counts_plot = plot_contact_loss_counts(derived.get("contact_loss"), out, system.scenario.name)
+        if counts_plot is not None:
+            post.commit({f"plot:{counts_plot.stem}": counts_plot})
     return comparison, comparison_text
