@@ -66,8 +66,14 @@ FMU_SLAVES: dict[str, tuple[str, tuple[str, ...]]] = {
     "WindSource": ("wind_source", ()),
     "Gearbox": ("gearbox", ("gearbox_parameters",)),
     "GeneratorRotor": ("generator_rotor", ()),
+    "Rotor": ("rotor", ()),
+    "TorqueController": ("torque_controller", ()),
+    "TimeSeriesSource": ("time_series_source", ()),
 }
 FMU_NAMES = tuple(FMU_SLAVES)
+#: the FMUs built from a preset (or a drivetrain) alone; a TimeSeriesSource is built from a record
+#: (:func:`build_fmu` with ``model`` and ``resources``, :mod:`orchestrator.cosim.series_fmus`)
+PRESET_FMU_NAMES = ("WindSource", "Gearbox", "GeneratorRotor", "Rotor", "TorqueController")
 
 _COMPONENTS_IMPORT = re.compile(r"^(\s*)from components((?:\.\w+)*) import ", re.MULTILINE)
 _FORBIDDEN_IMPORT = re.compile(r"^\s*(?:from|import)\s+(?:components|fmus|orchestrator)\b", re.MULTILINE)
@@ -278,7 +284,8 @@ def drivetrain_of_preset(preset: str) -> Drivetrain:
 
 def build_fmu(name: str, out_dir: Path | str, preset: str = "table6", source: SourceTree | None = None,
               validate: bool = True, *, drivetrain: Drivetrain | None = None, origin: str | None = None,
-              rotor_speed_rad_s: float | None = None) -> BuiltFmu:
+              rotor_speed_rad_s: float | None = None, model: dict | None = None,
+              resources: dict[str, Path] | None = None) -> BuiltFmu:
     """Build one FMU into ``out_dir`` (``<out_dir>/<name>.fmu``).
 
     Parameters
@@ -299,6 +306,11 @@ def build_fmu(name: str, out_dir: Path | str, preset: str = "table6", source: So
     rotor_speed_rad_s : float, optional
         Rotor speed of the operating point [rad/s]: the start values of the Gearbox's inputs, the
         generator's initial speed and the WindSource's omega0 (default: the paper's 16 rpm).
+    model : dict, optional
+        The record model to build from instead of the one of the drivetrain (a TimeSeriesSource's
+        ``{"series": ...}``); it must name the content of ``resources`` (a hash) so that the build id does.
+    resources : dict of str -> Path, optional
+        Extra files packed into the FMU's ``resources/`` (name inside -> file), e.g. ``series.npz``.
     """
     _check_pythonfmu()
     if name not in FMU_SLAVES:
@@ -309,7 +321,8 @@ def build_fmu(name: str, out_dir: Path | str, preset: str = "table6", source: So
         origin = origin or f"preset {preset}"
     origin = origin or "a drivetrain given to fmus.build"
     wind = None if rotor_speed_rad_s is None else WindParameters(mean_speed_rad_s=rotor_speed_rad_s)
-    model = model_of(name, drivetrain, wind)
+    if model is None:
+        model = model_of(name, drivetrain, wind)
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="dtcosim_fmu_") as tmp:
@@ -321,7 +334,8 @@ def build_fmu(name: str, out_dir: Path | str, preset: str = "table6", source: So
         try:
             fmu_path = Path(FmuBuilder.build_FMU(script, dest=out_dir / f"{name}.fmu",
                                                  project_files=[package_dir, Path(tmp) / RECORD_FILE,
-                                                                runtime.requirements_file],
+                                                                runtime.requirements_file,
+                                                                *_staged_resources(Path(tmp), resources)],
                                                  documentation_folder=runtime.documentation_dir,
                                                  canGetAndSetFMUstate=True, canSerializeFMUstate=True))
             slave_class = getattr(sys.modules[script.stem], name)
@@ -348,9 +362,20 @@ def build_fmu(name: str, out_dir: Path | str, preset: str = "table6", source: So
     return BuiltFmu(name, fmu_path, build_id, package, script.stem)
 
 
+def _staged_resources(tmp: Path, resources: dict[str, Path] | None) -> list[Path]:
+    """Copies of the extra resource files under their names inside the FMU (pythonfmu packs by file name)."""
+    out = []
+    for inside, path in (resources or {}).items():
+        target = tmp / "extra_resources" / inside
+        target.parent.mkdir(parents=True, exist_ok=True)
+        target.write_bytes(Path(path).read_bytes())
+        out.append(target)
+    return out
+
+
 def build_all(out_dir: Path | str, preset: str = "table6", source: SourceTree | None = None,
-              names: Sequence[str] = FMU_NAMES, validate: bool = True) -> list[BuiltFmu]:
-    """Build the FMUs ``names`` (default: all three) into ``out_dir``."""
+              names: Sequence[str] = PRESET_FMU_NAMES, validate: bool = True) -> list[BuiltFmu]:
+    """Build the FMUs ``names`` (default: every FMU of a preset) into ``out_dir``."""
     return [build_fmu(name, out_dir, preset, source, validate) for name in names]
 
 
@@ -359,13 +384,13 @@ def add_arguments(parser: argparse.ArgumentParser, default_out: Path | str) -> N
     parser.add_argument("--out", type=Path, default=Path(default_out), help=f"output directory (default: {default_out})")
     parser.add_argument("--preset", choices=PRESETS, default="table6",
                         help="drivetrain preset giving the structure and parameter defaults (default: table6)")
-    parser.add_argument("--fmu", choices=FMU_NAMES, action="append",
-                        help="build only this FMU (repeatable; default: all three)")
+    parser.add_argument("--fmu", choices=PRESET_FMU_NAMES, action="append",
+                        help="build only this FMU (repeatable; default: all of " + ", ".join(PRESET_FMU_NAMES) + ")")
 
 
 def run(args: argparse.Namespace) -> int:
     """Build per parsed arguments and print what was written."""
-    for built in build_all(args.out, args.preset, names=args.fmu or FMU_NAMES):
+    for built in build_all(args.out, args.preset, names=args.fmu or PRESET_FMU_NAMES):
         print(f"{built.path}  ({built.name}, preset {args.preset}, build {built.build_id})")
     return 0
 

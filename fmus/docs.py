@@ -18,7 +18,7 @@ import sys
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 
-from .build import FMU_NAMES, FMU_SLAVES, drivetrain_of_preset
+from .build import FMU_SLAVES, PRESET_FMU_NAMES, drivetrain_of_preset
 from .records import model_of
 from .slaves.interface import REAL, Variable
 
@@ -74,7 +74,7 @@ def _block(name: str, preset: str) -> str:
 
 def update(text: str, preset: str = "table6") -> str:
     """``text`` with every generated block replaced by the current table."""
-    for name in FMU_NAMES:
+    for name in PRESET_FMU_NAMES:
         pattern = re.compile(rf"<!-- BEGIN GENERATED {name} -->.*?<!-- END GENERATED {name} -->", re.DOTALL)
         text = pattern.sub(lambda _m, n=name: _block(n, preset), text)
     return text
@@ -88,7 +88,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.update:
         args.update.write_text(update(args.update.read_text(encoding="utf-8"), args.preset), encoding="utf-8")
     else:
-        for name in FMU_NAMES:
+        for name in PRESET_FMU_NAMES:
             print(f"## {name}\n\n{markdown_table(name, args.preset)}\n")
     return 0
 

@@ -49,6 +49,13 @@ INIT_NOTES = {
                "are not zero twist the shafts).",
     "GeneratorRotor": "set initial_speed (the Gearbox's omega_out) and initial_angle before "
                       "fmi2ExitInitializationMode; its input shaft_torque is used from the first fmi2DoStep on.",
+    "Rotor": "set initial_speed (and aero_torque, which sets a main shaft's initial twist) before "
+             "fmi2ExitInitializationMode; its outputs omega and phi drive the Gearbox's omega_rotor and phi_rotor, "
+             "the Gearbox's torque_rotor comes back as gearbox_torque from the first fmi2DoStep on.",
+    "TorqueController": "set generator_speed (the generator's initial speed) and pitch before "
+                        "fmi2ExitInitializationMode: they set the filter state and the initial torque.",
+    "TimeSeriesSource": "it has no inputs and comes first; set time_offset so that the run lies inside the "
+                        "record (out_of_record = error refuses a start outside it in fmi2ExitInitializationMode).",
 }
 
 _STYLE = """body{font-family:sans-serif;max-width:72em;margin:1em auto;padding:0 1em;line-height:1.4}

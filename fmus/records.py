@@ -12,6 +12,8 @@ from typing import Any, Iterable, Mapping
 import components
 from components.model.description import describe
 from components.model.drivetrain import Drivetrain
+from components.model.rotor import RotorParameters
+from components.model.torque_controller import TorqueLawParameters
 from components.model.wind import WindParameters
 
 from .slaves.interface import Variable
@@ -40,6 +42,11 @@ def model_of(name: str, drivetrain: Drivetrain, wind: WindParameters | None = No
         if drivetrain.generator is None:
             raise ValueError("a GeneratorRotor FMU needs a drivetrain with a generator")
         return {"generator": describe(drivetrain.generator),
+                "initial_speed_rad_s": drivetrain.ratio * wind.mean_speed_rad_s}
+    if name == "Rotor":
+        return {"rotor": describe(RotorParameters()), "initial_speed_rad_s": wind.mean_speed_rad_s}
+    if name == "TorqueController":
+        return {"controller": describe(TorqueLawParameters()),
                 "initial_speed_rad_s": drivetrain.ratio * wind.mean_speed_rad_s}
     raise ValueError(f"no record model for FMU {name!r}")
 

@@ -22,11 +22,14 @@ from .contact import MeshContact
 from .drivetrain import Drivetrain
 from .generator import GeneratorParameters, LoadEvent
 from .stages import ParallelStage, PlanetaryStage, Shaft
+from .rotor import RotorParameters
+from .torque_controller import TorqueLawParameters
 from .wind import WindParameters
 
 #: the classes a description may contain, by the name written into it
 TYPES: dict[str, type] = {cls.__name__: cls for cls in (
     Drivetrain, PlanetaryStage, ParallelStage, Shaft, MeshContact, GeneratorParameters, LoadEvent, WindParameters,
+    RotorParameters, TorqueLawParameters,
 )}
 _TYPE_KEY = "type"
 

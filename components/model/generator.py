@@ -198,12 +198,39 @@ class GeneratorRotor:
         """Counter torque at time ``t`` [N m]."""
         return self.schedule(t)
 
-    def step(self, t: float, h: float, shaft_torque_nm: float) -> None:
+    def step(self, t: float, h: float, shaft_torque_nm: float, counter_torque_nm: float | None = None,
+             brake_torque_nm: float = 0.0) -> None:
         """Advance from ``t`` to ``t + h`` [s] with the shaft torque [N m] held.
 
-        ``I omega_dot = T_shaft - T_gen(t)``, integrated exactly.
+        ``I omega_dot = T_shaft - T_gen(t) - T_brake sign(omega)``, integrated exactly. ``T_gen`` is the
+        schedule (base torque and events) unless ``counter_torque_nm`` is given (a torque input, e.g. a
+        controller's demand, held over the step). The high-speed-shaft brake ``|brake_torque_nm|`` acts
+        against the speed like dry friction: where it would reverse the rotor within the step, the rotor
+        stops there and stays at rest while the brake can hold the other torques.
         """
-        impulse, moment = self.schedule.integrals(t, t + h)
         inv_i = 1.0 / self.params.inertia_kgm2
+        if counter_torque_nm is None:
+            impulse, moment = self.schedule.integrals(t, t + h)
+        else:
+            impulse, moment = counter_torque_nm * h, 0.5 * counter_torque_nm * h * h
+        brake = abs(brake_torque_nm)
+        if brake > 0.0:
+            drive = shaft_torque_nm - impulse / h  # mean of the other torques over the step
+            w = self.speed_rad_s
+            if w == 0.0 and abs(drive) <= brake:
+                return  # held at rest
+            sign = (1.0 if w > 0.0 else -1.0) if w != 0.0 else (1.0 if drive > 0.0 else -1.0)
+            acc = (drive - sign * brake) * inv_i
+            if w != 0.0 and acc * w < 0.0 and -w / acc < h:  # comes to rest inside the step
+                tau = -w / acc
+                self.angle_rad += w * tau + 0.5 * acc * tau * tau
+                self.speed_rad_s = 0.0
+                if abs(drive) > brake:  # the brake slips again at once
+                    self.step(t + tau, h - tau, shaft_torque_nm, counter_torque_nm if counter_torque_nm is not None
+                              else impulse / h, brake_torque_nm)
+                return
+            self.angle_rad += w * h + 0.5 * acc * h * h
+            self.speed_rad_s += acc * h
+            return
         self.angle_rad += self.speed_rad_s * h + (0.5 * shaft_torque_nm * h * h - moment) * inv_i
         self.speed_rad_s += (shaft_torque_nm * h - impulse) * inv_i

@@ -1,6 +1,9 @@
 """GeneratorRotor FMU: generator inertia with counter torque and load events (:mod:`components.model.generator`).
 
-Input ``shaft_torque`` [N m] (shaft 3, from the Gearbox FMU), held over a step;
+Input ``shaft_torque`` [N m] (shaft 3, from the Gearbox FMU), held over a step; with the
+parameter ``torque_from_input`` the counter torque is the input ``counter_torque_input`` (a
+controller's demand or a recorded torque) instead of the schedule; ``brake_torque`` is a
+high-speed-shaft brake acting against the speed;
 the rotor is integrated exactly. Parameters: ``inertia``, ``counter_torque``,
 ``initial_speed``, ``initial_angle`` and four load-event slots
 ``event{i}.kind/start/duration/factor`` (kind 0 = none). Outputs ``omega``,
@@ -31,6 +34,7 @@ from .interface import (
     real_input,
     real_output,
     real_parameter,
+    boolean_parameter,
 )
 from .record import GENERATOR
 
@@ -73,7 +77,14 @@ class GeneratorRotor(DtcosimSlave):
                                "-|factor| x base; unused by grid_fault)"),
             ]
         variables += [
+            boolean_parameter("torque_from_input", False,
+                              "counter torque from the input counter_torque_input (e.g. a TorqueController) "
+                              "instead of counter_torque and the load events"),
             real_input("shaft_torque", 0.0, "N.m", "torque of shaft 3 driving the generator (Gearbox output)"),
+            real_input("counter_torque_input", 0.0, "N.m",
+                       "counter torque demand, used when torque_from_input is true (held over a step)"),
+            real_input("brake_torque", 0.0, "N.m",
+                       "high-speed-shaft brake torque magnitude, acting against the speed (dry friction)"),
             real_output("omega", "rad/s", "generator speed", "generator_speed"),
             real_output("phi", "rad", "generator angle", "generator_angle"),
             real_output("generator_torque", "N.m", "counter torque applied at the current time (base torque and events)",
@@ -90,6 +101,9 @@ class GeneratorRotor(DtcosimSlave):
         self.params = generator_from_values({n: self.value(n) for n in names}, build(self.model["generator"]))
         self._new_rotor()
         self._vr_torque = self.vr["shaft_torque"]
+        self._vr_demand = self.vr["counter_torque_input"]
+        self._vr_brake = self.vr["brake_torque"]
+        self._from_input = bool(self.value("torque_from_input"))
         self._vr_out = (self.vr["omega"], self.vr["phi"], self.vr["generator_torque"])
 
     def _new_rotor(self) -> None:
@@ -105,14 +119,18 @@ class GeneratorRotor(DtcosimSlave):
         torque = self._values[self._vr_torque]
         if not math.isfinite(torque):
             raise SolverError(f"non-finite input shaft_torque = {torque!r}", time)
-        self.rotor.step(time, step_size, torque)
+        demand = self._values[self._vr_demand] if self._from_input else None
+        brake = self._values[self._vr_brake]
+        if not math.isfinite(brake) or (demand is not None and not math.isfinite(demand)):
+            raise SolverError(f"non-finite input (counter_torque_input={demand!r}, brake_torque={brake!r})", time)
+        self.rotor.step(time, step_size, torque, demand, brake)
 
     def _refresh(self, group: Hashable) -> None:
         values = self._values
         i_omega, i_phi, i_torque = self._vr_out
         values[i_omega] = self.rotor.speed_rad_s
         values[i_phi] = self.rotor.angle_rad
-        values[i_torque] = self.rotor.counter_torque(self._time)
+        values[i_torque] = (values[self._vr_demand] if self._from_input else self.rotor.counter_torque(self._time))
 
     def _component_state(self) -> dict:
         return {"speed_rad_s": self.rotor.speed_rad_s, "angle_rad": self.rotor.angle_rad}

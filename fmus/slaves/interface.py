@@ -63,6 +63,10 @@ UNITS: dict[str, UnitDefinition] = {
         _unit("N.s/m2", {"kg": 1, "m": -1, "s": -1}),
         _unit("N.s/m", {"kg": 1, "s": -1}),
         _unit("1/m", {"m": -1}),
+        _unit("m/s", {"m": 1, "s": -1}),
+        _unit("W", {"kg": 1, "m": 2, "s": -3}, kW=1.0e-3),
+        _unit("N.m.s2/rad2", {"kg": 1, "m": 2, "rad": -2}),  # the torque law's k of k w^2
+        _unit("N.m/s", {"kg": 1, "m": 2, "s": -3}),  # torque rate
     )
 }
 

@@ -31,7 +31,9 @@ RECORD_FORMAT = 1
 
 #: roles a component of a drivetrain co-simulation can have
 WIND_SOURCE, GEARBOX, GENERATOR = "wind_source", "gearbox", "generator"
-ROLES = (WIND_SOURCE, GEARBOX, GENERATOR)
+#: a recorded time series (TimeSeriesSource), a torque-driven rotor, a generator torque controller
+TIME_SERIES, ROTOR, TORQUE_CONTROLLER = "time_series", "rotor", "torque_controller"
+ROLES = (WIND_SOURCE, GEARBOX, GENERATOR, TIME_SERIES, ROTOR, TORQUE_CONTROLLER)
 
 #: signal kinds an output can be declared as, per role; ``many``: any number of variables, else at most one
 SIGNALS: dict[str, dict[str, bool]] = {
@@ -39,6 +41,11 @@ SIGNALS: dict[str, dict[str, bool]] = {
     GEARBOX: {"contact_force": True, "shaft_torque": True, "body_speed": True, "output_speed": False,
               "rotor_torque": False, "generator_shaft_torque": True, "output_acceleration_peak": False},
     GENERATOR: {"generator_speed": False, "generator_angle": False, "generator_torque": False},
+    # "recorded": a channel of a record, info {"channel", "unit" (as recorded), "quantity" (the signal kind
+    # of another role it is the record of, e.g. generator_speed), "record"}
+    TIME_SERIES: {"recorded": True},
+    ROTOR: {"rotor_speed": False, "rotor_angle": False, "main_shaft_torque": False},
+    TORQUE_CONTROLLER: {"generator_torque_demand": False, "filtered_generator_speed": False},
 }
 
 

@@ -22,11 +22,22 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_arguments(p, default_out=default_fmu_dir())  # where `dtcosim run` looks for them
     p.add_argument("--drivetrain", default=None, metavar="FILE",
                    help="drivetrain TOML file or packaged name (grc-like, paper-table6, ...) instead of --preset")
+    p.add_argument("--scenario", default=None, metavar="SCENARIO",
+                   help="build every project FMU a scenario uses (its TimeSeriesSource from the record, drivetrain "
+                        "FMUs, ...) into the FMU directory --out, where `dtcosim run` finds them")
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     """Build from the preset or the drivetrain file and print what was written."""
+    if args.scenario is not None:
+        from ..cosim.fmu_store import ensure_fmus
+        from ..inputs.scenario import find_scenario, load_scenario
+
+        scenario = load_scenario(find_scenario(args.scenario))
+        for comp, path in ensure_fmus(scenario, args.out, report=print).items():
+            print(f"{path}  ({comp})")
+        return 0
     if args.drivetrain is None:
         return run_preset(args)
     from components.errors import ParameterError

@@ -137,6 +137,12 @@ def run(args: argparse.Namespace) -> int:
             if dev.get("max_abs") is not None:
                 print(f"generator vs {fig16['ratio']:.6g} x rotor speed (relative): mean {dev['mean']:+.2e}, "
                       f"max |dev| {dev['max_abs']:.2e}")
+        for row in s.get("recorded_comparison", []):
+            print(textwrap.fill(
+                f"simulated {row['simulated']} vs recorded {row['recorded']} over [{w0:g}, {w1:g}] s: "
+                f"RMS difference {row['rms_difference']:.4g} ({100 * row['rms_difference_relative']:.3g} % of the "
+                f"record's RMS), max {row['max_difference']:.4g} ({100 * row['max_difference_relative']:.3g} %), "
+                f"mean {row['mean_difference']:+.4g}", width=80, subsequent_indent="  "))
         analyses = format_analyses(s)
         if analyses:
             print(analyses)

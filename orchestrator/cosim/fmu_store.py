@@ -25,10 +25,10 @@ from .system import resolve_fmu_paths
 def buildable_fmu_names() -> tuple[str, ...]:
     """FMU model names that ``fmus.build`` can make (empty if the builder is unavailable)."""
     try:
-        from fmus.build import FMU_NAMES
+        from fmus.build import PRESET_FMU_NAMES
     except ImportError:
         return ()
-    return tuple(FMU_NAMES)
+    return tuple(PRESET_FMU_NAMES)
 
 
 def missing_fmus(scenario: Scenario, fmu_dir: Path) -> dict[str, Path]:
@@ -75,11 +75,17 @@ def ensure_fmus(scenario: Scenario, fmu_dir: str | Path | None = None, build: bo
                 wanted[spec.sha256] = (spec, names + [comp.fmu.stem])
         for spec, names in wanted.values():
             ensure_drivetrain_fmus(spec, fmu_dir, names, report)
+        from .series_fmus import ensure_series_fmu
+
+        for comp in scenario.components:
+            if comp.series is not None:
+                ensure_series_fmu(comp.series, fmu_dir, report)
     missing = missing_fmus(scenario, fmu_dir)
     if missing and build:
         buildable = buildable_fmu_names()
         names = sorted({scenario.component(c).fmu.stem for c, p in missing.items() if p.parent == Path(".")
-                        and p.suffix == ".fmu" and p.stem in buildable and scenario.component(c).drivetrain is None})
+                        and p.suffix == ".fmu" and p.stem in buildable and scenario.component(c).drivetrain is None
+                        and scenario.component(c).series is None})
         if names:
             from fmus.build import build_all
 

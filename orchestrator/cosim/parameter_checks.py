@@ -12,8 +12,11 @@ Three layers, each with the message the FMU itself would give:
    ``min``/``max`` attributes are checked the same way.
 3. The model: for a dtcosim FMU the parameter set is built from its record and
    the values, with the same functions the slave uses at initialisation
-   (:mod:`components.model.parameter_map`), so coupled constraints
-   (``f_max > f_min``, a kinematically consistent geometry) are found too.
+   (:mod:`components.model.parameter_map`, ``rotor_from_values``,
+   ``controller_from_values``), so coupled constraints (``f_max > f_min``, a
+   kinematically consistent geometry, the torque law's region order) are found
+   too; a TimeSeriesSource with ``out_of_record = 1`` (error) must cover the run
+   with its effective ``time_offset`` (:func:`record_coverage`).
 
 :func:`value_problem` is used per value by :func:`orchestrator.cosim.system.resolve_system`
 (scenarios, SSPs, ``--set``, study points), :func:`model_problem` once the system is resolved.
@@ -63,6 +66,29 @@ def value_problem(iface: FmuInterface, var: FmuVariable, value: Any) -> str | No
     return None
 
 
+def record_coverage(system, component: str) -> None:
+    """A ParameterError for ``time_offset`` when a TimeSeriesSource that refuses to leave its record would leave it.
+
+    The record's span is the FMU record's ``model["series"]`` (``start_s``, ``end_s``); the offset and
+    the policy are the component's effective parameter values, as the FMU sees them at initialisation.
+    """
+    from components.model.time_series import OUT_OF_RECORD
+
+    series = system.roles[component].record["model"]["series"]
+    values = system.parameter_values(component)
+    policy, offset = values.get("out_of_record"), values.get("time_offset")
+    if not (isinstance(policy, int) and 0 <= policy < len(OUT_OF_RECORD)) or OUT_OF_RECORD[policy] != "error" \
+            or not isinstance(offset, (int, float)) or not math.isfinite(offset):
+        return  # hold, or a value the bounds check reports
+    t0, t1 = float(series["start_s"]), float(series["end_s"])
+    sim = system.scenario.simulation
+    eps = 1e-9 * max(1.0, abs(t1))
+    if not (t0 - eps <= sim.start_s + offset and sim.stop_s + offset <= t1 + eps):
+        raise ParameterError("time_offset", offset, (
+            f"an offset keeping the run [{sim.start_s:g}, {sim.stop_s:g}] s inside the record {series['source']} "
+            f"[{t0:g}, {t1:g}] s (record time = simulation time + time_offset; or out_of_record = 0, hold)"))
+
+
 def model_problem(system) -> tuple[str, Any, str] | None:
     """``(scenario key, value, expectation)`` of the first dtcosim model that rejects the values, else None.
 
@@ -72,20 +98,23 @@ def model_problem(system) -> tuple[str, Any, str] | None:
     """
     from .physics_view import (
         PhysicsUnavailable,
+        controller_parameters,
         gearbox_drivetrain,
         generator_parameters,
+        rotor_parameters,
         wind_parameters,
     )
-    from .roles import GEARBOX, GENERATOR, WIND_SOURCE
+    from .roles import GEARBOX, GENERATOR, ROTOR, TIME_SERIES, TORQUE_CONTROLLER, WIND_SOURCE
 
-    builders = {GEARBOX: gearbox_drivetrain, WIND_SOURCE: wind_parameters, GENERATOR: generator_parameters}
+    builders = {GEARBOX: gearbox_drivetrain, WIND_SOURCE: wind_parameters, GENERATOR: generator_parameters,
+                ROTOR: rotor_parameters, TORQUE_CONTROLLER: controller_parameters, TIME_SERIES: record_coverage}
     for name, role in system.roles.items():
         if role.record is None or role.role not in builders:
             continue
         try:
             builders[role.role](system, name)
-        except PhysicsUnavailable as exc:
-            cause = exc.__context__
+        except (PhysicsUnavailable, ParameterError) as exc:
+            cause = exc if isinstance(exc, ParameterError) else exc.__context__
             if not isinstance(cause, ParameterError):
                 continue
             variables = system.interfaces[name].variables

@@ -19,6 +19,8 @@ from components.errors import DtcosimError, ParameterError
 from components.model.description import build
 from components.model.drivetrain import Drivetrain
 from components.model.generator import GeneratorParameters
+from components.model.rotor import RotorParameters, rotor_from_values
+from components.model.torque_controller import TorqueLawParameters, controller_from_values
 from components.model.parameter_map import (
     flatten,
     generator_from_values,
@@ -28,7 +30,7 @@ from components.model.parameter_map import (
 from components.model.wind import WindParameters
 
 from ..frozen_map import FrozenMap
-from .roles import GEARBOX, GENERATOR, WIND_SOURCE, ComponentRole
+from .roles import GEARBOX, GENERATOR, ROTOR, TORQUE_CONTROLLER, WIND_SOURCE, ComponentRole
 from .system import ResolvedSystem
 
 
@@ -121,6 +123,29 @@ def generator_parameters(system: ResolvedSystem, component: str) -> GeneratorPar
     try:
         return generator_from_values(_values(system, component),
                                      build(role.record["model"]["generator"], "model.generator"))
+    except ParameterError as exc:
+        raise PhysicsUnavailable(f"{component}: {exc}") from None
+
+
+def rotor_parameters(system: ResolvedSystem, component: str) -> RotorParameters:
+    """The rotor (and main shaft) of a Rotor FMU's record with the component's effective parameter values."""
+    role = system.roles.get(component)
+    if role is None or role.role != ROTOR or role.record is None:
+        raise PhysicsUnavailable(f"{component} is not a dtcosim Rotor FMU (it has no record of its rotor)")
+    try:
+        return rotor_from_values(_values(system, component), build(role.record["model"]["rotor"], "model.rotor"))
+    except ParameterError as exc:
+        raise PhysicsUnavailable(f"{component}: {exc}") from None
+
+
+def controller_parameters(system: ResolvedSystem, component: str) -> TorqueLawParameters:
+    """The torque law of a TorqueController FMU's record with the component's effective parameter values."""
+    role = system.roles.get(component)
+    if role is None or role.role != TORQUE_CONTROLLER or role.record is None:
+        raise PhysicsUnavailable(f"{component} is not a dtcosim TorqueController FMU (it has no record of its law)")
+    try:
+        return controller_from_values(_values(system, component),
+                                      build(role.record["model"]["controller"], "model.controller"))
     except ParameterError as exc:
         raise PhysicsUnavailable(f"{component}: {exc}") from None
 

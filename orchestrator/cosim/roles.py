@@ -20,13 +20,23 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Mapping
 
-from fmus.slaves.record import GEARBOX, GENERATOR, ROLES, SIGNALS, WIND_SOURCE
+from fmus.slaves.record import (
+    GEARBOX,
+    GENERATOR,
+    ROLES,
+    ROTOR,
+    SIGNALS,
+    TIME_SERIES,
+    TORQUE_CONTROLLER,
+    WIND_SOURCE,
+)
 
 from ..errors import ScenarioError, suggestion
 from ..frozen_map import FrozenMap
 from .fmu_interface import FmuInterface
 
-__all__ = ["GEARBOX", "GENERATOR", "ROLES", "SIGNALS", "WIND_SOURCE", "ComponentRole", "Signal", "declared_roles"]
+__all__ = ["GEARBOX", "GENERATOR", "ROLES", "ROTOR", "SIGNALS", "TIME_SERIES", "TORQUE_CONTROLLER", "WIND_SOURCE",
+           "ComponentRole", "Signal", "declared_roles"]
 
 
 @dataclass(frozen=True)

@@ -18,6 +18,9 @@ MAX_STUDY_POINTS         1 000 000       points of one study (the product of its
 MAX_SSP_MEMBERS          10 000          files in an .ssp archive
 MAX_SSP_BYTES            1 GiB           uncompressed size of an .ssp archive's content
 MAX_SSP_RATIO            200             uncompressed / compressed size of one member
+MAX_RECORD_BYTES         256 MiB         a recorded series file (.outb, .out, .csv): read
+                                         whole and decoded to float64 (an OpenFAST .outb
+                                         grows 4x); 600 s of 100 channels at 80 Hz is 10 MB
 =======================  ==============  ==================================================
 
 The number of harmonics of the wind (1 to 100 000) is a model limit:
@@ -34,3 +37,4 @@ MAX_STUDY_POINTS = 1_000_000
 MAX_SSP_MEMBERS = 10_000
 MAX_SSP_BYTES = 1 << 30
 MAX_SSP_RATIO = 200
+MAX_RECORD_BYTES = 256 << 20

@@ -72,6 +72,7 @@ from .limits import MIN_RELATIVE_STEP
 from .load_events import EventTable, ScenarioEvent, check_events_in_run
 from .master_options import ALGORITHMS, EXTRAPOLATIONS
 from .results_format import RESULTS_FORMATS
+from .series_spec import SeriesSpec, SeriesTable, series_from_table
 from .schema import (
     NAME_PATTERN,
     ParameterValue,
@@ -86,6 +87,14 @@ DRIVETRAIN_FMU_FILES = ("Gearbox.fmu", "GeneratorRotor.fmu")
 GENERATOR_FMU_FILE = "GeneratorRotor.fmu"
 #: folder of the FMU directory with the FMUs built from drivetrain files, one subfolder per file content
 DRIVETRAIN_FMU_FOLDER = "drivetrains"
+#: the project FMU a recorded series is built into, and the folder of the FMU directory with them
+SERIES_FMU_FILE = "TimeSeriesSource.fmu"
+SERIES_FMU_FOLDER = "series"
+
+
+def series_fmu_dir(fmu_dir: Path, spec: SeriesSpec) -> Path:
+    """Where the TimeSeriesSource built from a series lives: ``<fmu_dir>/series/<record stem>-<sha256[:16]>/``."""
+    return Path(fmu_dir) / SERIES_FMU_FOLDER / spec.key
 
 
 def drivetrain_fmu_dir(fmu_dir: Path, spec: DrivetrainSpec) -> Path:
@@ -169,6 +178,7 @@ class Component:
     signals: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
     drivetrain: DrivetrainSpec | None = None
     no_feedthrough: tuple[str, ...] = ()
+    series: SeriesSpec | None = None
 
     def __post_init__(self) -> None:
         from fmus.slaves.record import ROLES
@@ -195,6 +205,9 @@ class Component:
             raise ScenarioError(f"components.{self.name}.drivetrain", self.drivetrain.name,
                                 "a drivetrain file only for a project FMU built from it: fmu = "
                                 + " or ".join(f'"{f}"' for f in DRIVETRAIN_FMU_FILES) + f" (not {str(self.fmu)!r})")
+        if self.series is not None and str(self.fmu) != SERIES_FMU_FILE:
+            raise ScenarioError(f"components.{self.name}.series", self.series.record.name,
+                                f'a series only for fmu = "{SERIES_FMU_FILE}" (not {str(self.fmu)!r})')
         outputs = (self.no_feedthrough,) if isinstance(self.no_feedthrough, str) else self.no_feedthrough
         if not isinstance(outputs, (list, tuple)) or not all(isinstance(n, str) and n for n in outputs):
             raise ScenarioError(f"components.{self.name}.no_feedthrough", self.no_feedthrough,
@@ -429,6 +442,10 @@ class Scenario:
             if not isinstance(ev, ScenarioEvent):
                 raise ScenarioError(f"events[{i}]", ev, "a ScenarioEvent", src)
         check_events_in_run(self.events, self.simulation.start_s, self.simulation.stop_s, names, src)
+        for comp in self.components:
+            if comp.series is not None:  # a record shorter than the run: refused before any FMU exists
+                comp.series.check_covers(self.simulation.start_s, self.simulation.stop_s,
+                                         f"components.{comp.name}.series.record", src)
         if not isinstance(self.analysis, AnalysisSettings):
             raise ScenarioError("analysis", self.analysis, "an AnalysisSettings", src)
         if self.results_format not in RESULTS_FORMATS:
@@ -468,6 +485,9 @@ class Scenario:
         drivetrain file has one place: the folder of that file's content in the FMU
         directory (:func:`drivetrain_fmu_dir`).
         """
+        if component.series is not None:  # built from a record: only its content-keyed folder
+            root = Path(fmu_dir) if fmu_dir is not None else Path.cwd()
+            return [series_fmu_dir(root, component.series) / component.fmu.name]
         if component.drivetrain is not None:  # built from a drivetrain file: only its content-keyed folder
             root = Path(fmu_dir) if fmu_dir is not None else Path.cwd()
             return [drivetrain_fmu_dir(root, component.drivetrain) / component.fmu.name]
@@ -504,6 +524,7 @@ class _ComponentTable(Table):
                                    "name such as grc-like)")
     no_feedthrough: list[str] = Field(default_factory=list,
                                       description="a list of outputs that do not depend directly on any input")
+    series: SeriesTable | None = Field(None, description="a [components.<name>.series] table (recorded channels)")
 
 
 class _LinkTable(Table):
@@ -586,9 +607,11 @@ def scenario_from_dict(data: Mapping[str, Any], name: str | None = None, base_di
         spec = specs.get(cname)
         if spec is None and inherited is not None and ctab.fmu == GENERATOR_FMU_FILE:
             spec = inherited  # the generator of a drivetrain file's gearbox takes its defaults from the same file
+        series = (series_from_table(ctab.series, f"{path}.series", base_dir, source)
+                  if ctab.series is not None else None)
         try:
             components.append(Component(cname, Path(ctab.fmu), params, ctab.role, ctab.signals, spec,
-                                        tuple(ctab.no_feedthrough)))
+                                        tuple(ctab.no_feedthrough), series))
         except ScenarioError as exc:
             raise _rekeyed(exc, path if exc.key == "components" else None, source) from None
 

@@ -24,6 +24,7 @@ from .analyses import analyse_run
 from .comparison import compare, format_comparison, run_reference
 from .derived import Skipped, generator_vs_ideal
 from .plots import plot_run
+from .recorded import compare_recorded, plot_contact_loss_counts, plot_recorded
 from .results import build_summary, result_columns, results_writer
 from .run_folder import RunFolder
 from .writers import ResultWriter
@@ -100,15 +101,17 @@ def run_scenario(system: ResolvedSystem, out_dir: str | Path, *, compare_referen
     The folder is checked and the previous run's files are removed first
     (:class:`~orchestrator.run.run_folder.RunFolder`); ``summary.json`` says
     ``"status": "running"`` from then on and lists each file once it is whole.
-    The samples are streamed into ``timeseries.csv.partial`` block by block and
-    renamed to ``timeseries.csv`` when the co-simulation ends. SIGINT, SIGTERM
+    The samples are streamed into ``timeseries.csv.partial`` (``timeseries.parquet.partial``,
+    an Arrow IPC stream, for the binary format) block by block and made
+    ``timeseries.csv`` (``.parquet``) when the co-simulation ends. SIGINT, SIGTERM
     and SIGHUP stop the run between blocks of steps (or before the next FMU is
     instantiated, or before the next result file); an FMU failure, a failed
     initialisation and a write error (full disk) stop it too. Every stop ends
     with a ``summary.json`` saying ``complete: false``, the ``stage``, where
     (``stopped_at``) and why (``error``), and which files are whole (``files``)
     or not (``files_incomplete``). After SIGKILL the summary still says
-    ``running`` and ``timeseries.csv.partial`` is readable up to its last block.
+    ``running`` and the ``.partial`` file is readable up to its last block
+    (:func:`orchestrator.result_files.read_timeseries`).
 
     Parameters
     ----------
@@ -260,6 +263,10 @@ def _post_process(system, outcome, out, post: _PostProcessing, derived, skipped,
     if system.events:
         derived["events"] = [a.as_dict() for a in system.events]
     derived["analysis_settings"] = system.scenario.analysis.as_dict()
+    if post.go("recorded_comparison"):
+        recorded = compare_recorded(system, outcome)
+        if recorded:  # simulated against recorded channels (a TimeSeriesSource playing a record)
+            derived["recorded_comparison"] = recorded
     if post.go("analyses"):
         analyses = analyse_run(system, outcome, out, plots=plots)
         derived.update(analyses.summary)
@@ -282,4 +289,10 @@ def _post_process(system, outcome, out, post: _PostProcessing, derived, skipped,
                 skipped.append({"analysis": "comparison", "reason": str(exc)})
     if plots and post.go("plots"):
         post.commit({f"plot:{p.stem}": p for p in plot_run(system, outcome, out, skipped)})
+        recorded_plot = plot_recorded(system, outcome, out)
+        if recorded_plot is not None:
+            post.commit({f"plot:{recorded_plot.stem}": recorded_plot})
+        counts_plot = plot_contact_loss_counts(derived.get("contact_loss"), out, system.scenario.name)
+        if counts_plot is not None:
+            post.commit({f"plot:{counts_plot.stem}": counts_plot})
     return comparison, comparison_text

@@ -59,12 +59,29 @@ def read_timeseries(path: Path) -> dict[str, np.ndarray]:
     return {n: data[:, i] for i, n in enumerate(names)}
 
 
+def pythonfmu_exit_abort(proc: subprocess.CompletedProcess) -> bool:
+    """The known abort of a C host at exit, after its results were written (docs/fmus.md, "ecos").
+
+    pythonfmu 0.7's library frees its interpreter state from a C++ static destructor
+    and then touches it again from its library destructor (:mod:`fmus.slaves.shutdown`
+    releases it early in Python hosts; a C host such as ecos has no Python exit
+    handler to do it). Whether glibc notices depends on the heap layout, which even
+    the size of the environment changes. Exactly this signature - SIGABRT with glibc's
+    heap message after ecos said it wrote its CSV - is recognised; anything else fails.
+    """
+    text = proc.stdout + proc.stderr
+    return (proc.returncode in (-6, 134) and "corrupted double-linked list" in text
+            and "Wrote CSV data" in text)
+
+
 @pytest.mark.slow
 def test_readme_recipe_runs_the_exported_ssp_in_ecos(fmu_dir, tmp_path):
     _ecos_available()
     recipe = readme_recipe()
     assert "LD_PRELOAD=" in recipe and "--parameterSet dtcosim" in recipe
     proc = run_recipe(tmp_path, fmu_dir, recipe)
+    if pythonfmu_exit_abort(proc):  # pythonfmu 0.7's exit-time use-after-free in a C host: once, never twice
+        proc = run_recipe(tmp_path, fmu_dir, recipe)
     assert proc.returncode == 0, (proc.stdout + proc.stderr)[-3000:]
     ecos = read_ecos_csv(tmp_path / "paper.csv")
     assert ecos["time"][0] == 0.0 and ecos["time"][-1] == pytest.approx(0.999)  # ecos stops one step short of 1 s

@@ -1,0 +1,188 @@
+"""The recorded time series a TimeSeriesSource FMU is built from: the scenario's ``[components.<name>.series]``.
+
+::
+
+    [components.loads]
+    fmu = "TimeSeriesSource.fmu"
+    [components.loads.series]
+    record = "openfast-data/DLC1.1_0_NREL5MW_OC3_spar_0.outb"   # see "Where a record is found"
+    time_offset = 0.0            # s: record time = simulation time + time_offset
+    out_of_record = "error"      # or "hold" (first/last sample)
+    [[components.loads.series.channels]]
+    channel = "RotSpeed"         # as in the record
+    output = "rotor_speed"       # FMU output (default: the channel name)
+    interpolation = "pchip"      # C1 (default) or "linear" (C0)
+    angle = "rotor_angle"        # optional: also the integral of this channel (a speed), from angle_initial
+    quantity = "rotor_speed"     # optional: what it records (default from the OpenFAST channel name)
+
+Where a record is found: a path relative to the scenario file; else relative to each *data root*:
+the folders of ``$DTCOSIM_DATA`` (``os.pathsep``-separated), then ``shared/`` beside the dtcosim
+checkout (``<repo>/../shared``, where the project's OpenFAST data live). The record is read, its
+channels converted to SI and checked when the scenario is loaded, before any FMU exists; the FMU
+built from it (:mod:`orchestrator.cosim.series_fmus`) carries the converted samples and runs
+without the file.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import io
+import json
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+from pydantic import Field
+
+from ..errors import ScenarioError
+from .schema import Table
+from .series_file import RecordError, read_record, si_conversion
+
+#: environment variable with data roots
+DATA_ENV = "DTCOSIM_DATA"
+#: what an OpenFAST channel records (the signal kind of the simulated counterpart)
+OPENFAST_QUANTITIES = {
+    "RotSpeed": "rotor_speed", "GenSpeed": "generator_speed", "GenTq": "generator_torque", "Azimuth": "rotor_angle",
+    "RtFldMxh": "aerodynamic_torque", "RotTorq": "low_speed_shaft_torque", "HSSBrTq": "brake_torque",
+    "BldPitch1": "blade_pitch", "GenPwr": "generator_power", "Wind1VelX": "wind_speed",
+}
+_ANGLE_QUANTITIES = {"rotor_speed": "rotor_angle", "generator_speed": "generator_angle"}
+
+
+class ChannelTable(Table):
+    channel: str = Field(description="a channel name of the record")
+    output: str | None = Field(None, description="an FMU output name (default: the channel name)")
+    interpolation: Literal["pchip", "linear"] = "pchip"
+    angle: str | None = Field(None, description="an output name for the integral of this channel")
+    angle_initial: float = Field(0.0, description="the angle at the record's first time [rad]")
+    quantity: str | None = Field(None, description="what the channel records, e.g. generator_speed")
+
+
+class SeriesTable(Table):
+    record: str = Field(description="a record file (.outb, .out, .csv)")
+    time_offset: float = Field(0.0, description="record time minus simulation time [s]")
+    out_of_record: Literal["hold", "error"] = "error"
+    channels: list[ChannelTable] = Field(min_length=1, description="an array of tables [[...channels]]")
+
+
+def data_roots() -> list[Path]:
+    """Where records are looked for after the scenario's folder: ``$DTCOSIM_DATA``, then ``<repo>/../shared``."""
+    roots = [Path(p) for p in os.environ.get(DATA_ENV, "").split(os.pathsep) if p]
+    roots.append(Path(__file__).resolve().parents[2].parent / "shared")
+    return roots
+
+
+def find_record(spec: str, base_dir: Path | None, key: str, source: str | None) -> Path:
+    """The record file a scenario names (see the module docstring)."""
+    candidates = ([base_dir / spec] if base_dir is not None else [Path(spec)]) + [r / spec for r in data_roots()]
+    for path in candidates:
+        if path.is_file():
+            return path.resolve()
+    raise ScenarioError(key, spec, "a record file relative to the scenario file or a data root: tried "
+                        + ", ".join(str(p) for p in candidates), source)
+
+
+@dataclass(frozen=True, eq=False)
+class SeriesSpec:
+    """A checked selection of recorded channels, converted to SI.
+
+    Attributes
+    ----------
+    record : Path
+    outputs : tuple of dict
+        Per FMU output: output, channel, record_unit, unit (SI), column, interpolation, integral_of,
+        initial, quantity.
+    time_s : ndarray, shape (n,)
+    samples : ndarray, shape (n, k)
+        The selected channels in SI, one column each.
+    time_offset_s : float
+    out_of_record : str
+    """
+
+    record: Path
+    outputs: tuple
+    time_s: np.ndarray
+    samples: np.ndarray
+    time_offset_s: float
+    out_of_record: str
+
+    @property
+    def data_sha256(self) -> str:
+        digest = hashlib.sha256(self.time_s.tobytes() + self.samples.tobytes())
+        return digest.hexdigest()
+
+    def model(self) -> dict[str, Any]:
+        """The TimeSeriesSource record model (:mod:`fmus.slaves.time_series_source`)."""
+        return {"series": {"source": self.record.name, "time_offset_s": self.time_offset_s,
+                           "out_of_record": self.out_of_record, "outputs": [dict(o) for o in self.outputs],
+                           "start_s": float(self.time_s[0]), "end_s": float(self.time_s[-1]),
+                           "samples": int(self.time_s.size), "data_sha256": self.data_sha256}}
+
+    @property
+    def key(self) -> str:
+        """Folder name of the FMU built from it: ``<record stem>-<sha256[:16] of model and data>``."""
+        text = json.dumps(self.model(), sort_keys=True)
+        return f"{self.record.stem}-{hashlib.sha256(text.encode()).hexdigest()[:16]}"
+
+    def npz_bytes(self) -> bytes:
+        buf = io.BytesIO()
+        np.savez(buf, time_s=self.time_s, samples=self.samples)
+        return buf.getvalue()
+
+    def covers(self, start_s: float, stop_s: float) -> bool:
+        eps = 1e-9 * max(1.0, abs(float(self.time_s[-1])))
+        return (float(self.time_s[0]) - eps <= start_s + self.time_offset_s
+                and stop_s + self.time_offset_s <= float(self.time_s[-1]) + eps)
+
+    def check_covers(self, start_s: float, stop_s: float, key: str, source: str | None) -> None:
+        """With ``out_of_record = "error"``: a ScenarioError when the run leaves the record."""
+        if self.out_of_record == "error" and not self.covers(start_s, stop_s):
+            t0, t1 = float(self.time_s[0]), float(self.time_s[-1])
+            off = self.time_offset_s
+            raise ScenarioError(key, f"{self.record.name} [{t0:g}, {t1:g}] s", (
+                f"a record covering the run [{start_s:g}, {stop_s:g}] s + time_offset {off:g} s = "
+                f"[{start_s + off:g}, {stop_s + off:g}] s (the record is shorter than the run: shorten the run, "
+                f"set time_offset, or out_of_record = \"hold\")"), source)
+
+
+def series_from_table(table: SeriesTable, key: str, base_dir: Path | None, source: str | None) -> SeriesSpec:
+    """Read, select, convert and check the channels of a ``series`` table.
+
+    Raises
+    ------
+    ScenarioError, RecordError
+        The file is not found; any problem of the record (:func:`read_record`) or of a channel:
+        missing (with "did you mean"), a unit with no SI conversion, NaN, a duplicate output.
+    """
+    path = find_record(table.record, base_dir, f"{key}.record", source)
+    record = read_record(path)
+    outputs, columns, seen = [], [], {}
+    for i, ch in enumerate(table.channels):
+        ckey = f"{key}.channels[{i}]"
+        unit, values = record.channel(ch.channel)
+        si_unit, factor = si_conversion(unit, ch.channel, record.source)
+        bad = np.flatnonzero(~np.isfinite(values))
+        if bad.size:
+            raise RecordError(ch.channel, f"NaN at t = {record.time_s[bad[0]]:g} s (row {int(bad[0])})",
+                              f"finite samples ({bad.size} of {values.size} are not)", record.source)
+        quantity = ch.quantity or OPENFAST_QUANTITIES.get(ch.channel, "")
+        column = len(columns)
+        columns.append(values * factor)
+        names = [(ch.output or ch.channel, False, quantity)]
+        if ch.angle:
+            if si_unit != "rad/s":
+                raise ScenarioError(f"{ckey}.angle", ch.angle, f"an angle of a speed channel (rad/s); {ch.channel} "
+                                    f"is in {unit}", source)
+            names.append((ch.angle, True, _ANGLE_QUANTITIES.get(quantity, "")))
+        for name, integral, q in names:
+            if name in seen:
+                raise ScenarioError(f"{ckey}.output", name, f"a new output name (already {seen[name]})", source)
+            seen[name] = ckey
+            outputs.append({"output": name, "channel": ch.channel, "record_unit": unit,
+                            "unit": "rad" if integral else si_unit, "column": column,
+                            "interpolation": ch.interpolation, "integral_of": integral,
+                            "initial": float(ch.angle_initial) if integral else 0.0, "quantity": q})
+    return SeriesSpec(path, tuple(outputs), record.time_s.copy(), np.column_stack(columns), float(table.time_offset),
+                      table.out_of_record)
