@@ -267,7 +267,7 @@ def series_from_table(table: SeriesTable, key: str, base_dir: Path | None, sourc
     ScenarioError, RecordError
         Neither or both of ``record`` and ``records``; a file not found; any problem of a record
         (:func:`read_record`) or of a channel: missing (with "did you mean"), a unit with no SI
-        conversion, NaN, a duplicate output; records whose units of a channel differ.
+        conversion, NaN, a duplicate output; a record whose channel has another SI unit than the first's.
     """
     if (table.record is None) == (table.records is None):
         given = {k: v for k, v in (("record", table.record), ("records", table.records)) if v is not None}
@@ -278,12 +278,14 @@ def series_from_table(table: SeriesTable, key: str, base_dir: Path | None, sourc
     for name, rkey in zip(names, where):
         path = find_record(name, base_dir, rkey, source)
         these, samples = _selected(table, path, key, source)
-        if outputs is not None and these != outputs:
-            diff = next(f"{a['channel']} in {a['record_unit']} (first record: {b['record_unit']})"
-                        for a, b in zip(these, outputs) if a != b)
-            raise ScenarioError(rkey, name, f"a record of the same channels in the same units as the first: {diff}",
-                                source)
-        outputs = these
+        if outputs is not None:  # the same SI units (the recorded ones may differ: kN-m and N-m are converted)
+            diff = next((f"{a['channel']} in {a['record_unit']} = {a['unit']} (first record: {b['record_unit']})"
+                         for a, b in zip(these, outputs) if a["unit"] != b["unit"]), None)
+            if diff is not None:
+                raise ScenarioError(rkey, name, f"a record whose channels have the SI units of the first: {diff}",
+                                    source)
+        else:
+            outputs = these
         recorded.append(samples)
     return SeriesSpec(tuple(recorded), tuple(outputs), float(table.time_offset), table.out_of_record,
                       selectable=table.records is not None)
