@@ -6,7 +6,9 @@ names the outputs: one per channel (its interpolation: ``linear`` C0 or ``pchip`
 angles integrated from a speed channel. Parameters: ``time_offset`` [s] (record time =
 simulation time + offset), ``out_of_record`` (0 = hold the first/last sample, 1 = error: the
 step is discarded with a message) and ``<angle>.initial`` [rad] per integrated output. No
-inputs. Only numpy is imported at run time; no file outside the FMU is read.
+inputs. Built from several records (``model["series"]["records"]``, the seeds of one load case,
+say), the FMU packs each as ``time_s_<i>`` / ``samples_<i>`` and an Integer parameter ``record``
+(1-based, bounds ``[1, n]``) selects the one it plays. Only numpy is imported at run time; no file outside the FMU is read.
 """
 
 from __future__ import annotations
@@ -18,7 +20,7 @@ import numpy as np
 
 from components.errors import DtcosimError, ParameterError, SolverError
 from components.model.time_series import OUT_OF_RECORD, ChannelSpec, TimeSeriesPlayer
-from components.validation import choice_bounds, finite
+from components.validation import Bounds, choice_bounds, finite
 
 from .base import DtcosimSlave
 from .interface import Variable, enumeration_text, integer_parameter, real_output, real_parameter
@@ -44,6 +46,10 @@ class TimeSeriesSource(DtcosimSlave):
             integer_parameter("out_of_record", OUT_OF_RECORD.index(series["out_of_record"]),
                               f"outside the record: {enumeration_text(OUT_OF_RECORD)}"),
         ]
+        records = series.get("records")
+        if records:
+            variables.append(integer_parameter("record", 1, "the packed record played: " + ", ".join(
+                f"{i} = {r['source']}" for i, r in enumerate(records, start=1))))
         for ch in series["outputs"]:
             if ch["integral_of"]:
                 variables.append(real_parameter(f"{ch['output']}.initial", float(ch["initial"]), ch["unit"],
@@ -71,10 +77,17 @@ class TimeSeriesSource(DtcosimSlave):
             initial = finite(f"{ch['output']}.initial", self.value(f"{ch['output']}.initial")) if ch["integral_of"] else 0.0
             channels.append(ChannelSpec(ch["output"], int(ch["column"]), ch["interpolation"], bool(ch["integral_of"]),
                                         initial))
+        suffix = ""
+        records = series.get("records")
+        if records:
+            n = len(records)
+            number = Bounds(1, n, True, f"one of the {n} packed records: an integer within [1, {n}]").check(
+                "record", self.value("record"))
+            suffix = f"_{int(number)}"
         path = Path(self.resources) / DATA_FILE
         try:
             with np.load(path) as data:
-                time_s, samples = data["time_s"], data["samples"]
+                time_s, samples = data["time_s" + suffix], data["samples" + suffix]
         except (OSError, KeyError, ValueError) as exc:
             raise DtcosimError(f"cannot read the packed samples {path}: {exc}") from None
         self.player = TimeSeriesPlayer(time_s, samples, channels, offset, OUT_OF_RECORD[policy])

@@ -445,7 +445,8 @@ class Scenario:
         for comp in self.components:
             if comp.series is not None:  # a record shorter than the run: refused before any FMU exists
                 comp.series.check_covers(self.simulation.start_s, self.simulation.stop_s,
-                                         f"components.{comp.name}.series.record", src)
+                                         f"components.{comp.name}.series."
+                                         + ("records" if comp.series.selectable else "record"), src)
         if not isinstance(self.analysis, AnalysisSettings):
             raise ScenarioError("analysis", self.analysis, "an AnalysisSettings", src)
         if self.results_format not in RESULTS_FORMATS:

@@ -15,6 +15,11 @@
     angle = "rotor_angle"        # optional: also the integral of this channel (a speed), from angle_initial
     quantity = "rotor_speed"     # optional: what it records (default from the OpenFAST channel name)
 
+Several records of the same channels (e.g. the seeds of one load case) in one FMU: ``records = [...]``
+instead of ``record``; the FMU then has an Integer parameter ``record`` (1-based, default 1, bounds
+``[1, len(records)]`` declared like every other parameter) that selects the one it plays. Every record
+must cover the run (``out_of_record = "error"``); the record's span is the one all of them cover.
+
 Where a record is found: a path relative to the scenario file; else relative to each *data root*:
 the folders of ``$DTCOSIM_DATA`` (``os.pathsep``-separated), then ``shared/`` beside the dtcosim
 checkout (``<repo>/../shared``, where the project's OpenFAST data live). The record is read, its
@@ -61,7 +66,8 @@ class ChannelTable(Table):
 
 
 class SeriesTable(Table):
-    record: str = Field(description="a record file (.outb, .out, .csv)")
+    record: str | None = Field(None, description="a record file (.outb, .out, .csv)")
+    records: list[str] | None = Field(None, min_length=1, description="a list of record files (.outb, .out, .csv)")
     time_offset: float = Field(0.0, description="record time minus simulation time [s]")
     out_of_record: Literal["hold", "error"] = "error"
     channels: list[ChannelTable] = Field(min_length=1, description="an array of tables [[...channels]]")
@@ -85,78 +91,144 @@ def find_record(spec: str, base_dir: Path | None, key: str, source: str | None) 
 
 
 @dataclass(frozen=True, eq=False)
-class SeriesSpec:
-    """A checked selection of recorded channels, converted to SI.
+class RecordedSamples:
+    """The selected channels of one record file, converted to SI.
 
     Attributes
     ----------
     record : Path
-    outputs : tuple of dict
-        Per FMU output: output, channel, record_unit, unit (SI), column, interpolation, integral_of,
-        initial, quantity.
     time_s : ndarray, shape (n,)
     samples : ndarray, shape (n, k)
-        The selected channels in SI, one column each.
-    time_offset_s : float
-    out_of_record : str
+        One column per selected channel.
     """
 
     record: Path
-    outputs: tuple
     time_s: np.ndarray
     samples: np.ndarray
-    time_offset_s: float
-    out_of_record: str
 
     @property
     def data_sha256(self) -> str:
-        digest = hashlib.sha256(self.time_s.tobytes() + self.samples.tobytes())
-        return digest.hexdigest()
+        return hashlib.sha256(self.time_s.tobytes() + self.samples.tobytes()).hexdigest()
+
+    @property
+    def start_s(self) -> float:
+        return float(self.time_s[0])
+
+    @property
+    def end_s(self) -> float:
+        return float(self.time_s[-1])
+
+    def summary(self) -> dict[str, Any]:
+        return {"source": self.record.name, "start_s": self.start_s, "end_s": self.end_s,
+                "samples": int(self.time_s.size), "data_sha256": self.data_sha256}
+
+
+@dataclass(frozen=True, eq=False)
+class SeriesSpec:
+    """A checked selection of recorded channels, converted to SI, from one record or several.
+
+    Attributes
+    ----------
+    records : tuple of RecordedSamples
+        The record (``record = "..."``) or the records (``records = [...]``), same outputs in each.
+    outputs : tuple of dict
+        Per FMU output: output, channel, record_unit, unit (SI), column, interpolation, integral_of,
+        initial, quantity.
+    time_offset_s : float
+    out_of_record : str
+    selectable : bool
+        True for ``records = [...]``: the FMU packs them all and its ``record`` parameter selects one.
+    """
+
+    records: tuple
+    outputs: tuple
+    time_offset_s: float
+    out_of_record: str
+    selectable: bool = False
+
+    @property
+    def record(self) -> Path:
+        """The (first) record file."""
+        return self.records[0].record
+
+    @property
+    def time_s(self) -> np.ndarray:
+        """Times of the (first) record [s]."""
+        return self.records[0].time_s
+
+    @property
+    def samples(self) -> np.ndarray:
+        """Samples of the (first) record."""
+        return self.records[0].samples
+
+    @property
+    def start_s(self) -> float:
+        """The latest first time of the records: every record covers [start_s, end_s]."""
+        return max(r.start_s for r in self.records)
+
+    @property
+    def end_s(self) -> float:
+        return min(r.end_s for r in self.records)
+
+    @property
+    def data_sha256(self) -> str:
+        if len(self.records) == 1 and not self.selectable:
+            return self.records[0].data_sha256
+        return hashlib.sha256("".join(r.data_sha256 for r in self.records).encode()).hexdigest()
+
+    @property
+    def source(self) -> str:
+        return ", ".join(r.record.name for r in self.records)
 
     def model(self) -> dict[str, Any]:
         """The TimeSeriesSource record model (:mod:`fmus.slaves.time_series_source`)."""
-        return {"series": {"source": self.record.name, "time_offset_s": self.time_offset_s,
-                           "out_of_record": self.out_of_record, "outputs": [dict(o) for o in self.outputs],
-                           "start_s": float(self.time_s[0]), "end_s": float(self.time_s[-1]),
-                           "samples": int(self.time_s.size), "data_sha256": self.data_sha256}}
+        series = {"source": self.source, "time_offset_s": self.time_offset_s,
+                  "out_of_record": self.out_of_record, "outputs": [dict(o) for o in self.outputs],
+                  "start_s": self.start_s, "end_s": self.end_s,
+                  "samples": int(self.time_s.size), "data_sha256": self.data_sha256}
+        if self.selectable:
+            series["records"] = [r.summary() for r in self.records]
+        return {"series": series}
 
     @property
     def key(self) -> str:
-        """Folder name of the FMU built from it: ``<record stem>-<sha256[:16] of model and data>``."""
+        """Folder name of the FMU built from it: ``<record stem>[-<n>records]-<sha256[:16] of model and data>``."""
         text = json.dumps(self.model(), sort_keys=True)
-        return f"{self.record.stem}-{hashlib.sha256(text.encode()).hexdigest()[:16]}"
+        stem = self.record.stem + (f"-{len(self.records)}records" if self.selectable else "")
+        return f"{stem}-{hashlib.sha256(text.encode()).hexdigest()[:16]}"
 
     def npz_bytes(self) -> bytes:
+        """The packed samples: ``time_s``, ``samples``; with ``records``: ``time_s_<i>``, ``samples_<i>``, i = 1..n."""
         buf = io.BytesIO()
-        np.savez(buf, time_s=self.time_s, samples=self.samples)
+        if self.selectable:
+            arrays = {}
+            for i, r in enumerate(self.records, start=1):
+                arrays[f"time_s_{i}"], arrays[f"samples_{i}"] = r.time_s, r.samples
+            np.savez(buf, **arrays)
+        else:
+            np.savez(buf, time_s=self.time_s, samples=self.samples)
         return buf.getvalue()
 
     def covers(self, start_s: float, stop_s: float) -> bool:
-        eps = 1e-9 * max(1.0, abs(float(self.time_s[-1])))
-        return (float(self.time_s[0]) - eps <= start_s + self.time_offset_s
-                and stop_s + self.time_offset_s <= float(self.time_s[-1]) + eps)
+        eps = 1e-9 * max(1.0, abs(self.end_s))
+        return (self.start_s - eps <= start_s + self.time_offset_s
+                and stop_s + self.time_offset_s <= self.end_s + eps)
 
     def check_covers(self, start_s: float, stop_s: float, key: str, source: str | None) -> None:
-        """With ``out_of_record = "error"``: a ScenarioError when the run leaves the record."""
+        """With ``out_of_record = "error"``: a ScenarioError when the run leaves a record."""
         if self.out_of_record == "error" and not self.covers(start_s, stop_s):
-            t0, t1 = float(self.time_s[0]), float(self.time_s[-1])
             off = self.time_offset_s
-            raise ScenarioError(key, f"{self.record.name} [{t0:g}, {t1:g}] s", (
+            short = next(r for r in self.records if not (
+                r.start_s - 1e-9 * max(1.0, abs(r.end_s)) <= start_s + off
+                and stop_s + off <= r.end_s + 1e-9 * max(1.0, abs(r.end_s))))
+            raise ScenarioError(key, f"{short.record.name} [{short.start_s:g}, {short.end_s:g}] s", (
                 f"a record covering the run [{start_s:g}, {stop_s:g}] s + time_offset {off:g} s = "
                 f"[{start_s + off:g}, {stop_s + off:g}] s (the record is shorter than the run: shorten the run, "
                 f"set time_offset, or out_of_record = \"hold\")"), source)
 
 
-def series_from_table(table: SeriesTable, key: str, base_dir: Path | None, source: str | None) -> SeriesSpec:
-    """Read, select, convert and check the channels of a ``series`` table.
-
-    Raises
-    ------
-    ScenarioError, RecordError
-        The file is not found; any problem of the record (:func:`read_record`) or of a channel:
-        missing (with "did you mean"), a unit with no SI conversion, NaN, a duplicate output.
-    """
-    path = find_record(table.record, base_dir, f"{key}.record", source)
+def _selected(table: SeriesTable, path: Path, key: str, source: str | None) -> tuple[list[dict], RecordedSamples]:
+    """The outputs and the converted samples of ``table.channels`` in the record ``path``."""
     record = read_record(path)
     outputs, columns, seen = [], [], {}
     for i, ch in enumerate(table.channels):
@@ -184,5 +256,36 @@ def series_from_table(table: SeriesTable, key: str, base_dir: Path | None, sourc
                             "unit": "rad" if integral else si_unit, "column": column,
                             "interpolation": ch.interpolation, "integral_of": integral,
                             "initial": float(ch.angle_initial) if integral else 0.0, "quantity": q})
-    return SeriesSpec(path, tuple(outputs), record.time_s.copy(), np.column_stack(columns), float(table.time_offset),
-                      table.out_of_record)
+    return outputs, RecordedSamples(path, record.time_s.copy(), np.column_stack(columns))
+
+
+def series_from_table(table: SeriesTable, key: str, base_dir: Path | None, source: str | None) -> SeriesSpec:
+    """Read, select, convert and check the channels of a ``series`` table.
+
+    Raises
+    ------
+    ScenarioError, RecordError
+        Neither or both of ``record`` and ``records``; a file not found; any problem of a record
+        (:func:`read_record`) or of a channel: missing (with "did you mean"), a unit with no SI
+        conversion, NaN, a duplicate output; a record whose channel has another SI unit than the first's.
+    """
+    if (table.record is None) == (table.records is None):
+        given = {k: v for k, v in (("record", table.record), ("records", table.records)) if v is not None}
+        raise ScenarioError(key, given or None, 'either record = "file" or records = ["file", ...] (exactly one)', source)
+    names = [table.record] if table.record is not None else list(table.records)
+    where = [f"{key}.record"] if table.record is not None else [f"{key}.records[{i}]" for i in range(len(names))]
+    outputs, recorded = None, []
+    for name, rkey in zip(names, where):
+        path = find_record(name, base_dir, rkey, source)
+        these, samples = _selected(table, path, key, source)
+        if outputs is not None:  # the same SI units (the recorded ones may differ: kN-m and N-m are converted)
+            diff = next((f"{a['channel']} in {a['record_unit']} = {a['unit']} (first record: {b['record_unit']})"
+                         for a, b in zip(these, outputs) if a["unit"] != b["unit"]), None)
+            if diff is not None:
+                raise ScenarioError(rkey, name, f"a record whose channels have the SI units of the first: {diff}",
+                                    source)
+        else:
+            outputs = these
+        recorded.append(samples)
+    return SeriesSpec(tuple(recorded), tuple(outputs), float(table.time_offset), table.out_of_record,
+                      selectable=table.records is not None)

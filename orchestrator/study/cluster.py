@@ -80,8 +80,14 @@ def locked_down_local_cluster(workers: int | None = None, dashboard_address: str
             signal.signal(signal.SIGINT, previous)
 
 
-def connect(scheduler: str, timeout_s: float = 20.0):
+#: seconds to wait for an existing scheduler to answer (Dask retries a refused connection until then)
+CONNECT_TIMEOUT_S = 20.0
+
+
+def connect(scheduler: str, timeout_s: float | None = None):
     """A client of an existing scheduler, with the Dask configuration's TLS settings.
+
+    ``timeout_s`` defaults to :data:`CONNECT_TIMEOUT_S`.
 
     Raises
     ------
@@ -93,6 +99,7 @@ def connect(scheduler: str, timeout_s: float = 20.0):
     if "://" not in scheduler and ":" not in scheduler:
         raise StudyError("--scheduler", scheduler, "a scheduler address such as tls://10.0.0.5:8786")
     try:
+        timeout_s = CONNECT_TIMEOUT_S if timeout_s is None else timeout_s
         return Client(scheduler, timeout=f"{timeout_s:g}s", security=Security())
     except (OSError, ValueError, TypeError, TimeoutError) as exc:
         reason = str(exc) or type(exc).__name__

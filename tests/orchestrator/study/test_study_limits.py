@@ -57,7 +57,10 @@ def test_a_value_outside_the_fmus_bounds_is_refused_at_check(fmu_dir, write_stud
 
 
 @pytest.mark.parametrize("address", ["not a url", "tcp://127.0.0.1:1"])
-def test_a_bad_scheduler_address_is_a_named_error(write_study, tmp_path, capsys, address):
+def test_a_bad_scheduler_address_is_a_named_error(write_study, tmp_path, capsys, monkeypatch, address):
+    import orchestrator.study.cluster as cluster
+
+    monkeypatch.setattr(cluster, "CONNECT_TIMEOUT_S", 2.0)  # a refused port: no need to wait the default 20 s
     path = write_study(SMALL_STUDY)
     status = main(["sweep", str(path), "--scheduler", address, "--out", str(tmp_path / "out"), "-q"])
     err = capsys.readouterr().err
