@@ -918,6 +918,30 @@ def interpreted_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str
             else:
                 buf[j] = factor * flat[latest + col] + shift
 
+    def step_slot(entry, k: int, t: float, H: float, o1: int, o0: int, om: int, c: int) -> None:
+        """One FMU's inputs (Real and typed) and its ``fmi2DoStep`` from ``t_k``."""
+        i, inst, buf, buf_addr, vr_in, n_in, _, _, _, _, feeds, lin_feeds, before, _ = entry
+        set_inputs(buf, feeds, lin_feeds, o1, o0, om)
+        if before is not None:
+            before(k, c)
+        if n_in:
+            st = inst.set_real(inst.component, vr_in, n_in, buf_addr)
+            if st > 1:
+                raise _Stop(i, "fmi2SetReal", st, k)
+        st = inst.do_step(inst.component, t, H, 1)
+        if st > 1:
+            raise _Stop(i, "fmi2DoStep", st, k)
+
+    def read_slot(entry, k: int, n: int, a1: int, c: int) -> None:
+        """The first ``n`` Real outputs of one FMU at ``t_{k+1}`` (and its typed outputs)."""
+        i, inst, _, _, _, _, vr_out, _, _, offset, _, _, _, after = entry
+        if n:
+            st = inst.get_real(inst.component, vr_out, n, a1 + offset)
+            if st > 1:
+                raise _Stop(i, "fmi2GetReal", st, k)
+        if after is not None:
+            after(k, c)
+
     def advance(k_start: int, k_end: int, t0: float, H: float) -> int:
         r0 = k_start // stride + 1
         for k in range(k_start, k_end):
@@ -925,33 +949,9 @@ def interpreted_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str
             o1, o0, om, c = rows_of(k, k_start)
             sample = (k + 1) % stride == 0
             a1 = base + o1 * ctypes.sizeof(c_double)
-            for i, inst, buf, buf_addr, vr_in, n_in, vr_out, n_all, n_couple, offset, feeds, lin_feeds, before, \
-                    after in plan:
-                for j, upstream, col in feeds:
-                    latest, previous = (o1, o0) if upstream else (o0, om)
-                    if linear:
-                        a = 0.5 if upstream else 1.5
-                        buf[j] = a * flat[latest + col] + (1.0 - a) * flat[previous + col]
-                    else:
-                        buf[j] = flat[latest + col]
-                if lin_feeds:
-                    set_inputs(buf, (), lin_feeds, o1, o0, om)
-                if before is not None:
-                    before(k, c)
-                if n_in:
-                    st = inst.set_real(inst.component, vr_in, n_in, buf_addr)
-                    if st > 1:
-                        raise _Stop(i, "fmi2SetReal", st, k)
-                st = inst.do_step(inst.component, t, H, 1)
-                if st > 1:
-                    raise _Stop(i, "fmi2DoStep", st, k)
-                n = n_all if (stride == 1 or sample) else n_couple
-                if n:
-                    st = inst.get_real(inst.component, vr_out, n, a1 + offset)
-                    if st > 1:
-                        raise _Stop(i, "fmi2GetReal", st, k)
-                if after is not None:
-                    after(k, c)
+            for entry in plan:
+                step_slot(entry, k, t, H, o1, o0, om, c)
+                read_slot(entry, k, entry[7] if (stride == 1 or sample) else entry[8], a1, c)  # all or coupling
             if not direct and sample:
                 data[(k + 1) // stride - r0] = ring[(k + 1) % 3]
         return k_end
@@ -960,25 +960,10 @@ def interpreted_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str
         t = t0 + k * H
         o1, o0, om, c = rows_of(k, k_start)
         a1 = base + o1 * ctypes.sizeof(c_double)
-        for i, inst, buf, buf_addr, vr_in, n_in, vr_out, n_all, n_couple, offset, feeds, lin_feeds, before, \
-                after in plan[first:]:
-            if i > first:  # the FMUs after the one that ended: their usual step
-                set_inputs(buf, feeds, lin_feeds, o1, o0, om)
-                if before is not None:
-                    before(k, c)
-                if n_in:
-                    st = inst.set_real(inst.component, vr_in, n_in, buf_addr)
-                    if st > 1:
-                        raise _Stop(i, "fmi2SetReal", st, k)
-                st = inst.do_step(inst.component, t, H, 1)
-                if st > 1:
-                    raise _Stop(i, "fmi2DoStep", st, k)
-            if n_all:
-                st = inst.get_real(inst.component, vr_out, n_all, a1 + offset)
-                if st > 1:
-                    raise _Stop(i, "fmi2GetReal", st, k)
-            if after is not None:
-                after(k, c)
+        for entry in plan[first:]:
+            if entry[0] > first:  # the FMUs after the one that ended: their usual step
+                step_slot(entry, k, t, H, o1, o0, om, c)
+            read_slot(entry, k, entry[7], a1, c)
         return k + 1
 
     advance.finish_step = finish_step
