@@ -64,7 +64,7 @@ from components import __version__ as COMPONENTS_VERSION
 from components.errors import DtcosimError, ParameterError
 
 from .interface import BOOLEAN, INPUT, INTEGER, OUTPUT, PARAMETER, REAL, Value, Variable
-from .record import read_record
+from .record import START_VALUES_KEY, RecordError, read_record
 from .shutdown import register_state_release
 
 #: Life-cycle phases of an instance.
@@ -171,11 +171,13 @@ class DtcosimSlave(Fmi2Slave):
         super().__init__(**kwargs)
         register_state_release(self.resources)  # pythonfmu's exit-time use-after-free, see .shutdown
         #: the parameter set of this FMU's record (structure and defaults)
-        self.model: dict[str, Any] = read_record(self.resources)["model"]
+        record = read_record(self.resources)
+        self.model: dict[str, Any] = record["model"]
         variables = self.interface(self.model)
         self.variables: tuple[Variable, ...] = variables
         self.vr: dict[str, int] = {v.name: i for i, v in enumerate(variables)}
         self._values: list[Value] = [0.0 if v.start is None else v.start for v in variables]
+        self._apply_start_values(record.get(START_VALUES_KEY, {}))
         self._kind = [(v.type, v.causality) for v in variables]
         self._real_vrs = frozenset(i for i, v in enumerate(variables) if v.type == REAL)
         self._integer_vrs = frozenset(i for i, v in enumerate(variables) if v.type == INTEGER)
@@ -231,6 +233,27 @@ class DtcosimSlave(Fmi2Slave):
             if var.causality == PARAMETER:
                 kwargs["initial"] = Fmi2Initial.exact
         self.register_variable(_PYTHONFMU_TYPES[var.type](var.name, **kwargs), nested=False)
+
+    def _apply_start_values(self, start_values: Mapping[str, Any]) -> None:
+        """The record's ``start_values`` (a copy written by :mod:`fmus.start_values`) over the model's defaults.
+
+        Raises
+        ------
+        RecordError
+            A name that is not a parameter or input of this FMU, or a value of another type.
+        """
+        for name, value in start_values.items():
+            vr = self.vr.get(name)
+            if vr is None or self.variables[vr].causality not in (PARAMETER, INPUT):
+                raise RecordError(f"resources record {START_VALUES_KEY}: {name!r} is not a parameter or input of "
+                                  f"this FMU")
+            fmi_type = self.variables[vr].type
+            wrong = (isinstance(value, bool) != (fmi_type == BOOLEAN)
+                     or (fmi_type == REAL and not isinstance(value, (int, float)))
+                     or (fmi_type == INTEGER and not isinstance(value, int)))
+            if wrong:
+                raise RecordError(f"resources record {START_VALUES_KEY}: {name} = {value!r} is not a {fmi_type} value")
+            self._values[vr] = float(value) if fmi_type == REAL else value
 
     def value(self, name: str) -> Value:
         """Current value of a variable by name."""

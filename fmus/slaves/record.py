@@ -28,6 +28,8 @@ from typing import Any
 
 RECORD_FILE = "dtcosim.json"
 RECORD_FORMAT = 1
+#: record key of the start values a copy of an FMU was given (:mod:`fmus.start_values`)
+START_VALUES_KEY = "start_values"
 
 #: roles a component of a drivetrain co-simulation can have
 WIND_SOURCE, GEARBOX, GENERATOR = "wind_source", "gearbox", "generator"
@@ -72,4 +74,7 @@ def read_record(resources: str | Path | None) -> dict[str, Any]:
         raise RecordError(f"{path} is not valid JSON: {exc}") from None
     if not isinstance(record, dict) or record.get("format") != RECORD_FORMAT or not isinstance(record.get("model"), dict):
         raise RecordError(f"{path} is not a dtcosim record of format {RECORD_FORMAT}")
+    if not isinstance(record.get(START_VALUES_KEY, {}), dict):
+        raise RecordError(f"{path}: {START_VALUES_KEY} must be a table of variable name -> value, "
+                          f"not {record[START_VALUES_KEY]!r}")
     return record

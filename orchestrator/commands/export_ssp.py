@@ -19,7 +19,9 @@ def register(sub: argparse._SubParsersAction) -> None:
             "SystemStructure.ssd with components, connectors, parameter values, connections, the fixed-step "
             "algorithm for libcosim (osp:FixedStepAlgorithm) and dtcosim's own settings as an annotation, plus the "
             "FMUs under resources/. The FMUs are initialised once to compute the values of [[initial]] bindings, "
-            "which other hosts receive as parameter values."
+            "which other hosts receive as parameter values. dtcosim FMUs are archived as copies whose start values "
+            "are the exported values, so hosts that apply no parameter set (ecos without --parameterSet) run the "
+            "same system; other tools' FMUs are archived unchanged (their values are in the parameter set only)."
         ),
     )
     p.add_argument("scenario", nargs="?", default=None, metavar="SCENARIO",
@@ -37,7 +39,7 @@ def run(args: argparse.Namespace) -> int:
     from ..cosim.master import CoSimulation
     from ..cosim.system import resolve_system
     from ..interop.ssp import export_ssp
-    from ..interop.ssp_export import stale_warnings
+    from ..interop.ssp_export import PARAMETER_SET, stale_warnings, unbaked_components
 
     scenario = scenario_options.apply(scenario_options.load(args.scenario, args, "export-ssp"), args, "export-ssp")
     paths = ensure_fmus(scenario, args.fmu_dir, build=not args.no_build,
@@ -49,6 +51,11 @@ def run(args: argparse.Namespace) -> int:
     out = export_ssp(system, args.out, initial)
     for warning in stale_warnings(system, initial):
         print(f"dtcosim export-ssp: warning: {warning}", file=sys.stderr)
+    unbaked = unbaked_components(system, initial)
+    if unbaked:
+        print(f"dtcosim export-ssp: warning: {', '.join(unbaked)}: not dtcosim FMUs, archived unchanged; their "
+              f"parameter values are only in the parameter set '{PARAMETER_SET}', which a host must apply (ecos: "
+              f"--parameterSet {PARAMETER_SET})", file=sys.stderr)
     print(f"{out}: {len(scenario.components)} components, {len(scenario.connections)} connections"
           + (f", initial values {', '.join(f'{k} = {v:.10g}' for k, v in initial.items())}" if initial else ""))
     return 0

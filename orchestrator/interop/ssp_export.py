@@ -26,17 +26,30 @@ so the exporter also writes the value the binding produced at initialisation
 into the parameter set: other hosts start from the same state; dtcosim, on
 import, restores the binding instead of the fixed value.
 
+A host that applies no parameter set (ecos 0.7 without ``--parameterSet``) would run
+the FMUs with their build defaults. So a dtcosim FMU (one with a record) whose
+component has parameter values goes into the archive as a copy in which those values
+are the start values (:mod:`fmus.start_values`: ``modelDescription.xml`` and the
+record, which the slave applies before the host sets anything): every host runs the
+exported system, whether it applies the parameter set or not. Another tool's FMU is
+archived as it is; its values are in the parameter set only
+(:func:`unbaked_components` names them, and ``dtcosim export-ssp`` warns).
+
 Import is :mod:`orchestrator.interop.ssp_import`.
 """
 
 
 from __future__ import annotations
 
+import json
 import math
+import tempfile
 import xml.etree.ElementTree as ET
 import zipfile
 from pathlib import Path
 from typing import Any, Mapping
+
+from fmus.start_values import StartValueError, write_with_start_values
 
 from ..cosim.system import ResolvedSystem
 from ..errors import SspError
@@ -141,21 +154,48 @@ def _transformation(parent: ET.Element, transformation) -> None:
         ET.SubElement(el, _q("ssc:MapEntry"), source=text(source), target=text(target))
 
 
-def _resource_names(system: ResolvedSystem) -> dict[str, str]:
-    """Archive path of each component's FMU (one copy per distinct file)."""
-    by_sha: dict[str, str] = {}
+def component_values(system: ResolvedSystem, initial_values: Mapping[str, Any] | None = None) -> dict[str, dict]:
+    """Each component's exported parameter values: the scenario's, and the values its initial bindings produced."""
+    initial_values = dict(initial_values or {})
+    out = {}
+    for comp in system.scenario.components:
+        values = dict(comp.parameters)
+        for key, value in initial_values.items():
+            ref = VariableRef.parse(key, "initial")
+            if ref.component == comp.name:
+                values[ref.variable] = value
+        out[comp.name] = values
+    return out
+
+
+def baked_values(system: ResolvedSystem, initial_values: Mapping[str, Any] | None = None) -> dict[str, dict]:
+    """Component -> the start values its archived FMU copy carries (dtcosim FMUs with parameter values only)."""
+    return {name: values for name, values in component_values(system, initial_values).items()
+            if values and system.interfaces[name].record is not None}
+
+
+def unbaked_components(system: ResolvedSystem, initial_values: Mapping[str, Any] | None = None) -> list[str]:
+    """Components with parameter values whose FMU is archived unchanged (not a dtcosim FMU)."""
+    return [name for name, values in component_values(system, initial_values).items()
+            if values and system.interfaces[name].record is None]
+
+
+def _resource_names(system: ResolvedSystem, baked: Mapping[str, Mapping[str, Any]]) -> dict[str, str]:
+    """Archive path of each component's FMU (one file per distinct FMU and start values)."""
+    by_key: dict[tuple[str, str], str] = {}
     used: set[str] = set()
     out = {}
     for comp in system.scenario.components:
         iface = system.interfaces[comp.name]
-        if iface.sha256 in by_sha:
-            out[comp.name] = by_sha[iface.sha256]
+        key = (iface.sha256, json.dumps(baked.get(comp.name, {}), sort_keys=True, default=repr))
+        if key in by_key:
+            out[comp.name] = by_key[key]
             continue
         name = f"resources/{system.fmu_paths[comp.name].name}"
         if name in used:
             name = f"resources/{comp.name}_{system.fmu_paths[comp.name].name}"
         used.add(name)
-        by_sha[iface.sha256] = name
+        by_key[key] = name
         out[comp.name] = name
     return out
 
@@ -173,7 +213,8 @@ def system_structure(system: ResolvedSystem, initial_values: Mapping[str, float]
     sc = system.scenario
     sim = sc.simulation
     initial_values = dict(initial_values or {})
-    resources = _resource_names(system)
+    resources = _resource_names(system, baked_values(system, initial_values))
+    exported = component_values(system, initial_values)
     computed = computed_values(system)
     root = ET.Element(_q("ssd:SystemStructureDescription"), name=sc.name, version="1.0")
     sysel = ET.SubElement(root, _q("ssd:System"), name=sc.name)
@@ -214,11 +255,7 @@ def system_structure(system: ResolvedSystem, initial_values: Mapping[str, float]
             if unit:
                 units.setdefault(unit, iface.unit_definitions[unit])
             _connector(connectors, var_name, kind, var.type, unit)
-        values = dict(comp.parameters)
-        for key, value in initial_values.items():
-            ref = VariableRef.parse(key, "initial")
-            if ref.component == comp.name:
-                values[ref.variable] = value
+        values = exported[comp.name]
         if values:
             bindings = ET.SubElement(el, _q("ssd:ParameterBindings"))
             binding = ET.SubElement(bindings, _q("ssd:ParameterBinding"))
@@ -287,15 +324,28 @@ def export_ssp(system: ResolvedSystem, path: str | Path, initial_values: Mapping
         raise SspError(f"{path}: an SSP archive must have the extension .ssp")
     path.parent.mkdir(parents=True, exist_ok=True)
     tree = system_structure(system, initial_values)
-    resources = _resource_names(system)
+    baked = baked_values(system, initial_values)
+    resources = _resource_names(system, baked)
     tmp = path.with_name(path.name + ".tmp")
-    with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as zf:
-        zf.writestr(SSD_NAME, ET.tostring(tree.getroot(), encoding="UTF-8", xml_declaration=True))
-        written: set[str] = set()
-        for comp in system.scenario.components:
-            arc = resources[comp.name]
-            if arc not in written:
-                zf.write(system.fmu_paths[comp.name], arc, compress_type=zipfile.ZIP_STORED)
+    try:
+        with tempfile.TemporaryDirectory(prefix="dtcosim-ssp-") as staging, \
+                zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as zf:
+            zf.writestr(SSD_NAME, ET.tostring(tree.getroot(), encoding="UTF-8", xml_declaration=True))
+            written: set[str] = set()
+            for comp in system.scenario.components:
+                arc = resources[comp.name]
+                if arc in written:
+                    continue
+                source = system.fmu_paths[comp.name]
+                if comp.name in baked:
+                    try:
+                        source = write_with_start_values(source, Path(staging) / arc, baked[comp.name])
+                    except StartValueError as exc:
+                        raise SspError(f"components.{comp.name}: {exc}") from None
+                zf.write(source, arc, compress_type=zipfile.ZIP_STORED)
                 written.add(arc)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
     tmp.replace(path)
     return path

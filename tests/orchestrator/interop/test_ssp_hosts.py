@@ -4,9 +4,10 @@ The SSP is exported with a non-default wind seed (7), so the wind speed in the o
 hosts shows whether they applied it; the generator's initial speed in it is the value
 dtcosim's initialisation computed (not the FMU's default). libcosim applies the
 parameter sets without being told a name; ecos 0.7.2 applies a parameter set only
-when named (its ``init(parameterSet)``), so it is given ``dtcosim``, the name of every
-exported set. Both exchange values after all FMUs stepped (Jacobi), like
-``dtcosim run --algorithm jacobi``.
+when named (its ``init(parameterSet)``), and it runs the same system without one:
+the archived dtcosim FMUs are copies whose start values are the exported values
+(:mod:`fmus.start_values`). Both hosts exchange values after all FMUs stepped
+(Jacobi), like ``dtcosim run --algorithm jacobi``.
 """
 
 from __future__ import annotations
@@ -75,6 +76,24 @@ def exported(fmu_dir, tmp_path_factory):
     return ssp, exported_parameters(ssp), runs
 
 
+def test_archived_dtcosim_fmus_start_at_the_exported_values(exported):
+    """What a host that applies no parameter set reads: the copies' start values are the parameter set's."""
+    from fmpy import read_model_description
+
+    ssp, parameters, _ = exported
+    seen = {}
+    with zipfile.ZipFile(ssp) as zf:
+        root = etree.fromstring(zf.read("SystemStructure.ssd"))
+        for comp in root.iterfind(".//ssd:Component", NS):
+            zf.extract(comp.get("source"), ssp.parent / "unpacked")
+            md = read_model_description(str(ssp.parent / "unpacked" / comp.get("source")))
+            for v in md.modelVariables:
+                key = f"{comp.get('name')}.{v.name}"
+                if key in parameters:
+                    seen[key] = type(parameters[key])(v.start)
+    assert seen == parameters  # every exported value is its variable's start value (floats exactly)
+
+
 def assert_like_dtcosim(series: dict[str, np.ndarray], ours: dict[str, np.ndarray]) -> None:
     for name in RECORDED:
         reference = ours[name]
@@ -104,14 +123,15 @@ def test_libcosim_applies_every_parameter_and_matches_dtcosim_jacobi(exported):
     check_seed_and_initial_speed(lib.last, lib.values, parameters, runs)
 
 
-def test_ecos_applies_every_parameter_and_matches_dtcosim_jacobi(exported, tmp_path):
+@pytest.mark.parametrize("parameter_set", [None, PARAMETER_SET], ids=["no-set-named", "set-named"])
+def test_ecos_applies_every_parameter_and_matches_dtcosim_jacobi(exported, tmp_path, parameter_set):
     probe = subprocess.run([sys.executable, "-c", "import ecospy"], capture_output=True, text=True)
     if probe.returncode != 0:
         pytest.skip(f"ecospy does not load (it needs the system library libtbb12): {probe.stderr.strip()[-300:]}")
     ssp, parameters, runs = exported
     request = tmp_path / "request.json"
     request.write_text(json.dumps({"ssp": str(ssp), "step": STEP_S, "steps": round(STOP_S / STEP_S),
-                                   "parameter_set": PARAMETER_SET, "record": RECORDED, "parameters": parameters}))
+                                   "parameter_set": parameter_set, "record": RECORDED, "parameters": parameters}))
     out = tmp_path / "ecos.npz"
     proc = subprocess.run([sys.executable, str(DRIVERS / "ecos_ssp.py"), str(request), str(out)],
                           capture_output=True, text=True, timeout=600)

@@ -365,3 +365,22 @@ def test_other_tools_annotations_are_reported_and_ssd_folder_and_archive_read_al
     for other in (import_ssp(folder / "SystemStructure.ssd"), import_ssp(archive)):
         assert [c.name for c in other.components] == [c.name for c in from_folder.components]
         assert other.connections == from_folder.connections and other.simulation == from_folder.simulation
+
+
+def test_another_tools_fmu_is_archived_unchanged_and_named_as_needing_the_parameter_set(tmp_path):
+    import zipfile
+
+    from orchestrator.interop.ssp_export import export_ssp, unbaked_components
+
+    system = A_TO_B.format(
+        a=feedthrough("a", real("Float64_continuous_input", "input") + real("Float64_continuous_output", "output"),
+                      inline_values(("Float64_continuous_input", "Real", "5.0"))),
+        b=feedthrough("b", real("Float64_continuous_input", "input") + real("Float64_continuous_output", "output")),
+        transformation="")
+    resolved = resolve_system(import_ssp(write_ssp(tmp_path / "in", ssd(system))))
+    assert unbaked_components(resolved) == ["a"]  # b has no values; a's value lives in the parameter set only
+    out = export_ssp(resolved, tmp_path / "out.ssp")
+    with zipfile.ZipFile(out) as archive:
+        archived = {n for n in archive.namelist() if n.endswith(".fmu")}
+        assert len(archived) == 1  # both components share the unchanged file
+        assert archive.read(archived.pop()) == reference_fmu("Feedthrough").read_bytes()
