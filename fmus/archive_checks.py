@@ -46,7 +46,8 @@ def _platforms_in(names: set[str], model_identifier: str) -> tuple[str, ...]:
                         if f"binaries/{platform}/{model_identifier}{ext}" in names))
 
 
-def archive_problems(path: str | Path, model_identifier: str | None, generation_tool: str = "") -> list[str]:
+def archive_problems(path: str | Path, model_identifier: str | None, generation_tool: str = "",
+                     names: set[str] | None = None) -> list[str]:
     """What keeps the FMU at ``path`` from being loaded on this platform (empty: nothing found).
 
     Parameters
@@ -55,12 +56,15 @@ def archive_problems(path: str | Path, model_identifier: str | None, generation_
         The co-simulation model identifier (None: not a co-simulation FMU, no binary check).
     generation_tool : str
         The model description's ``generationTool`` (PythonFMU and dtcosim FMUs need their resources).
+    names : set of str, optional
+        The archive's member names, when the caller has read them already.
     """
-    try:
-        with zipfile.ZipFile(path) as archive:
-            names = set(archive.namelist())
-    except (zipfile.BadZipFile, OSError) as exc:
-        return [f"not a readable zip archive ({exc})"]
+    if names is None:
+        try:
+            with zipfile.ZipFile(path) as archive:
+                names = set(archive.namelist())
+        except (zipfile.BadZipFile, OSError) as exc:
+            return [f"not a readable zip archive ({exc})"]
     problems = []
     if model_identifier:
         binary = platform_binary(model_identifier)

@@ -56,30 +56,29 @@ def runtime_declaration_problems(fmu_path: Path | str) -> list[str]:
 
 
 
-def archive_problem(fmu_path: Path | str) -> str | None:
-    """Why the file cannot be an FMU archive at all (not a zip, no modelDescription.xml), or None."""
+def _member_names(fmu_path: Path | str) -> tuple[set[str], str | None]:
+    """The archive's member names, and why the file cannot be an FMU archive at all (or None)."""
     try:
         with zipfile.ZipFile(fmu_path) as archive:
             names = set(archive.namelist())
     except zipfile.BadZipFile as exc:
-        return f"not a zip archive, so not an FMU ({exc})"
+        return set(), f"not a zip archive, so not an FMU ({exc})"
     except OSError as exc:
-        return f"cannot be read ({exc})"
+        return set(), f"cannot be read ({exc})"
     if "modelDescription.xml" not in names:
-        return "the archive has no modelDescription.xml"
-    return None
+        return names, "the archive has no modelDescription.xml"
+    return names, None
 
 
 def is_dtcosim_fmu(fmu_path: Path | str) -> bool:
     """True for an FMU dtcosim built (it carries the record ``resources/dtcosim.json``)."""
-    with zipfile.ZipFile(fmu_path) as archive:
-        return RECORD_MEMBER in archive.namelist()
+    return RECORD_MEMBER in _member_names(fmu_path)[0]
 
 
 def check_fmu(fmu_path: Path | str) -> list[str]:
     """All problems of one FMU (empty if it is valid): a readable archive this platform can load, fmpy's validation,
     and dtcosim's conventions for its own FMUs."""
-    problem = archive_problem(fmu_path)
+    names, problem = _member_names(fmu_path)
     if problem is not None:
         return [problem]
     try:
@@ -90,8 +89,8 @@ def check_fmu(fmu_path: Path | str) -> list[str]:
         return list(problems)
     md = read_model_description(str(fmu_path), validate=False)
     identifier = md.coSimulation.modelIdentifier if md.coSimulation is not None else None
-    problems = archive_problems(fmu_path, identifier, md.generationTool or "")
-    return problems + (convention_problems(fmu_path) if is_dtcosim_fmu(fmu_path) else [])
+    problems = archive_problems(fmu_path, identifier, md.generationTool or "", names)
+    return problems + (convention_problems(fmu_path) if RECORD_MEMBER in names else [])
 
 
 def fmu_files(paths: Iterable[Path | str]) -> list[Path]:

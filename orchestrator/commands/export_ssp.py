@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 from . import scenario_options
+from .fmu_options import add_fmu_arguments
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -27,8 +28,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("scenario", nargs="?", default=None, metavar="SCENARIO",
                    help="scenario TOML/SSP file or packaged scenario name (default: paper-60s)")
     p.add_argument("--out", type=Path, required=True, metavar="FILE.ssp", help="output archive")
-    p.add_argument("--fmu-dir", type=Path, default=None, help="directory searched for FMUs after the scenario's own")
-    p.add_argument("--no-build", action="store_true", help="do not build missing FMUs (fail instead)")
+    add_fmu_arguments(p)
     scenario_options.add_arguments(p)
     p.set_defaults(func=run)
 

@@ -14,6 +14,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from .cluster_options import add_cluster_arguments, check_cluster_arguments
+from .fmu_options import add_fmu_arguments
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -33,9 +34,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("set", metavar="SET", help="load-case set TOML file or packaged set name (e.g. paper-turbine)")
     add_cluster_arguments(p)
     p.add_argument("--out", type=Path, default=None, help="output directory (default: results/<set name>)")
-    p.add_argument("--fmu-dir", type=Path, default=None,
-                   help="directory searched for the base scenario's FMUs (default: $DTCOSIM_FMU_DIR or the project's fmus/)")
-    p.add_argument("--no-build", action="store_true", help="do not build missing project FMUs (fail instead)")
+    add_fmu_arguments(p, "the base scenario's")
     p.add_argument("--length", type=float, default=None, metavar="SECONDS",
                    help="override the analysed length of each run (runs.length; changes the run keys)")
     p.add_argument("--transient", type=float, default=None, metavar="SECONDS",

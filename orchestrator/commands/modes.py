@@ -24,6 +24,8 @@ from components.errors import ParameterError
 from components.model.presets import PRESETS, preset
 from components.units import rpm
 
+from .fmu_options import add_fmu_arguments
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``modes`` subcommand."""
@@ -47,8 +49,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="rotor speed of the operating point [rpm] (default: the scenario's omega0, the drivetrain file's, else 16)")
     p.add_argument("--torque-nm", type=float, default=None,
                    help="output (generator) counter torque [N m] (default: the scenario's or the preset's, 25400 for table6)")
-    p.add_argument("--fmu-dir", type=Path, default=None,
-                   help="with a scenario: directory searched for its FMUs (default: $DTCOSIM_FMU_DIR or the project's fmus/)")
+    add_fmu_arguments(p, "a scenario's", build=False)
     p.add_argument("--out", default=None,
                    help="output directory (default: results/<scenario>/modes with a scenario, else results/modes)")
     p.add_argument("--load-law", choices=LOAD_LAWS, default="quadratic",

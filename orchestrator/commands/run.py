@@ -15,6 +15,7 @@ from pathlib import Path
 
 from ..inputs.results_format import RESULTS_FORMATS
 from . import scenario_options
+from .fmu_options import add_fmu_arguments
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -34,12 +35,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="output directory (default: results/<scenario name>, or results/<scenario name>-<id> "
                         "with --stop/--step/--output-interval/--algorithm/--extrapolation/--set; the files of a "
                         "previous run in it are replaced)")
-    p.add_argument("--fmu-dir", type=Path, default=None,
-                   help="directory searched for FMUs after the scenario's own (default: $DTCOSIM_FMU_DIR or the project's fmus/)")
+    add_fmu_arguments(p)
     p.add_argument("--compare-reference", action="store_true",
                    help="also run the monolithic reference solver on the same scenario and report every statistic of both")
     scenario_options.add_arguments(p)
-    p.add_argument("--no-build", action="store_true", help="do not build missing FMUs (fail instead)")
     p.add_argument("--check", action="store_true",
                    help="only check the scenario against the FMUs' model descriptions (nothing is instantiated) and exit")
     p.add_argument("--no-plots", action="store_true", help="do not write the PNG plots")

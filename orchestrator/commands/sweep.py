@@ -15,6 +15,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from .cluster_options import add_cluster_arguments, check_cluster_arguments
+from .fmu_options import add_fmu_arguments
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -32,9 +33,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("study", metavar="STUDY", help="study TOML file or packaged study name (e.g. paper-sensitivity)")
     add_cluster_arguments(p)
     p.add_argument("--out", type=Path, default=None, help="output directory (default: results/<study name>)")
-    p.add_argument("--fmu-dir", type=Path, default=None,
-                   help="directory searched for the base scenario's FMUs (default: $DTCOSIM_FMU_DIR or the project's fmus/)")
-    p.add_argument("--no-build", action="store_true", help="do not build missing project FMUs (fail instead)")
+    add_fmu_arguments(p, "the base scenario's")
     p.add_argument("--retry-failed", action="store_true",
                    help="run points whose journal record says 'failed' again (default: failures are final)")
     p.add_argument("--check", action="store_true", help="only validate the study against its base and print the plan")
