@@ -24,7 +24,9 @@ receiving FMU's output on the loop depends on *directly* (ModelStructure/Outputs
 ``dependencies``; an output without the attribute depends on all inputs). The
 variable graph has an edge for every connection (output -> input) and for every
 direct dependency inside an FMU (input -> output); any cycle in it is an
-algebraic loop that a non-iterative fixed-step master cannot resolve.
+algebraic loop that a non-iterative fixed-step master cannot resolve; the master
+solves them by iteration when a scenario asks (:func:`algebraic_loop_groups`,
+:mod:`orchestrator.cosim.algebraic_loops`).
 """
 
 from __future__ import annotations
@@ -196,3 +198,29 @@ def find_algebraic_loop(
             seen[node] = len(path)
             path.append(node)
     return None
+
+
+def algebraic_loop_groups(
+    connections: Iterable[tuple[str, str]],
+    feedthrough: Mapping[str, Iterable[str]],
+) -> list[list[str]]:
+    """The variables of each set of intertwined algebraic loops (a strongly connected part of the variable graph).
+
+    Parameters
+    ----------
+    connections, feedthrough
+        As for :func:`find_algebraic_loop`.
+
+    Returns
+    -------
+    list of list of str
+        One sorted list of ``"comp.var"`` names per group (empty: no algebraic loop).
+    """
+    edges: dict[str, list[str]] = {}
+    for out, inp in connections:
+        edges.setdefault(out, []).append(inp)
+    for inp, outs in feedthrough.items():
+        edges.setdefault(inp, []).extend(outs)
+    nodes = sorted(set(edges) | {v for vs in edges.values() for v in vs})
+    return [sorted(scc) for scc in strongly_connected(nodes, edges)
+            if len(scc) > 1 or scc[0] in edges.get(scc[0], ())]

@@ -99,12 +99,13 @@ import math
 import time
 from ctypes import c_double
 from dataclasses import dataclass, field
-from typing import Callable, Protocol
+from typing import Callable, Protocol, Sequence
 
 import numpy as np
 
 from ..atomic_files import describe_os_error
 from ..errors import FmuStepError, InitializationError
+from .algebraic_loops import LoopNotConverged, LoopSolver, loop_groups
 from .fmi_runtime import FmuInstance, value_references
 from .stop_requests import StopRequests
 from .system import RecordedVariable, ResolvedSystem
@@ -348,6 +349,8 @@ class CoSimulation:
                 block = np.full((BLOCK_STEPS // stride + 2, n_cols), np.nan)
                 ring = np.full((3, n_cols), np.nan)
             text = TextStore(n_rows, n_text)
+            timers = np.zeros((len(slots), 3)) if self.profile else None
+            advance = self._step_loop(slots, stride, block, ring, timers, text)
             # row 0: every output at t0, after initialisation
             first = np.full(n_cols, np.nan)
             for s in slots:
@@ -356,14 +359,17 @@ class CoSimulation:
                     first[s.col0:s.col0 + len(values)] = values
                 if s.ports is not None:
                     s.ports.read_initial(first, text, sim.start_s)
+            solver = getattr(advance, "loop_solver", None)
+            if solver is not None:  # the algebraic loops at t0
+                try:
+                    solver.solve(first, 0, sim.start_s)
+                except LoopNotConverged as exc:
+                    raise InitializationError(str(exc)) from None
             ring[:] = first
             text_columns = {j: col for j, col in enumerate(self._text_columns(slots)) if col >= 0}
             rows = _Rows(sim.start_s, sim.step_s * stride, order, n_rows if keep_values else 0, sink,
                          text=text, text_columns=text_columns)
             error = rows.deliver(first[None, :])
-            timers = np.zeros((len(slots), 3)) if self.profile else None
-            make_loop = compile_step_loop if self.step_loop == "generated" else interpreted_step_loop
-            advance = make_loop(slots, sim.algorithm, sim.extrapolation, stride, block, ring, timers, text=text)
             loop0 = time.perf_counter()
             loop_cpu0 = time.process_time()
             deadline = wall0 + wall_time_limit_s if wall_time_limit_s else math.inf
@@ -402,6 +408,19 @@ class CoSimulation:
             text={self.system.recorded[j].column: text.rows[:kept, col].copy() for j, col in text_columns.items()},
             ended_by=None if self._ended is None else self._ended[0],
         )
+
+    def _step_loop(self, slots, stride, block, ring, timers, text) -> Callable:
+        """The stepping loop: generated, or interpreted (also whenever algebraic loops are iterated)."""
+        sim = self.settings
+        loops = self.system.algebraic_loops
+        if loops:
+            if timers is not None:
+                raise ValueError("profiling times the generated step loop, which does not iterate algebraic loops")
+            return interpreted_step_loop(slots, sim.algorithm, sim.extrapolation, stride, block, ring, text=text,
+                                         loops=loops, loop_tolerance=sim.loop_tolerance,
+                                         loop_max_iterations=sim.loop_max_iterations)
+        make_loop = compile_step_loop if self.step_loop == "generated" else interpreted_step_loop
+        return make_loop(slots, sim.algorithm, sim.extrapolation, stride, block, ring, timers, text=text)
 
     def _text_columns(self, slots: list[_Slot]) -> list[int]:
         """TextStore column of each recorded variable in ``system.recorded`` order (only String ones: -1 for others)."""
@@ -455,6 +474,11 @@ class CoSimulation:
             incoming[dst.component].append((src, dst, transform))
         last: dict[str, float] = {}
         max_sweeps = len(self.system.init_order) + EXTRA_INIT_SWEEPS
+        # iterated algebraic loops: converged within the loop tolerance (else: exactly), within their sweep limit
+        loops = bool(self.system.algebraic_loops)
+        tolerance = self.settings.loop_tolerance if loops else 0.0
+        if loops:
+            max_sweeps = max(max_sweeps, self.settings.loop_max_iterations)
         changed: list[str] = []
         for _ in range(max_sweeps):
             changed = []
@@ -471,7 +495,9 @@ class CoSimulation:
                     if isinstance(v, float) and not math.isfinite(v):
                         raise InitializationError(f"initialisation: {src} = {v!r} at t = {t0:g} s (needed by {dst})")
                     key = str(dst)
-                    if last.get(key) != v:
+                    previous = last.get(key)
+                    if previous != v and not (loops and isinstance(v, float) and isinstance(previous, float)
+                                              and abs(v - previous) <= tolerance * max(1.0, abs(v))):
                         changed.append(key)
                     last[key] = v
                     values[dst.variable] = v
@@ -479,8 +505,11 @@ class CoSimulation:
             if not changed:
                 break
         else:
+            hint = (" (simulation.loop_max_iterations; an algebraic loop converges only where its gain is below 1 in "
+                    "magnitude)") if loops else ""
             raise InitializationError(
-                f"initialisation did not reach a fixed point after {max_sweeps} sweeps; still changing: {', '.join(changed)}"
+                f"initialisation did not reach a fixed point after {max_sweeps} sweeps{hint}; still changing: "
+                f"{', '.join(changed)}"
             )
         for name in self.system.init_order:
             self.instances[name].exit_initialization(t0)
@@ -589,6 +618,8 @@ class CoSimulation:
                     k = advance(k, k_end, t0, H)
                 except _Stop as failed:
                     k, error = self._stopped(advance, slots, failed, k_start, t0, H)
+                except LoopNotConverged as diverged:  # samples up to t_k are kept
+                    k, error = diverged.k, str(diverged)
                 # the block's finished rows: samples at t_{k_start + 1} ... t_k
                 last_time_s = None
                 if direct:
@@ -855,7 +886,8 @@ def compile_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str, st
 
 def interpreted_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str, stride: int,
                           data: np.ndarray, ring: np.ndarray, timers: np.ndarray | None = None,
-                          text: TextStore | None = None) -> Callable:
+                          text: TextStore | None = None, loops: Sequence[Sequence[str]] = (),
+                          loop_tolerance: float = 1e-10, loop_max_iterations: int = 100) -> Callable:
     """The same stepping loop as :func:`compile_step_loop`, as plain Python over the slots (no generated code).
 
     It makes the same FMI calls with the same values in the same order, so its
@@ -868,6 +900,11 @@ def interpreted_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str
     ``slot`` returned ``fmi2Discard`` with ``fmi2Terminated`` at ``t_{k+1}``: it reads
     that FMU's outputs and steps the FMUs after it in the stepping order as usual
     (the master then samples row ``t_{k+1}``, also off the output grid). Returns ``k + 1``.
+
+    ``loops`` (the components of each algebraic loop, ``simulation.algebraic_loops =
+    "iterate"``): after all FMUs stepped to ``t_{k+1}``, ``advance.loop_solver``
+    (:class:`~orchestrator.cosim.algebraic_loops.LoopSolver`, None without loops) iterates
+    them on that row; the generated loop has no such sweeps.
     """
     if timers is not None:
         raise ValueError("profiling timers need the generated step loop")
@@ -893,6 +930,10 @@ def interpreted_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str
                      ctypes.addressof(s.out_vr), len(s.out_names), s.n_couple, s.col0 * ctypes.sizeof(c_double),
                      feeds, lin_feeds, before, after))
     base = ring.ctypes.data
+    solver = None
+    if loops:
+        names = [s.name for s in slots]
+        solver = LoopSolver(loop_groups(plan, loops, names), loops, loop_tolerance, loop_max_iterations, _Stop)
 
     def rows_of(k: int, k_start: int) -> tuple[int, int, int, int]:
         """(offset of t_{k+1}, t_k, t_{k-1} in ``flat``, the block's row offset c)."""
@@ -952,6 +993,8 @@ def interpreted_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str
             for entry in plan:
                 step_slot(entry, k, t, H, o1, o0, om, c)
                 read_slot(entry, k, entry[7] if (stride == 1 or sample) else entry[8], a1, c)  # all or coupling
+            if solver is not None:
+                solver.solve(flat[o1:o1 + n_cols], k, t + H)
             if not direct and sample:
                 data[(k + 1) // stride - r0] = ring[(k + 1) % 3]
         return k_end
@@ -964,7 +1007,10 @@ def interpreted_step_loop(slots: list[_Slot], algorithm: str, extrapolation: str
             if entry[0] > first:  # the FMUs after the one that ended: their usual step
                 step_slot(entry, k, t, H, o1, o0, om, c)
             read_slot(entry, k, entry[7], a1, c)
+        if solver is not None:
+            solver.solve(flat[o1:o1 + n_cols], k, t + H)
         return k + 1
 
     advance.finish_step = finish_step
+    advance.loop_solver = solver
     return advance

@@ -33,7 +33,7 @@ from ..inputs.scenario import Scenario, VariableRef
 from .event_slots import AssignedEvent, assign_events
 from .fmu_folder import default_fmu_dir
 from .fmu_interface import FmuInterface, FmuVariable, read_fmu_interface
-from .graph import find_algebraic_loop, initialization_order, stepping_order
+from .graph import algebraic_loop_groups, find_algebraic_loop, initialization_order, stepping_order
 from .parameter_checks import model_problem, value_problem
 from .roles import ComponentRole, declared_roles
 from .values import transformation_problem, type_mismatch
@@ -93,6 +93,9 @@ class ResolvedSystem:
         The scenario's load events with the component and slot that apply them.
     roles : mapping of str -> ComponentRole
         Declared role of each component that has one (its FMU's record or the scenario).
+    algebraic_loops : tuple of tuple of str
+        With ``simulation.algebraic_loops = "iterate"``: the components of each algebraic
+        loop, which the master solves by iteration (:mod:`orchestrator.cosim.algebraic_loops`).
     """
 
     scenario: Scenario
@@ -103,6 +106,7 @@ class ResolvedSystem:
     recorded: tuple[RecordedVariable, ...]
     events: tuple[AssignedEvent, ...] = ()
     roles: Mapping[str, ComponentRole] = field(default_factory=dict)
+    algebraic_loops: tuple[tuple[str, ...], ...] = ()
 
     def with_role(self, role: str) -> list[ComponentRole]:
         """The components declared with ``role``, in scenario order."""
@@ -279,9 +283,13 @@ def resolve_system(
     recorded = _resolve_record(scenario, interfaces)
 
     feedthrough = _feedthrough(scenario, interfaces)
-    loop = find_algebraic_loop(((str(c.source), str(c.target)) for c in scenario.connections), feedthrough)
+    links = [(str(c.source), str(c.target)) for c in scenario.connections]
+    loop = find_algebraic_loop(links, feedthrough)
+    loops: tuple[tuple[str, ...], ...] = ()
     if loop is not None:
-        raise AlgebraicLoopError(loop, src, _loop_hint(loop, interfaces))
+        if scenario.simulation.algebraic_loops != "iterate":
+            raise AlgebraicLoopError(loop, src, _loop_hint(loop, interfaces))
+        loops = _iterated_loops(scenario, interfaces, algebraic_loop_groups(links, feedthrough))
 
     names = scenario.component_names
     edges = [(c.source.component, c.target.component) for c in scenario.connections]
@@ -297,6 +305,7 @@ def resolve_system(
         recorded=recorded,
         events=events,
         roles=FrozenMap(declared_roles(scenario, interfaces)),
+        algebraic_loops=loops,
     )
     problem = model_problem(system)
     if problem is not None:
@@ -366,8 +375,31 @@ def _feedthrough(scenario: Scenario, interfaces: Mapping[str, FmuInterface]) -> 
     return feedthrough
 
 
+def _iterated_loops(scenario: Scenario, interfaces: Mapping[str, FmuInterface],
+                    groups: list[list[str]]) -> tuple[tuple[str, ...], ...]:
+    """The components of each algebraic loop the master iterates (in stepping order later); Real connections only.
+
+    Raises
+    ------
+    ScenarioError
+        ``connections[i]``: a connection on a loop between variables that are not Real
+        (the iteration compares numbers).
+    """
+    out = []
+    for group in groups:
+        members = set(group)
+        for i, c in enumerate(scenario.connections):
+            if str(c.source) in members and str(c.target) in members \
+                    and interfaces[c.target.component].variables[c.target.variable].type != "Real":
+                raise ScenarioError(f"connections[{i}]", str(c), "a Real connection: simulation.algebraic_loops = "
+                                    "\"iterate\" solves loops of Real variables only", scenario.source)
+        out.append(tuple(dict.fromkeys(name.partition(".")[0] for name in group)))
+    return tuple(out)
+
+
 def _loop_hint(cycle: list[str], interfaces: Mapping[str, FmuInterface]) -> str:
-    """How to state that an output on the loop does not feed through, for FMUs that do not say."""
+    """How to state that an output on the loop does not feed through, for FMUs that do not say, or to iterate."""
+    iterate = 'or, for a loop that is really there, let the master iterate it: [simulation] algebraic_loops = "iterate"'
     undeclared = []
     for name in cycle:
         comp, _, var = name.partition(".")
@@ -375,12 +407,12 @@ def _loop_hint(cycle: list[str], interfaces: Mapping[str, FmuInterface]) -> str:
         if var in iface.outputs and iface.output_dependencies.get(var) is None and name not in undeclared:
             undeclared.append(name)
     if not undeclared:
-        return ""
+        return iterate
     tables = "; ".join(f'[components.{n.partition(".")[0]}] no_feedthrough = ["{n.partition(".")[2]}"]'
                        for n in undeclared)
     return (f"{', '.join(undeclared)} {'has' if len(undeclared) == 1 else 'have'} no declared dependencies, which "
             f"FMI 2 reads as depending directly on every input; if an output does not, say so in the scenario: "
-            f"{tables}")
+            f"{tables}; {iterate}")
 
 
 def _resolve_record(scenario: Scenario, interfaces: Mapping[str, FmuInterface]) -> tuple[RecordedVariable, ...]:

@@ -21,6 +21,8 @@ MAX_SSP_RATIO            200             uncompressed / compressed size of one m
 MAX_RECORD_BYTES         256 MiB         a recorded series file (.outb, .out, .csv): read
                                          whole and decoded to float64 (an OpenFAST .outb
                                          grows 4x); 600 s of 100 channels at 80 Hz is 10 MB
+MAX_LOOP_ITERATIONS      10 000          fixed-point sweeps of an algebraic loop per
+                                         communication point
 =======================  ==============  ==================================================
 
 The number of harmonics of the wind (1 to 100 000) is a model limit:
@@ -38,3 +40,4 @@ MAX_SSP_MEMBERS = 10_000
 MAX_SSP_BYTES = 1 << 30
 MAX_SSP_RATIO = 200
 MAX_RECORD_BYTES = 256 << 20
+MAX_LOOP_ITERATIONS = 10_000

@@ -23,6 +23,9 @@ TOML format (units SI; see ``docs/orchestrator.md`` for the full reference)::
     algorithm = "gauss-seidel"            # or "jacobi"
     extrapolation = "hold"                # or "linear"
     order = ["wind", "gearbox", "generator"]  # optional stepping order
+    algebraic_loops = "refuse"            # or "iterate": solve direct-feedthrough loops by fixed-point iteration
+    loop_tolerance = 1e-10                # iteration stops when every loop input moves by <= tol x max(1, |u|)
+    loop_max_iterations = 100             # ... or fails the run at that communication point
 
     [components.gearbox]
     fmu = "Gearbox.fmu"                   # relative to the scenario file or the FMU directory
@@ -68,9 +71,9 @@ from ..frozen_map import FrozenMap
 from .analysis_settings import AnalysisSettings, AnalysisTable
 from .drivetrain_file import DrivetrainSpec, find_drivetrain, load_drivetrain_file
 from .files import find_input_file, packaged_files, read_toml
-from .limits import MIN_RELATIVE_STEP
+from .limits import MAX_LOOP_ITERATIONS, MIN_RELATIVE_STEP
 from .load_events import EventTable, ScenarioEvent, check_events_in_run
-from .master_options import ALGORITHMS, EXTRAPOLATIONS
+from .master_options import ALGEBRAIC_LOOPS, ALGORITHMS, EXTRAPOLATIONS
 from .results_format import RESULTS_FORMATS
 from .series_spec import SeriesSpec, SeriesTable, series_from_table
 from .schema import (
@@ -271,6 +274,15 @@ class SimulationSettings:
         :mod:`orchestrator.cosim.master`).
     order : tuple of str, optional
         Stepping order of the components; default from the connection graph.
+    algebraic_loops : {"refuse", "iterate"}
+        A cycle of direct-feedthrough dependencies is refused when the system is
+        checked, or solved at every communication point by fixed-point iteration
+        (:mod:`orchestrator.cosim.algebraic_loops`).
+    loop_tolerance : float
+        Convergence of that iteration: every loop input moves by at most
+        ``loop_tolerance * max(1, |u|)`` in the last sweep (> 0, < 1).
+    loop_max_iterations : int
+        Sweeps per communication point before the run fails there (>= 1).
     """
 
     stop_s: float
@@ -281,6 +293,9 @@ class SimulationSettings:
     algorithm: str = "gauss-seidel"
     extrapolation: str = "hold"
     order: tuple[str, ...] | None = None
+    algebraic_loops: str = "refuse"
+    loop_tolerance: float = 1e-10
+    loop_max_iterations: int = 100
 
     def __post_init__(self) -> None:
         for key, value in (("simulation.start", self.start_s), ("simulation.stop", self.stop_s), ("simulation.step", self.step_s)):
@@ -322,6 +337,15 @@ class SimulationSettings:
             raise ScenarioError("simulation.algorithm", self.algorithm, "one of " + ", ".join(ALGORITHMS))
         if self.extrapolation not in EXTRAPOLATIONS:
             raise ScenarioError("simulation.extrapolation", self.extrapolation, "one of " + ", ".join(EXTRAPOLATIONS))
+        if self.algebraic_loops not in ALGEBRAIC_LOOPS:
+            raise ScenarioError("simulation.algebraic_loops", self.algebraic_loops, "one of " + ", ".join(ALGEBRAIC_LOOPS))
+        if not is_number(self.loop_tolerance) or not 0.0 < float(self.loop_tolerance) < 1.0:
+            raise ScenarioError("simulation.loop_tolerance", self.loop_tolerance, "a number > 0 and < 1")
+        if isinstance(self.loop_max_iterations, bool) or not isinstance(self.loop_max_iterations, int) \
+                or not 1 <= self.loop_max_iterations <= MAX_LOOP_ITERATIONS:
+            raise ScenarioError("simulation.loop_max_iterations", self.loop_max_iterations,
+                                f"a whole number from 1 to {MAX_LOOP_ITERATIONS}")
+        object.__setattr__(self, "loop_tolerance", float(self.loop_tolerance))
         order = None if self.order is None else tuple(self.order)
         if order is not None and not all(isinstance(o, str) for o in order):
             raise ScenarioError("simulation.order", self.order, "a list of component names")
@@ -514,6 +538,9 @@ class _SimulationTable(Table):
     algorithm: Literal[ALGORITHMS] = "gauss-seidel"
     extrapolation: Literal[EXTRAPOLATIONS] = "hold"
     order: list[str] | None = Field(None, description="a list of component names")
+    algebraic_loops: Literal[ALGEBRAIC_LOOPS] = "refuse"
+    loop_tolerance: float = Field(1e-10, description="a number > 0 and < 1")
+    loop_max_iterations: int = Field(100, description="a whole number >= 1")
 
 
 class _ComponentTable(Table):
@@ -555,7 +582,9 @@ class ScenarioFile(Table):
 
 
 _SIM_FIELDS = {"start": "start_s", "stop": "stop_s", "step": "step_s", "output_interval": "output_interval_s",
-               "window": "window_s", "algorithm": "algorithm", "extrapolation": "extrapolation", "order": "order"}
+               "window": "window_s", "algorithm": "algorithm", "extrapolation": "extrapolation", "order": "order",
+               "algebraic_loops": "algebraic_loops", "loop_tolerance": "loop_tolerance",
+               "loop_max_iterations": "loop_max_iterations"}
 
 
 def _rekeyed(exc: ScenarioError, key: str | None, source: str | None) -> ScenarioError:

@@ -292,6 +292,10 @@ def system_structure(system: ResolvedSystem, initial_values: Mapping[str, float]
     )
     if sim.order:
         settings.set("order", " ".join(sim.order))
+    if sim.algebraic_loops != "refuse":
+        settings.set("algebraicLoops", sim.algebraic_loops)
+        settings.set("loopTolerance", _num(sim.loop_tolerance))
+        settings.set("loopMaxIterations", str(sim.loop_max_iterations))
     for b in sc.initial:
         ET.SubElement(dtc, _q("dtc:Initial"), source=str(b.source), target=str(b.target))
     for pattern in sc.record:

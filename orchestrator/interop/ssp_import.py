@@ -62,6 +62,7 @@ from .ssp_xml import (
     children,
     element_error,
     float_attr,
+    int_attr,
     parse,
     tag,
     unit_definitions,
@@ -168,6 +169,13 @@ def _dtcosim_settings(annotation, ssd: Path, source: str) -> tuple[dict, list, l
                     sim[attr] = el.get(attr)
             if el.get("order"):
                 sim["order"] = tuple(el.get("order").split())
+            if el.get("algebraicLoops"):
+                sim["algebraic_loops"] = el.get("algebraicLoops")
+            tolerance = float_attr(el, "loopTolerance", ssd)
+            if tolerance is not None:
+                sim["loop_tolerance"] = tolerance
+            if el.get("loopMaxIterations") is not None:
+                sim["loop_max_iterations"] = int_attr(el, "loopMaxIterations", ssd)
         elif name == "dtc:Initial":
             i = len(initial)
             initial.append(InitialBinding(VariableRef.parse(el.get("source"), f"initial[{i}].from", source),

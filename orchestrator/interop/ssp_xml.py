@@ -173,6 +173,17 @@ def float_attr(el, name: str, path: Path | str, default: float | None = None) ->
     return out
 
 
+def int_attr(el, name: str, path: Path | str, default: int | None = None) -> int | None:
+    """A whole-number attribute (xs:int spelling)."""
+    value = el.get(name)
+    if value is None:
+        return default
+    try:
+        return int(value.strip())
+    except ValueError:
+        raise element_error(el, path, f"attribute {name}={value!r} is not a whole number") from None
+
+
 def bool_text(value: str, el, path: Path | str) -> bool:
     text = value.strip()
     if text in ("true", "1"):

@@ -11,6 +11,7 @@ Toys
 ToySine        no inputs; outputs y = amplitude sin(2 pi f t) and t_seen (last doStep start)
 ToyIntegrator  input u; outputs x (x' = u, exact for held u), u_seen, t_seen; parameter x0
 ToyGain        input u; output y = gain u (direct feedthrough: no dependencies attribute)
+ToyAdder       inputs u1, u2; output y = gain u1 + u2 (direct feedthrough: no dependencies attribute)
 ToyMassA       mass on a wall spring, input force F; outputs x, v (exact step for held F)
 ToyMassB       mass coupled to A by a spring-damper, inputs xa, va; outputs F (force on A), x, v
 ToyFailer      output y = t; fails at t >= fail_at (mode 0: discard, 1: exception, 2: NaN output)
@@ -91,6 +92,22 @@ class ToyGain(Fmi2Slave):
         self.register_variable(Real("gain", causality=Fmi2Causality.parameter, variability=Fmi2Variability.tunable))
         self.register_variable(Real("u", causality=Fmi2Causality.input))
         self.register_variable(Real("y", causality=Fmi2Causality.output, getter=lambda: self.gain * self.u))
+    def do_step(self, t, h):
+        return True
+""",
+    "ToyAdder": """
+class ToyAdder(Fmi2Slave):
+    # y = gain * u1 + u2, computed when read (direct feedthrough; like pythonfmu 0.7, no declared dependencies)
+    def __init__(self, **kw):
+        super().__init__(**kw)
+        self.gain = 1.0
+        self.u1 = 0.0
+        self.u2 = 0.0
+        self.register_variable(Real("gain", causality=Fmi2Causality.parameter, variability=Fmi2Variability.tunable))
+        self.register_variable(Real("u1", causality=Fmi2Causality.input))
+        self.register_variable(Real("u2", causality=Fmi2Causality.input))
+        self.register_variable(Real("y", causality=Fmi2Causality.output,
+                                    getter=lambda: self.gain * self.u1 + self.u2))
     def do_step(self, t, h):
         return True
 """,
@@ -239,7 +256,7 @@ class ToyTyped(Fmi2Slave):
 }
 
 #: toys whose outputs depend directly on their inputs (no dependencies attribute added)
-FEEDTHROUGH = {"ToyGain", "ToyInit"}
+FEEDTHROUGH = {"ToyGain", "ToyAdder", "ToyInit"}
 
 UNITS = {("ToyMassA", "x"): "m", ("ToyMassA", "v"): "m/s", ("ToyMassB", "F"): "N"}
 

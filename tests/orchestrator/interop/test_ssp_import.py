@@ -20,73 +20,18 @@ from orchestrator.errors import ScenarioError, SspError
 from orchestrator.interop.ssp import import_ssp
 from tests.helpers.reference_fmus import reference_fmu
 from tests.helpers.scenarios import dtcosim
-
-SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"
-SSC = "http://ssp-standard.org/SSP1/SystemStructureCommon"
-SSV = "http://ssp-standard.org/SSP1/SystemStructureParameterValues"
-SSM = "http://ssp-standard.org/SSP1/SystemStructureParameterMapping"
-OSP_HTTPS = "https://opensimulationplatform.com/SSP/OSPAnnotations"
-OSP_HTTP = "http://opensimulationplatform.com/SSP/OSPAnnotations"
-
-
-def osp_experiment(step: float = 0.1, stop: float = 1.0, namespace: str = OSP_HTTPS) -> str:
-    return f"""
-  <ssd:DefaultExperiment startTime="0" stopTime="{stop}">
-    <ssd:Annotations>
-      <ssc:Annotation type="com.opensimulationplatform">
-        <osp:Algorithm xmlns:osp="{namespace}">
-          <osp:FixedStepAlgorithm baseStepSize="{step}"/>
-        </osp:Algorithm>
-      </ssc:Annotation>
-    </ssd:Annotations>
-  </ssd:DefaultExperiment>"""
-
-
-def ssd(system: str, experiment: str | None = None, extra: str = "") -> str:
-    return f"""<?xml version="1.0" encoding="UTF-8"?>
-<ssd:SystemStructureDescription xmlns:ssd="{SSD}" xmlns:ssc="{SSC}" xmlns:ssv="{SSV}" xmlns:ssm="{SSM}"
-    name="test" version="1.0">
-{system}
-{extra}
-{osp_experiment() if experiment is None else experiment}
-</ssd:SystemStructureDescription>
-"""
-
-
-def real(name: str, kind: str, unit: str = "") -> str:
-    unit_attr = f' unit="{unit}"' if unit else ""
-    return f'<ssd:Connector name="{name}" kind="{kind}"><ssc:Real{unit_attr}/></ssd:Connector>'
-
-
-def feedthrough(name: str, connectors: str, bindings: str = "") -> str:
-    return f"""
-    <ssd:Component name="{name}" source="resources/Feedthrough.fmu">
-      <ssd:Connectors>{connectors}</ssd:Connectors>{bindings}
-    </ssd:Component>"""
-
-
-def inline_values(*params: tuple[str, str, str], prefix: str = "") -> str:
-    body = "".join(f'<ssv:Parameter name="{n}"><ssv:{t} value="{v}"/></ssv:Parameter>' for n, t, v in params)
-    prefix_attr = f' prefix="{prefix}"' if prefix else ""
-    return f"""
-      <ssd:ParameterBindings>
-        <ssd:ParameterBinding{prefix_attr}>
-          <ssd:ParameterValues>
-            <ssv:ParameterSet version="1.0" name="set"><ssv:Parameters>{body}</ssv:Parameters></ssv:ParameterSet>
-          </ssd:ParameterValues>
-        </ssd:ParameterBinding>
-      </ssd:ParameterBindings>"""
-
-
-def write_ssp(folder: Path, text: str, files: dict[str, str] | None = None) -> Path:
-    (folder / "resources").mkdir(parents=True, exist_ok=True)
-    for name in ("Feedthrough", "Dahlquist"):
-        shutil.copy(reference_fmu(name), folder / "resources" / f"{name}.fmu")
-    (folder / "SystemStructure.ssd").write_text(text)
-    for name, content in (files or {}).items():
-        (folder / name).write_text(content)
-    return folder
-
+from tests.helpers.ssp_documents import (
+    OSP_HTTP,
+    SSC,
+    SSM,
+    SSV,
+    feedthrough,
+    inline_values,
+    osp_experiment,
+    real,
+    ssd,
+    write_ssp,
+)
 
 def run(folder: Path, **kwargs):
     outcome = CoSimulation(resolve_system(import_ssp(folder, **kwargs))).run(handle_sigint=False)
