@@ -22,7 +22,7 @@ from ..cosim.roles import GEARBOX, GENERATOR, WIND_SOURCE, ComponentRole
 from ..cosim.system import ResolvedSystem
 from ..plotting import RPM_PER_RAD_S, envelope, new_figure, new_grid, plot_envelope, save_figure
 from .derived import Skipped, generator_vs_ideal, single_role
-from .memory import release_memory
+from .memory import release_between_phases
 
 #: mesh kind (declared signal info) -> label and line style
 _MESH_STYLE = {"sun_planet": ("sun-planet", "-"), "ring_planet": ("ring-planet", "--"), "parallel": ("mesh", "-")}
@@ -211,7 +211,6 @@ def plot_run(system: ResolvedSystem, outcome: RunOutcome, out_dir: str | Path,
         written.append(plot_rotor_speed(outcome, rotor, window, out_dir / "rotor_speed.png", suffix))
     except Skipped as exc:
         skipped.append({"analysis": "plot:rotor_speed", "reason": str(exc)})
-    release_memory()  # a drawn figure is a reference cycle: its pixels go when the collector runs
     try:
         rotor = signal_column(WIND_SOURCE, "rotor_speed")
         gen = signal_column(GENERATOR, "generator_speed")
@@ -220,7 +219,8 @@ def plot_run(system: ResolvedSystem, outcome: RunOutcome, out_dir: str | Path,
                                             out_dir / "generator_speed.png", suffix))
     except Skipped as exc:
         skipped.append({"analysis": "plot:generator_speed", "reason": str(exc)})
-    release_memory()
+    # a drawn figure is a reference cycle: its pixels go when the collector runs, before the largest figure
+    release_between_phases(outcome.values.nbytes)
     try:
         p = plot_contact_forces(outcome, single_role(system, GEARBOX), window, out_dir / "contact_forces.png", suffix)
         if p is None:

@@ -23,7 +23,7 @@ from ..inputs.scenario import Scenario, load_scenario
 from .analyses import analyse_run
 from .comparison import compare, format_comparison, run_reference
 from .derived import Skipped, generator_vs_ideal
-from .memory import release_memory
+from .memory import release_between_phases
 from .plots import plot_run
 from .recorded import compare_recorded, plot_contact_loss_counts, plot_recorded
 from .results import build_summary, result_columns, results_writer
@@ -173,7 +173,6 @@ def run_scenario(system: ResolvedSystem, out_dir: str | Path, *, compare_referen
                 outcome = RunOutcome.empty(system.recorded, sim.start_s, str(exc), exc.stage, interrupted=True,
                                            stop_signal=stop.signal_name or signal_name(exc.signum))
             _finish_timeseries(writer, outcome, folder, problems)
-        release_memory()  # the FMUs' and the results file's buffers, before the analyses allocate theirs
         derived: dict[str, Any] = {}
         skipped: list[dict[str, str]] = []
         comparison = None
@@ -276,7 +275,7 @@ def _post_process(system, outcome, out, post: _PostProcessing, derived, skipped,
             derived["analysis_notes"] = analyses.notes
         skipped += analyses.skipped
         post.commit(analyses.files)
-        release_memory()  # the analyses' figures and temporaries, before the run plots
+        release_between_phases(outcome.values.nbytes)  # the analyses' figures and temporaries, before the plots
     if compare_reference and post.go("comparison"):
         if not outcome.complete:
             comparison = {"skipped": "the co-simulation did not complete"}

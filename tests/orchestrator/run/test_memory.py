@@ -27,3 +27,14 @@ def test_glibc_malloc_trim_is_found_on_linux():
     trim = memory._malloc_trim()
     assert trim is not None
     assert trim(0) in (0, 1)
+
+
+@pytest.mark.parametrize("held_bytes, released", [(0, False), (memory.LARGE_RUN_BYTES, False),
+                                                  (memory.LARGE_RUN_BYTES + 1, True)])
+def test_only_large_runs_pay_for_a_full_collection(held_bytes, released):
+    fig, (ax,) = new_figure()
+    gone = weakref.ref(fig)
+    del fig, ax
+    assert memory.release_between_phases(held_bytes) is released
+    if released:
+        assert gone() is None
