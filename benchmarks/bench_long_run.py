@@ -226,6 +226,7 @@ def phases_main(args) -> None:
     from orchestrator.cosim.system import resolve_system
     from orchestrator.run.analyses import analyse_run
     from orchestrator.run.derived import generator_vs_ideal
+    from orchestrator.run.memory import release_between_phases
     from orchestrator.run.plots import plot_run
     from orchestrator.cosim.master import BLOCK_STEPS
     from orchestrator.run.results import (
@@ -260,6 +261,7 @@ def phases_main(args) -> None:
         npy = phases.run("(comparison: np.save of the same samples)", np.save, out / "timeseries.npy", outcome.values)
         fig16 = phases.run("generator vs ideal", generator_vs_ideal, system, outcome)
         analyses = phases.run("analyses + their plots", analyse_run, system, outcome, out, plots=True)
+        release_between_phases(outcome.values.nbytes)  # as run_scenario does before the run plots
         plots = phases.run("run plots", plot_run, system, outcome, out)
 
         def summary():

@@ -128,11 +128,15 @@ def register_runtime_symbols() -> bool:
 
     That is all machine code loaded from the cache needs; numba's own cache load
     refreshes the whole compilation context first (every lowering registry imported
-    and installed, the runtime's LLVM module compiled). ``rtsys.initialize`` registers
-    the same symbols before compiling its module, so registering them twice is
-    harmless. Returns False (nothing done) if numba's internals are not as expected.
+    and installed, the runtime's LLVM module compiled), which registers these symbols
+    and, beyond them, only the hash secrets of ``numba.cpython.hashing`` (imported here
+    too: 0.5 MB; tested, since a symbol missing at load would abort the process in LLVM).
+    ``rtsys.initialize`` registers the same symbols before compiling its module, so
+    registering them twice is harmless. Returns False (nothing done) if numba's
+    internals are not as expected.
     """
     try:
+        import numba.cpython.hashing  # noqa: F401  optional requirement: the compiled gearbox kernel
         from numba.core.runtime import nrt  # optional requirement: the compiled gearbox kernel
 
         if not nrt.rtsys._init:

@@ -76,3 +76,29 @@ def test_a_fresh_process_runs_the_cached_kernel_without_numba_lowerings():
     assert got["disk_cache"] and (got["hits"], got["misses"]) == (1, 0), got
     assert got["lowerings"] == [], got
     assert got["difference"] < 1e-9, got
+
+
+_SYMBOLS = textwrap.dedent("""
+    import json
+    import llvmlite.binding as ll
+    registered = []
+    add_symbol = ll.add_symbol
+    ll.add_symbol = lambda name, address: (registered.append(name), add_symbol(name, address))[1]
+    from numba.core.registry import cpu_target
+    from components.model.numba_cache import register_runtime_symbols
+    context = cpu_target.target_context
+    start = len(registered)
+    assert register_runtime_symbols()
+    light = set(registered[start:])
+    context.refresh()  # what numba's own cache load does first
+    print(json.dumps({"light": sorted(light), "refresh": sorted(set(registered[start:]) - light)}))
+""")
+
+
+def test_the_light_load_registers_every_symbol_a_context_refresh_would():
+    """A symbol the cached machine code needs and nobody registered would abort the process in LLVM."""
+    proc = subprocess.run([sys.executable, "-c", _SYMBOLS], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    got = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert any(name.startswith("NRT_") for name in got["light"]), got
+    assert got["refresh"] == [], got
