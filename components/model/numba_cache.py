@@ -31,6 +31,7 @@ running machine code read from disk does not need (issue 14, ``bench_long_run.py
 from __future__ import annotations
 
 import hashlib
+import importlib
 import os
 import sys
 from pathlib import Path
@@ -136,8 +137,9 @@ def register_runtime_symbols() -> bool:
     internals are not as expected.
     """
     try:
-        import numba.cpython.hashing  # noqa: F401  optional requirement: the compiled gearbox kernel
         from numba.core.runtime import nrt  # optional requirement: the compiled gearbox kernel
+
+        importlib.import_module("numba.cpython.hashing")  # registers its hash secrets on import
 
         if not nrt.rtsys._init:
             for name, address in nrt._nrt.c_helpers.items():
