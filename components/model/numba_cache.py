@@ -24,7 +24,7 @@ compiled in memory once per process instead (correct, only slower to start).
 Loading from the cache is lighter than numba's own load (:func:`register_runtime_symbols`):
 numba refreshes its whole compilation context before every cache load, which imports
 and registers every numba implementation (array, list, dict, random, ... lowerings) and
-compiles its runtime's LLVM module, about 45 MB of resident memory and 0.5 s that
+compiles its runtime's LLVM module, about 45 MB of resident memory and 0.3 s that
 running machine code read from disk does not need (issue 14, ``bench_long_run.py``).
 """
 
