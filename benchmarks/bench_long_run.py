@@ -9,13 +9,16 @@ Two parts:
    process (``ru_maxrss``: everything, imports and the FMUs included) and the size of the
    results file, against the targets of issue 14: <= 10 s wall including writing results
    and plots, <= 150 MB peak memory, results file <= 60 MB.
-2. **Phases** (``--phases``): the phases of a run one by one in this process, per phase wall
+2. **Imports** (``--imports``): the peak resident memory of a fresh process that imports
+   one package (or loads the compiled gearbox kernel from its disk cache), the footprint
+   each brings into a run's process.
+3. **Phases** (``--phases``): the phases of a run one by one in this process, per phase wall
    and CPU time, the peak resident memory during the phase (Linux: ``VmHWM``, reset before
    each phase through ``/proc/self/clear_refs``) and the resident memory after it; the
    results written in chunks of 250 rows as a run streams them, in both formats.
 
 Run: ``python benchmarks/bench_long_run.py [--stop 600] [--step H] [--formats csv,parquet]
-[--kernels compiled,numpy] [--phases]``.
+[--kernels compiled,numpy] [--phases] [--imports]``.
 """
 
 from __future__ import annotations
@@ -144,6 +147,47 @@ def whole_runs_main(args) -> None:
                       f"file {x['results_mb'] / base['results_mb']:.2f}")
 
 
+#: what --imports loads, each in a fresh process: label -> Python statements
+IMPORTS = {
+    "python": "pass",
+    "numpy": "import numpy",
+    "scipy.linalg": "import scipy.linalg",
+    "fmpy": "import fmpy.fmi2",
+    "pydantic": "import pydantic",
+    "orchestrator.run.runner (the host side of a run)": "import orchestrator.run.runner",
+    "llvmlite.binding": "import llvmlite.binding",
+    "numba": "import numba",
+    "numba + the compiled gearbox kernel from its disk cache": (
+        "from components.model import compiled_kernel as k; k.ensure_compiled()"),
+    "numba + kernel, numba's own cache load (context refresh)": (
+        "from components.model import compiled_kernel as k; from numba.core.registry import cpu_target; "
+        "cpu_target.target_context.refresh(); k.ensure_compiled()"),
+    "pyarrow": "import pyarrow",
+    "pyarrow.parquet": "import pyarrow.parquet",
+    "matplotlib (Figure, Agg canvas)": (
+        "import matplotlib.figure, matplotlib.backends.backend_agg"),
+    "matplotlib.pyplot": "import matplotlib.pyplot",
+    "pandas": "import pandas",
+}
+
+
+def imports_main() -> None:
+    """Peak RSS of a fresh process per import: what each package costs a run's process."""
+    code = "import resource\n{}\nprint(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0)"
+    print("| import (fresh process) | peak RSS [MB] | over bare python [MB] |")
+    print("|---|---|---|")
+    bare_mb = None
+    for label, statement in IMPORTS.items():
+        proc = subprocess.run([sys.executable, "-c", code.format(statement)], capture_output=True, text=True)
+        if proc.returncode != 0:
+            print(f"| {label} | failed: {proc.stderr.strip().splitlines()[-1:]} | |")
+            continue
+        mb = float(proc.stdout.strip().splitlines()[-1])
+        bare_mb = mb if bare_mb is None else bare_mb
+        over = f"{mb - bare_mb:.0f}" if label != "python" else ""
+        print(f"| {label} | {mb:.0f} | {over} |", flush=True)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--stop", type=float, default=600.0, help="stop time [s] (default 600)")
@@ -152,10 +196,13 @@ def main() -> None:
     parser.add_argument("--formats", default="csv,parquet", help="results formats of the whole runs")
     parser.add_argument("--kernels", default="compiled,numpy", help="Gearbox kernels of the whole runs")
     parser.add_argument("--phases", action="store_true", help="time the phases of one run in this process instead")
+    parser.add_argument("--imports", action="store_true", help="peak RSS of a fresh process per import instead")
     parser.add_argument("--child", default=None, help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child:
         child_main(args)
+    elif args.imports:
+        imports_main()
     elif args.phases:
         phases_main(args)
     else:
@@ -179,6 +226,7 @@ def phases_main(args) -> None:
     from orchestrator.cosim.system import resolve_system
     from orchestrator.run.analyses import analyse_run
     from orchestrator.run.derived import generator_vs_ideal
+    from orchestrator.run.memory import release_between_phases
     from orchestrator.run.plots import plot_run
     from orchestrator.cosim.master import BLOCK_STEPS
     from orchestrator.run.results import (
@@ -213,6 +261,7 @@ def phases_main(args) -> None:
         npy = phases.run("(comparison: np.save of the same samples)", np.save, out / "timeseries.npy", outcome.values)
         fig16 = phases.run("generator vs ideal", generator_vs_ideal, system, outcome)
         analyses = phases.run("analyses + their plots", analyse_run, system, outcome, out, plots=True)
+        release_between_phases(outcome.values.nbytes)  # as run_scenario does before the run plots
         plots = phases.run("run plots", plot_run, system, outcome, out)
 
         def summary():

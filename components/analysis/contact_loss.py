@@ -122,21 +122,28 @@ def contact_loss_events(
     state = np.where(f >= thr, 1, np.where(f <= -thr, -1, 0))
     separations = flank_changes = 0
     longest = 0.0
-    k = 0
     n = f.size
+    # the samples after which the state changes: the walk below visits only those (state[k] is
+    # always the state it holds, so between two changes there is nothing to count)
+    changes = np.flatnonzero(state[1:] != state[:-1])
+
+    def next_change(i: int) -> int:
+        """The first k >= i with state[k + 1] != state[k] (n - 1: none)."""
+        c = int(np.searchsorted(changes, i))
+        return int(changes[c]) if c < changes.size else n - 1
+
+    k = 0
     # episodes that are under way at the first sample: not a separation
     if state[0] == 0:
-        j = k
-        while j < n and state[j] == 0:
-            j += 1
+        j = next_change(0) + 1  # the first sample outside the band (n: none)
         longest = max(longest, float(inside_time[: min(j, n - 1)].sum()))
         k = j
     previous = state[k] if k < n else 0
     while k < n - 1:
+        k = next_change(k)
+        if k >= n - 1:
+            break
         s_next = state[k + 1]
-        if s_next == previous:
-            k += 1
-            continue
         if s_next == -previous:  # jumped through the band between two samples
             separations += 1
             flank_changes += 1
@@ -144,10 +151,8 @@ def contact_loss_events(
             previous = s_next
             k += 1
             continue
-        # s_next == 0: an episode starts in interval k
-        j = k + 1
-        while j < n and state[j] == 0:
-            j += 1
+        # s_next == 0: an episode starts in interval k and lasts up to the next change
+        j = next_change(k + 1) + 1
         separations += 1
         longest = max(longest, float(inside_time[k : min(j, n - 1)].sum()))
         if j < n:

@@ -20,8 +20,9 @@ import numpy as np
 from ..cosim.master import RunOutcome
 from ..cosim.roles import GEARBOX, GENERATOR, WIND_SOURCE, ComponentRole
 from ..cosim.system import ResolvedSystem
-from ..plotting import RPM_PER_RAD_S, new_figure, new_grid, plot_envelope, save_figure
+from ..plotting import RPM_PER_RAD_S, envelope, new_figure, new_grid, plot_envelope, save_figure
 from .derived import Skipped, generator_vs_ideal, single_role
+from .memory import release_between_phases
 
 #: mesh kind (declared signal info) -> label and line style
 _MESH_STYLE = {"sun_planet": ("sun-planet", "-"), "ring_planet": ("ring-planet", "--"), "parallel": ("mesh", "-")}
@@ -111,12 +112,13 @@ def symmetric_groups(series: list[tuple[str, str, np.ndarray]]) -> list[tuple[st
     return groups
 
 
-def _scale_to_window(ax, t, curves, window) -> None:
+def _scale_to_window(ax, t, curves, window, divisor: float = 1.0) -> None:
+    """Axis limits to the window; ``curves`` are drawn divided by ``divisor`` (> 0)."""
     sel = (t >= window[0]) & (t <= window[1])
     if not sel.any():
         return
-    lo = min(float(np.nanmin(c[sel])) for c in curves)
-    hi = max(float(np.nanmax(c[sel])) for c in curves)
+    lo = min(float(np.nanmin(c[sel])) for c in curves) / divisor
+    hi = max(float(np.nanmax(c[sel])) for c in curves) / divisor
     pad = 0.08 * (hi - lo) if hi > lo else max(abs(hi), 1e-9) * 0.01
     ax.set_xlim(max(window[0], t[0]), min(window[1], t[-1]))
     ax.set_ylim(lo - pad, hi + pad)
@@ -137,7 +139,7 @@ def plot_contact_forces(outcome: RunOutcome, gearbox: ComponentRole, window, pat
         i = recorded.get(f"{gearbox.component}.{s.variable}")
         if i is not None:
             stages.setdefault(s.info.get("stage", ""), []).append(
-                (s.variable, s.info.get("mesh", "parallel"), outcome.values[:, i] / 1e3))
+                (s.variable, s.info.get("mesh", "parallel"), outcome.values[:, i]))  # [N], a view: no copy
     if not stages:
         return None
     names = list(stages)
@@ -154,9 +156,12 @@ def plot_contact_forces(outcome: RunOutcome, gearbox: ComponentRole, window, pat
             if same:
                 merged = True
                 text += " = " + ", ".join(v[v.rfind("["):] if v.endswith("]") else v for v in same)
+            # the envelope of the samples in N, drawn in kN (the same points as the envelope of y / 1e3)
+            te, ye = envelope(t, y)
+            ye = ye / 1e3
             for ax in (whole, zoom):
-                plot_envelope(ax, t, y, lw=0.7, ls=style, color=f"C{k % 10}", label=text if ax is zoom else None)
-        _scale_to_window(zoom, t, [y for _, _, y, _ in groups], window)
+                ax.plot(te, ye, lw=0.7, ls=style, color=f"C{k % 10}", label=text if ax is zoom else None)
+        _scale_to_window(zoom, t, [y for _, _, y, _ in groups], window, divisor=1e3)
         for ax in (whole, zoom):
             ax.set_ylabel("force [kN]")
             ax.grid(True, lw=0.3)
@@ -214,6 +219,8 @@ def plot_run(system: ResolvedSystem, outcome: RunOutcome, out_dir: str | Path,
                                             out_dir / "generator_speed.png", suffix))
     except Skipped as exc:
         skipped.append({"analysis": "plot:generator_speed", "reason": str(exc)})
+    # a drawn figure is a reference cycle: its pixels go when the collector runs, before the largest figure
+    release_between_phases(outcome.values.nbytes)
     try:
         p = plot_contact_forces(outcome, single_role(system, GEARBOX), window, out_dir / "contact_forces.png", suffix)
         if p is None:

@@ -23,6 +23,7 @@ from ..inputs.scenario import Scenario, load_scenario
 from .analyses import analyse_run
 from .comparison import compare, format_comparison, run_reference
 from .derived import Skipped, generator_vs_ideal
+from .memory import release_between_phases
 from .plots import plot_run
 from .recorded import compare_recorded, plot_contact_loss_counts, plot_recorded
 from .results import build_summary, result_columns, results_writer
@@ -274,6 +275,7 @@ def _post_process(system, outcome, out, post: _PostProcessing, derived, skipped,
             derived["analysis_notes"] = analyses.notes
         skipped += analyses.skipped
         post.commit(analyses.files)
+        release_between_phases(outcome.values.nbytes)  # the analyses' figures and temporaries, before the plots
     if compare_reference and post.go("comparison"):
         if not outcome.complete:
             comparison = {"skipped": "the co-simulation did not complete"}
