@@ -124,6 +124,10 @@ def enable_stable_cache(dispatchers, source_path: str | os.PathLike, module_name
         return False
 
 
+#: numba versions (major, minor) whose runtime symbols the light cache load was tested to register completely
+LIGHT_LOAD_TESTED = {("0", "68")}
+
+
 def register_runtime_symbols() -> bool:
     """Make the C helpers of numba's runtime (NRT) known to the JIT linker, without compiling anything.
 
@@ -134,9 +138,15 @@ def register_runtime_symbols() -> bool:
     too: 0.5 MB; tested, since a symbol missing at load would abort the process in LLVM).
     ``rtsys.initialize`` registers the same symbols before compiling its module, so
     registering them twice is harmless. Returns False (nothing done) if numba's
-    internals are not as expected.
+    internals are not as expected, or numba is not a version it was tested with
+    (:data:`LIGHT_LOAD_TESTED`): numba's own load then.
     """
     try:
+        import numba  # optional requirement: the compiled gearbox kernel
+
+        # only where tested: a symbol missing at load aborts inside LLVM instead of raising
+        if tuple(numba.__version__.split(".")[:2]) not in LIGHT_LOAD_TESTED:
+            return False
         from numba.core.runtime import nrt  # optional requirement: the compiled gearbox kernel
 
         importlib.import_module("numba.cpython.hashing")  # registers its hash secrets on import
