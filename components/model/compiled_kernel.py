@@ -31,9 +31,12 @@ from .numba_cache import enable_stable_cache
 K0, EXPONENT, DAMPING, LAMBDA, HALF_JT, IMPACT, DMAX, CMAX, DEEP = range(9)
 N_CONTACT_COLUMNS = 9
 
-# entries of the integrator/state vector ``istate``
-H_NEXT, ACCEPTED, REJECTED, JACOBIANS, AGE, HD, BASIS_VALID, ALPHA_OUT_MAX = range(8)
-N_ISTATE = 8
+# entries of the integrator/state vector ``istate``: step-size memory and counters, Jacobian age, the
+# ``h d`` of the active factorisation ``W^-1`` and of the other one kept (``HD_PREV``, -1: none), their
+# time-derivative-basis flags, which of the two slots is active, eq. 11's running maximum
+(H_NEXT, ACCEPTED, REJECTED, JACOBIANS, AGE, HD, BASIS_VALID, ALPHA_OUT_MAX, HD_PREV, BASIS_PREV_VALID,
+ ACTIVE) = range(11)
+N_ISTATE = 11
 
 # entries of the settings vector ``control``
 RTOL, ATOL_Q, ATOL_V, H_MIN, MAX_STEPS, JAC_MAX_AGE, OUT_KINEMATIC, OUT_RATE_INDEX = range(8)
@@ -329,7 +332,33 @@ def _stiffness_sensitivity(defl, factor, contact, sqrt_cfs, out):
 
 
 @njit(cache=False)
-def advance(y, t_end, alpha_shift, driver, port, angle0, k, istate, control, dq, dv, winv, w_basis, port_jac,
+def _use_factorisation(hd, dq, dv, winvs, istate):
+    """Make ``W^-1`` for ``hd`` the active one of the two kept (``winvs``: both stacked, (4n, 2n)).
+
+    ``Rosenbrock23._step`` with its one-entry cache: the slot not in use holds the factorisation
+    of the step size used before (same Jacobian), so a step that returns to it (the first step of
+    a communication step after a shortened last one) switches slots instead of factorising again.
+    Returns the active slot.
+    """
+    other = 1 - int(istate[ACTIVE])
+    n2 = 2 * dq.shape[0]
+    if hd == istate[HD_PREV]:
+        istate[HD_PREV] = istate[HD]
+        valid = istate[BASIS_VALID]
+        istate[BASIS_VALID] = istate[BASIS_PREV_VALID]
+        istate[BASIS_PREV_VALID] = valid
+    else:
+        istate[HD_PREV] = istate[HD]
+        istate[BASIS_PREV_VALID] = istate[BASIS_VALID]
+        _factor(hd, dq, dv, winvs[other * n2:(other + 1) * n2])
+        istate[BASIS_VALID] = 0.0
+    istate[HD] = hd
+    istate[ACTIVE] = float(other)
+    return other
+
+
+@njit(cache=False)
+def advance(y, t_end, alpha_shift, driver, port, angle0, k, istate, control, dq, dv, winvs, w_bases, port_jac,
             last_acc, last_force, last_defl, state, backup):
     """Integrate one communication step ``[0, t_end]`` (``Rosenbrock23.advance`` with ``_StepSystem``).
 
@@ -348,8 +377,9 @@ def advance(y, t_end, alpha_shift, driver, port, angle0, k, istate, control, dq,
         Step-size memory, counters, Jacobian age, factorised ``h d``, basis flag, eq. 11 maximum.
     control : ndarray
         Tolerances and output-member constants (see the module constants).
-    dq, dv, winv, w_basis, port_jac : ndarray
-        Jacobian blocks, ``W^-1``, ``W^-1`` applied to the time-derivative basis, port Jacobian rows.
+    dq, dv, winvs, w_bases, port_jac : ndarray
+        Jacobian blocks; the two kept ``W^-1`` (stacked, (4n, 2n); ``istate[ACTIVE]`` says which is in
+        use) and ``W^-1`` applied to the time-derivative basis for each (stacked, (4n, 3)); port Jacobian rows.
     last_acc, last_force, last_defl : ndarray
         Loads of the last evaluation (written at the end state on success).
     state, backup : ndarray
@@ -391,6 +421,9 @@ def advance(y, t_end, alpha_shift, driver, port, angle0, k, istate, control, dq,
     out_idx = int(control[OUT_RATE_INDEX])
     for i in range(m):
         factor[i] = 1.0
+    active = int(istate[ACTIVE])
+    winv = winvs[active * n2:(active + 1) * n2]
+    w_basis = w_bases[active * n2:(active + 1) * n2]
     t = 0.0
     h = istate[H_NEXT] if istate[H_NEXT] > 0.0 else t_end - t
     for i in range(n):
@@ -411,13 +444,14 @@ def advance(y, t_end, alpha_shift, driver, port, angle0, k, istate, control, dq,
                      k[8], k[9], k[10], k[11], k[12], k[13], k[14], dq, dv, port_jac)
             istate[AGE] = 0.0
             istate[HD] = -1.0
+            istate[HD_PREV] = -1.0
             istate[JACOBIANS] += 1.0
         # ---- one step (Rosenbrock23._step)
         hd = h * _D
         if hd != istate[HD]:
-            _factor(hd, dq, dv, winv)
-            istate[HD] = hd
-            istate[BASIS_VALID] = 0.0
+            active = _use_factorisation(hd, dq, dv, winvs, istate)
+            winv = winvs[active * n2:(active + 1) * n2]
+            w_basis = w_bases[active * n2:(active + 1) * n2]
         if not tvs:  # W^-1 [0, h d a_t] with a_t = [port speed, port accel, jerk] @ [pj0; pj1; -kappa]
             if istate[BASIS_VALID] == 0.0:
                 for i in range(n2):
@@ -534,6 +568,7 @@ def advance(y, t_end, alpha_shift, driver, port, angle0, k, istate, control, dq,
                      k[8], k[9], k[10], k[11], k[12], k[13], k[14], dq, dv, port_jac)
                 istate[AGE] = 0.0
                 istate[HD] = -1.0
+                istate[HD_PREV] = -1.0
                 istate[JACOBIANS] += 1.0
                 h *= max(0.5, min(1.0, 0.9 * err ** (-1.0 / 3.0))) if math.isfinite(err) else 0.1
                 prev_h = -1.0
@@ -699,8 +734,8 @@ def gearbox_step(buf, lay, dims, t, h, omega_rotor, phi_rotor, omega_gen, phi_ge
     speed_start = out_kin * sc[S_DRIVER_SPEED] + y[out_idx]
     status, tau, h_fail, err = advance(
         y, h, sc[S_LAST_ALPHA] - _hermite_accel(driver, 0.0), driver, port, sc[S_ANGLE0], _constants(buf, lay, dims),
-        _vec(buf, lay, ISTATE), control, _mat(buf, lay, DQ, n), _mat(buf, lay, DV, n), _mat(buf, lay, WINV, 2 * n),
-        _mat(buf, lay, W_BASIS, 2 * n), _mat(buf, lay, PORT_JAC, 2), _vec(buf, lay, LAST_ACC),
+        _vec(buf, lay, ISTATE), control, _mat(buf, lay, DQ, n), _mat(buf, lay, DV, n), _mat(buf, lay, WINV, 4 * n),
+        _mat(buf, lay, W_BASIS, 4 * n), _mat(buf, lay, PORT_JAC, 2), _vec(buf, lay, LAST_ACC),
         _vec(buf, lay, LAST_FORCE), _mat(buf, lay, LAST_DEFL, 2), buf[lay[STATE_FIRST]:lay[STATE_LAST + 1]],
         _vec(buf, lay, BACKUP),
     )
@@ -787,6 +822,13 @@ def monolithic_jacobian(y, factor, a_t, a_port, contact, defl, nz_index, nz_valu
             jac[n + i, n + j] = dv[i, j]
 
 
+def _step_signature() -> tuple:
+    from numba import types  # optional requirement: the compiled gearbox kernel
+
+    vector, index = types.float64[::1], types.int64[::1]
+    return (vector, index, index) + (types.float64,) * 6
+
+
 def ensure_compiled() -> None:
     """Compile (or load from the disk cache) the entry points for the argument types they are called with.
 
@@ -796,8 +838,22 @@ def ensure_compiled() -> None:
     from numba import types  # optional requirement: the compiled gearbox kernel
 
     vector, index = types.float64[::1], types.int64[::1]
-    gearbox_step.compile((vector, index, index) + (types.float64,) * 6)
+    gearbox_step.compile(_step_signature())
     outputs.compile((vector, index, index))
+
+
+def step_entry_point():
+    """:func:`gearbox_step` for its one signature, without the dispatcher's per-call type resolution.
+
+    The compiled overload's own entry point (numba's ``overloads[signature].entry_point``) takes
+    the same arguments (a float64 buffer, two int64 index arrays, six floats) and saves ~0.2 us
+    per call. Falls back to the dispatcher itself if that attribute is not there (numba internals).
+    """
+    ensure_compiled()
+    try:
+        return gearbox_step.overloads[_step_signature()].entry_point
+    except Exception:  # noqa: BLE001 - numba internals changed: the dispatcher is always correct
+        return gearbox_step
 
 
 DISPATCHERS = (_sign, contact_force, stiffness_factors, _hermite, _hermite_rate, _hermite_accel, deflections,
