@@ -296,6 +296,14 @@ def _factor(hd, dq, dv, winv):
 
 
 @njit(cache=False, inline=_INLINE)
+def _copy(src, dst):
+    """``dst[:] = src`` for two 1-D float arrays of one length, as a plain loop (numba's slice assignment
+    checks and broadcasts: 4 x slower for the ~1500 numbers of the state saved at every step)."""
+    for i in range(src.shape[0]):
+        dst[i] = src[i]
+
+
+@njit(cache=False, inline=_INLINE)
 def _matvec(w, x, out):
     n2 = x.shape[0]
     for i in range(n2):
@@ -414,7 +422,7 @@ def advance(y, t_end, alpha_shift, driver, port, angle0, k, istate, control, dq,
     w_hdt = k[32]
     da = k[33]
     # save the state for a failure
-    backup[:] = state
+    _copy(state, backup)
 
     rtol = control[RTOL]
     atol_q = control[ATOL_Q]
@@ -594,10 +602,10 @@ def advance(y, t_end, alpha_shift, driver, port, angle0, k, istate, control, dq,
                 h *= fac
             istate[H_NEXT] = h
             if h < h_min:
-                state[:] = backup
+                _copy(backup, state)
                 return STEP_TOO_SMALL, t, h, err
         if steps > max_steps:
-            state[:] = backup
+            _copy(backup, state)
             return TOO_MANY_STEPS, t, h, err
     return OK, t, h, 0.0
 
@@ -862,7 +870,7 @@ def step_entry_point():
 
 
 DISPATCHERS = (_sign, contact_force, stiffness_factors, _hermite, _hermite_rate, _hermite_accel, deflections,
-               acceleration, jacobian, _invert, _factor, _matvec, _stiffness_sensitivity, advance,
+               acceleration, jacobian, _invert, _factor, _copy, _matvec, _stiffness_sensitivity, advance,
                _vec, _mat, _fit, _constants, outputs, gearbox_step, monolithic_rhs,
                monolithic_jacobian)
 #: True when the machine code is cached on disk (see :mod:`components.model.numba_cache`)
