@@ -45,7 +45,8 @@ Per FMU and step the loop makes one ``fmi2SetReal`` (if the FMU has connected
 inputs), one ``fmi2DoStep`` and one ``fmi2GetReal`` that reads the coupling
 outputs and, on sampling steps, the recorded variables, calling the C functions
 through this project's own prototypes with pre-built value-reference arrays
-(:mod:`orchestrator.cosim.fmi_runtime`). ``fmi2GetReal`` writes straight into a
+(:mod:`orchestrator.cosim.fmi_runtime`; a PythonFMU's functions are called without
+releasing the GIL, which its wrapper would take back at once). ``fmi2GetReal`` writes straight into a
 block buffer of :data:`BLOCK_STEPS` + 2 rows (or, when not every step is sampled,
 into a three-row ring buffer copied into the block's sample rows on sampling
 steps), and the coupled inputs are read from there: no per-step Python objects,
