@@ -112,8 +112,10 @@ from .system import RecordedVariable, ResolvedSystem
 from .termination import discard_status
 from .values import TextStore, TypedPorts
 
-#: stepping-loop implementations (see :func:`compile_step_loop`)
-STEP_LOOPS = ("generated", "interpreted")
+#: stepping-loop implementations: ``auto`` (the compiled loop where it can run, else the generated one),
+#: ``numba`` (:mod:`orchestrator.cosim.compiled_loop`, an error where it cannot run), ``generated``
+#: (:func:`compile_step_loop`), ``interpreted`` (:func:`interpreted_step_loop`)
+STEP_LOOPS = ("auto", "numba", "generated", "interpreted")
 #: steps between checks for stop requests, progress updates and hand-overs of rows to the sink
 BLOCK_STEPS = 250
 #: maximum initialisation sweeps beyond the number of components
@@ -263,11 +265,15 @@ class CoSimulation:
         Checked scenario (settings: algorithm, extrapolation, step, times, recording).
     profile : bool
         Time every FMI call of the stepping loop per FMU (:attr:`RunOutcome.profile`).
-    step_loop : {"generated", "interpreted"}
-        :func:`compile_step_loop` (default) or its plain-Python reference :func:`interpreted_step_loop`.
+    step_loop : {"auto", "numba", "generated", "interpreted"}
+        ``auto`` (default): the compiled loop of :mod:`orchestrator.cosim.compiled_loop` where it can
+        run (numba installed, PythonFMUs with Real variables only, no profiling), else
+        :func:`compile_step_loop`; ``numba``: the compiled loop or a ValueError saying why not;
+        ``generated``; ``interpreted``: the plain-Python reference :func:`interpreted_step_loop`.
+        All make the same FMI calls with the same values.
     """
 
-    def __init__(self, system: ResolvedSystem, profile: bool = False, step_loop: str = "generated") -> None:
+    def __init__(self, system: ResolvedSystem, profile: bool = False, step_loop: str = "auto") -> None:
         if step_loop not in STEP_LOOPS:
             raise ValueError(f"step_loop {step_loop!r}: expected one of {', '.join(STEP_LOOPS)}")
         self.system = system
@@ -363,8 +369,7 @@ class CoSimulation:
                          text=text, text_columns=text_columns)
             error = rows.deliver(first[None, :])
             timers = np.zeros((len(slots), 3)) if self.profile else None
-            make_loop = compile_step_loop if self.step_loop == "generated" else interpreted_step_loop
-            advance = make_loop(slots, sim.algorithm, sim.extrapolation, stride, block, ring, timers, text=text)
+            advance = self._step_loop(slots, sim.algorithm, sim.extrapolation, stride, block, ring, timers, text)
             loop0 = time.perf_counter()
             loop_cpu0 = time.process_time()
             deadline = wall0 + wall_time_limit_s if wall_time_limit_s else math.inf
@@ -403,6 +408,22 @@ class CoSimulation:
             text={self.system.recorded[j].column: text.rows[:kept, col].copy() for j, col in text_columns.items()},
             ended_by=None if self._ended is None else self._ended[0],
         )
+
+    def _step_loop(self, slots, algorithm, extrapolation, stride, block, ring, timers, text) -> Callable:
+        """The ``advance`` function of :attr:`step_loop` for these slots."""
+        if self.step_loop in ("auto", "numba"):
+            from . import compiled_loop
+
+            reason = compiled_loop.unavailable_reason(slots, timers)
+            if reason is None:
+                finish = interpreted_step_loop(slots, algorithm, extrapolation, stride, block, ring,
+                                               text=text).finish_step
+                return compiled_loop.compiled_step_loop(slots, algorithm, extrapolation, stride, block, ring,
+                                                        _Stop, finish)
+            if self.step_loop == "numba":
+                raise ValueError(f"step_loop 'numba' cannot run this system: {reason}")
+        make_loop = interpreted_step_loop if self.step_loop == "interpreted" else compile_step_loop
+        return make_loop(slots, algorithm, extrapolation, stride, block, ring, timers, text=text)
 
     def _text_columns(self, slots: list[_Slot]) -> list[int]:
         """TextStore column of each recorded variable in ``system.recorded`` order (only String ones: -1 for others)."""
