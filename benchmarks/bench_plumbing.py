@@ -9,7 +9,9 @@ through fmpy + pythonfmu and the master's own work. Compared:
 2. a hand-written loop calling the raw FMI functions with pre-built arrays (the floor), with the
    GIL held over each call (as the master calls PythonFMUs) and released (ctypes' default);
 3. the dtcosim master (Gauss-Seidel/Jacobi, hold/linear), recording every step, with its
-   generated step loop and with the plain-Python reference loop (what the code generation saves).
+   generated step loop, with the plain-Python reference loop (what the code generation saves)
+   and, where numba imports, with the compiled loop (``orchestrator.cosim.compiled_loop``: no
+   Python and no ctypes conversion per call, so it can go below the "floor" of item 2).
 
 Run: ``python benchmarks/bench_plumbing.py [--steps N]``. Prints microseconds per
 communication step and the master's overhead above the floor.
@@ -214,6 +216,13 @@ def main() -> None:
     labels += [f"dtcosim master {alg}/{ex}" for alg, ex in variants]
     interpreted = [f"  same, interpreted loop {alg}/{ex}" for alg, ex in variants]
     labels += interpreted
+    try:
+        import numba  # noqa: F401 - optional: the compiled step loop
+    except ImportError:
+        compiled = []
+    else:
+        compiled = [f"  same, compiled loop {alg}/{ex}" for alg, ex in variants]
+    labels += compiled
     times: dict[str, list[float]] = {label: [] for label in labels}
     with tempfile.TemporaryDirectory(prefix="dtcosim-bench-") as tmp:
         folder = Path(tmp)
@@ -226,6 +235,8 @@ def main() -> None:
                 times[label].append(master_loop(folder, args.steps, alg, ex))
             for label, (alg, ex) in zip(interpreted, variants):
                 times[label].append(master_loop(folder, args.steps, alg, ex, "interpreted"))
+            for label, (alg, ex) in zip(compiled, variants):
+                times[label].append(master_loop(folder, args.steps, alg, ex, "numba"))
     median = {label: statistics.median(v) for label, v in times.items()}
     floor = median[labels[1]]
     print(f"three trivial pythonfmu FMUs, {args.steps} steps, median of {args.repeat} interleaved runs")
