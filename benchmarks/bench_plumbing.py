@@ -6,9 +6,12 @@ through fmpy + pythonfmu and the master's own work. Compared:
 
 1. fmpy's high-level API in a plain Gauss-Seidel loop (``setReal``/``doStep``/``getReal``
    with Python lists, 8 calls per step) - DESIGN.md's reference loop;
-2. a hand-written loop calling the raw FMI functions with pre-built arrays (the floor);
+2. a hand-written loop calling the raw FMI functions with pre-built arrays (the floor), with the
+   GIL held over each call (as the master calls PythonFMUs) and released (ctypes' default);
 3. the dtcosim master (Gauss-Seidel/Jacobi, hold/linear), recording every step, with its
-   generated step loop and with the plain-Python reference loop (what the code generation saves).
+   generated step loop, with the plain-Python reference loop (what the code generation saves)
+   and, where numba imports, with the compiled loop (``orchestrator.cosim.compiled_loop``: no
+   Python and no ctypes conversion per call, so it can go below the "floor" of item 2).
 
 Run: ``python benchmarks/bench_plumbing.py [--steps N]``. Prints microseconds per
 communication step and the master's overhead above the floor.
@@ -149,15 +152,19 @@ def high_level_loop(paths, steps: int, h: float = 1e-3) -> float:
     return dt
 
 
-def raw_loop(paths, steps: int, h: float = 1e-3) -> float:
+def raw_loop(paths, steps: int, h: float = 1e-3, hold_gil: bool = True) -> float:
     """Hand-written loop, same 8 FMI calls per step, C functions called with plain addresses; s/step.
 
-    The floor of the plumbing: nothing but the FMI round trips (no recording).
+    The floor of the plumbing: nothing but the FMI round trips (no recording). ``hold_gil``:
+    the prototypes the master uses for PythonFMUs (the GIL stays held over the call); False:
+    the GIL-releasing prototypes (what the master used before, and uses for FMUs of other tools).
     """
     from ctypes import addressof, c_void_p, cast
 
-    from orchestrator.cosim.fmi_runtime import DO_STEP, REAL_VALUES
+    from orchestrator.cosim import fmi_runtime
 
+    DO_STEP, REAL_VALUES = ((fmi_runtime.DO_STEP_HOLDING_GIL, fmi_runtime.REAL_VALUES_HOLDING_GIL) if hold_gil
+                            else (fmi_runtime.DO_STEP, fmi_runtime.REAL_VALUES))
     fmus = _slaves(paths)
     c0, c1, c2 = (f.component for f in fmus)
     do0, do1, do2 = (DO_STEP(cast(f.dll.fmi2DoStep, c_void_p).value) for f in fmus)
@@ -203,11 +210,19 @@ def main() -> None:
     args = parser.parse_args()
     import statistics
 
-    labels = ["fmpy high-level loop (8 calls/step)", "raw FMI calls, plain addresses (floor)"]
+    labels = ["fmpy high-level loop (8 calls/step)", "raw FMI calls, plain addresses (floor)",
+              "  same, releasing the GIL per call"]
     variants = [(alg, ex) for alg in ("gauss-seidel", "jacobi") for ex in ("hold", "linear")]
     labels += [f"dtcosim master {alg}/{ex}" for alg, ex in variants]
     interpreted = [f"  same, interpreted loop {alg}/{ex}" for alg, ex in variants]
     labels += interpreted
+    try:
+        import numba  # noqa: F401 - optional: the compiled step loop
+    except ImportError:
+        compiled = []
+    else:
+        compiled = [f"  same, compiled loop {alg}/{ex}" for alg, ex in variants]
+    labels += compiled
     times: dict[str, list[float]] = {label: [] for label in labels}
     with tempfile.TemporaryDirectory(prefix="dtcosim-bench-") as tmp:
         folder = Path(tmp)
@@ -215,10 +230,13 @@ def main() -> None:
         for _ in range(args.repeat):  # interleaved, so machine noise hits every variant alike
             times[labels[0]].append(high_level_loop(paths, args.steps))
             times[labels[1]].append(raw_loop(paths, args.steps))
-            for label, (alg, ex) in zip(labels[2:], variants):
+            times[labels[2]].append(raw_loop(paths, args.steps, hold_gil=False))
+            for label, (alg, ex) in zip(labels[3:], variants):
                 times[label].append(master_loop(folder, args.steps, alg, ex))
             for label, (alg, ex) in zip(interpreted, variants):
                 times[label].append(master_loop(folder, args.steps, alg, ex, "interpreted"))
+            for label, (alg, ex) in zip(compiled, variants):
+                times[label].append(master_loop(folder, args.steps, alg, ex, "numba"))
     median = {label: statistics.median(v) for label, v in times.items()}
     floor = median[labels[1]]
     print(f"three trivial pythonfmu FMUs, {args.steps} steps, median of {args.repeat} interleaved runs")

@@ -79,8 +79,10 @@ def slot_shapes(n: int, m: int, n_shaft: int, module, width: int = 3) -> dict[st
         "stks_port": (n,), "stcs_port": (n,), "inv_m": (n,), "fd_w": (m,), "fv_w": (m,), "phasing": (7, m),
         "kappa": (n,), "force_rows": (m, n), "factor_w": (m,), "slope_w": (m,), "sens_w": (m,),
         **{name: (n2,) for name in ("f0", "f1", "fn", "k1", "k2", "k3", "y1", "yn", "rhs", "w_hdt")},
-        "da": (n,), "nz_index": (m, width), "nz_value": (m, width), "cos_alpha": (m,), "control": (8,), "istate": (module.N_ISTATE,), "dq": (n, n), "dv": (n, n), "winv": (n2, n2),
-        "w_basis": (n2, 3), "port_jac": (2, n), "last_acc": (n,), "last_force": (m,), "last_defl": (2, m),
+        "da": (n,), "nz_index": (m, width), "nz_value": (m, width), "cos_alpha": (m,), "control": (8,),
+        "istate": (module.N_ISTATE,), "dq": (n, n), "dv": (n, n),
+        "winv": (2, n2, n2), "w_basis": (2, n2, 3),  # the active W^-1 and the one kept (istate[ACTIVE])
+        "port_jac": (2, n), "last_acc": (n,), "last_force": (m,), "last_defl": (2, m),
         "y": (n2,), "driver": (4,), "port": (4,), "scalars": (len(module.SCALAR_NAMES),), "twist_q": (n2,),
         "output_matrix": (m + n2 + 4, n_linear), "outputs": (n_linear + 4,),
     }
@@ -143,6 +145,7 @@ class CompiledGearboxModel(GearboxModel):
         self._y_view = v["y"]
         self._outputs_view = v["outputs"]
         self._dims = np.zeros(6, dtype=np.int64)
+        self._kernel_step = module.step_entry_point()
         self._compiled_stale = True
 
     def _finish_allocation(self) -> None:
@@ -239,9 +242,12 @@ class CompiledGearboxModel(GearboxModel):
         ist[mod.AGE] = it._age
         ist[mod.HD] = it._hd
         ist[mod.BASIS_VALID] = 0.0
+        ist[mod.ACTIVE] = 0.0
+        ist[mod.HD_PREV] = -1.0  # the numpy side's kept factorisation is not carried over: formed again if needed
+        ist[mod.BASIS_PREV_VALID] = 0.0
         v["dq"][:] = it._dq
         v["dv"][:] = it._dv
-        v["winv"][:] = it._winv
+        v["winv"][0] = it._winv
         v["last_acc"][:] = sysm.last_acceleration
         v["last_force"][:] = sysm.last_force
         v["last_defl"][:] = sysm.last_deflection
@@ -270,9 +276,10 @@ class CompiledGearboxModel(GearboxModel):
         it._hd = float(ist[mod.HD])
         it._dq = v["dq"].copy()
         it._dv = v["dv"].copy()
-        it._winv = v["winv"].copy()
+        it._winv = v["winv"][int(ist[mod.ACTIVE])].copy()
         it._winv_v = np.ascontiguousarray(it._winv[:, self.assembly.n_dof:])
         it._w_basis = None
+        it._previous = None  # the kept factorisation stays in the buffer (formed again if the numpy side steps)
         sysm.last_acceleration = v["last_acc"].copy()
         sysm.last_force = v["last_force"].copy()
         sysm.last_deflection = v["last_defl"].copy()
@@ -283,16 +290,31 @@ class CompiledGearboxModel(GearboxModel):
 
     # ------------------------------------------------------------ stepping
     def step(self, t: float, h: float, omega_rotor: float, phi_rotor: float, omega_gen: float, phi_gen: float) -> None:
-        """Advance from ``t`` to ``t + h`` [s] (as :meth:`GearboxModel.step`, in the compiled kernel)."""
-        if not self.initialized:
-            self.initialize(t, omega_rotor, phi_rotor, omega_gen, phi_gen)
-        if not h > 0.0:
-            raise ParameterError("step_size", h, "> 0")
+        """Advance from ``t`` to ``t + h`` [s] (as :meth:`GearboxModel.step`, in the compiled kernel).
+
+        Hot path (every communication step): one check, one call of the kernel's compiled entry
+        point (:func:`~components.model.compiled_kernel.step_entry_point`), one status test. An
+        uninitialised model is always stale (:meth:`initialize` and :meth:`set_state` hand the state
+        to the numpy side), so the first test covers both.
+        """
         if self._compiled_stale:
+            if not self.initialized:
+                self.initialize(t, omega_rotor, phi_rotor, omega_gen, phi_gen)
+            if not h > 0.0:
+                raise ParameterError("step_size", h, "> 0")
             self._load_compiled()
+        elif not h > 0.0:
+            raise ParameterError("step_size", h, "> 0")
+        kb = self._kb
+        status, tau, h_fail, err = self._kernel_step(kb.buffer, kb.offsets, self._dims, t, h,
+                                                     omega_rotor, phi_rotor, omega_gen, phi_gen)
+        if status:  # OK is 0
+            self._step_failed(status, t, tau, h_fail, err, omega_rotor, phi_rotor, omega_gen, phi_gen)
+
+    def _step_failed(self, status: int, t: float, tau: float, h_fail: float, err: float, omega_rotor: float,
+                     phi_rotor: float, omega_gen: float, phi_gen: float) -> None:
+        """Raise the SolverError of a failed kernel step (the buffer is as it was at ``t``)."""
         mod = self._module
-        status, tau, h_fail, err = mod.gearbox_step(self._kb.buffer, self._kb.offsets, self._dims, t, h,
-                                                    omega_rotor, phi_rotor, omega_gen, phi_gen)
         if status != mod.OK:
             c = self._integrator.control
             if status == mod.NON_FINITE_INPUT:

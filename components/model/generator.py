@@ -159,9 +159,9 @@ class TorqueSchedule:
 
     def integrals(self, t0: float, t1: float) -> tuple[float, float]:
         """``(int_t0^t1 T dt, int_t0^t1 (t1 - s) T(s) ds)`` [N m s, N m s^2], exact."""
-        if len(self.values) == 1:
+        if len(self._value_list) == 1:  # no events (every communication step: plain floats)
             h = t1 - t0
-            v = float(self.values[0])
+            v = self._value_list[0]
             return v * h, 0.5 * v * h * h
         impulse = 0.0
         moment = 0.0

@@ -263,7 +263,7 @@ class PhasorStepper:
 
     def __init__(self, process: RotorSpeedProcess) -> None:
         self.process = process
-        self._w = process.amplitudes_rad_s.astype(complex)  # complex copies: z @ w is one BLAS call
+        self._w = process.amplitudes_rad_s.astype(complex)  # complex copies: z . w is one BLAS call
         self._w_over_f = process._w_over_f.astype(complex)
         self._offset = process._angle_offset
         self._w0 = process.params.mean_speed_rad_s
@@ -283,8 +283,9 @@ class PhasorStepper:
     def advance(self, t: float, h: float) -> None:
         """Move the phasors from ``t`` to ``t + h`` [s] (closed form if ``t`` is not where they are)."""
         t1 = t + h
+        steps = self.steps_since_anchor + 1
         # a master computing t = n h instead of summing may differ from time_s in the last bits: same point
-        if abs(t - self.time_s) > 1e-12 * max(1.0, abs(t)) or self.steps_since_anchor + 1 >= self.REANCHOR_STEPS:
+        if abs(t - self.time_s) > 1e-12 * (t if t > 1.0 else -t if t < -1.0 else 1.0) or steps >= self.REANCHOR_STEPS:
             self.reset(t1)
             return
         if h != self._step_s:
@@ -292,13 +293,18 @@ class PhasorStepper:
             self._step_s = h
         self._z *= self._rotation
         self.time_s = t1
-        self.steps_since_anchor += 1
+        self.steps_since_anchor = steps
 
     def speed_and_angle(self) -> tuple[float, float]:
-        """Speed [rad/s] and angle [rad] at the current time."""
+        """Speed [rad/s] and angle [rad] at the current time.
+
+        Two dot products (one BLAS call each; one matrix product for both would sum in another
+        order and change the last bits of the signal), taken to Python numbers at once.
+        """
         z = self._z
-        return (float(self._w0 + (z @ self._w).real),
-                float(self._w0 * self.time_s + ((z @ self._w_over_f).imag - self._offset)))
+        speed_sum = complex(z.dot(self._w))
+        angle_sum = complex(z.dot(self._w_over_f))
+        return (self._w0 + speed_sum.real, self._w0 * self.time_s + (angle_sum.imag - self._offset))
 
     def get_state(self) -> dict:
         """Complete state (JSON-serialisable, exact float round trip)."""

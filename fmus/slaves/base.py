@@ -74,6 +74,7 @@ INSTANTIATED, INITIALIZATION, STEPPING, TERMINATED = "instantiated", "initializa
 STATE_FORMAT = 1
 
 _PYTHONFMU_TYPES = {REAL: Real, INTEGER: Integer, BOOLEAN: Boolean}
+_INF = math.inf
 
 
 @contextmanager
@@ -335,27 +336,43 @@ class DtcosimSlave(Fmi2Slave):
         self._stale = set(self._all_groups)
 
     def do_step(self, current_time: float, step_size: float) -> bool:
-        """One communication step; ``False`` (``fmi2Discard``) if the component could not take it."""
-        if self._phase != STEPPING:
-            self._report(f"doStep at t = {current_time:g} s called in phase {self._phase!r} (call exitInitializationMode first)")
-            return False
-        if not (math.isfinite(current_time) and math.isfinite(step_size) and step_size > 0.0):
-            self._report(f"doStep refused: communication point {current_time!r} s and step {step_size!r} s must be "
-                         "finite numbers, the step > 0; state kept")
-            return False
+        """One communication step; ``False`` (``fmi2Discard``) if the component could not take it.
+
+        Hot path (every communication step): one chained comparison checks the phase-independent
+        arguments (NaN fails every comparison), the eager groups are refreshed, and the stale set
+        is only rebuilt when the FMU has lazy groups.
+        """
+        if self._phase != STEPPING or not (-_INF < current_time < _INF and 0.0 < step_size < _INF):
+            return self._refuse_step(current_time, step_size)
         try:
             self._step(current_time, step_size)
         except Exception as exc:  # noqa: BLE001
-            if not (isinstance(exc, DtcosimError) or is_arithmetic_failure(exc)):
-                self._fail(f"doStep from t = {current_time:.9g} s", exc)
-            self._report(f"doStep from t = {current_time:.9g} s, h = {step_size:.3g} s failed: {plain_reason(exc)}; "
-                         "state kept at the start of the step")
-            return False
+            return self._step_failed(current_time, step_size, exc)
         self._time = current_time + step_size
         for group in self._eager_groups:
             self._refresh(group)
-        self._stale = set(self._lazy_groups)
+        if self._lazy_groups:
+            self._stale = set(self._lazy_groups)
+        elif self._stale:
+            self._stale = set()
         return True
+
+    def _refuse_step(self, current_time: float, step_size: float) -> bool:
+        """``doStep`` outside the stepping phase or with a time or step that is not a finite number (> 0)."""
+        if self._phase != STEPPING:
+            self._report(f"doStep at t = {current_time:g} s called in phase {self._phase!r} (call exitInitializationMode first)")
+        else:
+            self._report(f"doStep refused: communication point {current_time!r} s and step {step_size!r} s must be "
+                         "finite numbers, the step > 0; state kept")
+        return False
+
+    def _step_failed(self, current_time: float, step_size: float, exc: Exception) -> bool:
+        """A step that raised: a model failure is a discard (state kept), anything else reaches the host as fatal."""
+        if not (isinstance(exc, DtcosimError) or is_arithmetic_failure(exc)):
+            self._fail(f"doStep from t = {current_time:.9g} s", exc)
+        self._report(f"doStep from t = {current_time:.9g} s, h = {step_size:.3g} s failed: {plain_reason(exc)}; "
+                     "state kept at the start of the step")
+        return False
 
     def terminate(self) -> None:
         """Terminate the simulation run."""

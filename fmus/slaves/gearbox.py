@@ -20,6 +20,7 @@ e.g. ``omega_out = ratio * omega_rotor``.
 
 from __future__ import annotations
 
+from operator import itemgetter
 from typing import Any, Hashable, Iterable, Mapping
 
 from pythonfmu.enums import Fmi2Status
@@ -132,6 +133,7 @@ class Gearbox(DtcosimSlave):
         self._template = template_of(self.model)
         vr = self.vr
         self._vr_inputs = tuple(vr[n] for n in ("omega_rotor", "phi_rotor", "omega_gen", "phi_gen"))
+        self._inputs = itemgetter(*self._vr_inputs)  # values list -> the four inputs, in one C call
         names = GearboxModel(self._template).output_names
         self._vr_outputs = [vr[n] for n in names]
         first = self._vr_outputs[0]
@@ -161,12 +163,10 @@ class Gearbox(DtcosimSlave):
         self.model.initialize(start_time, *(values[i] for i in self._vr_inputs))
 
     def _step(self, time: float, step_size: float) -> None:
-        values = self._values
-        i = self._vr_inputs
-        self.model.step(time, step_size, values[i[0]], values[i[1]], values[i[2]], values[i[3]])
+        self.model.step(time, step_size, *self._inputs(self._values))
 
     def _refresh(self, group: Hashable) -> None:
-        out = self.model.output_list()
+        out = self.model.output_list()  # the compiled model: its kernel wrote them during the step
         if self._output_slice is not None:
             self._values[self._output_slice] = out
         else:

@@ -22,6 +22,7 @@ import tempfile
 from collections import deque
 from ctypes import (
     CFUNCTYPE,
+    PYFUNCTYPE,
     addressof,
     byref,
     c_double,
@@ -44,6 +45,30 @@ FMI_OK, FMI_WARNING, FMI_ERROR, FMI_FATAL = 0, 1, 3, 4
 DO_STEP = CFUNCTYPE(c_int, c_void_p, c_double, c_double, c_int)
 #: fmi2GetReal / fmi2SetReal(c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[])
 REAL_VALUES = CFUNCTYPE(c_int, c_void_p, c_void_p, c_size_t, c_void_p)
+#: the same prototypes called with the GIL held, for FMUs whose functions run Python in this
+#: interpreter (:func:`runs_python`): their wrapper takes the GIL on entry and releases it on
+#: return, so releasing it around the call only adds a hand-over each way (~0.3-0.5 us per call,
+#: eight calls per communication step in the paper system: ``benchmarks/bench_plumbing.py``)
+DO_STEP_HOLDING_GIL = PYFUNCTYPE(c_int, c_void_p, c_double, c_double, c_int)
+REAL_VALUES_HOLDING_GIL = PYFUNCTYPE(c_int, c_void_p, c_void_p, c_size_t, c_void_p)
+
+
+def runs_python(iface: FmuInterface) -> bool:
+    """True for a PythonFMU (dtcosim's FMUs among them): its FMI functions execute Python code in this process.
+
+    Such functions need the GIL themselves (pythonfmu's C++ wrapper calls
+    ``PyGILState_Ensure``), so the master calls them without releasing it
+    (:data:`DO_STEP_HOLDING_GIL`); FMUs of other tools (compiled C) are called
+    with the GIL released, so other Python threads keep running meanwhile.
+    """
+    return "pythonfmu" in iface.generation_tool.lower()
+
+
+def hot_prototypes(iface: FmuInterface) -> tuple:
+    """``(do_step prototype, get/set prototype)`` the master uses for this FMU (see :func:`runs_python`)."""
+    if runs_python(iface):
+        return DO_STEP_HOLDING_GIL, REAL_VALUES_HOLDING_GIL
+    return DO_STEP, REAL_VALUES
 
 _EXTRACTED: dict[str, Path] = {}
 #: log message lists of the live instances by instance name (see FmuInstance)
@@ -85,7 +110,8 @@ class FmuInstance:
         The ``fmi2Component`` handle (as an integer address).
     do_step, set_real, get_real : ctypes function
         The FMU's FMI functions with this module's prototypes (:data:`DO_STEP`,
-        :data:`REAL_VALUES`); call as ``do_step(component, t, h, 1)``,
+        :data:`REAL_VALUES`, or their GIL-holding twins for a PythonFMU: :func:`hot_prototypes`);
+        call as ``do_step(component, t, h, 1)``,
         ``set_real(component, address_of_vrs, n, address_of_values)``.
     log : collections.deque of str
         Last log messages, formatted ``"[status] category: message"``.
@@ -136,13 +162,14 @@ class FmuInstance:
         self._callbacks = cb
         self._logger = logger  # keep the ctypes callback alive
         dll = self.slave.dll  # fmpy's loaded shared library (public attribute)
-        self.do_step = DO_STEP(cast(getattr(dll, "fmi2DoStep"), c_void_p).value)
-        self.set_real = REAL_VALUES(cast(getattr(dll, "fmi2SetReal"), c_void_p).value)
-        self.get_real = REAL_VALUES(cast(getattr(dll, "fmi2GetReal"), c_void_p).value)
+        do_step_type, values_type = hot_prototypes(interface)
+        self.do_step = do_step_type(cast(getattr(dll, "fmi2DoStep"), c_void_p).value)
+        self.set_real = values_type(cast(getattr(dll, "fmi2SetReal"), c_void_p).value)
+        self.get_real = values_type(cast(getattr(dll, "fmi2GetReal"), c_void_p).value)
         #: fmi2Get/SetInteger, -Boolean, -String by FMI type (same argument layout: pointers to arrays)
-        self.typed_get = {typ: REAL_VALUES(cast(getattr(dll, f"fmi2Get{typ}"), c_void_p).value)
+        self.typed_get = {typ: values_type(cast(getattr(dll, f"fmi2Get{typ}"), c_void_p).value)
                           for typ in ("Integer", "Boolean", "String")}
-        self.typed_set = {typ: REAL_VALUES(cast(getattr(dll, f"fmi2Set{typ}"), c_void_p).value)
+        self.typed_set = {typ: values_type(cast(getattr(dll, f"fmi2Set{typ}"), c_void_p).value)
                           for typ in ("Integer", "Boolean", "String")}
         self.component: Any = None
 

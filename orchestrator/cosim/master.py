@@ -45,7 +45,8 @@ Per FMU and step the loop makes one ``fmi2SetReal`` (if the FMU has connected
 inputs), one ``fmi2DoStep`` and one ``fmi2GetReal`` that reads the coupling
 outputs and, on sampling steps, the recorded variables, calling the C functions
 through this project's own prototypes with pre-built value-reference arrays
-(:mod:`orchestrator.cosim.fmi_runtime`). ``fmi2GetReal`` writes straight into a
+(:mod:`orchestrator.cosim.fmi_runtime`; a PythonFMU's functions are called without
+releasing the GIL, which its wrapper would take back at once). ``fmi2GetReal`` writes straight into a
 block buffer of :data:`BLOCK_STEPS` + 2 rows (or, when not every step is sampled,
 into a three-row ring buffer copied into the block's sample rows on sampling
 steps), and the coupled inputs are read from there: no per-step Python objects,
@@ -112,8 +113,10 @@ from .system import RecordedVariable, ResolvedSystem
 from .termination import discard_status
 from .values import TextStore, TypedPorts
 
-#: stepping-loop implementations (see :func:`compile_step_loop`)
-STEP_LOOPS = ("generated", "interpreted")
+#: stepping-loop implementations: ``auto`` (the compiled loop where it can run, else the generated one),
+#: ``numba`` (:mod:`orchestrator.cosim.compiled_loop`, an error where it cannot run), ``generated``
+#: (:func:`compile_step_loop`), ``interpreted`` (:func:`interpreted_step_loop`)
+STEP_LOOPS = ("auto", "numba", "generated", "interpreted")
 #: steps between checks for stop requests, progress updates and hand-overs of rows to the sink
 BLOCK_STEPS = 250
 #: maximum initialisation sweeps beyond the number of components
@@ -263,11 +266,15 @@ class CoSimulation:
         Checked scenario (settings: algorithm, extrapolation, step, times, recording).
     profile : bool
         Time every FMI call of the stepping loop per FMU (:attr:`RunOutcome.profile`).
-    step_loop : {"generated", "interpreted"}
-        :func:`compile_step_loop` (default) or its plain-Python reference :func:`interpreted_step_loop`.
+    step_loop : {"auto", "numba", "generated", "interpreted"}
+        ``auto`` (default): the compiled loop of :mod:`orchestrator.cosim.compiled_loop` where it can
+        run (numba installed, PythonFMUs with Real variables only, no profiling), else
+        :func:`compile_step_loop`; ``numba``: the compiled loop or a ValueError saying why not;
+        ``generated``; ``interpreted``: the plain-Python reference :func:`interpreted_step_loop`.
+        All make the same FMI calls with the same values.
     """
 
-    def __init__(self, system: ResolvedSystem, profile: bool = False, step_loop: str = "generated") -> None:
+    def __init__(self, system: ResolvedSystem, profile: bool = False, step_loop: str = "auto") -> None:
         if step_loop not in STEP_LOOPS:
             raise ValueError(f"step_loop {step_loop!r}: expected one of {', '.join(STEP_LOOPS)}")
         self.system = system
@@ -410,17 +417,33 @@ class CoSimulation:
         )
 
     def _step_loop(self, slots, stride, block, ring, timers, text) -> Callable:
-        """The stepping loop: generated, or interpreted (also whenever algebraic loops are iterated)."""
+        """The ``advance`` function of :attr:`step_loop` for these slots (interpreted whenever algebraic loops are
+        iterated: only it has the sweeps)."""
         sim = self.settings
+        algorithm, extrapolation = sim.algorithm, sim.extrapolation
         loops = self.system.algebraic_loops
         if loops:
             if timers is not None:
                 raise ValueError("profiling times the generated step loop, which does not iterate algebraic loops")
-            return interpreted_step_loop(slots, sim.algorithm, sim.extrapolation, stride, block, ring, text=text,
+            if self.step_loop in ("numba", "generated"):
+                raise ValueError(f"step_loop {self.step_loop!r} cannot iterate algebraic loops (the interpreted "
+                                 f"loop does)")
+            return interpreted_step_loop(slots, algorithm, extrapolation, stride, block, ring, text=text,
                                          loops=loops, loop_tolerance=sim.loop_tolerance,
                                          loop_max_iterations=sim.loop_max_iterations)
-        make_loop = compile_step_loop if self.step_loop == "generated" else interpreted_step_loop
-        return make_loop(slots, sim.algorithm, sim.extrapolation, stride, block, ring, timers, text=text)
+        if self.step_loop in ("auto", "numba"):
+            from . import compiled_loop
+
+            reason = compiled_loop.unavailable_reason(slots, timers)
+            if reason is None:
+                finish = interpreted_step_loop(slots, algorithm, extrapolation, stride, block, ring,
+                                               text=text).finish_step
+                return compiled_loop.compiled_step_loop(slots, algorithm, extrapolation, stride, block, ring,
+                                                        _Stop, finish)
+            if self.step_loop == "numba":
+                raise ValueError(f"step_loop 'numba' cannot run this system: {reason}")
+        make_loop = interpreted_step_loop if self.step_loop == "interpreted" else compile_step_loop
+        return make_loop(slots, algorithm, extrapolation, stride, block, ring, timers, text=text)
 
     def _text_columns(self, slots: list[_Slot]) -> list[int]:
         """TextStore column of each recorded variable in ``system.recorded`` order (only String ones: -1 for others)."""

@@ -241,6 +241,29 @@ def test_the_generated_step_loop_equals_its_plain_python_reference(toy_scenario,
     np.testing.assert_array_equal(generated.values, reference.values)  # the same FMI calls with the same values
 
 
+@pytest.mark.parametrize("algorithm", ["gauss-seidel", "jacobi"])
+@pytest.mark.parametrize("extrapolation", ["hold", "linear"])
+@pytest.mark.parametrize("interval", [0.001, 0.003])
+def test_the_compiled_step_loop_equals_the_generated_one(toy_scenario, algorithm, extrapolation, interval):
+    pytest.importorskip("numba")
+    text = MASSES.format(step=1e-3, algorithm=algorithm).replace(
+        "output_interval = 0.02", f'output_interval = {interval}\nextrapolation = "{extrapolation}"')
+    system = resolve_system(load_scenario(toy_scenario(text)))
+    compiled = CoSimulation(system, step_loop="numba").run(handle_sigint=False)
+    generated = CoSimulation(system, step_loop="generated").run(handle_sigint=False)
+    assert compiled.complete and generated.complete and compiled.steps == generated.steps
+    np.testing.assert_array_equal(compiled.values, generated.values)  # the same FMI calls with the same values
+
+
+def test_the_compiled_step_loop_refuses_what_it_cannot_run(toy_scenario):
+    pytest.importorskip("numba")
+    system = resolve_system(load_scenario(toy_scenario(MASSES.format(step=1e-3, algorithm="jacobi"))))
+    with pytest.raises(ValueError, match="step_loop 'numba' cannot run this system: profiling timers"):
+        CoSimulation(system, profile=True, step_loop="numba").run(handle_sigint=False)
+    profiled = CoSimulation(system, profile=True).run(handle_sigint=False)  # auto: the generated loop times the calls
+    assert profiled.complete and profiled.profile is not None
+
+
 def test_an_unknown_step_loop_is_refused(toy_scenario):
     with pytest.raises(ValueError, match="step_loop 'compiled'"):
         CoSimulation(resolve_system(load_scenario(toy_scenario())), step_loop="compiled")
