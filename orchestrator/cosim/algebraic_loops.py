@@ -26,6 +26,7 @@ FMI 2 defines without a step.
 
 from __future__ import annotations
 
+import math
 from typing import Any, Sequence
 
 import numpy as np
@@ -77,9 +78,6 @@ class LoopSolver:
         self.tolerance = float(tolerance)
         self.max_iterations = int(max_iterations)
         self.stop = stop
-        #: sweeps of the last solve per loop, and the most any solve needed
-        self.last_sweeps = [0] * len(self.groups)
-        self.max_sweeps = [0] * len(self.groups)
 
     def solve(self, row: np.ndarray, k: int, t: float) -> None:
         """Iterate every loop at the communication point whose values are ``row`` (a contiguous float64 row).
@@ -94,15 +92,15 @@ class LoopSolver:
         tol, stop = self.tolerance, self.stop
         for g, group in enumerate(self.groups):
             moved = 0.0
-            for sweep in range(1, self.max_iterations + 1):
+            for _ in range(self.max_iterations):
                 moved = 0.0
                 for m in group:
                     buf = m.buf
                     for j, col, factor, offset in m.feeds:
                         u = factor * row[col] + offset
                         change = abs(u - buf[j]) / max(1.0, abs(u))
-                        if change > moved or change != change:  # NaN never converges
-                            moved = change if change == change else float("inf")
+                        if not change <= moved:  # also a NaN, which never converges
+                            moved = change if change == change else math.inf
                         buf[j] = u
                     inst = m.inst
                     if m.n_in:
@@ -120,8 +118,6 @@ class LoopSolver:
                                           f"{t:.6g} s: an input still moved by {moved:.3g} (relative) after "
                                           f"{self.max_iterations} sweeps (simulation.loop_max_iterations; the loop's "
                                           f"gain must be below 1 in magnitude for the iteration to converge)")
-            self.last_sweeps[g] = sweep
-            self.max_sweeps[g] = max(self.max_sweeps[g], sweep)
 
 
 def loop_groups(plan: Sequence[tuple], loops: Sequence[Sequence[str]], slot_names: Sequence[str]) -> list[list[tuple]]:

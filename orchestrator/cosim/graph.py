@@ -155,6 +155,23 @@ def initialization_order(components: Sequence[str], edges: Iterable[tuple[str, s
     return reverse
 
 
+def _variable_edges(connections: Iterable[tuple[str, str]],
+                    feedthrough: Mapping[str, Iterable[str]]) -> dict[str, list[str]]:
+    """The variable graph: output -> connected input, input -> the outputs that depend on it directly."""
+    edges: dict[str, list[str]] = {}
+    for out, inp in connections:
+        edges.setdefault(out, []).append(inp)
+    for inp, outs in feedthrough.items():
+        edges.setdefault(inp, []).extend(outs)
+    return edges
+
+
+def _cyclic_parts(edges: Mapping[str, list[str]]) -> list[list[str]]:
+    """The strongly connected parts of a graph that hold a cycle (more than one node, or a self-loop)."""
+    nodes = sorted(set(edges) | {v for vs in edges.values() for v in vs})
+    return [scc for scc in strongly_connected(nodes, edges) if len(scc) > 1 or scc[0] in edges.get(scc[0], ())]
+
+
 def find_algebraic_loop(
     connections: Iterable[tuple[str, str]],
     feedthrough: Mapping[str, Iterable[str]],
@@ -175,16 +192,9 @@ def find_algebraic_loop(
         The variables on one cycle, first repeated at the end
         (``["a.y", "b.u", "b.y", "a.u", "a.y"]``), or None if there is none.
     """
-    edges: dict[str, list[str]] = {}
-    for out, inp in connections:
-        edges.setdefault(out, []).append(inp)
-    for inp, outs in feedthrough.items():
-        edges.setdefault(inp, []).extend(outs)
-    nodes = sorted(set(edges) | {v for vs in edges.values() for v in vs})
-    for scc in strongly_connected(nodes, edges):
+    edges = _variable_edges(connections, feedthrough)
+    for scc in _cyclic_parts(edges):
         members = set(scc)
-        if len(scc) == 1 and scc[0] not in edges.get(scc[0], ()):
-            continue
         # walk inside the SCC until a node repeats: that is a cycle
         start = min(scc)
         path = [start]
@@ -216,11 +226,4 @@ def algebraic_loop_groups(
     list of list of str
         One sorted list of ``"comp.var"`` names per group (empty: no algebraic loop).
     """
-    edges: dict[str, list[str]] = {}
-    for out, inp in connections:
-        edges.setdefault(out, []).append(inp)
-    for inp, outs in feedthrough.items():
-        edges.setdefault(inp, []).extend(outs)
-    nodes = sorted(set(edges) | {v for vs in edges.values() for v in vs})
-    return [sorted(scc) for scc in strongly_connected(nodes, edges)
-            if len(scc) > 1 or scc[0] in edges.get(scc[0], ())]
+    return [sorted(scc) for scc in _cyclic_parts(_variable_edges(connections, feedthrough))]

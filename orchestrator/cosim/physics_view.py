@@ -104,50 +104,38 @@ def gearbox_drivetrain(system: ResolvedSystem, component: str) -> Drivetrain:
         raise PhysicsUnavailable(f"{component}: {exc}") from None
 
 
-def wind_parameters(system: ResolvedSystem, component: str) -> WindParameters:
-    """The rotor-speed process of a WindSource FMU's record with the component's effective parameter values."""
+def _from_record(system: ResolvedSystem, component: str, role_name: str, fmu: str, key: str, what: str,
+                 from_values):
+    """``from_values(effective values, record model[key])`` of a dtcosim FMU of ``role_name``, errors as PhysicsUnavailable."""
     role = system.roles.get(component)
-    if role is None or role.role != WIND_SOURCE or role.record is None:
-        raise PhysicsUnavailable(f"{component} is not a dtcosim WindSource FMU (it has no record of its wind model)")
+    if role is None or role.role != role_name or role.record is None:
+        raise PhysicsUnavailable(f"{component} is not a dtcosim {fmu} FMU (it has no record of its {what})")
     try:
-        return wind_from_values(_values(system, component), build(role.record["model"]["wind"], "model.wind"))
+        return from_values(_values(system, component), build(role.record["model"][key], f"model.{key}"))
     except ParameterError as exc:
         raise PhysicsUnavailable(f"{component}: {exc}") from None
+
+
+def wind_parameters(system: ResolvedSystem, component: str) -> WindParameters:
+    """The rotor-speed process of a WindSource FMU's record with the component's effective parameter values."""
+    return _from_record(system, component, WIND_SOURCE, "WindSource", "wind", "wind model", wind_from_values)
 
 
 def generator_parameters(system: ResolvedSystem, component: str) -> GeneratorParameters:
     """The generator of a GeneratorRotor FMU's record with the component's effective values (events included)."""
-    role = system.roles.get(component)
-    if role is None or role.role != GENERATOR or role.record is None:
-        raise PhysicsUnavailable(f"{component} is not a dtcosim GeneratorRotor FMU (it has no record of its generator)")
-    try:
-        return generator_from_values(_values(system, component),
-                                     build(role.record["model"]["generator"], "model.generator"))
-    except ParameterError as exc:
-        raise PhysicsUnavailable(f"{component}: {exc}") from None
+    return _from_record(system, component, GENERATOR, "GeneratorRotor", "generator", "generator",
+                        generator_from_values)
 
 
 def rotor_parameters(system: ResolvedSystem, component: str) -> RotorParameters:
     """The rotor (and main shaft) of a Rotor FMU's record with the component's effective parameter values."""
-    role = system.roles.get(component)
-    if role is None or role.role != ROTOR or role.record is None:
-        raise PhysicsUnavailable(f"{component} is not a dtcosim Rotor FMU (it has no record of its rotor)")
-    try:
-        return rotor_from_values(_values(system, component), build(role.record["model"]["rotor"], "model.rotor"))
-    except ParameterError as exc:
-        raise PhysicsUnavailable(f"{component}: {exc}") from None
+    return _from_record(system, component, ROTOR, "Rotor", "rotor", "rotor", rotor_from_values)
 
 
 def controller_parameters(system: ResolvedSystem, component: str) -> TorqueLawParameters:
     """The torque law of a TorqueController FMU's record with the component's effective parameter values."""
-    role = system.roles.get(component)
-    if role is None or role.role != TORQUE_CONTROLLER or role.record is None:
-        raise PhysicsUnavailable(f"{component} is not a dtcosim TorqueController FMU (it has no record of its law)")
-    try:
-        return controller_from_values(_values(system, component),
-                                      build(role.record["model"]["controller"], "model.controller"))
-    except ParameterError as exc:
-        raise PhysicsUnavailable(f"{component}: {exc}") from None
+    return _from_record(system, component, TORQUE_CONTROLLER, "TorqueController", "controller", "law",
+                        controller_from_values)
 
 
 def physics_view(system: ResolvedSystem) -> PhysicsView:

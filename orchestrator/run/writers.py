@@ -39,7 +39,7 @@ from typing import Protocol, Sequence
 import numpy as np
 
 from ..atomic_files import fsync_directory
-from ..columnar_files import TYPE_TAGS, header_field
+from ..columnar_files import header_field
 
 #: suffix of a results file while it is being written
 PARTIAL_SUFFIX = ".partial"

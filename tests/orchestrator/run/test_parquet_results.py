@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import errno
-
 import numpy as np
 import pytest
 
@@ -15,6 +13,7 @@ from orchestrator.result_files import find_timeseries, read_timeseries
 from orchestrator.run.parquet_writer import ParquetWriter
 from orchestrator.run.results import results_writer
 from orchestrator.run.writers import Column, CsvWriter
+from tests.helpers.failing_files import FillingDisk
 
 #: one column of every FMI 2.0 type, with and without units
 COLUMNS = [Column("gearbox.F_sp[1]", "N"), Column("gearbox.omega_out", "rad/s"), Column("fail.mode", "", "Integer"),
@@ -83,23 +82,6 @@ def test_the_partial_stream_reads_to_its_last_whole_batch_after_a_kill(tmp_path)
     np.testing.assert_array_equal(table.data[:, 0], np.arange(8) * 1e-3)
     header, rows = read_timeseries(writer.partial_path)
     assert rows.shape == (8, 7) and header[1] == "gearbox.F_sp[1] [N]"
-
-
-class FillingDisk:
-    """A file object that takes ``room`` more bytes, then fails like a full disk (after a partial write)."""
-
-    def __init__(self, fh, room: int) -> None:
-        self.fh, self.room = fh, room
-
-    def write(self, data) -> int:
-        if self.room <= 0:
-            raise OSError(errno.ENOSPC, "No space left on device")
-        n = self.fh.write(bytes(data[:self.room]))
-        self.room -= n
-        return n
-
-    def __getattr__(self, name):
-        return getattr(self.fh, name)
 
 
 def test_a_write_error_cuts_the_stream_back_to_the_last_whole_batch(tmp_path):

@@ -2,31 +2,13 @@
 
 from __future__ import annotations
 
-import errno
-
 import numpy as np
 import pytest
 
 from orchestrator.atomic_files import atomic_path, write_text_atomic
 from orchestrator.result_files import read_timeseries
 from orchestrator.run.writers import Column, CsvWriter
-
-
-class FillingDisk:
-    """A file object that takes ``room`` more bytes, then fails like a full disk (after a partial write)."""
-
-    def __init__(self, fh, room: int) -> None:
-        self.fh, self.room = fh, room
-
-    def write(self, data) -> int:
-        if self.room <= 0:
-            raise OSError(errno.ENOSPC, "No space left on device")
-        n = self.fh.write(bytes(data[:self.room]))
-        self.room -= n
-        return n
-
-    def __getattr__(self, name):
-        return getattr(self.fh, name)
+from tests.helpers.failing_files import FillingDisk
 
 
 def test_rows_stream_into_a_partial_file_that_becomes_whole_on_close(tmp_path):
