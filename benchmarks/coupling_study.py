@@ -16,10 +16,18 @@ then the largest H that keeps every Table 7 statistic within ``--tolerance``
 (default 1e-4) and the generator-speed RMS below ``--omega-tolerance`` (default
 1e-4 rad/s): the ``step`` the packaged scenarios use.
 
+Then, at that H, the Gearbox FMU's internal error control (``solver.rtol``,
+``solver.atol_q``, ``solver.atol_v``) at ``--tolerance-scales`` times the FMU's
+defaults (1e-4, 1e-8 rad, 1e-5 rad/s), with the same columns, and the loosest
+scale that keeps the same criteria: the Gearbox tolerances ``paper-60s`` sets.
+Looser tolerances only save time until the Gearbox takes one internal step per
+communication step; beyond that scale the results do not change.
+
 ``--variants`` prints the older comparison of master variants (algorithm, order,
 extrapolation, shaft-torque coupling) instead.
 
-Run: ``python benchmarks/coupling_study.py [--stop 60] [--steps 1,2,5,10,20]`` (H in ms).
+Run: ``python benchmarks/coupling_study.py [--stop 60] [--steps 1,2,5,10,20] [--tolerance-scales 1,3,10]``
+(H in ms).
 Prints Markdown tables (used in docs/orchestrator.md).
 """
 
@@ -49,8 +57,8 @@ def _setup(stop: float, fmu_dir, output_interval: float | None):
     base = load_scenario(find_scenario("paper-60s"))
     window = base.simulation.window_s if stop == base.simulation.stop_s else (min(5.0, stop / 2), stop)
     changes = {"stop_s": stop, "window_s": window}
-    if output_interval is not None:
-        changes["output_interval_s"] = output_interval
+    if output_interval is not None:  # the step too: the scenario's own step may not divide the interval
+        changes.update(step_s=output_interval, output_interval_s=output_interval)
     base = base.with_simulation(**changes)
     paths = ensure_fmus(base, fmu_dir)
     system = resolve_system(base, fmu_paths=paths)
@@ -72,6 +80,7 @@ def accuracy_and_cost(outcome, reference, system, setup) -> dict[str, float]:
         "mean": max(abs(v["relative_difference"]["mean"]) for v in forces.values()),
         "std": max(abs(v["relative_difference"]["std"]) for v in forces.values()),
         "omega_rms": variables["generator.omega"]["rms_difference"],
+        "force_rms": max(v["rms_relative_to_std"] for v in forces.values()),
         "loop_cpu_per_s": outcome.loop_cpu_time_s / stop,
         "cpu_per_s": outcome.cpu_time_s / stop,
     }
@@ -101,15 +110,17 @@ def step_study(args) -> None:
             raise SystemExit(f"H = {h * 1e3:g} ms: {outcome.error}")
         ref_h = reference if h == min(steps) else run_reference(system, setup)
         rows.append((h, accuracy_and_cost(outcome, ref_h, system, setup)))
+    print(f"Gearbox tolerances of the scenario: {_tolerance_text(base)}\n")
     print("| H [ms] | max rel. diff. mean (contact forces) | max rel. diff. std (contact forces) | "
-          "generator-speed RMS error [rad/s] | stepping CPU per simulated s [s] | run CPU per simulated s [s] | within |")
-    print("|---|---|---|---|---|---|---|")
+          "generator-speed RMS error [rad/s] | max RMS difference / std (contact forces) | "
+          "stepping CPU per simulated s [s] | run CPU per simulated s [s] | within |")
+    print("|---|---|---|---|---|---|---|---|")
     chosen = None
     for h, r in rows:
-        ok = r["mean"] <= args.tolerance and r["std"] <= args.tolerance and r["omega_rms"] < args.omega_tolerance
+        ok = _within(r, args)
         if ok and (chosen is None or h > chosen):
             chosen = h
-        print(f"| {h * 1e3:g} | {r['mean']:.2e} | {r['std']:.2e} | {r['omega_rms']:.2e} | "
+        print(f"| {h * 1e3:g} | {r['mean']:.2e} | {r['std']:.2e} | {r['omega_rms']:.2e} | {r['force_rms']:.2e} | "
               f"{r['loop_cpu_per_s']:.4f} | {r['cpu_per_s']:.4f} | {'yes' if ok else 'no'} |")
     costs = [r["loop_cpu_per_s"] for h, r in rows if h >= 5e-3]
     print()
@@ -121,6 +132,65 @@ def step_study(args) -> None:
     else:
         print(f"largest H with every Table 7 statistic within {args.tolerance:g} and generator-speed RMS < "
               f"{args.omega_tolerance:g} rad/s: {chosen * 1e3:g} ms")
+        if args.tolerance_scales:
+            tolerance_study(args, base, paths, setup, chosen, reference if chosen == min(steps) else None)
+
+
+#: the Gearbox FMU's error-control parameters the tolerance table scales
+SOLVER_TOLERANCES = ("solver.rtol", "solver.atol_q", "solver.atol_v")
+
+
+def _within(r: dict, args) -> bool:
+    return r["mean"] <= args.tolerance and r["std"] <= args.tolerance and r["omega_rms"] < args.omega_tolerance
+
+
+def _tolerance_text(scenario) -> str:
+    from components.model.integrators import StepControl
+
+    given = next(c for c in scenario.components if c.name == "gearbox").parameters
+    defaults = StepControl()
+    values = [given.get(name, getattr(defaults, name.split(".")[1])) for name in SOLVER_TOLERANCES]
+    return ", ".join(f"{name} = {value:g}" for name, value in zip(SOLVER_TOLERANCES, values))
+
+
+def tolerance_study(args, base, paths, setup, step_s: float, reference) -> None:
+    """The Gearbox's error control at ``args.tolerance_scales`` x its defaults, at the communication step ``step_s``."""
+    from components.model.integrators import StepControl
+    from orchestrator.cosim.master import CoSimulation
+    from orchestrator.cosim.system import resolve_system
+    from orchestrator.run.comparison import run_reference
+
+    defaults = StepControl()
+    scales = [float(x) for x in args.tolerance_scales.split(",")]
+    print(f"\nGearbox error control at H = {step_s * 1e3:g} ms, scale x the FMU's defaults (solver.rtol "
+          f"{defaults.rtol:g}, solver.atol_q {defaults.atol_q:g} rad, solver.atol_v {defaults.atol_v:g} rad/s)\n")
+    print("| scale | max rel. diff. mean | max rel. diff. std | generator-speed RMS error [rad/s] | "
+          "max RMS difference / std | stepping CPU per simulated s [s] | within |")
+    print("|---|---|---|---|---|---|---|")
+    chosen = None
+    for scale in scales:
+        values = {name: scale * getattr(defaults, name.split(".")[1]) for name in SOLVER_TOLERANCES}
+        sc = base.with_simulation(step_s=step_s, output_interval_s=step_s).with_parameters("gearbox", **values)
+        system = resolve_system(sc, fmu_paths=paths)
+        CoSimulation(system).run(handle_sigint=False)  # warm-up: the cost column compares like with like
+        outcome = CoSimulation(system).run(handle_sigint=False)
+        if not outcome.complete:
+            raise SystemExit(f"scale {scale:g}: {outcome.error}")
+        if reference is None:  # the same grid for every scale: one reference run
+            reference = run_reference(system, setup)
+        r = accuracy_and_cost(outcome, reference, system, setup)
+        ok = _within(r, args)
+        if ok and (chosen is None or scale > chosen):
+            chosen = scale
+        print(f"| {scale:g} | {r['mean']:.2e} | {r['std']:.2e} | {r['omega_rms']:.2e} | {r['force_rms']:.2e} | "
+              f"{r['loop_cpu_per_s']:.4f} | {'yes' if ok else 'no'} |")
+    print()
+    if chosen is None:
+        print("no scale meets the criteria")
+    else:
+        print(f"loosest scale within the criteria: {chosen:g} ("
+              + ", ".join(f"{name} = {chosen * getattr(defaults, name.split('.')[1]):g}" for name in SOLVER_TOLERANCES)
+              + f"); the scenario has {_tolerance_text(base)}")
 
 
 def variant_study(args) -> None:
@@ -170,6 +240,8 @@ def main() -> None:
                         "(default 1,2,5,10,20; with --variants 10,5,2,1)")
     parser.add_argument("--tolerance", type=float, default=1e-4, help="relative tolerance on Table 7's mean and std")
     parser.add_argument("--omega-tolerance", type=float, default=1e-4, help="generator-speed RMS tolerance [rad/s]")
+    parser.add_argument("--tolerance-scales", default="1,3,10", help="Gearbox error-control scales (x the FMU's "
+                        "defaults) tried at the chosen H, comma separated (default 1,3,10; empty: skip)")
     parser.add_argument("--variants", action="store_true", help="compare master variants instead")
     parser.add_argument("--fmu-dir", default=None, help="FMU directory (default: the project's fmus/)")
     args = parser.parse_args()

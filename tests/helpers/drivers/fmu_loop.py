@@ -9,7 +9,9 @@ ratio * phi_rotor`` (zero twist); GeneratorRotor ``initial_speed/angle`` from
 those; then every FMU exits initialisation mode. With ``init="scenario"`` the
 generator angle is left at its default (0) and ``phi_gen`` is that angle, as
 ``dtcosim run`` initialises the paper scenario (its only initial binding is the
-generator's initial speed), so the two give the same numbers. Stepping (Gauss-Seidel, step
+generator's initial speed), and every component gets the parameter values of
+``paper-60s.toml`` (read with ``tomllib``; e.g. the Gearbox's solver tolerances),
+so the two give the same numbers. Stepping (Gauss-Seidel, step
 ``H``): the Gearbox steps with the wind and generator motion at ``t``, the
 generator steps with the Gearbox's ``shaft_torque``, the wind steps.
 
@@ -19,6 +21,7 @@ Usage: ``python fmu_loop.py FMU_DIR T_END H OUT.npz [zero-twist|scenario]``
 from __future__ import annotations
 
 import sys
+import tomllib
 from ctypes import c_double, c_uint32
 from pathlib import Path
 
@@ -26,6 +29,8 @@ import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
+#: the scenario whose parameter values ``init="scenario"`` applies
+PAPER_SCENARIO = Path(__file__).resolve().parents[3] / "orchestrator" / "scenarios" / "paper-60s.toml"
 #: recorded signals: (FMU, variable)
 RECORDED = (
     ("WindSource", "omega"),
@@ -43,6 +48,7 @@ class Instance:
     def __init__(self, fmu_path: Path, name: str) -> None:
         md = read_model_description(str(fmu_path))
         self.vr = {v.name: v.valueReference for v in md.modelVariables}
+        self.type = {v.name: v.type for v in md.modelVariables}
         self.unzip_dir = extract(str(fmu_path))
         self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=self.unzip_dir,
                              modelIdentifier=md.coSimulation.modelIdentifier, instanceName=name)
@@ -55,6 +61,14 @@ class Instance:
 
     def set(self, **values: float) -> None:
         self.fmu.setReal([self.vr[n] for n in values], list(values.values()))
+
+    def set_parameters(self, values: dict[str, float | int]) -> None:
+        """Set parameter values of any type the paper scenario uses (Real, Integer)."""
+        for name, value in values.items():
+            if self.type[name] == "Integer":
+                self.fmu.setInteger([self.vr[name]], [int(value)])
+            else:
+                self.fmu.setReal([self.vr[name]], [float(value)])
 
     def setter(self, *names: str):
         """Fast setter for fixed value references (pre-built arrays)."""
@@ -91,6 +105,11 @@ def run(fmu_dir: str | Path, t_end: float, step: float, init: str = "zero-twist"
     gearbox = Instance(fmu_dir / "Gearbox.fmu", "gearbox")
     generator = Instance(fmu_dir / "GeneratorRotor.fmu", "generator")
     instances = {"WindSource": wind, "Gearbox": gearbox, "GeneratorRotor": generator}
+    if init == "scenario":
+        with open(PAPER_SCENARIO, "rb") as f:
+            components = tomllib.load(f)["components"]
+        for table in components.values():
+            instances[Path(table["fmu"]).stem].set_parameters(table.get("parameters", {}))
 
     omega_rotor, phi_rotor = wind.get("omega", "phi")
     gearbox.set(omega_rotor=omega_rotor, phi_rotor=phi_rotor)
