@@ -15,26 +15,14 @@ Both paths give the same results to round-off (the tests compare them to 1e-9).
 
 from __future__ import annotations
 
-import os
 from types import ModuleType
 
-from ..errors import ParameterError
+from .kernel_request import ENVIRONMENT_VARIABLE, KERNELS, compiled_or_numpy, requested_kernel
 
-KERNELS = ("auto", "numpy", "compiled")
-ENVIRONMENT_VARIABLE = "DTCOSIM_KERNEL"
+__all__ = ["ENVIRONMENT_VARIABLE", "KERNELS", "choose_kernel", "compiled_module", "requested_kernel"]
 
 _compiled: ModuleType | None = None
 _import_error: str | None = None
-
-
-def requested_kernel(kernel: str | None = None) -> str:
-    """The kernel asked for: ``kernel`` if given, else ``$DTCOSIM_KERNEL``, else ``auto``."""
-    value = kernel if kernel is not None else os.environ.get(ENVIRONMENT_VARIABLE, "auto")
-    value = str(value).strip().lower() or "auto"
-    if value not in KERNELS:
-        source = "kernel" if kernel is not None else ENVIRONMENT_VARIABLE
-        raise ParameterError(source, value, f"one of {', '.join(KERNELS)}")
-    return value
 
 
 def compiled_module() -> tuple[ModuleType | None, str | None]:
@@ -65,12 +53,5 @@ def choose_kernel(kernel: str | None = None) -> tuple[str, str | None]:
     ParameterError
         Unknown name, or ``compiled`` requested where it cannot be imported.
     """
-    wanted = requested_kernel(kernel)
-    if wanted == "numpy":
-        return "numpy", None
-    module, reason = compiled_module()
-    if module is not None:
-        return "compiled", None
-    if wanted == "compiled":
-        raise ParameterError("kernel", "compiled", f"an importable numba ({reason})")
-    return "numpy", f"compiled gearbox kernel unavailable ({reason}); using the numpy path"
+    module, note = compiled_or_numpy(kernel, compiled_module, "compiled gearbox kernel")
+    return ("compiled" if module is not None else "numpy"), note

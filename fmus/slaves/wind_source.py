@@ -7,12 +7,15 @@ Outputs: rotor speed ``omega`` [rad/s] and angle ``phi`` [rad] (``phi(0) = 0``)
 at the current communication point. The signal is a closed-form function of
 time; the FMU steps it by rotating the harmonics' phasors
 (:class:`components.model.wind.PhasorStepper`, re-anchored on the closed form
-periodically), whose state the FMU state carries.
+periodically; one compiled loop where numba imports, else numpy, said once through
+the FMI logger), whose state the FMU state carries.
 """
 
 from __future__ import annotations
 
 from typing import Any, Hashable, Iterable, Mapping
+
+from pythonfmu.enums import Fmi2Status
 
 from components.errors import ParameterError
 from components.model.description import build
@@ -41,6 +44,7 @@ class WindSource(DtcosimSlave):
     description = "dtcosim WindSource: stochastic rotor speed omega(t) and angle phi(t) of eq. 13-14 (SI units)"
     role = WIND_SOURCE
     eager_output_groups = frozenset({"motion"})
+    _kernel_reported = False
 
     @classmethod
     def build_interface(cls, model: Mapping[str, Any]) -> Iterable[Variable]:
@@ -68,6 +72,9 @@ class WindSource(DtcosimSlave):
         values = {name: self.value(name) for name in (*WIND_FIELDS, "amplitude")}
         self.process = RotorSpeedProcess(wind_from_values(values, build(self.model["wind"], "model.wind")))
         self.stepper = PhasorStepper(self.process)
+        if self.stepper.kernel_note and not self._kernel_reported:  # once per instance: why it is slower
+            self._report(f"WindSource: {self.stepper.kernel_note}", Fmi2Status.warning)
+            self._kernel_reported = True
         self._vr_omega = self.vr["omega"]
         self._vr_phi = self.vr["phi"]
 

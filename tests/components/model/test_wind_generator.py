@@ -92,11 +92,21 @@ def test_generator_integrates_through_an_event_exactly():
     assert gen.angle_rad == pytest.approx(10.0 * 0.5 * (0.75**2 - 0.25**2))
 
 
-def test_phasor_stepper_follows_the_closed_form():
+def _wind_kernels() -> list:
+    """Both paths of the phasor step; the compiled one skipped where numba does not import."""
+    from components.model.wind import _compiled_wind_module
+
+    reason = _compiled_wind_module()[1]
+    return ["numpy", pytest.param("compiled", marks=pytest.mark.skipif(reason is not None, reason=str(reason)))]
+
+
+@pytest.mark.parametrize("kernel", _wind_kernels())
+def test_phasor_stepper_follows_the_closed_form(kernel):
     from components.model.wind import PhasorStepper
 
     process = RotorSpeedProcess(WindParameters())
-    stepper = PhasorStepper(process)
+    stepper = PhasorStepper(process, kernel)
+    assert stepper.kernel == kernel and stepper.kernel_note is None
     h = 1e-3
     n = 2 * PhasorStepper.REANCHOR_STEPS + 100  # across two re-anchorings
     got = np.empty((n, 2))
@@ -110,17 +120,18 @@ def test_phasor_stepper_follows_the_closed_form():
     assert stepper.steps_since_anchor < PhasorStepper.REANCHOR_STEPS
 
 
-def test_phasor_stepper_state_continues_bit_identically_and_jumps_are_exact():
+@pytest.mark.parametrize("kernel", _wind_kernels())
+def test_phasor_stepper_state_continues_bit_identically_and_jumps_are_exact(kernel):
     import json
 
     from components.model.wind import PhasorStepper
 
     process = RotorSpeedProcess(WindParameters(seed=4))
-    a = PhasorStepper(process)
+    a = PhasorStepper(process, kernel)
     for k in range(500):
         a.advance(k * 2e-3, 2e-3)
     state = json.loads(json.dumps(a.get_state()))
-    b = PhasorStepper(process)
+    b = PhasorStepper(process, kernel)
     b.set_state(state)
     for k in range(500, 800):
         a.advance(k * 2e-3, 2e-3)
@@ -130,3 +141,38 @@ def test_phasor_stepper_state_continues_bit_identically_and_jumps_are_exact():
     assert b.speed_and_angle() == pytest.approx((process.speed(10.001), process.angle(10.001)), abs=1e-12)
     with pytest.raises(ParameterError, match="phasors"):
         b.set_state({**state, "re": state["re"][:3]})
+
+
+@pytest.mark.parametrize("kernel", _wind_kernels()[1:])
+def test_compiled_phasor_step_agrees_with_the_numpy_path_to_round_off(kernel):
+    """The compiled loop sums in index order, BLAS in its own: the same signal to the last bits, and the
+    closed-form re-anchoring keeps it so (1.5 x REANCHOR_STEPS steps)."""
+    from components.model.wind import PhasorStepper
+
+    process = RotorSpeedProcess(WindParameters(seed=3))
+    numpy_path, compiled_path = PhasorStepper(process, "numpy"), PhasorStepper(process, kernel)
+    assert numpy_path.speed_and_angle() == pytest.approx(compiled_path.speed_and_angle(), rel=1e-15, abs=1e-14)
+    for k in range(3 * PhasorStepper.REANCHOR_STEPS // 2):
+        numpy_path.advance(k * 5e-3, 5e-3)
+        compiled_path.advance(k * 5e-3, 5e-3)
+        (w_a, phi_a), (w_b, phi_b) = numpy_path.speed_and_angle(), compiled_path.speed_and_angle()
+        assert abs(w_a - w_b) <= 1e-13 and abs(phi_a - phi_b) <= 1e-13 * max(1.0, abs(phi_a)), k
+    # the rotations too may round differently (numpy's complex multiply may be fused): |z| = 1 to 1e-14
+    np.testing.assert_allclose(numpy_path.get_state()["re"], compiled_path.get_state()["re"], rtol=0, atol=1e-14)
+
+
+def test_phasor_stepper_without_numba_falls_back_or_refuses(monkeypatch):
+    from components.model import wind
+    from components.model.wind import PhasorStepper
+
+    monkeypatch.setattr(wind, "_compiled_wind_module", lambda: (None, "ModuleNotFoundError: No module named 'numba'"))
+    process = RotorSpeedProcess(WindParameters())
+    stepper = PhasorStepper(process, "auto")
+    assert stepper.kernel == "numpy"
+    assert stepper.kernel_note == ("compiled wind step unavailable (ModuleNotFoundError: No module named 'numba'); "
+                                   "using the numpy path")
+    assert PhasorStepper(process, "numpy").kernel_note is None
+    with pytest.raises(ParameterError, match=r"kernel = 'compiled'.*an importable numba \(ModuleNotFoundError"):
+        PhasorStepper(process, "compiled")
+    with pytest.raises(ParameterError, match="kernel = 'fast'.*one of auto, numpy, compiled"):
+        PhasorStepper(process, "fast")
