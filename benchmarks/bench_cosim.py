@@ -43,7 +43,7 @@ def main() -> None:
     args = parser.parse_args()
 
     from components.model.kernel import ENVIRONMENT_VARIABLE, choose_kernel
-    from orchestrator.cosim.fmu_store import ensure_fmus
+    from current_fmus import current_fmu_paths
     from orchestrator.cosim.master import CoSimulation
     from orchestrator.cosim.physics_view import physics_view
     from orchestrator.cosim.system import resolve_system
@@ -57,7 +57,7 @@ def main() -> None:
         scenario = scenario.with_simulation(stop_s=args.stop, window_s=(min(5.0, args.stop / 2), args.stop))
     if args.step is not None:
         scenario = scenario.with_simulation(step_s=args.step, output_interval_s=args.step)
-    system = resolve_system(scenario, fmu_paths=ensure_fmus(scenario, args.fmu_dir))
+    system = resolve_system(scenario, fmu_paths=current_fmu_paths(scenario, args.fmu_dir))
     sim = scenario.simulation
     kernel = choose_kernel()[0]
     print(f"paper-60s: 0-{sim.stop_s:g} s, H = {sim.step_s * 1e3:g} ms ({sim.n_steps} steps), output every "

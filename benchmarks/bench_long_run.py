@@ -90,12 +90,12 @@ def child_main(args) -> None:
     """One whole run in this (fresh) process; prints one JSON line."""
     wall0 = time.perf_counter()
     from components.model.kernel import choose_kernel
-    from orchestrator.cosim.fmu_store import ensure_fmus
+    from current_fmus import current_fmu_paths
     from orchestrator.cosim.system import resolve_system
     from orchestrator.run.runner import run_scenario
 
     scenario = _long_scenario(args)
-    system = resolve_system(scenario, fmu_paths=ensure_fmus(scenario, None))
+    system = resolve_system(scenario, fmu_paths=current_fmu_paths(scenario))
     prepared_s = time.perf_counter() - wall0
     with tempfile.TemporaryDirectory(prefix="dtcosim-long-") as tmp:
         wall, cpu = time.perf_counter(), time.process_time()
@@ -221,7 +221,7 @@ def phases_main(args) -> None:
     import numpy as np
 
     from components.model.kernel import choose_kernel
-    from orchestrator.cosim.fmu_store import ensure_fmus
+    from current_fmus import current_fmu_paths
     from orchestrator.cosim.master import CoSimulation
     from orchestrator.cosim.system import resolve_system
     from orchestrator.run.analyses import analyse_run
@@ -240,7 +240,7 @@ def phases_main(args) -> None:
 
     def resolve():
         scenario = _long_scenario(args)
-        return resolve_system(scenario, fmu_paths=ensure_fmus(scenario, None))
+        return resolve_system(scenario, fmu_paths=current_fmu_paths(scenario))
 
     system = phases.run("scenario + FMU paths", resolve)
     sim = system.scenario.simulation

@@ -48,7 +48,7 @@ VARIANTS = [
 
 
 def _setup(stop: float, fmu_dir, output_interval: float | None):
-    from orchestrator.cosim.fmu_store import ensure_fmus
+    from current_fmus import current_fmu_paths
     from orchestrator.cosim.physics_view import physics_view
     from orchestrator.cosim.system import resolve_system
     from orchestrator.inputs.scenario import find_scenario, load_scenario
@@ -60,7 +60,7 @@ def _setup(stop: float, fmu_dir, output_interval: float | None):
     if output_interval is not None:  # the step too: the scenario's own step may not divide the interval
         changes.update(step_s=output_interval, output_interval_s=output_interval)
     base = base.with_simulation(**changes)
-    paths = ensure_fmus(base, fmu_dir)
+    paths = current_fmu_paths(base, fmu_dir)
     system = resolve_system(base, fmu_paths=paths)
     setup = physics_view(system)
     cpu0 = time.process_time()
