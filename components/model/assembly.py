@@ -359,7 +359,7 @@ class Assembly:
 
     def _mesh_deflections(self, y: np.ndarray, port_angle_rad: float, port_speed_rad_s: float) -> np.ndarray:
         """Mesh deflections [m] (row 0) and their rates [m/s] (row 1) of state ``[q, v]``, shape (2, n_mesh)."""
-        D = y.reshape(2, self.n_dof) @ self._A_T
+        D = np.dot(y.reshape(2, self.n_dof), self._A_T)  # np.dot: the same product as @, cheaper on tiny arrays
         if self._port_meshes:
             D[0] += self.A_port[:, 0] * port_angle_rad
             D[1] += self.A_port[:, 0] * port_speed_rad_s
@@ -472,13 +472,17 @@ class Assembly:
         deflection : ndarray, shape (2, n_mesh)
             Deflections [m] (row 0) and their rates [m/s] (row 1).
         """
-        D = self._mesh_deflections(y, port_angle_rad, port_speed_rad_s)
-        force = self.law.force(D[0], D[1], stiffness_factor)
+        D = np.dot(y.reshape(2, self.n_dof), self._A_T)  # as _mesh_deflections (inlined: hot path)
+        if self._port_meshes:
+            D[0] += self.A_port[:, 0] * port_angle_rad
+            D[1] += self.A_port[:, 0] * port_speed_rad_s
+        deflection, rate = D
+        force = self.law.force(deflection, rate, stiffness_factor)
         extra = self._fast_extra
         extra[0] = port_angle_rad
         extra[1] = port_speed_rad_s
         extra[2] = driver_acceleration
-        return np.concatenate((force, y, extra)) @ self._fast_matrix, force, D
+        return np.dot(np.concatenate((force, y, extra)), self._fast_matrix), force, D
 
     def generalised_forces(self, loads: InternalLoads) -> np.ndarray:
         """Generalised torques on the free bodies from meshes and shafts [N m], shape (..., n_dof)."""

@@ -55,6 +55,11 @@ class _Hermite:
     def rate(self, tau: float) -> float:
         return self.c1 + tau * (2.0 * self.c2 + 3.0 * tau * self.c3)
 
+    def value_and_rate(self, tau: float) -> tuple[float, float]:
+        """``(value(tau), rate(tau))`` in one call (the same expressions)."""
+        c2, c3 = self.c2, self.c3
+        return self.c0 + tau * (self.c1 + tau * (c2 + tau * c3)), self.c1 + tau * (2.0 * c2 + 3.0 * tau * c3)
+
     def accel(self, tau: float) -> float:
         return 2.0 * self.c2 + 6.0 * tau * self.c3
 
@@ -82,6 +87,7 @@ class _StepSystem:
         self.last_alpha = 0.0  # driver acceleration used in the last evaluation [rad/s^2]
         self.last_force = np.zeros(assembly.n_mesh)
         self.last_deflection = np.zeros((2, assembly.n_mesh))
+        self._constant_stiffness = not assembly.time_varying_stiffness
 
     def stiffness_factor(self, tau: float):
         a = self.assembly
@@ -91,9 +97,9 @@ class _StepSystem:
 
     def acceleration(self, tau: float, y: np.ndarray) -> np.ndarray:
         alpha = self.driver.accel(tau)
-        acc, force, deflection = self.assembly.fast_acceleration(
-            y, self.port.value(tau), self.port.rate(tau), alpha, self.stiffness_factor(tau)
-        )
+        port_angle, port_speed = self.port.value_and_rate(tau)
+        factor = 1.0 if self._constant_stiffness else self.stiffness_factor(tau)
+        acc, force, deflection = self.assembly.fast_acceleration(y, port_angle, port_speed, alpha, factor)
         self.last_acceleration, self.last_alpha, self.last_force, self.last_deflection = acc, alpha, force, deflection
         return acc
 
@@ -293,7 +299,7 @@ class GearboxModel:
     @property
     def output_speed_rad_s(self) -> float:
         """Speed of the last stage's output member [rad/s] (its entry of :attr:`speeds_rad_s`)."""
-        return float(self._out_kinematic * self.driver_speed_rad_s + self.y[self._out_rate_index])
+        return self._out_kinematic * self.driver_speed_rad_s + self.y.item(self._out_rate_index)
 
     @property
     def output_acceleration_rad_s2(self) -> float:
@@ -373,7 +379,7 @@ class GearboxModel:
         internal step since initialisation).
         """
         z = np.concatenate((self.system.last_force, self.y, self._output_extra()))
-        linear = z @ self._output_matrix
+        linear = np.dot(z, self._output_matrix)
         avg = self.shaft_torque_average_nm
         head = (avg if self.shaft_torque_mode == "average" else linear[0], avg)
         tail = (self.alpha_out_average_rad_s2, self.alpha_out_max_rad_s2)
@@ -499,7 +505,7 @@ class GearboxModel:
 
     def _output_twist(self) -> float:
         """Twist of the output shaft (shaft 3) [rad]."""
-        return float(self._twist_q @ self.y) + self._twist_port * self.port_angle_rad
+        return float(np.dot(self._twist_q, self.y)) + self._twist_port * self.port_angle_rad
 
     # ---------------------------------------------------------------- state
     def get_state(self) -> dict:
