@@ -247,7 +247,7 @@ class ContactLaw:
         """
         h = self._half_jt
         abs_d = np.abs(deflection)
-        if not (abs_d < self._deep).any():  # all deep in flank contact: tanh saturated exactly
+        if not np.count_nonzero(abs_d < self._deep):  # all deep in flank contact: tanh saturated exactly
             flank = np.sign(deflection)
             return deflection - flank * h, np.ones_like(abs_d), np.zeros_like(abs_d)
         lam = self._lam

@@ -239,6 +239,7 @@ class GearboxModel:
         # output twist = _twist_q . q + _twist_port * port angle
         self._twist_q = np.concatenate((a.S[-1], np.zeros(a.n_dof)))
         self._twist_port = float(a.S_port[-1, 0])
+        self._out_shaft_kc = (float(a.shaft_k[-1]), float(a.shaft_c[-1]))  # shaft 3 stiffness, damping
         self._output_matrix = self._build_output_matrix()
         self._out_kinematic = float(a.kinematic_ratio[self._out_member])
         self._out_rate_index = a.n_dof + self._out_member  # its speed in [q, v], its acceleration in [v, a]
@@ -315,7 +316,7 @@ class GearboxModel:
 
     def _track_output_acceleration(self, tau: float, f: np.ndarray) -> None:
         # absolute acceleration = kinematic part of the driver's + relative (deviation) part
-        alpha = abs(self._out_kinematic * self.system.driver.accel(tau) + f[self._out_rate_index])
+        alpha = abs(self._out_kinematic * self.system.driver.accel(tau) + f.item(self._out_rate_index))
         if alpha > self.alpha_out_max_rad_s2:
             self.alpha_out_max_rad_s2 = float(alpha)
 
@@ -379,11 +380,14 @@ class GearboxModel:
         internal step since initialisation).
         """
         z = np.concatenate((self.system.last_force, self.y, self._output_extra()))
-        linear = np.dot(z, self._output_matrix)
+        out = np.empty(self._output_matrix.shape[1] + 4)
+        linear = np.dot(z, self._output_matrix, out=out[2:-2])
         avg = self.shaft_torque_average_nm
-        head = (avg if self.shaft_torque_mode == "average" else linear[0], avg)
-        tail = (self.alpha_out_average_rad_s2, self.alpha_out_max_rad_s2)
-        return np.concatenate((head, linear, tail))
+        out[0] = avg if self.shaft_torque_mode == "average" else linear[0]
+        out[1] = avg
+        out[-2] = self.alpha_out_average_rad_s2
+        out[-1] = self.alpha_out_max_rad_s2
+        return out
 
     def output_list(self) -> list[float]:
         """:meth:`output_vector` as a list of floats (what an FMU writes into its variables)."""
@@ -484,8 +488,8 @@ class GearboxModel:
         self.last_step_s = h
         # (1/h) int T dt = k mean(twist) + c (twist_end - twist_start) / h, trapezoid for the mean twist
         twist_end = self.output_twist_rad = self._output_twist()
-        k = a.shaft_k[-1]
-        self.shaft_torque_average_nm = k * 0.5 * (twist_start + twist_end) + a.shaft_c[-1] * (twist_end - twist_start) / h
+        k, c = self._out_shaft_kc
+        self.shaft_torque_average_nm = k * 0.5 * (twist_start + twist_end) + c * (twist_end - twist_start) / h
         self.alpha_out_average_rad_s2 = (self.output_speed_rad_s - speed_start) / h
 
     @property

@@ -59,6 +59,9 @@ from ..validation import integer_at_least, positive
 
 _D = 1.0 / (2.0 + math.sqrt(2.0))
 _E32 = 6.0 + math.sqrt(2.0)
+#: _E32 as a 0-d array: multiplying an array by it is the same operation as by the float, but
+#: skips numpy's conversion of a Python scalar (a measurable cost on arrays this small)
+_E32_ARRAY = np.array(_E32)
 #: bounds of the error order observed between two rejected attempts (see module docstring)
 OBSERVED_ORDER_MIN, OBSERVED_ORDER_MAX = 0.2, 3.0
 
@@ -178,6 +181,9 @@ class Rosenbrock23:
         self._basis_form = basis is not None and basis() is not None
         c = self.control
         self._atol = np.concatenate((np.full(n, c.atol_q), np.full(n, c.atol_v)))
+        self._rtol = np.array(c.rtol)  # 0-d, see _E32_ARRAY
+        #: (y, |y|) of the last step's end state: the next step starts there (arrays are never mutated)
+        self._abs_end: tuple[np.ndarray | None, np.ndarray | None] = (None, None)
         #: called as ``on_accept(t, f)`` after every accepted step, ``t`` its end time [s] and
         #: ``f = [v, a]`` the derivative there (shape (2n,), not to be modified); None: no call
         self.on_accept: Callable[[float, np.ndarray], None] | None = None
@@ -246,8 +252,13 @@ class Rosenbrock23:
         yn = y + h * k2
         fn = np.concatenate((yn[n:], system.acceleration(t + h, yn)))
         d10 = k1 - f0
-        k3 = dot(winv, fn - _E32 * (k2 - f1) - (d10 + d10)) + w_hdT
-        scale = self._atol + self.control.rtol * np.maximum(np.abs(y), np.abs(yn))
+        k3 = dot(winv, fn - _E32_ARRAY * (k2 - f1) - (d10 + d10)) + w_hdT
+        start, abs_start = self._abs_end
+        abs_end = np.abs(yn)
+        self._abs_end = (yn, abs_end)
+        if start is not y:
+            abs_start = np.abs(y)
+        scale = self._atol + self._rtol * np.maximum(abs_start, abs_end)
         err = (h / 6.0) * float((np.abs(k1 + k3 - (k2 + k2)) / scale).max())
         if not math.isfinite(err):
             err = math.inf
