@@ -291,7 +291,7 @@ class ContactLaw:
         -------
         ContactForces
         """
-        k = self._k * stiffness_factor
+        k = self._k if type(stiffness_factor) is float and stiffness_factor == 1.0 else self._k * stiffness_factor
         e = self._e
         if self._all_impact:
             return self._impact_law(deflection, rate, k)

@@ -60,6 +60,11 @@ class _Hermite:
         c2, c3 = self.c2, self.c3
         return self.c0 + tau * (self.c1 + tau * (c2 + tau * c3)), self.c1 + tau * (2.0 * c2 + 3.0 * tau * c3)
 
+    def rate_and_accel(self, tau: float) -> tuple[float, float]:
+        """``(rate(tau), accel(tau))`` in one call (the same expressions)."""
+        c2, c3 = self.c2, self.c3
+        return self.c1 + tau * (2.0 * c2 + 3.0 * tau * c3), 2.0 * c2 + 6.0 * tau * c3
+
     def accel(self, tau: float) -> float:
         return 2.0 * self.c2 + 6.0 * tau * self.c3
 
@@ -132,7 +137,7 @@ class _StepSystem:
 
     def time_derivative_coefficients(self, tau: float) -> tuple[float, float, float]:
         """Coefficients of :meth:`time_derivative_basis` at local time ``tau`` [s]."""
-        return (self.port.rate(tau), self.port.accel(tau), self.driver.jerk())
+        return (*self.port.rate_and_accel(tau), self.driver.jerk())
 
     def time_derivative(self, tau: float, y: np.ndarray) -> np.ndarray:
         a = self.assembly
