@@ -224,6 +224,7 @@ class ContactLaw:
             _sqrt_law=bool(np.all(self._e == 1.5)),
             # |delta| beyond which tanh(lambda (|delta| -+ j_t/2)) == 1 in double precision
             _deep=self._half_jt + 20.0 / self._lam,
+            _zeros=np.zeros(len(m)),  # clipping bound (an array operand is cheaper than the scalar 0)
         )
 
     @property
@@ -246,7 +247,7 @@ class ContactLaw:
         """
         h = self._half_jt
         abs_d = np.abs(deflection)
-        if not (abs_d < self._deep).any():  # all deep in flank contact: tanh saturated exactly
+        if not np.count_nonzero(abs_d < self._deep):  # all deep in flank contact: tanh saturated exactly
             flank = np.sign(deflection)
             return deflection - flank * h, np.ones_like(abs_d), np.zeros_like(abs_d)
         lam = self._lam
@@ -290,7 +291,7 @@ class ContactLaw:
         -------
         ContactForces
         """
-        k = self._k * stiffness_factor
+        k = self._k if type(stiffness_factor) is float and stiffness_factor == 1.0 else self._k * stiffness_factor
         e = self._e
         if self._all_impact:
             return self._impact_law(deflection, rate, k)
@@ -357,20 +358,22 @@ class ContactLaw:
         if self._any_impact:
             return self.evaluate(deflection, rate, stiffness_factor).force
         abs_d = np.abs(deflection)
-        if self._sqrt_law and not (abs_d < self._deep).any():
-            # every mesh deep in flank contact: d_BL = delta - sgn(delta) j_t/2 and d d_BL/d delta = 1 exactly
-            flank = np.sign(deflection)
+        # (count_nonzero: the same test as .any(), without the reduction machinery)
+        if self._sqrt_law and not np.count_nonzero(abs_d < self._deep):
+            # every mesh deep in flank contact: d_BL = delta - sgn(delta) j_t/2 and d d_BL/d delta = 1 exactly.
+            # Here delta != 0, so sgn(delta) = +-1 and, c0 and the clipped force being >= 0, the products
+            # c0 sgn(delta) and sgn(delta) max(., 0) are exactly copysign(., delta) (one numpy call less)
             pen = abs_d - self._half_jt
             k = self._k if type(stiffness_factor) is float and stiffness_factor == 1.0 else self._k * stiffness_factor
-            signed = pen * (k * np.sqrt(pen) + self._c * flank * rate)
-            return flank * np.maximum(signed, 0.0)
+            signed = pen * (k * np.sqrt(pen) + np.copysign(self._c, deflection) * rate)
+            return np.copysign(np.maximum(signed, self._zeros), deflection)
         d_bl, rate_bl = self._regularised(deflection, rate)
         abs_bl = np.abs(d_bl)
         sgn = np.sign(d_bl)
         root = np.sqrt(abs_bl) if self._sqrt_law else abs_bl ** (self._e - 1.0)
         flank = np.sign(deflection)
         signed = flank * abs_bl * (self._k * stiffness_factor * sgn * root + self._c * rate_bl)  # sgn(delta) * eq. 2
-        return flank * np.maximum(signed, 0.0)  # flank-consistent clipping
+        return flank * np.maximum(signed, self._zeros)  # flank-consistent clipping
 
     def stiffness_sensitivity(
         self, deflection: np.ndarray, rate: np.ndarray, stiffness_factor: np.ndarray | float = 1.0

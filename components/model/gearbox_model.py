@@ -55,6 +55,16 @@ class _Hermite:
     def rate(self, tau: float) -> float:
         return self.c1 + tau * (2.0 * self.c2 + 3.0 * tau * self.c3)
 
+    def value_and_rate(self, tau: float) -> tuple[float, float]:
+        """``(value(tau), rate(tau))`` in one call (the same expressions)."""
+        c2, c3 = self.c2, self.c3
+        return self.c0 + tau * (self.c1 + tau * (c2 + tau * c3)), self.c1 + tau * (2.0 * c2 + 3.0 * tau * c3)
+
+    def rate_and_accel(self, tau: float) -> tuple[float, float]:
+        """``(rate(tau), accel(tau))`` in one call (the same expressions)."""
+        c2, c3 = self.c2, self.c3
+        return self.c1 + tau * (2.0 * c2 + 3.0 * tau * c3), 2.0 * c2 + 6.0 * tau * c3
+
     def accel(self, tau: float) -> float:
         return 2.0 * self.c2 + 6.0 * tau * self.c3
 
@@ -82,6 +92,7 @@ class _StepSystem:
         self.last_alpha = 0.0  # driver acceleration used in the last evaluation [rad/s^2]
         self.last_force = np.zeros(assembly.n_mesh)
         self.last_deflection = np.zeros((2, assembly.n_mesh))
+        self._constant_stiffness = not assembly.time_varying_stiffness
 
     def stiffness_factor(self, tau: float):
         a = self.assembly
@@ -91,9 +102,9 @@ class _StepSystem:
 
     def acceleration(self, tau: float, y: np.ndarray) -> np.ndarray:
         alpha = self.driver.accel(tau)
-        acc, force, deflection = self.assembly.fast_acceleration(
-            y, self.port.value(tau), self.port.rate(tau), alpha, self.stiffness_factor(tau)
-        )
+        port_angle, port_speed = self.port.value_and_rate(tau)
+        factor = 1.0 if self._constant_stiffness else self.stiffness_factor(tau)
+        acc, force, deflection = self.assembly.fast_acceleration(y, port_angle, port_speed, alpha, factor)
         self.last_acceleration, self.last_alpha, self.last_force, self.last_deflection = acc, alpha, force, deflection
         return acc
 
@@ -126,7 +137,7 @@ class _StepSystem:
 
     def time_derivative_coefficients(self, tau: float) -> tuple[float, float, float]:
         """Coefficients of :meth:`time_derivative_basis` at local time ``tau`` [s]."""
-        return (self.port.rate(tau), self.port.accel(tau), self.driver.jerk())
+        return (*self.port.rate_and_accel(tau), self.driver.jerk())
 
     def time_derivative(self, tau: float, y: np.ndarray) -> np.ndarray:
         a = self.assembly
@@ -233,6 +244,7 @@ class GearboxModel:
         # output twist = _twist_q . q + _twist_port * port angle
         self._twist_q = np.concatenate((a.S[-1], np.zeros(a.n_dof)))
         self._twist_port = float(a.S_port[-1, 0])
+        self._out_shaft_kc = (float(a.shaft_k[-1]), float(a.shaft_c[-1]))  # shaft 3 stiffness, damping
         self._output_matrix = self._build_output_matrix()
         self._out_kinematic = float(a.kinematic_ratio[self._out_member])
         self._out_rate_index = a.n_dof + self._out_member  # its speed in [q, v], its acceleration in [v, a]
@@ -293,7 +305,7 @@ class GearboxModel:
     @property
     def output_speed_rad_s(self) -> float:
         """Speed of the last stage's output member [rad/s] (its entry of :attr:`speeds_rad_s`)."""
-        return float(self._out_kinematic * self.driver_speed_rad_s + self.y[self._out_rate_index])
+        return self._out_kinematic * self.driver_speed_rad_s + self.y.item(self._out_rate_index)
 
     @property
     def output_acceleration_rad_s2(self) -> float:
@@ -309,7 +321,7 @@ class GearboxModel:
 
     def _track_output_acceleration(self, tau: float, f: np.ndarray) -> None:
         # absolute acceleration = kinematic part of the driver's + relative (deviation) part
-        alpha = abs(self._out_kinematic * self.system.driver.accel(tau) + f[self._out_rate_index])
+        alpha = abs(self._out_kinematic * self.system.driver.accel(tau) + f.item(self._out_rate_index))
         if alpha > self.alpha_out_max_rad_s2:
             self.alpha_out_max_rad_s2 = float(alpha)
 
@@ -373,11 +385,14 @@ class GearboxModel:
         internal step since initialisation).
         """
         z = np.concatenate((self.system.last_force, self.y, self._output_extra()))
-        linear = z @ self._output_matrix
+        out = np.empty(self._output_matrix.shape[1] + 4)
+        linear = np.dot(z, self._output_matrix, out=out[2:-2])
         avg = self.shaft_torque_average_nm
-        head = (avg if self.shaft_torque_mode == "average" else linear[0], avg)
-        tail = (self.alpha_out_average_rad_s2, self.alpha_out_max_rad_s2)
-        return np.concatenate((head, linear, tail))
+        out[0] = avg if self.shaft_torque_mode == "average" else linear[0]
+        out[1] = avg
+        out[-2] = self.alpha_out_average_rad_s2
+        out[-1] = self.alpha_out_max_rad_s2
+        return out
 
     def output_list(self) -> list[float]:
         """:meth:`output_vector` as a list of floats (what an FMU writes into its variables)."""
@@ -478,8 +493,8 @@ class GearboxModel:
         self.last_step_s = h
         # (1/h) int T dt = k mean(twist) + c (twist_end - twist_start) / h, trapezoid for the mean twist
         twist_end = self.output_twist_rad = self._output_twist()
-        k = a.shaft_k[-1]
-        self.shaft_torque_average_nm = k * 0.5 * (twist_start + twist_end) + a.shaft_c[-1] * (twist_end - twist_start) / h
+        k, c = self._out_shaft_kc
+        self.shaft_torque_average_nm = k * 0.5 * (twist_start + twist_end) + c * (twist_end - twist_start) / h
         self.alpha_out_average_rad_s2 = (self.output_speed_rad_s - speed_start) / h
 
     @property
@@ -499,7 +514,7 @@ class GearboxModel:
 
     def _output_twist(self) -> float:
         """Twist of the output shaft (shaft 3) [rad]."""
-        return float(self._twist_q @ self.y) + self._twist_port * self.port_angle_rad
+        return float(np.dot(self._twist_q, self.y)) + self._twist_port * self.port_angle_rad
 
     # ---------------------------------------------------------------- state
     def get_state(self) -> dict:
