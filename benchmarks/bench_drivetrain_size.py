@@ -24,6 +24,8 @@ Usage::
 
 from __future__ import annotations
 
+import one_blas_thread  # noqa: F401 - first: one BLAS thread (CPU time without spinning workers)
+
 import argparse
 import statistics
 import sys

@@ -9,6 +9,8 @@ Run: ``python benchmarks/bench_monolithic.py [--repeat N]``
 
 from __future__ import annotations
 
+import one_blas_thread  # noqa: F401 - first: one BLAS thread (CPU time without spinning workers)
+
 import argparse
 import statistics
 import time

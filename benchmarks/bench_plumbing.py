@@ -19,6 +19,8 @@ communication step and the master's overhead above the floor.
 
 from __future__ import annotations
 
+import one_blas_thread  # noqa: F401 - first: one BLAS thread (CPU time without spinning workers)
+
 import argparse
 import tempfile
 import textwrap

@@ -33,6 +33,8 @@ Prints Markdown tables (used in docs/orchestrator.md).
 
 from __future__ import annotations
 
+import one_blas_thread  # noqa: F401 - first: one BLAS thread (CPU time without spinning workers)
+
 import argparse
 import time
 

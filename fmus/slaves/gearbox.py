@@ -136,9 +136,13 @@ class Gearbox(DtcosimSlave):
         self._inputs = itemgetter(*self._vr_inputs)  # values list -> the four inputs, in one C call
         names = GearboxModel(self._template).output_names
         self._vr_outputs = [vr[n] for n in names]
-        first = self._vr_outputs[0]
-        contiguous = self._vr_outputs == list(range(first, first + len(names)))
-        self._output_slice = slice(first, first + len(names)) if contiguous else None
+        # the outputs usually occupy one range of value references, not in the model's order (shaft_torque_end
+        # and _avg are swapped): one slice assignment of the reordered list (itemgetter: one C call) per refresh
+        first, n = min(self._vr_outputs), len(names)
+        contiguous = sorted(self._vr_outputs) == list(range(first, first + n))
+        self._output_slice = slice(first, first + n) if contiguous else None
+        order = [self._vr_outputs.index(first + j) for j in range(n)] if contiguous else []
+        self._output_order = itemgetter(*order) if n > 1 and order != list(range(n)) else None
         self.model: GearboxModel | None = None
         self._kernel_reported = False
 
@@ -168,7 +172,7 @@ class Gearbox(DtcosimSlave):
     def _refresh(self, group: Hashable) -> None:
         out = self.model.output_list()  # the compiled model: its kernel wrote them during the step
         if self._output_slice is not None:
-            self._values[self._output_slice] = out
+            self._values[self._output_slice] = out if self._output_order is None else self._output_order(out)
         else:
             values = self._values
             for vr, value in zip(self._vr_outputs, out):
