@@ -12,9 +12,9 @@ the kernel's dispatchers a locator whose directory is
 ``~/.cache`` on POSIX, ``%LOCALAPPDATA%`` on Windows), and whose freshness stamp is
 the same hash: any copy of the same kernel source, wherever it was extracted,
 finds the machine code compiled by the first run. The module name is part of
-the key because numba's cache refers to the module by name: every FMU build
-imports the kernel under its own private package name (stable for a build, see
-:mod:`fmus.build`), so each build compiles once and then reuses its cache.
+the key because numba's cache refers to the module by name; the kernels are
+loaded under a name keyed by their sources (:mod:`components.model.shared_module`),
+the same for the host and every FMU build, so a machine compiles each version once.
 Nothing else numba caches in the process is affected.
 
 This uses numba's cache classes (``numba.core.caching``), which are not public

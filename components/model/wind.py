@@ -23,13 +23,19 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 from types import ModuleType
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .. import units
 from ..errors import ParameterError
 from .kernel_request import compiled_or_numpy
+from .shared_module import load_shared
+
+if TYPE_CHECKING:  # what an FMU's source closure follows: the module is loaded by load_shared
+    from . import compiled_wind  # noqa: F401
 from ..validation import (
     finite,
     integer_at_least,
@@ -363,12 +369,10 @@ def _compiled_wind_module() -> tuple[ModuleType | None, str | None]:
     """:mod:`components.model.compiled_wind`, or None and why it cannot be imported (tried once per process)."""
     global _compiled_wind, _compiled_wind_error
     if _compiled_wind is None and _compiled_wind_error is None:
-        try:
-            from . import compiled_wind
+        try:  # one module (and one compiled cache) per source version, whichever copy asks
+            _compiled_wind = load_shared(Path(__file__).with_name("compiled_wind.py"), __package__, ("numba_cache.py",))
         except Exception as exc:  # noqa: BLE001 - numba missing or broken: the numpy path runs instead
             _compiled_wind_error = f"{type(exc).__name__}: {exc}"
-        else:
-            _compiled_wind = compiled_wind
     return _compiled_wind, _compiled_wind_error
 
 

@@ -30,7 +30,7 @@ _CHILD = textwrap.dedent("""
     from components.model.generator import GeneratorRotor
     from components.model.presets import cosim_preset
     from components.model.wind import RotorSpeedProcess, WindParameters
-    from components.model import compiled_kernel as ck
+    from components.model.kernel import compiled_module
 
     # one communication step of the compiled kernel from states of a numpy-path run (start-up impacts included)
     dt = cosim_preset("table6")
@@ -56,6 +56,7 @@ _CHILD = textwrap.dedent("""
         compiled.set_state(json.loads(state))
         compiled.step(t, h, *inputs)
         difference = max(difference, float(np.max(np.abs(compiled.output_vector() - expected) / scale)))
+    ck = compiled_module()[0]  # the module GearboxModel used (one per process for the same sources)
     print(json.dumps({
         "disk_cache": ck.DISK_CACHE,
         "hits": sum(ck.gearbox_step.stats.cache_hits.values()),
