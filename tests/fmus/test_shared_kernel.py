@@ -10,7 +10,9 @@ from components.model.kernel import compiled_module
 
 
 def _kernel_modules() -> list[str]:
-    return sorted(name for name in sys.modules if name.endswith("compiled_kernel") or "_compiled_kernel_" in name)
+    """The kernel modules in this process: shared ones, and build-specific or host copies imported by name."""
+    return sorted(name for name in sys.modules
+                  if name.endswith(".model.compiled_kernel") or name.startswith("_dtcosim_compiled_kernel_"))
 
 
 def test_the_gearbox_fmu_runs_on_the_hosts_kernel_module(fmu_path):
