@@ -107,6 +107,7 @@ def step_study(args) -> None:
     for h in steps:
         sc = base.with_simulation(step_s=h, output_interval_s=h)
         system = resolve_system(sc, fmu_paths=paths)
+        CoSimulation(system).run(handle_sigint=False)  # warm-up: the first run also loads the compiled kernels
         outcome = CoSimulation(system).run(handle_sigint=False)
         if not outcome.complete:
             raise SystemExit(f"H = {h * 1e3:g} ms: {outcome.error}")
