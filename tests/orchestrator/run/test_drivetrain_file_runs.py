@@ -9,6 +9,7 @@ from pathlib import Path
 
 import pytest
 
+from components.model.kernel import choose_kernel
 from orchestrator.inputs.drivetrain_file import find_drivetrain, load_drivetrain_file
 from orchestrator.inputs.scenario import drivetrain_fmu_dir, find_scenario
 from tests.helpers.scenarios import dtcosim
@@ -95,7 +96,10 @@ def test_paper_table6_file_gives_the_table7_statistics_of_the_preset(fmu_home, p
             a, b = stats[name][m], preset_stats[name][m]
             assert abs(a - b) <= 1e-9 * max(abs(b), 1e-300), (name, m, a, b)
     mean, std = stats["gearbox.stage1.F_sp[1]"]["mean"], stats["gearbox.stage1.F_sp[1]"]["std"]
-    assert abs(mean / TABLE7_STAGE1_F_SP1[0] - 1) < 1e-9 and abs(std / TABLE7_STAGE1_F_SP1[1] - 1) < 1e-9
+    # pinned for the compiled kernel; the numpy path's round-off, amplified by the step control over 60 s,
+    # moves the std by ~3e-8 (both paths agree per step to 1e-9: tests/components/model/test_compiled_kernel.py)
+    tolerance = 1e-9 if choose_kernel()[0] == "compiled" else 1e-6
+    assert abs(mean / TABLE7_STAGE1_F_SP1[0] - 1) < tolerance and abs(std / TABLE7_STAGE1_F_SP1[1] - 1) < tolerance
 
 
 def test_five_stage_file_builds_runs_5_s_and_validates(fmu_home, tmp_path):
