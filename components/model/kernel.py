@@ -20,7 +20,7 @@ from types import ModuleType
 from typing import TYPE_CHECKING
 
 from .kernel_request import ENVIRONMENT_VARIABLE, KERNELS, compiled_or_numpy, requested_kernel
-from .shared_module import load_shared
+from .shared_module import try_load_shared
 
 if TYPE_CHECKING:  # what an FMU's source closure follows: the kernel module is loaded by load_shared
     from . import compiled_kernel  # noqa: F401
@@ -30,23 +30,13 @@ KERNEL_DEPENDENCIES = ("integrators.py", "numba_cache.py")
 
 __all__ = ["ENVIRONMENT_VARIABLE", "KERNELS", "choose_kernel", "compiled_module", "requested_kernel"]
 
-_compiled: ModuleType | None = None
-_import_error: str | None = None
-
-
 def compiled_module() -> tuple[ModuleType | None, str | None]:
-    """The compiled kernel module, or None and the reason it cannot be used (imported once per process).
+    """The compiled kernel module, or None and the reason it cannot be used (tried once per process).
 
     Loaded by :func:`~components.model.shared_module.load_shared`: every copy of the same kernel
     sources (the host's, each FMU build's) gets one module, compiled and cached once per machine.
     """
-    global _compiled, _import_error
-    if _compiled is None and _import_error is None:
-        try:
-            _compiled = load_shared(Path(__file__).with_name("compiled_kernel.py"), __package__, KERNEL_DEPENDENCIES)
-        except Exception as exc:  # noqa: BLE001 - numba missing or broken: the numpy path runs instead
-            _import_error = f"{type(exc).__name__}: {exc}"
-    return _compiled, _import_error
+    return try_load_shared(Path(__file__).with_name("compiled_kernel.py"), __package__, KERNEL_DEPENDENCIES)
 
 
 def choose_kernel(kernel: str | None = None) -> tuple[str, str | None]:

@@ -57,11 +57,12 @@ def compiled_or_numpy(kernel: str | None, load: Callable[[], tuple[ModuleType | 
     ParameterError
         Unknown name, or ``compiled`` requested where it cannot be imported.
     """
-    if requested_kernel(kernel) == "numpy":
+    wanted = requested_kernel(kernel)
+    if wanted == "numpy":
         return None, None
     module, reason = load()
     if module is not None:
         return module, None
-    if requested_kernel(kernel) == "compiled":
+    if wanted == "compiled":
         raise ParameterError("kernel", "compiled", f"an importable numba ({reason})")
     return None, f"{what} unavailable ({reason}); using the numpy path"

@@ -65,3 +65,21 @@ def load_shared(path: Path, package: str, dependencies: tuple[str, ...]) -> Modu
         del sys.modules[name]
         raise
     return module
+
+
+#: results of :func:`try_load_shared` per (file, dependencies): a module or the reason it could not load
+_attempts: dict[tuple[str, tuple[str, ...]], tuple[ModuleType | None, str | None]] = {}
+
+
+def try_load_shared(path: Path, package: str, dependencies: tuple[str, ...]) -> tuple[ModuleType | None, str | None]:
+    """:func:`load_shared`, tried once per process: the module and None, or None and why it failed.
+
+    For optional compiled modules: a failure (numba missing or broken) is remembered, not retried.
+    """
+    key = (str(path), dependencies)
+    if key not in _attempts:
+        try:
+            _attempts[key] = (load_shared(path, package, dependencies), None)
+        except Exception as exc:  # noqa: BLE001 - the caller runs its numpy path instead and says why
+            _attempts[key] = (None, f"{type(exc).__name__}: {exc}")
+    return _attempts[key]

@@ -32,7 +32,7 @@ import numpy as np
 from .. import units
 from ..errors import ParameterError
 from .kernel_request import compiled_or_numpy
-from .shared_module import load_shared
+from .shared_module import try_load_shared
 
 if TYPE_CHECKING:  # what an FMU's source closure follows: the module is loaded by load_shared
     from . import compiled_wind  # noqa: F401
@@ -361,19 +361,12 @@ class PhasorStepper:
         self._form_sums()
 
 
-_compiled_wind: ModuleType | None = None
-_compiled_wind_error: str | None = None
-
-
 def _compiled_wind_module() -> tuple[ModuleType | None, str | None]:
-    """:mod:`components.model.compiled_wind`, or None and why it cannot be imported (tried once per process)."""
-    global _compiled_wind, _compiled_wind_error
-    if _compiled_wind is None and _compiled_wind_error is None:
-        try:  # one module (and one compiled cache) per source version, whichever copy asks
-            _compiled_wind = load_shared(Path(__file__).with_name("compiled_wind.py"), __package__, ("numba_cache.py",))
-        except Exception as exc:  # noqa: BLE001 - numba missing or broken: the numpy path runs instead
-            _compiled_wind_error = f"{type(exc).__name__}: {exc}"
-    return _compiled_wind, _compiled_wind_error
+    """:mod:`components.model.compiled_wind`, or None and why it cannot be imported (tried once per process).
+
+    One module (and one compiled cache) per source version, whichever copy asks.
+    """
+    return try_load_shared(Path(__file__).with_name("compiled_wind.py"), __package__, ("numba_cache.py",))
 
 
 @dataclass(frozen=True)

@@ -51,3 +51,16 @@ def test_a_module_that_fails_to_execute_is_not_kept(packages):
     with pytest.raises(ModuleNotFoundError, match="module_that_does_not_exist"):
         load_shared(path, "build_a", ("helper.py",))
     assert shared_name(path, ("helper.py",)) not in sys.modules
+
+
+def test_try_load_shared_says_why_and_tries_once(packages):
+    from components.model.shared_module import try_load_shared
+
+    marker = packages / "attempts.txt"
+    path = _copy(packages, "build_a", 3, kernel=f"open({str(marker)!r}, 'a').write('x')\nimport no_such_module\n")
+    first = try_load_shared(path, "build_a", ("helper.py",))
+    assert first == (None, "ModuleNotFoundError: No module named 'no_such_module'")
+    assert try_load_shared(path, "build_a", ("helper.py",)) == first and marker.read_text() == "x"
+    good = _copy(packages, "build_b", 3)
+    module, reason = try_load_shared(good, "build_b", ("helper.py",))
+    assert reason is None and module.scaled(2) == 6
