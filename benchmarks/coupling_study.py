@@ -143,36 +143,40 @@ def step_study(args) -> None:
 SOLVER_TOLERANCES = ("solver.rtol", "solver.atol_q", "solver.atol_v")
 
 
+def _solver_defaults() -> dict[str, float]:
+    """The Gearbox FMU's default error control, by parameter name (``solver.rtol``: ...)."""
+    from components.model.integrators import StepControl
+
+    defaults = StepControl()
+    return {name: getattr(defaults, name.split(".")[1]) for name in SOLVER_TOLERANCES}
+
+
 def _within(r: dict, args) -> bool:
     return r["mean"] <= args.tolerance and r["std"] <= args.tolerance and r["omega_rms"] < args.omega_tolerance
 
 
 def _tolerance_text(scenario) -> str:
-    from components.model.integrators import StepControl
-
     given = next(c for c in scenario.components if c.name == "gearbox").parameters
-    defaults = StepControl()
-    values = [given.get(name, getattr(defaults, name.split(".")[1])) for name in SOLVER_TOLERANCES]
-    return ", ".join(f"{name} = {value:g}" for name, value in zip(SOLVER_TOLERANCES, values))
+    return ", ".join(f"{name} = {given.get(name, value):g}" for name, value in _solver_defaults().items())
 
 
 def tolerance_study(args, base, paths, setup, step_s: float, reference) -> None:
     """The Gearbox's error control at ``args.tolerance_scales`` x its defaults, at the communication step ``step_s``."""
-    from components.model.integrators import StepControl
     from orchestrator.cosim.master import CoSimulation
     from orchestrator.cosim.system import resolve_system
     from orchestrator.run.comparison import run_reference
 
-    defaults = StepControl()
+    defaults = _solver_defaults()
     scales = [float(x) for x in args.tolerance_scales.split(",")]
     print(f"\nGearbox error control at H = {step_s * 1e3:g} ms, scale x the FMU's defaults (solver.rtol "
-          f"{defaults.rtol:g}, solver.atol_q {defaults.atol_q:g} rad, solver.atol_v {defaults.atol_v:g} rad/s)\n")
+          f"{defaults['solver.rtol']:g}, solver.atol_q {defaults['solver.atol_q']:g} rad, solver.atol_v "
+          f"{defaults['solver.atol_v']:g} rad/s)\n")
     print("| scale | max rel. diff. mean | max rel. diff. std | generator-speed RMS error [rad/s] | "
           "max RMS difference / std | stepping CPU per simulated s [s] | within |")
     print("|---|---|---|---|---|---|---|")
     chosen = None
     for scale in scales:
-        values = {name: scale * getattr(defaults, name.split(".")[1]) for name in SOLVER_TOLERANCES}
+        values = {name: scale * value for name, value in defaults.items()}
         sc = base.with_simulation(step_s=step_s, output_interval_s=step_s).with_parameters("gearbox", **values)
         system = resolve_system(sc, fmu_paths=paths)
         CoSimulation(system).run(handle_sigint=False)  # warm-up: the cost column compares like with like
@@ -192,7 +196,7 @@ def tolerance_study(args, base, paths, setup, step_s: float, reference) -> None:
         print("no scale meets the criteria")
     else:
         print(f"loosest scale within the criteria: {chosen:g} ("
-              + ", ".join(f"{name} = {chosen * getattr(defaults, name.split('.')[1]):g}" for name in SOLVER_TOLERANCES)
+              + ", ".join(f"{name} = {chosen * value:g}" for name, value in defaults.items())
               + f"); the scenario has {_tolerance_text(base)}")
 
 
