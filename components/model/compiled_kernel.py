@@ -372,7 +372,7 @@ def _use_factorisation(hd, dq, dv, winvs, istate):
 
 @njit(cache=False)
 def advance(y, t_end, alpha_shift, driver, port, angle0, k, istate, control, dq, dv, winvs, w_bases, port_jac,
-            last_acc, last_force, last_defl, state, backup):
+            last_acc, last_force, last_defl, state, backup, twist_q, twist_port):
     """Integrate one communication step ``[0, t_end]`` (``Rosenbrock23.advance`` with ``_StepSystem``).
 
     Parameters
@@ -398,11 +398,16 @@ def advance(y, t_end, alpha_shift, driver, port, angle0, k, istate, control, dq,
     state, backup : ndarray
         The contiguous region of the buffer holding all of the above state, and room for a copy of it
         (restored on failure).
+    twist_q : ndarray (2n,), twist_port : float
+        Weights of the output-shaft twist on ``[q, 0]`` and on the port angle (its rate: the same weights on
+        the speeds ``v`` and on the port speed).
 
     Returns
     -------
-    status, time, step, error : (int, float, float, float)
-        ``OK`` or the failure code with the local time, step size and error norm at the failure.
+    status, time, step, error, twist_integral : (int, float, float, float, float)
+        ``OK`` or the failure code with the local time, step size and error norm at the failure; the
+        integral of the output-shaft twist over ``[0, t_end]`` [rad s] (Hermite-corrected trapezoid per
+        accepted step, ``GearboxModel._accumulate_twist``; 0 on failure).
     """
     n = dq.shape[0]
     n2 = 2 * n
@@ -442,6 +447,13 @@ def advance(y, t_end, alpha_shift, driver, port, angle0, k, istate, control, dq,
     for i in range(n):
         f0[i] = y[n + i]
         f0[n + i] = last_acc[i] + kappa[i] * alpha_shift
+    twist_t = 0.0  # output-shaft twist, its rate and their integral at the last accepted time
+    twist_a = twist_port * _hermite(port, 0.0)
+    twist_r = twist_port * _hermite_rate(port, 0.0)
+    for i in range(n):
+        twist_a += twist_q[i] * y[i]
+        twist_r += twist_q[i] * y[n + i]
+    twist_integral = 0.0
     steps = 0
     prev_h = -1.0  # (h, err) of a rejected attempt at this t with a fresh Jacobian (prev_h < 0: none)
     prev_err = 0.0
@@ -565,6 +577,16 @@ def advance(y, t_end, alpha_shift, driver, port, angle0, k, istate, control, dq,
             alpha_out = abs(out_kin * _hermite_accel(driver, t) + f0[out_idx])
             if alpha_out > istate[ALPHA_OUT_MAX]:
                 istate[ALPHA_OUT_MAX] = alpha_out
+            twist_b = twist_port * _hermite(port, t)
+            rate_b = twist_port * _hermite_rate(port, t)
+            for i in range(n):
+                twist_b += twist_q[i] * y[i]
+                rate_b += twist_q[i] * y[n + i]
+            dt = t - twist_t
+            twist_integral += 0.5 * dt * (twist_a + twist_b) + dt * dt * (twist_r - rate_b) / 12.0
+            twist_t = t
+            twist_a = twist_b
+            twist_r = rate_b
             fac = 5.0 if err == 0.0 else min(5.0, 0.9 * err ** (-1.0 / 3.0))
             fac = 1.0 if 1.0 <= fac <= 2.0 else fac
             if not last or fac < 1.0:
@@ -603,11 +625,11 @@ def advance(y, t_end, alpha_shift, driver, port, angle0, k, istate, control, dq,
             istate[H_NEXT] = h
             if h < h_min:
                 _copy(backup, state)
-                return STEP_TOO_SMALL, t, h, err
+                return STEP_TOO_SMALL, t, h, err, 0.0
         if steps > max_steps:
             _copy(backup, state)
-            return TOO_MANY_STEPS, t, h, err
-    return OK, t, h, 0.0
+            return TOO_MANY_STEPS, t, h, err, 0.0
+    return OK, t, h, 0.0, twist_integral
 
 
 # ---------------------------------------------------------------- one communication step
@@ -745,12 +767,13 @@ def gearbox_step(buf, lay, dims, t, h, omega_rotor, phi_rotor, omega_gen, phi_ge
     _fit(port, h, sc[S_PORT_ANGLE], sc[S_PORT_SPEED], port1, port_speed1)
     twist_start = sc[S_OUTPUT_TWIST]
     speed_start = out_kin * sc[S_DRIVER_SPEED] + y[out_idx]
-    status, tau, h_fail, err = advance(
+    twist_q = _vec(buf, lay, TWIST_Q)
+    status, tau, h_fail, err, twist_integral = advance(
         y, h, sc[S_LAST_ALPHA] - _hermite_accel(driver, 0.0), driver, port, sc[S_ANGLE0], _constants(buf, lay, dims),
         _vec(buf, lay, ISTATE), control, _mat(buf, lay, DQ, n), _mat(buf, lay, DV, n), _mat(buf, lay, WINV, 4 * n),
         _mat(buf, lay, W_BASIS, 4 * n), _mat(buf, lay, PORT_JAC, 2), _vec(buf, lay, LAST_ACC),
         _vec(buf, lay, LAST_FORCE), _mat(buf, lay, LAST_DEFL, 2), buf[lay[STATE_FIRST]:lay[STATE_LAST + 1]],
-        _vec(buf, lay, BACKUP),
+        _vec(buf, lay, BACKUP), twist_q, sc[S_TWIST_PORT],
     )
     if status != OK:
         return status, tau, h_fail, err
@@ -764,13 +787,12 @@ def gearbox_step(buf, lay, dims, t, h, omega_rotor, phi_rotor, omega_gen, phi_ge
     sc[S_LAST_OMEGA_ROTOR] = omega_rotor
     sc[S_LAST_OMEGA_GEN] = omega_gen
     sc[S_LAST_STEP] = h
-    twist_q = _vec(buf, lay, TWIST_Q)
     twist_end = 0.0
     for i in range(2 * n):
         twist_end += twist_q[i] * y[i]
     twist_end += sc[S_TWIST_PORT] * port1
     sc[S_OUTPUT_TWIST] = twist_end
-    sc[S_SHAFT_TORQUE_AVG] = sc[S_SHAFT_K] * 0.5 * (twist_start + twist_end) + sc[S_SHAFT_C] * (twist_end - twist_start) / h
+    sc[S_SHAFT_TORQUE_AVG] = sc[S_SHAFT_K] * twist_integral / h + sc[S_SHAFT_C] * (twist_end - twist_start) / h
     sc[S_ALPHA_OUT_AVG] = (out_kin * speed1 + y[out_idx] - speed_start) / h
     outputs(buf, lay, dims)
     return OK, tau, h, 0.0

@@ -178,7 +178,8 @@ class GearboxModel:
         Integrator tolerances.
     shaft_torque_mode : {"average", "end"}
         Which value :attr:`shaft_torque_nm` reports: the torque averaged over the
-        last step (conserves the exchanged impulse) or its end-of-step value.
+        last step (conserves the exchanged impulse: the twist integrated along the
+        accepted internal steps) or its end-of-step value.
     extrapolate : bool
         Estimate the input slopes from the last two inputs (True) or hold the
         input speeds over the step (False).
@@ -243,6 +244,9 @@ class GearboxModel:
         self.output_twist_rad = 0.0  # twist of the output shaft (shaft 3) [rad]
         # output twist = _twist_q . q + _twist_port * port angle
         self._twist_q = np.concatenate((a.S[-1], np.zeros(a.n_dof)))
+        self._twist_v = np.concatenate((np.zeros(a.n_dof), a.S[-1]))  # its rate: on v, and _twist_port on the port speed
+        #: (time, twist, twist rate, integral of the twist) at the last accepted internal step of the current step
+        self._twist_accumulator = [0.0, 0.0, 0.0, 0.0]
         self._twist_port = float(a.S_port[-1, 0])
         self._out_shaft_kc = (float(a.shaft_k[-1]), float(a.shaft_c[-1]))  # shaft 3 stiffness, damping
         self._output_matrix = self._build_output_matrix()
@@ -252,7 +256,7 @@ class GearboxModel:
         self.alpha_out_max_rad_s2 = 0.0
         #: d omega_out / dt averaged over the last step [rad/s^2] (instantaneous before the first step)
         self.alpha_out_average_rad_s2 = 0.0
-        self._integrator.on_accept = self._track_output_acceleration
+        self._integrator.on_accept = self._on_accept
         self._finish_allocation()
 
     # ------------------------------------------------------------ outputs
@@ -319,11 +323,20 @@ class GearboxModel:
         sysm = self.system
         return float(self._out_kinematic * sysm.last_alpha + sysm.last_acceleration[self._out_member])
 
-    def _track_output_acceleration(self, tau: float, f: np.ndarray) -> None:
+    def _on_accept(self, tau: float, y: np.ndarray, f: np.ndarray) -> None:
+        """After every accepted internal step: eq. 11's running maximum and the integral of the output twist."""
         # absolute acceleration = kinematic part of the driver's + relative (deviation) part
         alpha = abs(self._out_kinematic * self.system.driver.accel(tau) + f.item(self._out_rate_index))
         if alpha > self.alpha_out_max_rad_s2:
             self.alpha_out_max_rad_s2 = float(alpha)
+        port = self.system.port
+        twist = float(np.dot(self._twist_q, y)) + self._twist_port * port.value(tau)
+        rate = float(np.dot(self._twist_v, y)) + self._twist_port * port.rate(tau)
+        acc = self._twist_accumulator
+        dt = tau - acc[0]
+        # Hermite-corrected trapezoid over the internal step (exact for a cubic twist)
+        acc[3] += 0.5 * dt * (acc[1] + twist) + dt * dt * (acc[2] - rate) / 12.0
+        acc[0], acc[1], acc[2] = tau, twist, rate
 
     @property
     def rotor_torque_nm(self) -> float:
@@ -470,6 +483,8 @@ class GearboxModel:
         sysm.port.fit(h, self.port_angle_rad, self.port_speed_rad_s, port1, port_speed1)
         twist_start = self.output_twist_rad
         speed_start = self.output_speed_rad_s
+        self._twist_accumulator[:] = (0.0, twist_start,
+                                      float(np.dot(self._twist_v, self.y)) + self._twist_port * self.port_speed_rad_s, 0.0)
         # first stage reuses the loads at the end of the previous step: the prescribed
         # motions are C1, so only the driver-acceleration term changes
         a0 = sysm.last_acceleration + a.kinematic_ratio * (sysm.last_alpha - sysm.driver.accel(0.0))
@@ -491,10 +506,11 @@ class GearboxModel:
         self.last_omega_rotor = omega_rotor
         self.last_omega_gen = omega_gen
         self.last_step_s = h
-        # (1/h) int T dt = k mean(twist) + c (twist_end - twist_start) / h, trapezoid for the mean twist
+        # (1/h) int T dt = k mean(twist) + c (twist_end - twist_start) / h, the mean twist integrated along the
+        # accepted internal steps (_on_accept)
         twist_end = self.output_twist_rad = self._output_twist()
         k, c = self._out_shaft_kc
-        self.shaft_torque_average_nm = k * 0.5 * (twist_start + twist_end) + c * (twist_end - twist_start) / h
+        self.shaft_torque_average_nm = k * self._twist_accumulator[3] / h + c * (twist_end - twist_start) / h
         self.alpha_out_average_rad_s2 = (self.output_speed_rad_s - speed_start) / h
 
     @property

@@ -184,9 +184,9 @@ class Rosenbrock23:
         self._rtol = np.array(c.rtol)  # 0-d, see _E32_ARRAY
         #: (y, |y|) of the last step's end state: the next step starts there (arrays are never mutated)
         self._abs_end: tuple[np.ndarray | None, np.ndarray | None] = (None, None)
-        #: called as ``on_accept(t, f)`` after every accepted step, ``t`` its end time [s] and
-        #: ``f = [v, a]`` the derivative there (shape (2n,), not to be modified); None: no call
-        self.on_accept: Callable[[float, np.ndarray], None] | None = None
+        #: called as ``on_accept(t, y, f)`` after every accepted step, ``t`` its end time [s], ``y`` the
+        #: state and ``f = [v, a]`` the derivative there (shape (2n,), not to be modified); None: no call
+        self.on_accept: Callable[[float, np.ndarray, np.ndarray], None] | None = None
 
     # ------------------------------------------------------------- linear algebra
     def _refresh_jacobian(self, t: float, y: np.ndarray) -> None:
@@ -309,7 +309,7 @@ class Rosenbrock23:
                 t = t_end if last else t + h
                 y, f = yn, fn
                 if self.on_accept is not None:
-                    self.on_accept(t, f)
+                    self.on_accept(t, y, f)
                 factor = 5.0 if err == 0.0 else min(5.0, 0.9 * err ** (-1.0 / 3.0))
                 # keep the step (and the factorisation) unless it clearly should change
                 factor = 1.0 if 1.0 <= factor <= 2.0 else factor

@@ -197,3 +197,40 @@ def test_monolithic_wall_time_limit():
     with pytest.raises(ParameterError, match=r"wall_time_limit_s = -1\.0: expected >= 0"):
         SolverSettings(wall_time_limit_s=-1.0)
     assert simulate_monolithic(dt, wind, 0.05, settings=SolverSettings(wall_time_limit_s=60.0)).complete
+
+
+@pytest.mark.parametrize("kernel", ["numpy", "compiled"])
+def test_step_average_torque_integrates_a_ringing_shaft_along_the_internal_steps(kernel):
+    """The exchanged impulse of one 10 ms step matches 200 sub-steps along the same input motion.
+
+    Constant input speeds (no extrapolation), the generator end 0.5 rad/s too fast: shaft 3 rings inside the
+    step, so the plain trapezoid of the two end twists is visibly off; the twist integrated along the accepted
+    internal steps is not.
+    """
+    if kernel == "compiled":
+        pytest.importorskip("numba")
+    dt, wind = _paper_setup()
+    omega_r, h, n_sub = wind.speed(0.0), 1e-2, 200
+    omega_g = dt.ratio * omega_r + 0.5
+
+    def model():
+        m = GearboxModel(dt, extrapolate=False, kernel=kernel)
+        m.initialize(0.0, omega_r, 0.0, omega_g, 0.0)
+        return m
+
+    one = model()
+    twist_start = one.output_twist_rad
+    one.step(0.0, h, omega_r, 0.0, omega_g, 0.0)
+    assert one.integrator.accepted > 3  # the ringing is resolved by several internal steps
+    fine = model()
+    averages = []
+    for k in range(n_sub):
+        t = k * h / n_sub
+        fine.step(t, h / n_sub, omega_r, omega_r * t, omega_g, omega_g * t)
+        averages.append(fine.shaft_torque_average_nm)
+    exact = float(np.mean(averages))
+    k3, c3 = dt.output_shaft.stiffness_nm_per_rad, dt.output_shaft.damping_nms_per_rad
+    twist_end = one.output_twist_rad
+    trapezoid = k3 * 0.5 * (twist_start + twist_end) + c3 * (twist_end - twist_start) / h
+    assert abs(trapezoid - exact) > 5e-3 * abs(exact)  # measured 0.85 % (integrated: 0.018 %, 152 internal steps)
+    assert abs(one.shaft_torque_average_nm - exact) < 0.05 * abs(trapezoid - exact)
