@@ -245,6 +245,7 @@ class GearboxModel:
         # output twist = _twist_q . q + _twist_port * port angle
         self._twist_q = np.concatenate((a.S[-1], np.zeros(a.n_dof)))
         self._twist_v = np.concatenate((np.zeros(a.n_dof), a.S[-1]))  # its rate: on v, and _twist_port on the port speed
+        self._twist_qv = np.stack((self._twist_q, self._twist_v))  # both in one product
         #: (time, twist, twist rate, integral of the twist) at the last accepted internal step of the current step
         self._twist_accumulator = [0.0, 0.0, 0.0, 0.0]
         self._twist_port = float(a.S_port[-1, 0])
@@ -329,9 +330,10 @@ class GearboxModel:
         alpha = abs(self._out_kinematic * self.system.driver.accel(tau) + f.item(self._out_rate_index))
         if alpha > self.alpha_out_max_rad_s2:
             self.alpha_out_max_rad_s2 = float(alpha)
-        port = self.system.port
-        twist = float(np.dot(self._twist_q, y)) + self._twist_port * port.value(tau)
-        rate = float(np.dot(self._twist_v, y)) + self._twist_port * port.rate(tau)
+        twist, rate = (self._twist_qv @ y).tolist()
+        port_angle, port_speed = self.system.port.value_and_rate(tau)
+        twist += self._twist_port * port_angle
+        rate += self._twist_port * port_speed
         acc = self._twist_accumulator
         dt = tau - acc[0]
         # Hermite-corrected trapezoid over the internal step (exact for a cubic twist)
