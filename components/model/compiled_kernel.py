@@ -407,7 +407,7 @@ def advance(y, t_end, alpha_shift, driver, port, angle0, k, istate, control, dq,
     status, time, step, error, twist_integral : (int, float, float, float, float)
         ``OK`` or the failure code with the local time, step size and error norm at the failure; the
         integral of the output-shaft twist over ``[0, t_end]`` [rad s] (Hermite-corrected trapezoid per
-        accepted step, ``GearboxModel._accumulate_twist``; 0 on failure).
+        accepted step, as ``GearboxModel._on_accept``; 0 on failure).
     """
     n = dq.shape[0]
     n2 = 2 * n
@@ -447,7 +447,8 @@ def advance(y, t_end, alpha_shift, driver, port, angle0, k, istate, control, dq,
     for i in range(n):
         f0[i] = y[n + i]
         f0[n + i] = last_acc[i] + kappa[i] * alpha_shift
-    twist_t = 0.0  # output-shaft twist, its rate and their integral at the last accepted time
+    # time, output-shaft twist and its rate at the last accepted internal step, and the twist's integral so far
+    twist_t = 0.0
     twist_a = twist_port * _hermite(port, 0.0)
     twist_r = twist_port * _hermite_rate(port, 0.0)
     for i in range(n):
