@@ -370,6 +370,17 @@ def _use_factorisation(hd, dq, dv, winvs, istate):
     return other
 
 
+@njit(cache=False, inline=_INLINE)
+def _twist_and_rate(twist_q, y, n, twist_port, port, tau):
+    """Output-shaft twist [rad] and its rate [rad/s] at ``tau``: the weights on ``q`` and on ``v``, plus the port's."""
+    twist = twist_port * _hermite(port, tau)
+    rate = twist_port * _hermite_rate(port, tau)
+    for i in range(n):
+        twist += twist_q[i] * y[i]
+        rate += twist_q[i] * y[n + i]
+    return twist, rate
+
+
 @njit(cache=False)
 def advance(y, t_end, alpha_shift, driver, port, angle0, k, istate, control, dq, dv, winvs, w_bases, port_jac,
             last_acc, last_force, last_defl, state, backup, twist_q, twist_port):
@@ -449,11 +460,7 @@ def advance(y, t_end, alpha_shift, driver, port, angle0, k, istate, control, dq,
         f0[n + i] = last_acc[i] + kappa[i] * alpha_shift
     # time, output-shaft twist and its rate at the last accepted internal step, and the twist's integral so far
     twist_t = 0.0
-    twist_a = twist_port * _hermite(port, 0.0)
-    twist_r = twist_port * _hermite_rate(port, 0.0)
-    for i in range(n):
-        twist_a += twist_q[i] * y[i]
-        twist_r += twist_q[i] * y[n + i]
+    twist_a, twist_r = _twist_and_rate(twist_q, y, n, twist_port, port, 0.0)
     twist_integral = 0.0
     steps = 0
     prev_h = -1.0  # (h, err) of a rejected attempt at this t with a fresh Jacobian (prev_h < 0: none)
@@ -578,11 +585,7 @@ def advance(y, t_end, alpha_shift, driver, port, angle0, k, istate, control, dq,
             alpha_out = abs(out_kin * _hermite_accel(driver, t) + f0[out_idx])
             if alpha_out > istate[ALPHA_OUT_MAX]:
                 istate[ALPHA_OUT_MAX] = alpha_out
-            twist_b = twist_port * _hermite(port, t)
-            rate_b = twist_port * _hermite_rate(port, t)
-            for i in range(n):
-                twist_b += twist_q[i] * y[i]
-                rate_b += twist_q[i] * y[n + i]
+            twist_b, rate_b = _twist_and_rate(twist_q, y, n, twist_port, port, t)
             dt = t - twist_t
             twist_integral += 0.5 * dt * (twist_a + twist_b) + dt * dt * (twist_r - rate_b) / 12.0
             twist_t = t
@@ -892,9 +895,8 @@ def step_entry_point():
         return gearbox_step
 
 
-DISPATCHERS = (_sign, contact_force, stiffness_factors, _hermite, _hermite_rate, _hermite_accel, deflections,
-               acceleration, jacobian, _invert, _factor, _copy, _matvec, _stiffness_sensitivity, advance,
-               _vec, _mat, _fit, _constants, outputs, gearbox_step, monolithic_rhs,
-               monolithic_jacobian)
+DISPATCHERS = (_sign, contact_force, stiffness_factors, _hermite, _hermite_rate, _hermite_accel, _twist_and_rate,
+               deflections, acceleration, jacobian, _invert, _factor, _copy, _matvec, _stiffness_sensitivity, advance,
+               _vec, _mat, _fit, _constants, outputs, gearbox_step, monolithic_rhs, monolithic_jacobian)
 #: True when the machine code is cached on disk (see :mod:`components.model.numba_cache`)
 DISK_CACHE = enable_stable_cache(DISPATCHERS, __file__, __name__)

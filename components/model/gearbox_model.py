@@ -244,8 +244,8 @@ class GearboxModel:
         self.output_twist_rad = 0.0  # twist of the output shaft (shaft 3) [rad]
         # output twist = _twist_q . q + _twist_port * port angle
         self._twist_q = np.concatenate((a.S[-1], np.zeros(a.n_dof)))
-        self._twist_v = np.concatenate((np.zeros(a.n_dof), a.S[-1]))  # its rate: on v, and _twist_port on the port speed
-        self._twist_qv = np.stack((self._twist_q, self._twist_v))  # both in one product
+        # twist and its rate in one product: the same weights on q and on v (and _twist_port on the port's)
+        self._twist_qv = np.stack((self._twist_q, np.concatenate((np.zeros(a.n_dof), a.S[-1]))))
         #: (time, twist, twist rate, integral of the twist) at the last accepted internal step of the current step
         self._twist_accumulator = [0.0, 0.0, 0.0, 0.0]
         self._twist_port = float(a.S_port[-1, 0])
@@ -330,10 +330,7 @@ class GearboxModel:
         alpha = abs(self._out_kinematic * self.system.driver.accel(tau) + f.item(self._out_rate_index))
         if alpha > self.alpha_out_max_rad_s2:
             self.alpha_out_max_rad_s2 = float(alpha)
-        twist, rate = (self._twist_qv @ y).tolist()
-        port_angle, port_speed = self.system.port.value_and_rate(tau)
-        twist += self._twist_port * port_angle
-        rate += self._twist_port * port_speed
+        twist, rate = self._twist_and_rate(y, *self.system.port.value_and_rate(tau))
         acc = self._twist_accumulator
         dt = tau - acc[0]
         # Hermite-corrected trapezoid over the internal step (exact for a cubic twist)
@@ -485,8 +482,8 @@ class GearboxModel:
         sysm.port.fit(h, self.port_angle_rad, self.port_speed_rad_s, port1, port_speed1)
         twist_start = self.output_twist_rad
         speed_start = self.output_speed_rad_s
-        self._twist_accumulator[:] = (0.0, twist_start,
-                                      float(np.dot(self._twist_v, self.y)) + self._twist_port * self.port_speed_rad_s, 0.0)
+        rate_start = self._twist_and_rate(self.y, self.port_angle_rad, self.port_speed_rad_s)[1]
+        self._twist_accumulator[:] = (0.0, twist_start, rate_start, 0.0)
         # first stage reuses the loads at the end of the previous step: the prescribed
         # motions are C1, so only the driver-acceleration term changes
         a0 = sysm.last_acceleration + a.kinematic_ratio * (sysm.last_alpha - sysm.driver.accel(0.0))
@@ -529,6 +526,11 @@ class GearboxModel:
 
     def _store_compiled(self) -> None:
         """Hook of the compiled model: hand the state its buffer holds back to the numpy side."""
+
+    def _twist_and_rate(self, y: np.ndarray, port_angle_rad: float, port_speed_rad_s: float) -> tuple[float, float]:
+        """Twist [rad] and twist rate [rad/s] of the output shaft (shaft 3) at the state ``y`` and port motion."""
+        twist, rate = (self._twist_qv @ y).tolist()
+        return twist + self._twist_port * port_angle_rad, rate + self._twist_port * port_speed_rad_s
 
     def _output_twist(self) -> float:
         """Twist of the output shaft (shaft 3) [rad]."""
