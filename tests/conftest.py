@@ -27,7 +27,9 @@ def built_fmus(tmp_path_factory):
     Tests only read them; a test that needs changed FMUs builds its own.
     """
     from fmus.build import build_all
+    from orchestrator.cosim.compiled_kernels import ensure_compiled_kernels
 
+    ensure_compiled_kernels()  # the kernels compiled ahead of time (as `dtcosim build` and `run` do)
     out = tmp_path_factory.mktemp("fmus")
     return {b.name: b for b in build_all(out, "table6")}
 

@@ -46,5 +46,10 @@ def rotate_and_sum(z, rotation, amplitudes, amplitudes_over_f):
 
 
 DISPATCHERS = (phasor_sums, rotate_and_sum)
+#: entry points of the ahead-of-time compiled module (:mod:`components.model.aot`) and their signatures
+AOT_EXPORTS = {
+    "phasor_sums": "UniTuple(f8, 2)(c16[::1], f8[::1], f8[::1])",
+    "rotate_and_sum": "UniTuple(f8, 2)(c16[::1], c16[::1], f8[::1], f8[::1])",
+}
 #: True when the machine code is cached on disk (see :mod:`components.model.numba_cache`)
 DISK_CACHE = enable_stable_cache(DISPATCHERS, __file__, __name__)

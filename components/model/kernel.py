@@ -5,7 +5,8 @@
 :class:`~components.reference.solver.MonolithicSystem` chooses:
 
 * ``auto`` (default): the compiled kernel (:mod:`components.model.compiled_kernel`,
-  numba) where numba imports, else the numpy path;
+  numba) where it is built ahead of time (:mod:`components.model.aot`) or numba imports,
+  else the numpy path;
 * ``numpy``: always the numpy path (the single source of truth of the equations);
 * ``compiled``: the compiled kernel, or a :class:`~components.errors.ParameterError`
   saying why it is unavailable.
@@ -19,24 +20,64 @@ from pathlib import Path
 from types import ModuleType
 from typing import TYPE_CHECKING
 
+from . import kernel_layout
+from .aot import AotKernel, facade, load_module
 from .kernel_request import ENVIRONMENT_VARIABLE, KERNELS, compiled_or_numpy, requested_kernel
-from .shared_module import try_load_shared
+from .shared_module import shared_name, try_load_shared
 
 if TYPE_CHECKING:  # what an FMU's source closure follows: the kernel module is loaded by load_shared
     from . import compiled_kernel  # noqa: F401
 
 #: project modules the kernel imports (their sources are part of its shared name)
-KERNEL_DEPENDENCIES = ("integrators.py", "numba_cache.py")
+KERNEL_DEPENDENCIES = ("integrators.py", "kernel_layout.py", "numba_cache.py")
+_SOURCE = Path(__file__).with_name("compiled_kernel.py")
 
-__all__ = ["ENVIRONMENT_VARIABLE", "KERNELS", "choose_kernel", "compiled_module", "requested_kernel"]
+__all__ = ["ENVIRONMENT_VARIABLE", "KERNELS", "aot_kernel", "choose_kernel", "compiled_module", "jit_module",
+           "requested_kernel"]
 
-def compiled_module() -> tuple[ModuleType | None, str | None]:
-    """The compiled kernel module, or None and the reason it cannot be used (tried once per process).
+
+def jit_module() -> tuple[ModuleType | None, str | None]:
+    """The just-in-time kernel module (numba), or None and the reason it cannot be used (tried once per process).
 
     Loaded by :func:`~components.model.shared_module.load_shared`: every copy of the same kernel
     sources (the host's, each FMU build's) gets one module, compiled and cached once per machine.
     """
-    return try_load_shared(Path(__file__).with_name("compiled_kernel.py"), __package__, KERNEL_DEPENDENCIES)
+    return try_load_shared(_SOURCE, __package__, KERNEL_DEPENDENCIES)
+
+
+def _jit_kernel_module() -> ModuleType:
+    """:func:`jit_module` or its error (the ahead-of-time builder's provider)."""
+    module, reason = jit_module()
+    if module is None:
+        raise ImportError(reason)
+    return module
+
+
+def aot_kernel() -> AotKernel:
+    """The gearbox kernel as :mod:`components.model.aot` builds and finds it."""
+    return AotKernel(shared_name(_SOURCE, KERNEL_DEPENDENCIES), f"{__name__}:_jit_kernel_module")
+
+
+_facades: dict[str, ModuleType] = {}
+
+
+def compiled_module() -> tuple[ModuleType | None, str | None]:
+    """The compiled kernel: its ahead-of-time module where built, else :func:`jit_module`.
+
+    The ahead-of-time form (:func:`components.model.aot.facade`) has the stepping entry points
+    (``gearbox_step``, ``outputs``) and :mod:`~components.model.kernel_layout`; any other name
+    (the monolithic reference's functions) comes from the just-in-time module on first use.
+    """
+    kernel = aot_kernel()
+    front = _facades.get(kernel.shared)
+    if front is None:
+        module = load_module(kernel)
+        if module is None:
+            return jit_module()
+        front = facade(module, kernel.module_name + "_facade", kernel_layout, jit_module,
+                       ensure_compiled=lambda: None, step_entry_point=lambda: module.gearbox_step)
+        _facades[kernel.shared] = front
+    return front, None
 
 
 def choose_kernel(kernel: str | None = None) -> tuple[str, str | None]:

@@ -31,8 +31,9 @@ import numpy as np
 
 from .. import units
 from ..errors import ParameterError
+from .aot import AotKernel, facade, load_module
 from .kernel_request import compiled_or_numpy
-from .shared_module import try_load_shared
+from .shared_module import shared_name, try_load_shared
 
 if TYPE_CHECKING:  # what an FMU's source closure follows: the module is loaded by load_shared
     from . import compiled_wind  # noqa: F401
@@ -361,12 +362,42 @@ class PhasorStepper:
         self._form_sums()
 
 
-def _compiled_wind_module() -> tuple[ModuleType | None, str | None]:
-    """:mod:`components.model.compiled_wind`, or None and why it cannot be imported (tried once per process).
+_WIND_SOURCE = Path(__file__).with_name("compiled_wind.py")
+_WIND_DEPENDENCIES = ("numba_cache.py",)
+_wind_facades: dict[str, ModuleType] = {}
+
+
+def _jit_wind_module() -> tuple[ModuleType | None, str | None]:
+    """:mod:`components.model.compiled_wind` just in time, or None and why it cannot be imported (tried once).
 
     One module (and one compiled cache) per source version, whichever copy asks.
     """
-    return try_load_shared(Path(__file__).with_name("compiled_wind.py"), __package__, ("numba_cache.py",))
+    return try_load_shared(_WIND_SOURCE, __package__, _WIND_DEPENDENCIES)
+
+
+def _jit_wind_kernel_module() -> ModuleType:
+    """:func:`_jit_wind_module` or its error (the ahead-of-time builder's provider)."""
+    module, reason = _jit_wind_module()
+    if module is None:
+        raise ImportError(reason)
+    return module
+
+
+def aot_wind_kernel() -> AotKernel:
+    """The compiled wind step as :mod:`components.model.aot` builds and finds it."""
+    return AotKernel(shared_name(_WIND_SOURCE, _WIND_DEPENDENCIES), f"{__name__}:_jit_wind_kernel_module")
+
+
+def _compiled_wind_module() -> tuple[ModuleType | None, str | None]:
+    """The compiled wind step: its ahead-of-time module where built, else :func:`_jit_wind_module`."""
+    kernel = aot_wind_kernel()
+    front = _wind_facades.get(kernel.shared)
+    if front is None:
+        module = load_module(kernel)
+        if module is None:
+            return _jit_wind_module()
+        front = _wind_facades[kernel.shared] = facade(module, kernel.module_name + "_facade", None, _jit_wind_module)
+    return front, None
 
 
 @dataclass(frozen=True)

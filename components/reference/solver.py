@@ -24,7 +24,8 @@ from scipy.integrate import odeint
 from ..errors import ParameterError, SolverError, WallTimeLimitError
 from ..model.assembly import Assembly
 from ..model.drivetrain import Drivetrain
-from ..model.kernel import choose_kernel, compiled_module
+from ..model.kernel import jit_module
+from ..model.kernel_request import compiled_or_numpy
 from ..validation import finite, non_negative, positive
 from .results import EnergyAudit, SimulationResult
 
@@ -111,13 +112,14 @@ class MonolithicSystem:
         self.deadline = math.inf  # time.perf_counter() value past which rhs raises (see start_clock)
         self.wall_time_limit_s = 0.0
         self._motion = getattr(driver, "motion", None)
-        self.kernel, self.kernel_note = choose_kernel(kernel)
-        self._compiled = self._compiled_arrays() if self.kernel == "compiled" else None
+        # the monolithic right-hand side is not compiled ahead of time: numba's just-in-time kernel
+        module, self.kernel_note = compiled_or_numpy(kernel, jit_module, "compiled gearbox kernel")
+        self.kernel = "numpy" if module is None else "compiled"
+        self._compiled = None if module is None else self._compiled_arrays(module)
 
-    def _compiled_arrays(self):
+    def _compiled_arrays(self, module):
         from ..model.gearbox_kernel import contact_table, mesh_sparsity
 
-        module = compiled_module()[0]
         a = self.assembly
         n, m = a.n_dof, a.n_mesh
         c = np.ascontiguousarray

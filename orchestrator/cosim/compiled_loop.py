@@ -25,9 +25,13 @@ from __future__ import annotations
 import ctypes
 from ctypes import c_double
 from pathlib import Path
+from types import ModuleType
 from typing import Callable
 
 import numpy as np
+
+from components.model.aot import AotKernel, facade, load_module
+from components.model.shared_module import shared_name
 
 from .compiled_loop_layout import (
     FUNCTIONS,
@@ -51,16 +55,39 @@ _module = None
 _import_error: str | None = None
 
 
+_SOURCE = Path(__file__).with_name("compiled_loop_kernel.py")
+_DEPENDENCIES = ("compiled_loop_layout.py",)
+
+
+def _jit_kernel_module() -> ModuleType:
+    """The numba module of the loop (the ahead-of-time builder's provider; raises without numba)."""
+    from . import compiled_loop_kernel  # optional requirement: numba
+
+    return compiled_loop_kernel
+
+
+def aot_loop_kernel() -> AotKernel:
+    """The compiled stepping loop as :mod:`components.model.aot` builds and finds it."""
+    return AotKernel(shared_name(_SOURCE, _DEPENDENCIES), f"{__name__}:_jit_kernel_module")
+
+
+def _jit_module() -> tuple[ModuleType | None, str | None]:
+    try:
+        return _jit_kernel_module(), None
+    except Exception as exc:  # noqa: BLE001 - numba missing or broken: the generated loop runs
+        return None, f"{type(exc).__name__}: {exc}"
+
+
 def _load():
-    """The compiled part (numba), or None with the reason (imported once per process)."""
+    """The compiled part (ahead of time where built, else numba), or None with the reason (once per process)."""
     global _module, _import_error
     if _module is None and _import_error is None:
-        try:
-            from . import compiled_loop_kernel as _kernel
-        except Exception as exc:  # noqa: BLE001 - numba missing or broken: the generated loop runs
-            _import_error = f"{type(exc).__name__}: {exc}"
+        kernel = aot_loop_kernel()
+        aot = load_module(kernel)
+        if aot is not None:
+            _module = facade(aot, kernel.module_name + "_facade", None, _jit_module)
         else:
-            _module = _kernel
+            _module, _import_error = _jit_module()
     return _module
 
 

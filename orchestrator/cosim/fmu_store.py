@@ -3,7 +3,8 @@
 A relative FMU path is looked up next to the scenario file, then in the FMU
 directory (:func:`orchestrator.cosim.fmu_folder.default_fmu_dir`). ``dtcosim run`` builds a
 missing ``WindSource.fmu``, ``Gearbox.fmu`` or ``GeneratorRotor.fmu`` (the FMUs
-this project makes, with ``fmus.build``) into the FMU directory; any other
+this project makes, with ``fmus.build``) into the FMU directory, and the kernels they step
+compiled ahead of time (:mod:`orchestrator.cosim.compiled_kernels`); any other
 missing FMU is a scenario error naming the component. A component built from a
 drivetrain file (``drivetrain = "..."``) gets its FMU in the folder of that file's
 content (:mod:`orchestrator.cosim.drivetrain_fmus`), built when missing or stale.
@@ -65,6 +66,10 @@ def ensure_fmus(scenario: Scenario, fmu_dir: str | Path | None = None, build: bo
         ``components.<name>.fmu`` for a missing FMU that cannot be built.
     """
     fmu_dir = default_fmu_dir() if fmu_dir is None else Path(fmu_dir)
+    if build:  # the kernels the FMUs and the master step, compiled ahead of time once per machine
+        from .compiled_kernels import ensure_compiled_kernels
+
+        ensure_compiled_kernels(report)
     if build:  # FMUs of drivetrain files: in their content's folder, built when missing or stale
         from .drivetrain_fmus import ensure_drivetrain_fmus
 

@@ -9,9 +9,12 @@ import zipfile
 import numpy as np
 import pytest
 
+from components.model.aot import ENVIRONMENT_VARIABLE as AOT_VARIABLE
+from components.model.aot import missing
 from components.model.kernel_request import requested_kernel
 from fmus.model_description import rewrite_archive
 from fmus.selftest import environment_python, run_fmus
+from orchestrator.cosim.compiled_kernels import aot_kernels
 from tests.helpers.fmu_hosts import load_driver, run_python
 from tests.helpers.scenarios import dtcosim
 
@@ -40,8 +43,9 @@ def test_environment_has_nothing_but_the_declared_requirements_and_fmpy(requirem
 @pytest.mark.slow
 def test_one_second_cosimulation_agrees_with_dtcosim_run(fmu_dir, requirements_python, tmp_path):
     out = tmp_path / "loop.npz"
+    # the numpy path there (not the kernels compiled ahead of time, which need no numba either: test_hosts.py)
     loop = run_python(requirements_python, load_driver("fmu_loop").__file__, str(fmu_dir), "1.0", str(H), str(out),
-                      "scenario")
+                      "scenario", env={AOT_VARIABLE: "0"})
     assert loop.returncode == 0, loop.stderr[-3000:]
     bare = np.load(out)
     assert list(bare["modules"]) and all(m.startswith("_dtcosim_") for m in bare["modules"])
@@ -69,6 +73,8 @@ def test_validate_host_runs_each_fmu_in_the_declared_environment(fmu_dir, requir
     assert out.count("host self-test ok (a bare fmpy loop without dtcosim; imports ") == 5  # the five preset FMUs
     assert out.count(", all declared)") == 5
     if requested_kernel() == "numpy":  # DTCOSIM_KERNEL=numpy reaches the FMUs: they do not even try numba
+        assert "imports numba" not in out and out.count("imports numpy, all declared") == 5
+    elif not missing(aot_kernels()):  # the kernels compiled ahead of time: no numba needed, none tried
         assert "imports numba" not in out and out.count("imports numpy, all declared") == 5
     else:  # numba: optional, tried (and missing in that environment)
         assert "imports numba, numpy, all declared" in out

@@ -13,11 +13,14 @@ import numpy as np
 import pytest
 from fmpy import read_model_description
 
+from components.model.aot import ENVIRONMENT_VARIABLE as AOT_VARIABLE
+from components.model.aot import missing
 from components.model.gearbox_model import GearboxModel
 from components.model.generator import GeneratorRotor
 from components.model.presets import cosim_preset
 from components.model.wind import PhasorStepper, RotorSpeedProcess, WindParameters
 from fmus.build import SourceTree, build_fmu
+from orchestrator.cosim.compiled_kernels import aot_kernels
 from tests.helpers.fmu_hosts import Instance, load_driver, run_python
 
 H = 1.0e-3
@@ -60,24 +63,37 @@ def test_fmpy_loop_reproduces_the_components_bit_for_bit(fmu_dir):
 
 
 @pytest.mark.slow
-def test_loop_runs_in_a_fresh_venv_without_dtcosim(fmu_dir, bare_python, tmp_path, monkeypatch):
+@pytest.mark.parametrize("ahead_of_time", [False, True], ids=["numpy-fallback", "ahead-of-time-kernels"])
+def test_loop_runs_in_a_fresh_venv_without_dtcosim(fmu_dir, bare_python, tmp_path, monkeypatch, ahead_of_time):
+    """Only numpy and scipy: the numpy fallback, or (where built on this machine) the kernels compiled ahead of time."""
+    if ahead_of_time and missing(aot_kernels()):
+        pytest.skip("the kernels could not be compiled ahead of time on this machine")
     assert run_python(bare_python, "-c", "import components").returncode != 0
     assert run_python(bare_python, "-c", "import fmus").returncode != 0
-    assert run_python(bare_python, "-c", "import numba").returncode != 0  # only numpy and scipy: the fallback
+    assert run_python(bare_python, "-c", "import numba").returncode != 0
     out = tmp_path / "bare.npz"
     driver = load_driver("fmu_loop").__file__
-    # the default kernel choice (auto), whatever this process was asked for: the FMU must find numba missing
-    result = run_python(bare_python, driver, str(fmu_dir), "1.0", str(H), str(out), env={"DTCOSIM_KERNEL": "auto"})
+    # the default kernel choice (auto), whatever this process was asked for
+    env = {"DTCOSIM_KERNEL": "auto", AOT_VARIABLE: "1" if ahead_of_time else "0"}
+    result = run_python(bare_python, driver, str(fmu_dir), "1.0", str(H), str(out), env=env)
     assert result.returncode == 0, result.stderr[-3000:]
-    # the Gearbox says once, through the FMI logger, that it runs the numpy path
-    assert (result.stdout + result.stderr).count("compiled gearbox kernel unavailable") == 1, result.stdout[-2000:]
+    # without numba and compiled modules, the Gearbox says once, through the FMI logger, that it runs the numpy path
+    said = (result.stdout + result.stderr).count("compiled gearbox kernel unavailable")
+    assert said == (0 if ahead_of_time else 1), result.stdout[-2000:]
     bare = np.load(out)
+    assert not bare["numba_loaded"]
     modules = list(bare["modules"])
     assert modules and all(m.startswith("_dtcosim_") for m in modules), modules  # only the FMUs' private copies
-    monkeypatch.setenv("DTCOSIM_KERNEL", "numpy")  # compare like with like: this process has the compiled kernel
+    assert any(m.endswith("_aot") for m in modules) == ahead_of_time, modules
+    # compare like with like: the compiled kernels run the numba-lowered code of this process's just-in-time ones
+    monkeypatch.setenv("DTCOSIM_KERNEL", "auto" if ahead_of_time else "numpy")
+    monkeypatch.setenv(AOT_VARIABLE, "0")
     in_process = load_driver("fmu_loop").run(fmu_dir, 1.0, H)
     for key in ("GeneratorRotor.omega", "Gearbox.shaft_torque", "Gearbox.stage1.F_sp[1]", "WindSource.omega"):
-        np.testing.assert_allclose(bare[key], in_process[key], rtol=1e-9, atol=1e-6, err_msg=key)
+        if ahead_of_time:
+            np.testing.assert_array_equal(bare[key], in_process[key], err_msg=key)
+        else:
+            np.testing.assert_allclose(bare[key], in_process[key], rtol=1e-9, atol=1e-6, err_msg=key)
 
 
 @pytest.mark.slow

@@ -162,4 +162,5 @@ def loaded_dtcosim_modules() -> list[str]:
 if __name__ == "__main__":
     fmu_dir, t_end, step, out_path = sys.argv[1], float(sys.argv[2]), float(sys.argv[3]), sys.argv[4]
     result = run(fmu_dir, t_end, step, *sys.argv[5:6])
-    np.savez(out_path, modules=np.array(loaded_dtcosim_modules()), **result)
+    np.savez(out_path, modules=np.array(loaded_dtcosim_modules()), numba_loaded=np.array("numba" in sys.modules),
+             **result)

@@ -1,0 +1,201 @@
+"""Ahead-of-time compiled kernels: numba's machine code in a plain extension module that runs without numba.
+
+The compiled kernels (:mod:`components.model.compiled_kernel`, :mod:`components.model.compiled_wind`,
+the master's stepping loop) are numba functions. Used just in time, they bring numba and
+llvmlite into every process that steps them: ~75 MB of resident memory and ~0.5 s of
+imports even when the machine code comes from numba's disk cache (``bench_long_run.py
+--imports``). Each kernel module therefore also declares ``AOT_EXPORTS`` (entry point ->
+numba signature), and :func:`build_module` compiles those entry points with ``numba.pycc``
+into an extension module that imports with numpy alone (the same numba lowering of the same
+source: the tests compare its results with the just-in-time functions bit for bit).
+
+* **Name**: ``<shared name>_aot``, the shared name keyed by the kernel's sources
+  (:func:`components.model.shared_module.shared_name`), so a module built from other sources
+  is never loaded; the directory (:func:`aot_directory`) is keyed by the Python ABI and the
+  numpy version it was built against.
+* **Building** needs numba and a C compiler (setuptools' compiler: gcc or clang, MSVC on
+  Windows): ~10 s and ~1 MB per kernel, once per machine and source version. It runs in a
+  child process (:func:`build_in_subprocess`), so the builder's numba stays out of the run.
+* **Loading** (:func:`load_module`) needs only the file: where it is missing, cannot be
+  imported or ``DTCOSIM_AOT=0``, the kernel's owner uses the just-in-time module as before.
+
+:func:`facade` joins the extension module's entry points, the kernel's layout constants and,
+for anything else (the monolithic reference's functions, test helpers), the just-in-time
+module, loaded only when such a name is asked for.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.machinery
+import importlib.util
+import os
+import subprocess
+import sys
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+from types import ModuleType
+from typing import Callable, Sequence
+
+from .numba_cache import user_cache_root
+
+#: ``DTCOSIM_AOT=0``: never load ahead-of-time modules (the just-in-time kernels run instead)
+ENVIRONMENT_VARIABLE = "DTCOSIM_AOT"
+
+
+@dataclass(frozen=True)
+class AotKernel:
+    """One kernel that can be compiled ahead of time.
+
+    Attributes
+    ----------
+    shared : str
+        Its shared name (:func:`~components.model.shared_module.shared_name`): the key of the module.
+    provider : str
+        ``"package.module:function"``: a function returning the just-in-time kernel module (which
+        defines ``AOT_EXPORTS``), called by the builder process.
+    """
+
+    shared: str
+    provider: str
+
+    @property
+    def module_name(self) -> str:
+        """Import name of the extension module."""
+        return f"{self.shared}_aot"
+
+    def file(self, directory: Path | None = None) -> Path:
+        """Path of the extension module in ``directory`` (default :func:`aot_directory`)."""
+        return (directory or aot_directory()) / (self.module_name + importlib.machinery.EXTENSION_SUFFIXES[0])
+
+
+def aot_directory() -> Path:
+    """``<user cache>/aot/<python cache tag>-numpy<major.minor>``: where this interpreter's modules live."""
+    import numpy as np
+
+    numpy_version = ".".join(np.__version__.split(".")[:2])
+    return user_cache_root() / "aot" / f"{sys.implementation.cache_tag}-numpy{numpy_version}"
+
+
+def enabled() -> bool:
+    """False where ``DTCOSIM_AOT=0``, and in an interpreter a non-Python program embeds (a C host of a PythonFMU).
+
+    In a C host that starts Python through pythonfmu's FMU library (``tests/fmus/test_hosts.py``),
+    the process aborts at exit (``free(): corrupted unsorted chunks``, in libgfortran's exit
+    handler) when an ahead-of-time module was loaded; the same steps in a C program embedding
+    Python (with pythonfmu's thread-state handling) exit cleanly, and valgrind finds pythonfmu's
+    exit-time finalisation reading freed memory, so the fault is likely pythonfmu's. Such hosts
+    (``sys.orig_argv`` empty: no Python command line) run the just-in-time or numpy kernels.
+    """
+    if not getattr(sys, "orig_argv", ["python"]):
+        return False
+    return os.environ.get(ENVIRONMENT_VARIABLE, "1").strip() != "0"
+
+
+def load_module(kernel: AotKernel) -> ModuleType | None:
+    """The kernel's extension module if it was built for this interpreter and imports; else None."""
+    if not enabled():
+        return None
+    module = sys.modules.get(kernel.module_name)
+    if module is not None:
+        return module
+    path = kernel.file()
+    if not path.is_file():
+        return None
+    try:
+        spec = importlib.util.spec_from_file_location(kernel.module_name, path)
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+    except Exception:  # noqa: BLE001 - not importable here (another ABI, a damaged file): the JIT kernel runs
+        return None
+    sys.modules[kernel.module_name] = module
+    return module
+
+
+def facade(module: ModuleType, name: str, constants: ModuleType | None,
+           jit_module: Callable[[], tuple[ModuleType | None, str | None]], **extra) -> ModuleType:
+    """A module with the entry points of ``module``, the public names of ``constants`` and ``extra``.
+
+    Any other attribute is looked up in the just-in-time module (``jit_module()``, loaded on
+    first use); where that cannot load, the attribute error says why.
+    """
+    front = ModuleType(name, f"ahead-of-time kernel {module.__name__} ({module.__file__})")
+    if constants is not None:
+        front.__dict__.update({k: v for k, v in vars(constants).items() if not k.startswith("_")})
+    front.__dict__.update({k: v for k, v in vars(module).items() if not k.startswith("_")})
+    front.__dict__.update(extra)
+    front.AHEAD_OF_TIME = module.__file__
+
+    def __getattr__(attribute: str):
+        jit, reason = jit_module()
+        if jit is None:
+            raise AttributeError(f"{attribute} is not in the ahead-of-time kernel {module.__name__} and the "
+                                 f"just-in-time kernel is unavailable ({reason})")
+        return getattr(jit, attribute)
+
+    front.__getattr__ = __getattr__
+    return front
+
+
+def build_module(kernel: AotKernel, directory: Path | None = None) -> Path:
+    """Compile the kernel's ``AOT_EXPORTS`` into its extension module in ``directory``; returns the file.
+
+    Needs numba and a C compiler; written atomically (a concurrent build of the same kernel
+    leaves one complete file).
+    """
+    from numba.pycc import CC  # optional requirement: only the builder needs numba
+
+    provider_module, function = kernel.provider.split(":")
+    jit = getattr(importlib.import_module(provider_module), function)()
+    directory = Path(directory or aot_directory())
+    directory.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(dir=directory, prefix=".build-") as tmp:
+        cc = CC(kernel.module_name)
+        cc.output_dir = tmp
+        cc.verbose = False
+        for entry, signature in jit.AOT_EXPORTS.items():
+            cc.export(entry, signature)(getattr(jit, entry).py_func)
+        cc.compile()
+        built = Path(tmp) / kernel.file(Path(".")).name
+        if not built.is_file():
+            raise RuntimeError(f"numba.pycc wrote no {built.name} in {tmp}")
+        target = kernel.file(directory)
+        os.replace(built, target)
+    return target
+
+
+def missing(kernels: Sequence[AotKernel]) -> list[AotKernel]:
+    """The kernels whose extension module is not in :func:`aot_directory`."""
+    return [k for k in kernels if not k.file().is_file()]
+
+
+def build_in_subprocess(kernels: Sequence[AotKernel], timeout_s: float = 600.0) -> str | None:
+    """Build ``kernels`` in a child Python process; None on success, else what went wrong (one line)."""
+    if not kernels:
+        return None
+    if importlib.util.find_spec("numba") is None:
+        return "numba is not installed"
+    args = [sys.executable, "-m", __name__, *(f"{k.shared}={k.provider}" for k in kernels)]
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in sys.path if p)}
+    try:
+        done = subprocess.run(args, capture_output=True, text=True, timeout=timeout_s, env=env)
+    except (OSError, subprocess.TimeoutExpired) as exc:
+        return f"{type(exc).__name__}: {exc}"
+    if done.returncode != 0:
+        lines = [line for line in (done.stderr or done.stdout).strip().splitlines() if line.strip()]
+        return lines[-1] if lines else f"the builder exited with status {done.returncode}"
+    return None
+
+
+def main(argv: Sequence[str]) -> int:
+    """``python -m components.model.aot SHARED=module:function ...``: build each kernel."""
+    for item in argv:
+        shared, _, provider = item.partition("=")
+        path = build_module(AotKernel(shared, provider))
+        print(path)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,158 @@
+"""The kernels compiled ahead of time (components.model.aot): same results as numba's just-in-time kernels, no numba.
+
+The extension modules are built once per machine by ``ensure_compiled_kernels`` (the
+session fixture ``built_fmus`` and ``dtcosim build``/``run`` call it); the tests that use
+them are skipped where they could not be built (no C compiler).
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+
+import components.model.gearbox_kernel as gearbox_kernel
+from components.model import aot
+from components.model.aot import AotKernel, facade, load_module
+from components.model.gearbox_model import GearboxModel
+from components.model.generator import GeneratorRotor
+from components.model.kernel import aot_kernel, compiled_module, jit_module
+from components.model.presets import cosim_preset
+from components.model.wind import PhasorStepper, RotorSpeedProcess, WindParameters, aot_wind_kernel
+from orchestrator.cosim.compiled_kernels import ensure_compiled_kernels
+
+
+@pytest.fixture(scope="module")
+def built():
+    """The ahead-of-time modules of this machine (built if missing), or skip."""
+    problem = ensure_compiled_kernels()
+    if problem is not None or aot.missing([aot_kernel(), aot_wind_kernel()]) or jit_module()[0] is None:
+        pytest.skip(f"kernels not compiled ahead of time here ({problem})")
+    return load_module(aot_kernel())
+
+
+def _run(dt, module, steps=1500, h=5e-3):
+    """Contact forces and outputs of a coupled run whose Gearbox steps through ``module``."""
+    original = gearbox_kernel.compiled_module
+    gearbox_kernel.compiled_module = lambda: (module, None)
+    try:
+        model = GearboxModel(dt, kernel="compiled")
+    finally:
+        gearbox_kernel.compiled_module = original
+    wind = RotorSpeedProcess(WindParameters())
+    w0, p0 = wind.speed(0.0), wind.angle(0.0)
+    model.initialize(0.0, w0, p0, model.ratio * w0, model.ratio * p0)
+    gen = GeneratorRotor(dt.generator, model.output_speed_rad_s, model.ratio * p0)
+    out = []
+    for k in range(steps):
+        t = k * h
+        model.step(t, h, wind.speed(t), wind.angle(t), gen.speed_rad_s, gen.angle_rad)
+        gen.step(t, h, model.shaft_torque_nm)
+        out.append(model.output_vector())
+    return np.array(out), model.get_state()["integrator"]
+
+
+@pytest.mark.parametrize("make", [lambda: cosim_preset("table6"), lambda: cosim_preset("table5"),
+                                  lambda: cosim_preset("table6").with_meshes(law="impact", stiffness_variation=0.3)],
+                         ids=["table6", "table5-planetary", "table6-impact-tvms"])
+def test_the_ahead_of_time_kernel_steps_bit_for_bit_as_the_just_in_time_one(built, make):
+    dt = make()
+    front = compiled_module()[0]
+    assert front.AHEAD_OF_TIME == built.__file__
+    jit = jit_module()[0]
+    got, got_counters = _run(dt, front)
+    expected, expected_counters = _run(dt, jit)
+    np.testing.assert_array_equal(got, expected)
+    assert got_counters == expected_counters
+    assert np.ptp(got[:, 0]) > 1.0  # a real transient, not a constant
+
+
+def test_the_wind_step_is_bit_for_bit_the_just_in_time_one(built):
+    process = RotorSpeedProcess(WindParameters())
+    stepper = PhasorStepper(process)
+    assert getattr(stepper._compiled, "AHEAD_OF_TIME", None), "the wind step is not the ahead-of-time module"
+    jit = stepper._compiled.__getattr__("rotate_and_sum")  # the just-in-time function behind the facade
+    z = np.exp(1j * np.linspace(0.0, 3.0, 256))
+    rotation = np.exp(1j * 1e-3 * np.arange(1, 257))
+    w, w_f = np.linspace(0.1, 1.0, 256), np.linspace(1.0, 0.1, 256)
+    z_aot, z_jit = z.copy(), z.copy()
+    assert stepper._compiled.rotate_and_sum(z_aot, rotation, w, w_f) == jit(z_jit, rotation, w, w_f)
+    np.testing.assert_array_equal(z_aot, z_jit)
+
+
+def test_the_facade_takes_other_names_from_the_just_in_time_module(built):
+    front = compiled_module()[0]
+    assert front.SLOTS == gearbox_kernel.compiled_module()[0].SLOTS and front.N_ISTATE == 11  # kernel_layout
+    assert front.monolithic_rhs is jit_module()[0].monolithic_rhs
+    with pytest.raises(AttributeError, match="no_such_function"):
+        front.no_such_function  # noqa: B018
+
+
+def test_the_facade_says_why_a_missing_name_has_no_just_in_time_module():
+    module = type(sys)("stand_in_aot")
+    module.__file__ = "/nowhere/stand_in_aot.so"
+    front = facade(module, "stand_in_aot_facade", None, lambda: (None, "ImportError: No module named 'numba'"))
+    with pytest.raises(AttributeError, match=r"monolithic_rhs .*unavailable \(ImportError: No module named 'numba'\)"):
+        front.monolithic_rhs  # noqa: B018
+
+
+def test_a_missing_damaged_or_disabled_module_is_not_loaded(tmp_path, monkeypatch):
+    monkeypatch.setenv("DTCOSIM_CACHE_DIR", str(tmp_path))
+    kernel = AotKernel("_dtcosim_test_kernel_0123456789abcdef", "nowhere:nothing")
+    assert load_module(kernel) is None  # no file
+    kernel.file().parent.mkdir(parents=True)
+    kernel.file().write_bytes(b"not an ELF file")
+    assert load_module(kernel) is None  # not importable: the just-in-time kernel runs instead
+    assert kernel.module_name not in sys.modules
+    monkeypatch.setenv(aot.ENVIRONMENT_VARIABLE, "0")
+    assert not aot.enabled()
+
+
+def test_the_key_follows_the_kernel_sources(tmp_path):
+    from components.model.shared_module import shared_name
+
+    source = tmp_path / "compiled_thing.py"
+    source.write_text("x = 1\n")
+    first = shared_name(source, ())
+    source.write_text("x = 2\n")
+    assert shared_name(source, ()) != first  # a changed kernel never loads an old module
+
+
+_CHILD = textwrap.dedent("""
+    import json, sys
+    import numpy as np
+    from components.model.wind import PhasorStepper, RotorSpeedProcess, WindParameters
+    stepper = PhasorStepper(RotorSpeedProcess(WindParameters()))
+    values = []
+    for k in range(2000):
+        stepper.advance(k * 1e-3, 1e-3)
+        values.append(stepper.speed_and_angle())
+    print(json.dumps({"numba": "numba" in sys.modules, "kernel": stepper.kernel,
+                      "aot": getattr(stepper._compiled, "AHEAD_OF_TIME", None), "values": values}))
+""")
+
+
+@pytest.mark.slow
+def test_a_module_built_here_runs_without_numba_and_as_the_jit_kernel(tmp_path):
+    """``build_module`` into an empty cache (what a new machine does), then a process that never imports numba."""
+    kernel = aot_wind_kernel()
+    env_cache = {"DTCOSIM_CACHE_DIR": str(tmp_path)}
+    build = subprocess.run([sys.executable, "-m", "components.model.aot", f"{kernel.shared}={kernel.provider}"],
+                           capture_output=True, text=True, timeout=600, env={**__import__("os").environ, **env_cache})
+    if build.returncode != 0 and "CompileError" in build.stderr + build.stdout:
+        pytest.skip("no C compiler for numba.pycc")
+    assert build.returncode == 0, build.stderr[-2000:]
+    results = {}
+    for label, extra in (("aot", {}), ("jit", {aot.ENVIRONMENT_VARIABLE: "0"})):
+        proc = subprocess.run([sys.executable, "-c", _CHILD], capture_output=True, text=True, timeout=300,
+                              env={**__import__("os").environ, **env_cache, **extra})
+        assert proc.returncode == 0, proc.stderr[-2000:]
+        results[label] = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert results["aot"]["aot"] and str(tmp_path) in results["aot"]["aot"]
+    assert results["aot"]["numba"] is False and results["jit"]["numba"] is True
+    assert results["aot"]["kernel"] == results["jit"]["kernel"] == "compiled"
+    assert results["aot"]["values"] == results["jit"]["values"]
