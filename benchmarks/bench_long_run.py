@@ -4,7 +4,8 @@ Two parts:
 
 1. **Whole runs** (default): ``run_scenario`` (what ``dtcosim run`` does: stream the samples
    into the results file, analyses, plots, summary) in a fresh process per results format
-   (``csv``, ``parquet``) and per Gearbox kernel (``DTCOSIM_KERNEL`` = ``compiled``,
+   (``csv``, ``parquet``) and per Gearbox kernel (``compiled``: compiled ahead of time where
+   built, :mod:`components.model.aot`; ``jit``: numba just in time, ``DTCOSIM_AOT=0``;
    ``numpy``), printing wall and CPU time of the run, the peak resident memory of the
    process (``ru_maxrss``: everything, imports and the FMUs included) and the size of the
    results file, against the targets of issue 14: <= 10 s wall including writing results
@@ -18,7 +19,7 @@ Two parts:
    results written in chunks of 250 rows as a run streams them, in both formats.
 
 Run: ``python benchmarks/bench_long_run.py [--stop 600] [--step H] [--formats csv,parquet]
-[--kernels compiled,numpy] [--phases] [--imports]``.
+[--kernels compiled,jit,numpy] [--phases] [--imports]``.
 """
 
 from __future__ import annotations
@@ -104,7 +105,8 @@ def child_main(args) -> None:
         assert report.outcome.complete and not report.problems, (report.outcome.error, report.problems)
         results = report.files["timeseries"]
         print(json.dumps({
-            "format": args.child, "kernel": choose_kernel()[0], "wall_s": wall, "cpu_s": cpu,
+            "format": args.child, "kernel": os.environ.get("BENCH_KERNEL_LABEL", choose_kernel()[0]),
+            "numba_imported": "numba" in sys.modules, "wall_s": wall, "cpu_s": cpu,
             "start_up_s": prepared_s, "cosimulation_s": report.outcome.wall_time_s,
             "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
             "results_file": results.name, "results_mb": results.stat().st_size / 1e6,
@@ -118,22 +120,24 @@ def whole_runs_main(args) -> None:
     print(f"paper-60s over 0-{args.stop:g} s, H = {'the scenario default' if args.step is None else args.step}; "
           f"each run in a fresh process (peak RSS = the whole process)\n")
     print("| kernel | results | wall [s] | CPU [s] | of which co-simulation wall [s] | peak RSS [MB] | "
-          "results file [MB] |")
-    print("|---|---|---|---|---|---|---|")
+          "results file [MB] | numba in the process |")
+    print("|---|---|---|---|---|---|---|---|")
     rows = []
     for kernel in args.kernels.split(","):
         for fmt in args.formats.split(","):
             cmd = [sys.executable, __file__, "--child", fmt, "--stop", str(args.stop)]
             if args.step is not None:
                 cmd += ["--step", str(args.step)]
-            proc = subprocess.run(cmd, capture_output=True, text=True, env={**os.environ, "DTCOSIM_KERNEL": kernel})
+            env = {**os.environ, **KERNEL_ENVIRONMENTS[kernel], "BENCH_KERNEL_LABEL": kernel}
+            proc = subprocess.run(cmd, capture_output=True, text=True, env=env)
             if proc.returncode != 0:
                 print(f"| {kernel} | {fmt} | failed: {proc.stderr.strip().splitlines()[-1:]} |")
                 continue
             r = json.loads(proc.stdout.strip().splitlines()[-1])
             rows.append(r)
             print(f"| {r['kernel']} | {r['results_file']} | {r['wall_s']:.2f} | {r['cpu_s']:.2f} | "
-                  f"{r['cosimulation_s']:.2f} | {r['peak_rss_mb']:.0f} | {r['results_mb']:.1f} |", flush=True)
+                  f"{r['cosimulation_s']:.2f} | {r['peak_rss_mb']:.0f} | {r['results_mb']:.1f} | "
+                  f"{'yes' if r['numba_imported'] else 'no'} |", flush=True)
     if rows:
         r = rows[0]
         print(f"\n{r['samples']} samples, {r['steps']} steps, {r['plots']} plots per run; targets: wall <= 10 s, "
@@ -146,6 +150,13 @@ def whole_runs_main(args) -> None:
                       f"CPU {x['cpu_s'] / base['cpu_s']:.2f}, peak RSS {x['peak_rss_mb'] / base['peak_rss_mb']:.2f}, "
                       f"file {x['results_mb'] / base['results_mb']:.2f}")
 
+
+#: environment of a whole run per --kernels entry
+KERNEL_ENVIRONMENTS = {
+    "compiled": {"DTCOSIM_KERNEL": "compiled"},  # ahead of time where built (components.model.aot), else JIT
+    "jit": {"DTCOSIM_KERNEL": "compiled", "DTCOSIM_AOT": "0"},
+    "numpy": {"DTCOSIM_KERNEL": "numpy"},
+}
 
 #: what --imports loads, each in a fresh process: label -> Python statements
 IMPORTS = {
@@ -162,6 +173,9 @@ IMPORTS = {
     "numba + kernel, numba's own cache load (context refresh)": (
         "from components.model import compiled_kernel as k; from numba.core.registry import cpu_target; "
         "cpu_target.target_context.refresh(); k.ensure_compiled()"),
+    "the compiled gearbox kernel ahead of time (no numba)": (
+        "from components.model.kernel import compiled_module; m = compiled_module()[0]; "
+        "assert getattr(m, 'AHEAD_OF_TIME', None), 'not built: dtcosim build'"),
     "pyarrow": "import pyarrow",
     "pyarrow.parquet": "import pyarrow.parquet",
     "matplotlib (Figure, Agg canvas)": (
@@ -194,7 +208,8 @@ def main() -> None:
     parser.add_argument("--step", type=float, default=None, help="communication step [s] (default: the scenario's)")
     parser.add_argument("--out", type=Path, default=None, help="result directory of --phases (default: temporary)")
     parser.add_argument("--formats", default="csv,parquet", help="results formats of the whole runs")
-    parser.add_argument("--kernels", default="compiled,numpy", help="Gearbox kernels of the whole runs")
+    parser.add_argument("--kernels", default="compiled,jit,numpy",
+                        help="Gearbox kernels of the whole runs: compiled (ahead of time), jit, numpy")
     parser.add_argument("--phases", action="store_true", help="time the phases of one run in this process instead")
     parser.add_argument("--imports", action="store_true", help="peak RSS of a fresh process per import instead")
     parser.add_argument("--child", default=None, help=argparse.SUPPRESS)

@@ -16,8 +16,9 @@ source: the tests compare its results with the just-in-time functions bit for bi
 * **Building** needs numba and a C compiler (setuptools' compiler: gcc or clang, MSVC on
   Windows): ~10 s and ~1 MB per kernel, once per machine and source version. It runs in a
   child process (:func:`build_in_subprocess`), so the builder's numba stays out of the run.
-* **Loading** (:func:`load_module`) needs only the file: where it is missing, cannot be
-  imported or ``DTCOSIM_AOT=0``, the kernel's owner uses the just-in-time module as before.
+* **Loading** (:func:`load_module`) needs only the file, carried by an FMU beside its copy of
+  the kernel's source or found in the user cache: where it is missing, cannot be imported or
+  ``DTCOSIM_AOT=0``, the kernel's owner uses the just-in-time module as before.
 
 :func:`facade` joins the extension module's entry points, the kernel's layout constants and,
 for anything else (the monolithic reference's functions, test helpers), the just-in-time
@@ -93,24 +94,34 @@ def enabled() -> bool:
     return os.environ.get(ENVIRONMENT_VARIABLE, "1").strip() != "0"
 
 
-def load_module(kernel: AotKernel) -> ModuleType | None:
-    """The kernel's extension module if it was built for this interpreter and imports; else None."""
+#: folder beside a kernel's source where an FMU carries the kernel's extension module (``fmus.build``)
+BUNDLE_FOLDER = "_aot"
+
+
+def load_module(kernel: AotKernel, source: Path | None = None) -> ModuleType | None:
+    """The kernel's extension module if it was built for this interpreter and imports; else None.
+
+    Looked for in the :data:`BUNDLE_FOLDER` beside ``source`` (the kernel's source file: an FMU
+    carries its module there), then in :func:`aot_directory`.
+    """
     if not enabled():
         return None
     module = sys.modules.get(kernel.module_name)
     if module is not None:
         return module
-    path = kernel.file()
-    if not path.is_file():
-        return None
-    try:
-        spec = importlib.util.spec_from_file_location(kernel.module_name, path)
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
-    except Exception:  # noqa: BLE001 - not importable here (another ABI, a damaged file): the JIT kernel runs
-        return None
-    sys.modules[kernel.module_name] = module
-    return module
+    folders = ([source.parent / BUNDLE_FOLDER] if source is not None else []) + [aot_directory()]
+    for path in (kernel.file(folder) for folder in folders):
+        if not path.is_file():
+            continue
+        try:
+            spec = importlib.util.spec_from_file_location(kernel.module_name, path)
+            module = importlib.util.module_from_spec(spec)
+            spec.loader.exec_module(module)
+        except Exception:  # noqa: BLE001 - not importable here (another ABI, a damaged file): the next, or JIT
+            continue
+        sys.modules[kernel.module_name] = module
+        return module
+    return None
 
 
 def facade(module: ModuleType, name: str, constants: ModuleType | None,
@@ -171,21 +182,31 @@ def missing(kernels: Sequence[AotKernel]) -> list[AotKernel]:
 
 
 def build_in_subprocess(kernels: Sequence[AotKernel], timeout_s: float = 600.0) -> str | None:
-    """Build ``kernels`` in a child Python process; None on success, else what went wrong (one line)."""
+    """Build ``kernels`` in child Python processes, one per kernel, concurrently; None on success, else why not.
+
+    The reason is one line (the first failing kernel's last line of output).
+    """
     if not kernels:
         return None
     if importlib.util.find_spec("numba") is None:
         return "numba is not installed"
-    args = [sys.executable, "-m", __name__, *(f"{k.shared}={k.provider}" for k in kernels)]
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in sys.path if p)}
+    children = []
     try:
-        done = subprocess.run(args, capture_output=True, text=True, timeout=timeout_s, env=env)
+        for k in kernels:
+            children.append(subprocess.Popen([sys.executable, "-m", __name__, f"{k.shared}={k.provider}"],
+                                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env))
+        problems = []
+        for child in children:
+            out, err = child.communicate(timeout=timeout_s)
+            if child.returncode != 0:
+                lines = [line for line in (err or out).strip().splitlines() if line.strip()]
+                problems.append(lines[-1] if lines else f"the builder exited with status {child.returncode}")
     except (OSError, subprocess.TimeoutExpired) as exc:
+        for child in children:
+            child.kill()
         return f"{type(exc).__name__}: {exc}"
-    if done.returncode != 0:
-        lines = [line for line in (done.stderr or done.stdout).strip().splitlines() if line.strip()]
-        return lines[-1] if lines else f"the builder exited with status {done.returncode}"
-    return None
+    return problems[0] if problems else None
 
 
 def main(argv: Sequence[str]) -> int:

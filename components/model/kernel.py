@@ -53,9 +53,9 @@ def _jit_kernel_module() -> ModuleType:
     return module
 
 
-def aot_kernel() -> AotKernel:
-    """The gearbox kernel as :mod:`components.model.aot` builds and finds it."""
-    return AotKernel(shared_name(_SOURCE, KERNEL_DEPENDENCIES), f"{__name__}:_jit_kernel_module")
+def aot_kernel(source: Path = _SOURCE) -> AotKernel:
+    """The gearbox kernel as :mod:`components.model.aot` builds and finds it (``source``: a copy of its file)."""
+    return AotKernel(shared_name(source, KERNEL_DEPENDENCIES), f"{__name__}:_jit_kernel_module")
 
 
 _facades: dict[str, ModuleType] = {}
@@ -71,7 +71,7 @@ def compiled_module() -> tuple[ModuleType | None, str | None]:
     kernel = aot_kernel()
     front = _facades.get(kernel.shared)
     if front is None:
-        module = load_module(kernel)
+        module = load_module(kernel, _SOURCE)
         if module is None:
             return jit_module()
         front = facade(module, kernel.module_name + "_facade", kernel_layout, jit_module,

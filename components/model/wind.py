@@ -383,9 +383,9 @@ def _jit_wind_kernel_module() -> ModuleType:
     return module
 
 
-def aot_wind_kernel() -> AotKernel:
-    """The compiled wind step as :mod:`components.model.aot` builds and finds it."""
-    return AotKernel(shared_name(_WIND_SOURCE, _WIND_DEPENDENCIES), f"{__name__}:_jit_wind_kernel_module")
+def aot_wind_kernel(source: Path = _WIND_SOURCE) -> AotKernel:
+    """The compiled wind step as :mod:`components.model.aot` builds and finds it (``source``: a copy of its file)."""
+    return AotKernel(shared_name(source, _WIND_DEPENDENCIES), f"{__name__}:_jit_wind_kernel_module")
 
 
 def _compiled_wind_module() -> tuple[ModuleType | None, str | None]:
@@ -393,7 +393,7 @@ def _compiled_wind_module() -> tuple[ModuleType | None, str | None]:
     kernel = aot_wind_kernel()
     front = _wind_facades.get(kernel.shared)
     if front is None:
-        module = load_module(kernel)
+        module = load_module(kernel, _WIND_SOURCE)
         if module is None:
             return _jit_wind_module()
         front = _wind_facades[kernel.shared] = facade(module, kernel.module_name + "_facade", None, _jit_wind_module)

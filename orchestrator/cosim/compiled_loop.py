@@ -83,7 +83,7 @@ def _load():
     global _module, _import_error
     if _module is None and _import_error is None:
         kernel = aot_loop_kernel()
-        aot = load_module(kernel)
+        aot = load_module(kernel, _SOURCE)
         if aot is not None:
             _module = facade(aot, kernel.module_name + "_facade", None, _jit_module)
         else:

@@ -65,7 +65,7 @@ def test_fmpy_loop_reproduces_the_components_bit_for_bit(fmu_dir):
 @pytest.mark.slow
 @pytest.mark.parametrize("ahead_of_time", [False, True], ids=["numpy-fallback", "ahead-of-time-kernels"])
 def test_loop_runs_in_a_fresh_venv_without_dtcosim(fmu_dir, bare_python, tmp_path, monkeypatch, ahead_of_time):
-    """Only numpy and scipy: the numpy fallback, or (where built on this machine) the kernels compiled ahead of time."""
+    """Only numpy and scipy: the numpy fallback, or the kernels compiled ahead of time that the FMUs carry."""
     if ahead_of_time and missing(aot_kernels()):
         pytest.skip("the kernels could not be compiled ahead of time on this machine")
     assert run_python(bare_python, "-c", "import components").returncode != 0
@@ -73,8 +73,10 @@ def test_loop_runs_in_a_fresh_venv_without_dtcosim(fmu_dir, bare_python, tmp_pat
     assert run_python(bare_python, "-c", "import numba").returncode != 0
     out = tmp_path / "bare.npz"
     driver = load_driver("fmu_loop").__file__
-    # the default kernel choice (auto), whatever this process was asked for
-    env = {"DTCOSIM_KERNEL": "auto", AOT_VARIABLE: "1" if ahead_of_time else "0"}
+    # the default kernel choice (auto), whatever this process was asked for; an empty user cache: the compiled
+    # modules come from the FMUs themselves
+    env = {"DTCOSIM_KERNEL": "auto", AOT_VARIABLE: "1" if ahead_of_time else "0",
+           "DTCOSIM_CACHE_DIR": str(tmp_path / "empty-cache")}
     result = run_python(bare_python, driver, str(fmu_dir), "1.0", str(H), str(out), env=env)
     assert result.returncode == 0, result.stderr[-3000:]
     # without numba and compiled modules, the Gearbox says once, through the FMI logger, that it runs the numpy path

@@ -11,6 +11,7 @@ import json
 import subprocess
 import sys
 import textwrap
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -156,3 +157,18 @@ def test_a_module_built_here_runs_without_numba_and_as_the_jit_kernel(tmp_path):
     assert results["aot"]["numba"] is False and results["jit"]["numba"] is True
     assert results["aot"]["kernel"] == results["jit"]["kernel"] == "compiled"
     assert results["aot"]["values"] == results["jit"]["values"]
+
+
+def test_the_fmus_carry_the_modules_of_their_kernel_sources(built, fmu_path):
+    import zipfile
+
+    for fmu, kernels in (("Gearbox", [aot_kernel(), aot_wind_kernel()]), ("WindSource", [aot_wind_kernel()])):
+        with zipfile.ZipFile(fmu_path(fmu)) as archive:
+            carried = {Path(n).name for n in archive.namelist() if f"/model/{aot.BUNDLE_FOLDER}/" in n}
+        assert carried == {k.file().name for k in kernels}, fmu
+
+
+def test_a_failing_build_says_why_in_one_line():
+    problem = aot.build_in_subprocess([AotKernel("_dtcosim_test_kernel_0123456789abcdef",
+                                                 "components.model.kernel:no_such_provider")])
+    assert problem is not None and "no_such_provider" in problem and "\n" not in problem
