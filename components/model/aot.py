@@ -181,10 +181,37 @@ def missing(kernels: Sequence[AotKernel]) -> list[AotKernel]:
     return [k for k in kernels if not k.file().is_file()]
 
 
+def failure_file(kernel: AotKernel) -> Path:
+    """Where a failed build of ``kernel`` left its reason (so that later runs do not retry it each time)."""
+    return aot_directory() / f"{kernel.module_name}.failed"
+
+
+def failed_before(kernel: AotKernel) -> str | None:
+    """The reason a build of this very kernel version failed on this machine, or None."""
+    try:
+        return failure_file(kernel).read_text(encoding="utf-8").strip() or "unknown reason"
+    except OSError:
+        return None
+
+
+def _remember(kernel: AotKernel, problem: str | None) -> None:
+    """Record (or, on success, clear) the failure of a build; best effort (a read-only cache keeps nothing)."""
+    path = failure_file(kernel)
+    try:
+        if problem is None:
+            path.unlink(missing_ok=True)
+        else:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_text(problem + "\n", encoding="utf-8")
+    except OSError:
+        pass
+
+
 def build_in_subprocess(kernels: Sequence[AotKernel], timeout_s: float = 600.0) -> str | None:
     """Build ``kernels`` in child Python processes, one per kernel, concurrently; None on success, else why not.
 
-    The reason is one line (the first failing kernel's last line of output).
+    The reason is one line (the first failing kernel's last line of output); each kernel's
+    outcome is remembered (:func:`failed_before`).
     """
     if not kernels:
         return None
@@ -197,11 +224,14 @@ def build_in_subprocess(kernels: Sequence[AotKernel], timeout_s: float = 600.0) 
             children.append(subprocess.Popen([sys.executable, "-m", __name__, f"{k.shared}={k.provider}"],
                                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env))
         problems = []
-        for child in children:
+        for kernel, child in zip(kernels, children):
             out, err = child.communicate(timeout=timeout_s)
+            problem = None
             if child.returncode != 0:
                 lines = [line for line in (err or out).strip().splitlines() if line.strip()]
-                problems.append(lines[-1] if lines else f"the builder exited with status {child.returncode}")
+                problem = lines[-1] if lines else f"the builder exited with status {child.returncode}"
+                problems.append(problem)
+            _remember(kernel, problem)
     except (OSError, subprocess.TimeoutExpired) as exc:
         for child in children:
             child.kill()

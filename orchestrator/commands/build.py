@@ -32,7 +32,7 @@ def run(args: argparse.Namespace) -> int:
     """Build from the preset or the drivetrain file and print what was written."""
     from ..cosim.compiled_kernels import ensure_compiled_kernels
 
-    ensure_compiled_kernels(report=print)
+    ensure_compiled_kernels(report=print, retry=True)
     if args.scenario is not None:
         from ..cosim.fmu_store import ensure_fmus
         from ..inputs.scenario import find_scenario, load_scenario

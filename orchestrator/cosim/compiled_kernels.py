@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from typing import Callable
 
-from components.model.aot import AotKernel, aot_directory, build_in_subprocess, enabled, missing
+from components.model.aot import AotKernel, aot_directory, build_in_subprocess, enabled, failed_before, missing
 from components.model.kernel import aot_kernel
 from components.model.wind import aot_wind_kernel
 
@@ -24,8 +24,11 @@ def aot_kernels() -> tuple[AotKernel, ...]:
     return aot_kernel(), aot_wind_kernel(), aot_loop_kernel()
 
 
-def ensure_compiled_kernels(report: Callable[[str], None] | None = None) -> str | None:
+def ensure_compiled_kernels(report: Callable[[str], None] | None = None, retry: bool = False) -> str | None:
     """Build the kernels missing in :func:`~components.model.aot.aot_directory`.
+
+    A kernel version whose build failed on this machine before (no C compiler, say) is not
+    retried on every run, only with ``retry`` (``dtcosim build``) or once its sources change.
 
     Returns
     -------
@@ -36,11 +39,22 @@ def ensure_compiled_kernels(report: Callable[[str], None] | None = None) -> str 
     if not enabled():
         return None
     todo = missing(aot_kernels())
+    if not retry:
+        earlier = [(k, failed_before(k)) for k in todo]
+        earlier = [(k, reason) for k, reason in earlier if reason is not None]
+        if earlier:
+            todo = [k for k in todo if k not in dict(earlier)]
+            if not todo:
+                problem = earlier[0][1]
+                if report:
+                    report(f"kernels not compiled ahead of time on this machine ({problem}); numba compiles them "
+                           "just in time (`dtcosim build` tries again)")
+                return problem
     if not todo:
         return None
     if report:
         report(f"compiling {len(todo)} kernel(s) ahead of time into {aot_directory()} (once per machine and "
-               "version, ~10 s each) ...")
+               "version, ~15 s) ...")
     problem = build_in_subprocess(todo)
     if problem and report:
         report(f"kernels not compiled ahead of time ({problem}); numba compiles them just in time instead")

@@ -168,7 +168,23 @@ def test_the_fmus_carry_the_modules_of_their_kernel_sources(built, fmu_path):
         assert carried == {k.file().name for k in kernels}, fmu
 
 
-def test_a_failing_build_says_why_in_one_line():
-    problem = aot.build_in_subprocess([AotKernel("_dtcosim_test_kernel_0123456789abcdef",
-                                                 "components.model.kernel:no_such_provider")])
+def test_a_failing_build_says_why_in_one_line_and_is_not_retried_on_every_run(tmp_path, monkeypatch):
+    import orchestrator.cosim.compiled_kernels as compiled_kernels
+
+    monkeypatch.setenv("DTCOSIM_CACHE_DIR", str(tmp_path))
+    fake = AotKernel("_dtcosim_test_kernel_0123456789abcdef", "components.model.kernel:no_such_provider")
+    monkeypatch.setattr(compiled_kernels, "aot_kernels", lambda: (fake,))
+    said = []
+    problem = compiled_kernels.ensure_compiled_kernels(said.append)
     assert problem is not None and "no_such_provider" in problem and "\n" not in problem
+    assert aot.failed_before(fake) == problem and "numba compiles them just in time" in said[-1]
+
+    def no_build(kernels):
+        raise AssertionError(f"rebuilt {kernels}")
+
+    monkeypatch.setattr(compiled_kernels, "build_in_subprocess", no_build)
+    said.clear()
+    assert compiled_kernels.ensure_compiled_kernels(said.append) == problem  # remembered, not rebuilt
+    assert len(said) == 1 and problem in said[0] and "`dtcosim build` tries again" in said[0]
+    with pytest.raises(AssertionError, match="rebuilt"):
+        compiled_kernels.ensure_compiled_kernels(said.append, retry=True)  # dtcosim build tries again
