@@ -149,6 +149,35 @@ def facade(module: ModuleType, name: str, constants: ModuleType | None,
     return front
 
 
+_facades: dict[str, ModuleType] = {}
+
+
+def compiled_or_jit(kernel: AotKernel, source: Path, jit_module: Callable[[], tuple[ModuleType | None, str | None]],
+                    constants: ModuleType | None = None,
+                    extra: Callable[[ModuleType], dict] | None = None) -> tuple[ModuleType | None, str | None]:
+    """The kernel's :func:`facade` over its ahead-of-time module where one loads, else ``jit_module()``.
+
+    One facade per kernel version and process; ``extra(module)`` gives names the facade adds.
+    """
+    front = _facades.get(kernel.shared)
+    if front is None:
+        module = load_module(kernel, source)
+        if module is None:
+            return jit_module()
+        front = facade(module, kernel.module_name + "_facade", constants, jit_module,
+                       **(extra(module) if extra else {}))
+        _facades[kernel.shared] = front
+    return front, None
+
+
+def required(jit_module: Callable[[], tuple[ModuleType | None, str | None]]) -> ModuleType:
+    """``jit_module()``'s module, or ImportError with its reason (what a builder's provider returns)."""
+    module, reason = jit_module()
+    if module is None:
+        raise ImportError(reason)
+    return module
+
+
 def build_module(kernel: AotKernel, directory: Path | None = None) -> Path:
     """Compile the kernel's ``AOT_EXPORTS`` into its extension module in ``directory``; returns the file.
 

@@ -16,12 +16,13 @@ Both paths give the same results to round-off (the tests compare them to 1e-9).
 
 from __future__ import annotations
 
+from functools import lru_cache
 from pathlib import Path
 from types import ModuleType
 from typing import TYPE_CHECKING
 
 from . import kernel_layout
-from .aot import AotKernel, facade, load_module
+from .aot import AotKernel, compiled_or_jit, required
 from .kernel_request import ENVIRONMENT_VARIABLE, KERNELS, compiled_or_numpy, requested_kernel
 from .shared_module import shared_name, try_load_shared
 
@@ -46,19 +47,14 @@ def jit_module() -> tuple[ModuleType | None, str | None]:
 
 
 def _jit_kernel_module() -> ModuleType:
-    """:func:`jit_module` or its error (the ahead-of-time builder's provider)."""
-    module, reason = jit_module()
-    if module is None:
-        raise ImportError(reason)
-    return module
+    """The ahead-of-time builder's provider: :func:`jit_module` or its ImportError."""
+    return required(jit_module)
 
 
+@lru_cache(maxsize=None)  # once per source file: an FMU's extracted copy may be gone by its next instance
 def aot_kernel(source: Path = _SOURCE) -> AotKernel:
     """The gearbox kernel as :mod:`components.model.aot` builds and finds it (``source``: a copy of its file)."""
     return AotKernel(shared_name(source, KERNEL_DEPENDENCIES), f"{__name__}:_jit_kernel_module")
-
-
-_facades: dict[str, ModuleType] = {}
 
 
 def compiled_module() -> tuple[ModuleType | None, str | None]:
@@ -68,16 +64,8 @@ def compiled_module() -> tuple[ModuleType | None, str | None]:
     (``gearbox_step``, ``outputs``) and :mod:`~components.model.kernel_layout`; any other name
     (the monolithic reference's functions) comes from the just-in-time module on first use.
     """
-    kernel = aot_kernel()
-    front = _facades.get(kernel.shared)
-    if front is None:
-        module = load_module(kernel, _SOURCE)
-        if module is None:
-            return jit_module()
-        front = facade(module, kernel.module_name + "_facade", kernel_layout, jit_module,
-                       ensure_compiled=lambda: None, step_entry_point=lambda: module.gearbox_step)
-        _facades[kernel.shared] = front
-    return front, None
+    return compiled_or_jit(aot_kernel(), _SOURCE, jit_module, kernel_layout, lambda module: {
+        "ensure_compiled": lambda: None, "step_entry_point": lambda: module.gearbox_step})
 
 
 def choose_kernel(kernel: str | None = None) -> tuple[str, str | None]:

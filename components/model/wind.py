@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 from pathlib import Path
 from types import ModuleType
 from typing import TYPE_CHECKING
@@ -31,7 +32,7 @@ import numpy as np
 
 from .. import units
 from ..errors import ParameterError
-from .aot import AotKernel, facade, load_module
+from .aot import AotKernel, compiled_or_jit, required
 from .kernel_request import compiled_or_numpy
 from .shared_module import shared_name, try_load_shared
 
@@ -364,7 +365,6 @@ class PhasorStepper:
 
 _WIND_SOURCE = Path(__file__).with_name("compiled_wind.py")
 _WIND_DEPENDENCIES = ("numba_cache.py",)
-_wind_facades: dict[str, ModuleType] = {}
 
 
 def _jit_wind_module() -> tuple[ModuleType | None, str | None]:
@@ -376,13 +376,11 @@ def _jit_wind_module() -> tuple[ModuleType | None, str | None]:
 
 
 def _jit_wind_kernel_module() -> ModuleType:
-    """:func:`_jit_wind_module` or its error (the ahead-of-time builder's provider)."""
-    module, reason = _jit_wind_module()
-    if module is None:
-        raise ImportError(reason)
-    return module
+    """The ahead-of-time builder's provider: :func:`_jit_wind_module` or its ImportError."""
+    return required(_jit_wind_module)
 
 
+@lru_cache(maxsize=None)  # once per source file: an FMU's extracted copy may be gone by its next instance
 def aot_wind_kernel(source: Path = _WIND_SOURCE) -> AotKernel:
     """The compiled wind step as :mod:`components.model.aot` builds and finds it (``source``: a copy of its file)."""
     return AotKernel(shared_name(source, _WIND_DEPENDENCIES), f"{__name__}:_jit_wind_kernel_module")
@@ -390,14 +388,7 @@ def aot_wind_kernel(source: Path = _WIND_SOURCE) -> AotKernel:
 
 def _compiled_wind_module() -> tuple[ModuleType | None, str | None]:
     """The compiled wind step: its ahead-of-time module where built, else :func:`_jit_wind_module`."""
-    kernel = aot_wind_kernel()
-    front = _wind_facades.get(kernel.shared)
-    if front is None:
-        module = load_module(kernel, _WIND_SOURCE)
-        if module is None:
-            return _jit_wind_module()
-        front = _wind_facades[kernel.shared] = facade(module, kernel.module_name + "_facade", None, _jit_wind_module)
-    return front, None
+    return compiled_or_jit(aot_wind_kernel(), _WIND_SOURCE, _jit_wind_module)
 
 
 @dataclass(frozen=True)

@@ -24,13 +24,14 @@ from __future__ import annotations
 
 import ctypes
 from ctypes import c_double
+from functools import lru_cache
 from pathlib import Path
 from types import ModuleType
 from typing import Callable
 
 import numpy as np
 
-from components.model.aot import AotKernel, facade, load_module
+from components.model.aot import AotKernel, compiled_or_jit
 from components.model.shared_module import shared_name
 
 from .compiled_loop_layout import (
@@ -66,6 +67,7 @@ def _jit_kernel_module() -> ModuleType:
     return compiled_loop_kernel
 
 
+@lru_cache(maxsize=None)  # once per source file: an FMU's extracted copy may be gone by its next instance
 def aot_loop_kernel() -> AotKernel:
     """The compiled stepping loop as :mod:`components.model.aot` builds and finds it."""
     return AotKernel(shared_name(_SOURCE, _DEPENDENCIES), f"{__name__}:_jit_kernel_module")
@@ -82,12 +84,7 @@ def _load():
     """The compiled part (ahead of time where built, else numba), or None with the reason (once per process)."""
     global _module, _import_error
     if _module is None and _import_error is None:
-        kernel = aot_loop_kernel()
-        aot = load_module(kernel, _SOURCE)
-        if aot is not None:
-            _module = facade(aot, kernel.module_name + "_facade", None, _jit_module)
-        else:
-            _module, _import_error = _jit_module()
+        _module, _import_error = compiled_or_jit(aot_loop_kernel(), _SOURCE, _jit_module)
     return _module
 
 

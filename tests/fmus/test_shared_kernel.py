@@ -28,3 +28,12 @@ def test_the_gearbox_fmu_runs_on_the_hosts_kernel_module(fmu_path):
     shared = aot_kernel().shared
     assert _kernel_modules() and all(name in (shared, f"{shared}_aot") for name in _kernel_modules()), _kernel_modules()
     assert compiled_module()[0] is host
+
+
+@pytest.mark.parametrize("name, output", [("Gearbox", "shaft_torque"), ("WindSource", "omega")])
+def test_the_same_fmu_runs_again_after_its_first_extraction_is_gone(fmu_path, name, output):
+    """fmpy deletes an FMU's extracted folder after a run; the modules the first run imported stay cached."""
+    from fmpy import simulate_fmu
+
+    runs = [simulate_fmu(str(fmu_path(name)), stop_time=0.01, step_size=1e-3, output=[output]) for _ in range(2)]
+    assert list(runs[0][output]) == list(runs[1][output])
