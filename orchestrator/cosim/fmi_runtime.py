@@ -35,7 +35,7 @@ from ctypes import (
 from pathlib import Path
 from typing import Any, Iterable
 
-from ..errors import FmuStepError, status_label
+from ..errors import FmuStepError, InitializationError, status_label
 from .fmu_interface import FmuInterface
 
 FMI_OK, FMI_WARNING, FMI_ERROR, FMI_FATAL = 0, 1, 3, 4
@@ -87,7 +87,12 @@ def _extract(iface: FmuInterface) -> Path:
         _EXTRACT_ROOT = Path(tempfile.mkdtemp(prefix="dtcosim-fmus-"))
         atexit.register(shutil.rmtree, _EXTRACT_ROOT, True)
     target = _EXTRACT_ROOT / iface.sha256[:16]
-    extract(str(iface.path), str(target))
+    try:
+        extract(str(iface.path), str(target))
+    except OSError as exc:  # a full disk, a file-size limit, a read-only temporary folder
+        shutil.rmtree(target, ignore_errors=True)
+        reason = exc.strerror or str(exc) or type(exc).__name__
+        raise InitializationError(f"cannot extract the FMU {iface.path} into {target}: {reason}") from None
     _EXTRACTED[iface.sha256] = target
     return target
 

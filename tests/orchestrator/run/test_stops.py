@@ -128,6 +128,18 @@ def test_a_file_size_limit_keeps_what_was_written_and_says_so(fmu_dir, tmp_path)
     _check_disk_full(proc, out, "File too large")
 
 
+def test_an_fmu_that_cannot_be_extracted_is_a_named_error_before_stepping(fmu_dir, tmp_path):
+    """A file-size limit below the Gearbox's compiled module (0.85 MB): the extraction fails, one clear line."""
+    out = tmp_path / "limited"
+    out.mkdir()
+    proc = start(fmu_dir, out, "--stop", "1", preexec_fn=_file_size_limit(300_000))
+    _, stderr = proc.communicate(timeout=300)
+    assert proc.returncode == 1, stderr
+    assert "cannot extract the FMU" in stderr and "File too large" in stderr and "Traceback" not in stderr, stderr
+    summary = summary_of(out)
+    assert summary["status"] == "failed" and summary["stage"] == "initialisation" and summary["complete"] is False
+
+
 def test_a_full_disk_keeps_what_was_written_and_says_so(fmu_dir, tmp_path):
     disk = tmp_path / "disk"
     disk.mkdir()
