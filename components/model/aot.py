@@ -56,10 +56,13 @@ class AotKernel:
     provider : str
         ``"package.module:function"``: a function returning the just-in-time kernel module (which
         defines ``AOT_EXPORTS``), called by the builder process.
+    source : pathlib.Path or None
+        The kernel's source file (numba's just-in-time cache is keyed by its hash).
     """
 
     shared: str
     provider: str
+    source: Path | None = None
 
     @property
     def module_name(self) -> str:

@@ -54,7 +54,7 @@ def _jit_kernel_module() -> ModuleType:
 @lru_cache(maxsize=None)  # once per source file: an FMU's extracted copy may be gone by its next instance
 def aot_kernel(source: Path = _SOURCE) -> AotKernel:
     """The gearbox kernel as :mod:`components.model.aot` builds and finds it (``source``: a copy of its file)."""
-    return AotKernel(shared_name(source, KERNEL_DEPENDENCIES), f"{__name__}:_jit_kernel_module")
+    return AotKernel(shared_name(source, KERNEL_DEPENDENCIES), f"{__name__}:_jit_kernel_module", source)
 
 
 def compiled_module() -> tuple[ModuleType | None, str | None]:

@@ -383,7 +383,7 @@ def _jit_wind_kernel_module() -> ModuleType:
 @lru_cache(maxsize=None)  # once per source file: an FMU's extracted copy may be gone by its next instance
 def aot_wind_kernel(source: Path = _WIND_SOURCE) -> AotKernel:
     """The compiled wind step as :mod:`components.model.aot` builds and finds it (``source``: a copy of its file)."""
-    return AotKernel(shared_name(source, _WIND_DEPENDENCIES), f"{__name__}:_jit_wind_kernel_module")
+    return AotKernel(shared_name(source, _WIND_DEPENDENCIES), f"{__name__}:_jit_wind_kernel_module", source)
 
 
 def _compiled_wind_module() -> tuple[ModuleType | None, str | None]:

@@ -25,6 +25,7 @@ COMMAND_MODULES = (
     "orchestrator.commands.build",
     "orchestrator.commands.validate",
     "orchestrator.commands.modes",
+    "orchestrator.commands.cache",
     "orchestrator.commands.drivetrain",
     "orchestrator.commands.sweep",
     "orchestrator.commands.loads",

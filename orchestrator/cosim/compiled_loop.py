@@ -70,7 +70,7 @@ def _jit_kernel_module() -> ModuleType:
 @lru_cache(maxsize=None)  # once per source file: an FMU's extracted copy may be gone by its next instance
 def aot_loop_kernel() -> AotKernel:
     """The compiled stepping loop as :mod:`components.model.aot` builds and finds it."""
-    return AotKernel(shared_name(_SOURCE, _DEPENDENCIES), f"{__name__}:_jit_kernel_module")
+    return AotKernel(shared_name(_SOURCE, _DEPENDENCIES), f"{__name__}:_jit_kernel_module", _SOURCE)
 
 
 def _jit_module() -> tuple[ModuleType | None, str | None]:

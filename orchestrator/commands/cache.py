@@ -1,0 +1,101 @@
+"""``dtcosim cache [--prune]``: what the per-user cache of compiled kernels holds, and removing what is stale.
+
+The cache (:func:`components.model.numba_cache.user_cache_root`, ``~/.cache/dtcosim``) keeps
+the kernels compiled ahead of time (``aot/<python tag>-numpy<version>/``, one module per
+kernel version: :mod:`components.model.aot`) and numba's just-in-time machine code
+(``numba-<numba version>/<source hash>/``). Every new version of a kernel's sources adds
+entries and nothing removes the old ones: ``--prune`` deletes every entry that the
+installed dtcosim, Python, numpy and numba would not load (FMUs carry their own compiled
+modules, so an older FMU keeps running; a later run rebuilds what it needs).
+"""
+
+from __future__ import annotations
+
+import argparse
+import shutil
+from dataclasses import dataclass
+from pathlib import Path
+
+from components.model.aot import aot_directory
+from components.model.numba_cache import source_hash, user_cache_root
+
+from ..cosim.compiled_kernels import aot_kernels
+
+
+@dataclass(frozen=True)
+class CacheEntry:
+    """One file or folder of the cache: its path, size [bytes] and whether the installed code uses it."""
+
+    path: Path
+    size_bytes: int
+    current: bool
+
+
+def _size(path: Path) -> int:
+    if path.is_file():
+        return path.stat().st_size
+    return sum(p.stat().st_size for p in path.rglob("*") if p.is_file())
+
+
+def _jit_keys() -> tuple[str | None, set[str]]:
+    """numba's version directory name and the source hashes of the kernels its cache is keyed by."""
+    try:
+        import numba  # optional requirement: only to name the current just-in-time cache
+    except ImportError:
+        return None, set()
+    return f"numba-{numba.__version__}", {source_hash(k.source)[:16] for k in aot_kernels() if k.source is not None}
+
+
+def cache_entries(root: Path | None = None) -> list[CacheEntry]:
+    """Every module of ``aot/`` and every kernel folder of ``numba-*/``, marked current or stale."""
+    root = Path(root or user_cache_root())
+    entries = []
+    current_aot_dir = aot_directory()
+    current_files = {k.file().name for k in aot_kernels()}
+    for folder in sorted((root / "aot").glob("*")):
+        for path in sorted(p for p in folder.iterdir() if not p.name.startswith(".build-")):
+            current = folder == current_aot_dir and path.name in current_files
+            entries.append(CacheEntry(path, _size(path), current))
+    numba_dir, hashes = _jit_keys()
+    for folder in sorted(root.glob("numba-*")):
+        for kernel_dir in sorted(p for p in folder.iterdir() if p.is_dir()):
+            current = folder.name == numba_dir and kernel_dir.name in hashes
+            entries.append(CacheEntry(kernel_dir, _size(kernel_dir), current))
+    return entries
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add the ``cache`` subcommand."""
+    p = sub.add_parser("cache", help="list the per-user cache of compiled kernels; --prune removes stale entries",
+                       description=__doc__.splitlines()[0].split(": ", 1)[1])
+    p.add_argument("--prune", action="store_true",
+                   help="delete every entry the installed dtcosim, Python, numpy and numba would not load")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Print the entries (and prune the stale ones with ``--prune``)."""
+    root = user_cache_root()
+    entries = cache_entries(root)
+    print(f"cache: {root}")
+    if not entries:
+        print("  (empty)")
+        return 0
+    for e in entries:
+        print(f"  {'current' if e.current else 'stale  '}  {e.size_bytes / 1e6:7.2f} MB  {e.path.relative_to(root)}")
+    stale = [e for e in entries if not e.current]
+    total = sum(e.size_bytes for e in entries) / 1e6
+    print(f"{len(entries)} entries, {total:.1f} MB; stale: {len(stale)}, {sum(e.size_bytes for e in stale) / 1e6:.1f} MB")
+    if args.prune:
+        for e in stale:
+            if e.path.is_dir():
+                shutil.rmtree(e.path, ignore_errors=True)
+            else:
+                e.path.unlink(missing_ok=True)
+        for folder in [*(root / "aot").glob("*"), *root.glob("numba-*")]:
+            if folder.is_dir() and not any(folder.iterdir()):
+                folder.rmdir()
+        print(f"pruned {len(stale)} stale entries")
+    elif stale:
+        print("`dtcosim cache --prune` removes the stale entries")
+    return 0

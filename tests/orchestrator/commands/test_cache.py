@@ -1,0 +1,66 @@
+"""``dtcosim cache``: the per-user cache of compiled kernels listed, and only its stale entries pruned."""
+
+from __future__ import annotations
+
+import pytest
+
+from components.model.aot import aot_directory
+from components.model.numba_cache import source_hash
+from orchestrator.commands.cli import main
+from orchestrator.cosim.compiled_kernels import aot_kernels
+
+
+@pytest.fixture
+def cache(tmp_path, monkeypatch):
+    """A cache with each installed kernel's module and JIT folder (current) and entries of older code (stale)."""
+    monkeypatch.setenv("DTCOSIM_CACHE_DIR", str(tmp_path))
+    numba = pytest.importorskip("numba")
+    current = []
+    for kernel in aot_kernels():
+        module = kernel.file()
+        module.parent.mkdir(parents=True, exist_ok=True)
+        module.write_bytes(b"x" * 1000)
+        jit = tmp_path / f"numba-{numba.__version__}" / source_hash(kernel.source)[:16]
+        jit.mkdir(parents=True)
+        (jit / "index.nbi").write_bytes(b"y" * 10)
+        current += [module, jit]
+    stale = [aot_directory() / "_dtcosim_compiled_kernel_0000000000000000_aot.cpython-311-x86_64-linux-gnu.so",
+             tmp_path / "aot" / "cpython-310-numpy1.26" / "_dtcosim_compiled_wind_0000000000000000_aot.so",
+             tmp_path / f"numba-{numba.__version__}" / "0000000000000000",
+             tmp_path / "numba-0.60.0" / source_hash(aot_kernels()[0].source)[:16]]
+    for path in stale:
+        if path.suffix == ".so":
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_bytes(b"z" * 500)
+        else:
+            path.mkdir(parents=True)
+            (path / "index.nbi").write_bytes(b"z")
+    return tmp_path, current, stale
+
+
+def test_the_listing_marks_what_the_installed_code_loads(cache, capsys):
+    root, current, stale = cache
+    assert main(["cache"]) == 0
+    out = capsys.readouterr().out
+    assert f"cache: {root}" in out
+    for path in current:
+        assert "current" in next(line for line in out.splitlines() if line.endswith(str(path.relative_to(root))))
+    for path in stale:
+        assert "stale" in next(line for line in out.splitlines() if line.endswith(str(path.relative_to(root))))
+    assert f"{len(current) + len(stale)} entries" in out and f"stale: {len(stale)}," in out
+    assert "`dtcosim cache --prune`" in out
+    assert all(p.exists() for p in current + stale)  # listing changes nothing
+
+
+def test_prune_removes_only_the_stale_entries(cache, capsys):
+    root, current, stale = cache
+    assert main(["cache", "--prune"]) == 0
+    assert f"pruned {len(stale)} stale entries" in capsys.readouterr().out
+    assert all(p.exists() for p in current) and not any(p.exists() for p in stale)
+    assert not (root / "aot" / "cpython-310-numpy1.26").exists() and not (root / "numba-0.60.0").exists()
+
+
+def test_an_empty_cache_says_so(tmp_path, monkeypatch, capsys):
+    monkeypatch.setenv("DTCOSIM_CACHE_DIR", str(tmp_path / "nothing"))
+    assert main(["cache", "--prune"]) == 0
+    assert "(empty)" in capsys.readouterr().out
