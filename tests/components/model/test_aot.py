@@ -74,7 +74,7 @@ def test_the_ahead_of_time_kernel_steps_bit_for_bit_as_the_just_in_time_one(buil
 
 def test_the_wind_step_is_bit_for_bit_the_just_in_time_one(built):
     process = RotorSpeedProcess(WindParameters())
-    stepper = PhasorStepper(process)
+    stepper = PhasorStepper(process, kernel="compiled")  # whatever DTCOSIM_KERNEL says
     assert getattr(stepper._compiled, "AHEAD_OF_TIME", None), "the wind step is not the ahead-of-time module"
     jit = stepper._compiled.__getattr__("rotate_and_sum")  # the just-in-time function behind the facade
     z = np.exp(1j * np.linspace(0.0, 3.0, 256))
@@ -141,7 +141,7 @@ _CHILD = textwrap.dedent("""
 def test_a_module_built_here_runs_without_numba_and_as_the_jit_kernel(tmp_path):
     """``build_module`` into an empty cache (what a new machine does), then a process that never imports numba."""
     kernel = aot_wind_kernel()
-    env_cache = {"DTCOSIM_CACHE_DIR": str(tmp_path)}
+    env_cache = {"DTCOSIM_CACHE_DIR": str(tmp_path), "DTCOSIM_KERNEL": "auto"}
     build = subprocess.run([sys.executable, "-m", "components.model.aot", f"{kernel.shared}={kernel.provider}"],
                            capture_output=True, text=True, timeout=600, env={**__import__("os").environ, **env_cache})
     if build.returncode != 0 and "CompileError" in build.stderr + build.stdout:
