@@ -101,18 +101,18 @@ def enabled() -> bool:
 BUNDLE_FOLDER = "_aot"
 
 
-def load_module(kernel: AotKernel, source: Path | None = None) -> ModuleType | None:
+def load_module(kernel: AotKernel) -> ModuleType | None:
     """The kernel's extension module if it was built for this interpreter and imports; else None.
 
-    Looked for in the :data:`BUNDLE_FOLDER` beside ``source`` (the kernel's source file: an FMU
-    carries its module there), then in :func:`aot_directory`.
+    Looked for in the :data:`BUNDLE_FOLDER` beside ``kernel.source`` (an FMU carries its module
+    there), then in :func:`aot_directory`.
     """
     if not enabled():
         return None
     module = sys.modules.get(kernel.module_name)
     if module is not None:
         return module
-    folders = ([source.parent / BUNDLE_FOLDER] if source is not None else []) + [aot_directory()]
+    folders = ([kernel.source.parent / BUNDLE_FOLDER] if kernel.source is not None else []) + [aot_directory()]
     for path in (kernel.file(folder) for folder in folders):
         if not path.is_file():
             continue
@@ -155,7 +155,7 @@ def facade(module: ModuleType, name: str, constants: ModuleType | None,
 _facades: dict[str, ModuleType] = {}
 
 
-def compiled_or_jit(kernel: AotKernel, source: Path, jit_module: Callable[[], tuple[ModuleType | None, str | None]],
+def compiled_or_jit(kernel: AotKernel, jit_module: Callable[[], tuple[ModuleType | None, str | None]],
                     constants: ModuleType | None = None,
                     extra: Callable[[ModuleType], dict] | None = None) -> tuple[ModuleType | None, str | None]:
     """The kernel's :func:`facade` over its ahead-of-time module where one loads, else ``jit_module()``.
@@ -164,7 +164,7 @@ def compiled_or_jit(kernel: AotKernel, source: Path, jit_module: Callable[[], tu
     """
     front = _facades.get(kernel.shared)
     if front is None:
-        module = load_module(kernel, source)
+        module = load_module(kernel)
         if module is None:
             return jit_module()
         front = facade(module, kernel.module_name + "_facade", constants, jit_module,

@@ -64,7 +64,7 @@ def compiled_module() -> tuple[ModuleType | None, str | None]:
     (``gearbox_step``, ``outputs``) and :mod:`~components.model.kernel_layout`; any other name
     (the monolithic reference's functions) comes from the just-in-time module on first use.
     """
-    return compiled_or_jit(aot_kernel(), _SOURCE, jit_module, kernel_layout, lambda module: {
+    return compiled_or_jit(aot_kernel(), jit_module, kernel_layout, lambda module: {
         "ensure_compiled": lambda: None, "step_entry_point": lambda: module.gearbox_step})
 
 

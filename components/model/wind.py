@@ -388,7 +388,7 @@ def aot_wind_kernel(source: Path = _WIND_SOURCE) -> AotKernel:
 
 def _compiled_wind_module() -> tuple[ModuleType | None, str | None]:
     """The compiled wind step: its ahead-of-time module where built, else :func:`_jit_wind_module`."""
-    return compiled_or_jit(aot_wind_kernel(), _WIND_SOURCE, _jit_wind_module)
+    return compiled_or_jit(aot_wind_kernel(), _jit_wind_module)
 
 
 @dataclass(frozen=True)

@@ -84,7 +84,7 @@ def _load():
     """The compiled part (ahead of time where built, else numba), or None with the reason (once per process)."""
     global _module, _import_error
     if _module is None and _import_error is None:
-        _module, _import_error = compiled_or_jit(aot_loop_kernel(), _SOURCE, _jit_module)
+        _module, _import_error = compiled_or_jit(aot_loop_kernel(), _jit_module)
     return _module
 
 
