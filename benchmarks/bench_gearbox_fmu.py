@@ -18,11 +18,17 @@ process); the runners take turns block by block, so load changes on a shared
 machine hit them alike.
 
 Targets (issue 14): compiled <= 20 us per step; numpy fallback no slower than
-before the issue (82 us).
+before the issue (82 us on the machine of that day). ``--baseline REV`` measures
+that comparison on this machine: it builds the Gearbox FMU of git revision ``REV``
+(default :data:`PRE_ISSUE_REVISION`, the last commit before issue 14's work) in a
+temporary ``git worktree`` and runs it block by block with the others (its own
+package name keeps its code apart from today's in this process), then prints the
+fallback's ratio to it.
 
 Usage::
 
     python benchmarks/bench_gearbox_fmu.py [--steps 1000] [--repeat 5] [--warmup 3.0] [--preset table6]
+        [--baseline [REV]]
 """
 
 from __future__ import annotations
@@ -32,6 +38,7 @@ import one_blas_thread  # noqa: F401 - first: one BLAS thread (CPU time without 
 import argparse
 import os
 import statistics
+import subprocess
 import sys
 import tempfile
 import textwrap
@@ -180,6 +187,31 @@ def numpy_fmu(path: Path, initial: dict[str, float]) -> LowLevelFmu:
             os.environ[ENVIRONMENT_VARIABLE] = previous
 
 
+#: the last commit before issue 14's work (the Gearbox FMU of "today 82 us")
+PRE_ISSUE_REVISION = "2597187^"
+
+
+def build_baseline_fmu(revision: str, out_dir: Path) -> Path:
+    """The Gearbox FMU of git ``revision``, built in a temporary worktree of this repository."""
+    repo = Path(__file__).resolve().parents[1]
+    tree = out_dir / "baseline-tree"
+    subprocess.run(["git", "-C", str(repo), "worktree", "add", "--detach", "-f", str(tree), revision],
+                   check=True, capture_output=True)
+    try:
+        code = ("import sys; sys.path.insert(0, sys.argv[1]); from fmus.build import build_fmu; "
+                "print(build_fmu('Gearbox', sys.argv[2], sys.argv[3]).path)")
+        env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+        out = subprocess.run([sys.executable, "-c", code, str(tree), str(out_dir / "baseline"), PRESET_OF_RUN[0]],
+                             check=True, capture_output=True, text=True, cwd=tree, env=env)
+        return Path(out.stdout.strip().splitlines()[-1])
+    finally:
+        subprocess.run(["git", "-C", str(repo), "worktree", "remove", "--force", str(tree)], capture_output=True)
+
+
+#: the preset of this run (set by main; the baseline is built with the same)
+PRESET_OF_RUN = ["table6"]
+
+
 def interleaved_blocks(runners: dict, inputs: np.ndarray, warmup: int, steps: int, repeat: int) -> dict[str, list[float]]:
     """Mean cost per step [us] of ``repeat`` blocks of ``steps`` steps, the runners taking turns block by block."""
     for runner in runners.values():
@@ -198,7 +230,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--repeat", type=int, default=5, help="timed blocks (default 5)")
     parser.add_argument("--warmup", type=float, default=3.0, help="simulated start-up time not timed [s] (default 3)")
     parser.add_argument("--preset", default="table6", help="drivetrain preset (default table6)")
+    parser.add_argument("--baseline", nargs="?", const=PRE_ISSUE_REVISION, default=None, metavar="REV",
+                        help=f"also run the Gearbox FMU of git revision REV (default {PRE_ISSUE_REVISION})")
     args = parser.parse_args(argv)
+    PRESET_OF_RUN[0] = args.preset
 
     warmup = int(round(args.warmup / STEP_S))
     n_total = warmup + args.steps * args.repeat
@@ -216,9 +251,13 @@ def main(argv: list[str] | None = None) -> int:
             "model": DirectModel(args.preset, initial),
             "model_numpy": DirectModel(args.preset, initial, kernel="numpy"),
         }
+        if args.baseline:
+            runners["baseline"] = LowLevelFmu(build_baseline_fmu(args.baseline, tmp), INPUTS, "shaft_torque",
+                                              fmu_initial)
         times = interleaved_blocks(runners, inputs, warmup, args.steps, args.repeat)
-        for name in ("gearbox", "gearbox_numpy", "trivial"):
-            runners[name].close()
+        for name in ("gearbox", "gearbox_numpy", "trivial", "baseline"):
+            if name in runners:
+                runners[name].close()
     med = {name: statistics.median(v) for name, v in times.items()}
     layer = statistics.median(a - b for a, b in zip(times["gearbox"], times["model"]))
 
@@ -233,13 +272,22 @@ def main(argv: list[str] | None = None) -> int:
     print(line("trivial FMU", "trivial"))
     print(line(f"GearboxModel.step alone ({kernel})", "model"))
     print(line("GearboxModel.step alone (numpy)", "model_numpy"))
+    if args.baseline:
+        print(line(f"Gearbox FMU of {args.baseline}", "baseline"))
     print("ratios (same run)")
     print(f"  Gearbox FMU numpy / {kernel}       {med['gearbox_numpy'] / med['gearbox']:6.2f}")
     print(f"  Gearbox FMU {kernel} / trivial FMU  {med['gearbox'] / med['trivial']:6.2f}")
     print(f"  FMU layer + FMI round trip ({kernel}): {layer:.1f} us/step (median of blockwise differences)")
     if kernel == "compiled":
         print(f"  target compiled <= 20 us/step -> {'met' if med['gearbox'] <= 20.0 else 'NOT met'}")
-    print(f"  target numpy fallback <= 82 us/step (before issue 14) -> {'met' if med['gearbox_numpy'] <= 82.0 else 'NOT met'}")
+    if args.baseline:
+        ratio = med["gearbox_numpy"] / med["baseline"]
+        print(f"  Gearbox FMU numpy / the FMU of {args.baseline}: {ratio:.2f} "
+              f"(blockwise: {', '.join(f'{a / b:.2f}' for a, b in zip(times['gearbox_numpy'], times['baseline']))})")
+        print(f"  target numpy fallback no slower than before issue 14 -> {'met' if ratio <= 1.0 else 'NOT met'}")
+    else:
+        print(f"  target numpy fallback <= 82 us/step (before issue 14, that day's machine) -> "
+              f"{'met' if med['gearbox_numpy'] <= 82.0 else 'NOT met'}; --baseline measures it here")
     return 0
 
 

@@ -23,10 +23,10 @@ The Parquet file is written with Snappy compression and PLAIN encoding (no
 dictionary), the combination every Parquet reader supports (it is MATLAB's
 ``parquetwrite`` default codec); :data:`PARQUET_OPTIONS`.
 
-Only this module imports ``pyarrow``, and only when a columnar file is written or
-read. Arrays are built from the numpy buffers (``pyarrow.Array.from_buffers``):
-``pyarrow.array`` would load pyarrow's conversion machinery, about 50 MB of
-resident memory, into the run's process.
+The stream is encoded without pyarrow (:mod:`orchestrator.arrow_stream`); only
+this module imports ``pyarrow``, to read a columnar file and to convert the stream,
+which a run does in a child process (:mod:`orchestrator.parquet_conversion`), so
+pyarrow's ~45 MB of resident memory never adds to the run's.
 """
 
 from __future__ import annotations
@@ -34,7 +34,6 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Sequence
 
 import numpy as np
 
@@ -44,25 +43,12 @@ PARQUET_MAGIC = b"PAR1"
 ARROW_STREAM_MAGIC = b"\xff\xff\xff\xff"
 #: the end-of-stream marker of an Arrow IPC stream
 ARROW_END_OF_STREAM = b"\xff\xff\xff\xff\x00\x00\x00\x00"
-#: FMI 2.0 type -> numpy dtype of its Arrow column (String: see :func:`_string_array`)
-NUMPY_TYPES = {"Real": np.float64, "Integer": np.int32, "Enumeration": np.int32, "Boolean": np.bool_}
 #: rows per Parquet row group: the conversion holds one (1.5 MB for 23 float64 columns; 65536 rows cost 25 MB more peak RSS)
 ROW_GROUP_ROWS = 8192
 #: options of the Parquet writer: Snappy and PLAIN encoding, which every Parquet reader supports
 PARQUET_OPTIONS = {"compression": "snappy", "use_dictionary": False}
 #: header tag of the non-Real columns that have no unit (as in ``timeseries.csv``)
 TYPE_TAGS = {"Boolean": "Boolean 0/1", "String": "String"}
-
-
-def _memory_pool(pa):
-    """The allocator of the buffers written here: the C library's ``malloc``.
-
-    pyarrow's default pool (mimalloc or jemalloc) keeps freed memory for reuse; in a
-    run's process, beside the FMUs, that is resident memory nothing else can use
-    (~2 MB of the peak of streaming and converting a 600 s run). The file bytes do not
-    depend on it.
-    """
-    return pa.system_memory_pool()
 
 
 def header_field(name: str, unit: str, fmi_type: str = "Real") -> str:
@@ -105,65 +91,6 @@ def is_columnar(path: str | Path) -> bool:
     with open(path, "rb") as fh:
         head = fh.read(4)
     return head in (PARQUET_MAGIC, ARROW_STREAM_MAGIC)
-
-
-def arrow_schema(columns: Sequence[Any]):
-    """The Arrow schema of ``columns`` (objects with ``name``, ``unit``, ``fmi_type``; ``time`` first)."""
-    import pyarrow as pa
-
-    types = {"Real": pa.float64(), "Integer": pa.int32(), "Enumeration": pa.int32(), "Boolean": pa.bool_(),
-             "String": pa.string()}
-    fields = [pa.field(c.name, types[c.fmi_type], nullable=c.fmi_type == "String",
-                       metadata={"unit": c.unit, "fmi_type": c.fmi_type}) for c in columns]
-    described = [{"name": c.name, "unit": c.unit, "fmi_type": c.fmi_type} for c in columns]
-    attrs = {"units": {c.name: c.unit for c in columns}, "fmi_types": {c.name: c.fmi_type for c in columns}}
-    return pa.schema(fields, metadata={"dtcosim": json.dumps({"columns": described}),
-                                       "PANDAS_ATTRS": json.dumps(attrs)})
-
-
-def _numeric_array(pa, arrow_type, values: np.ndarray, fmi_type: str):
-    if fmi_type == "Boolean":
-        bits = np.packbits(np.asarray(values) != 0.0, bitorder="little")
-        return pa.Array.from_buffers(arrow_type, len(values), [None, pa.py_buffer(bits)])
-    data = np.ascontiguousarray(values, dtype=NUMPY_TYPES[fmi_type])
-    return pa.Array.from_buffers(arrow_type, len(data), [None, pa.py_buffer(data)])
-
-
-def _string_array(pa, strings: np.ndarray):
-    """A UTF-8 string array from its offsets and bytes (no ``pyarrow.array``)."""
-    encoded = [str(s).encode("utf-8") for s in strings]
-    offsets = np.zeros(len(encoded) + 1, dtype=np.int32)
-    np.cumsum([len(b) for b in encoded], out=offsets[1:])
-    return pa.Array.from_buffers(pa.string(), len(encoded),
-                                 [None, pa.py_buffer(offsets), pa.py_buffer(b"".join(encoded))])
-
-
-def record_batch_bytes(schema, time_s: np.ndarray, values: np.ndarray,
-                       text: dict[int, np.ndarray] | None = None) -> bytes:
-    """One encapsulated Arrow IPC record-batch message of rows ``time_s`` (n,), ``values`` (n, m).
-
-    ``text``: value column index -> the n strings of a String column.
-    """
-    import pyarrow as pa
-
-    arrays = [_numeric_array(pa, schema.field(0).type, time_s, "Real")]
-    for j in range(values.shape[1]):
-        f = schema.field(j + 1)
-        fmi_type = f.metadata[b"fmi_type"].decode()
-        if fmi_type == "String":
-            if not text or j not in text:
-                raise ValueError(f"no strings given for String column {f.name!r}")
-            arrays.append(_string_array(pa, text[j]))
-        else:
-            arrays.append(_numeric_array(pa, f.type, values[:, j], fmi_type))
-    return pa.RecordBatch.from_arrays(arrays, schema=schema).serialize(memory_pool=_memory_pool(pa)).to_pybytes()
-
-
-def schema_bytes(schema) -> bytes:
-    """The encapsulated schema message that starts an Arrow IPC stream."""
-    import pyarrow as pa
-
-    return schema.serialize(memory_pool=_memory_pool(pa)).to_pybytes()
 
 
 def _table_of(schema, batches, whole: bool) -> ColumnarTable:
@@ -241,7 +168,7 @@ def stream_to_parquet(stream_path: str | Path, parquet_path: str | Path) -> None
     import pyarrow.ipc as ipc
     import pyarrow.parquet as pq
 
-    pool = _memory_pool(pa)
+    pool = pa.system_memory_pool()  # the C library's malloc: pyarrow's own pool keeps freed memory
     with pa.OSFile(str(stream_path)) as src:
         reader = ipc.open_stream(src, memory_pool=pool)
         try:

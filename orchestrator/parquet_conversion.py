@@ -1,0 +1,113 @@
+"""Converting a run's Arrow IPC stream to ``timeseries.parquet``, in a child process where that saves memory.
+
+The conversion needs pyarrow (:func:`orchestrator.columnar_files.stream_to_parquet`),
+whose libraries and modules cost a process ~45 MB of resident memory and stay
+loaded once imported. A run converts when its co-simulation is over, before its
+analyses and plots (which load matplotlib, ~40 MB more): in the run's own process
+the two would add up. :func:`convert_stream` therefore runs the conversion in a
+short-lived child Python process unless this process has imported pyarrow
+already (a notebook, a test), where converting here costs nothing more. The
+child's peak adds to the run's only while it runs, when the run holds the least
+(measured: ``python benchmarks/bench_long_run.py``, the ``converter`` column).
+
+Errors keep their meaning across the process boundary: an ``OSError`` of the
+child (a full disk, a file-size limit) is raised here with its errno, message and
+file name; a child that fails otherwise or is killed raises ``OSError`` naming the
+Parquet file and what the child said. The stream is never removed here
+(:class:`orchestrator.run.parquet_writer.ParquetWriter` removes it after a
+conversion that succeeded).
+"""
+
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import sys
+from pathlib import Path
+from typing import Literal
+
+#: the folder that holds the ``orchestrator`` package (the child imports the same code)
+PACKAGE_ROOT = Path(__file__).resolve().parents[1]
+#: exit status of a child whose conversion raised OSError (its fields as JSON on stderr)
+EXIT_OS_ERROR = 3
+#: the child's program: this module's :func:`main` with the same package first on sys.path
+CHILD_CODE = ("import sys; sys.path.insert(0, sys.argv[1]); "
+              "from orchestrator.parquet_conversion import main; sys.exit(main(sys.argv[2:]))")
+
+Where = Literal["auto", "child", "here"]
+
+
+def convert_in_child() -> bool:
+    """True where :func:`convert_stream` with ``where="auto"`` starts a child: pyarrow not imported here."""
+    return "pyarrow" not in sys.modules
+
+
+def convert_stream(stream_path: str | Path, parquet_path: str | Path, where: Where = "auto") -> str:
+    """Convert the Arrow IPC stream ``stream_path`` to the Parquet file ``parquet_path``.
+
+    Parameters
+    ----------
+    stream_path, parquet_path : path
+        The (complete) stream and the file to write.
+    where : {"auto", "child", "here"}
+        ``"child"``: in a child Python process; ``"here"``: in this process;
+        ``"auto"``: a child unless pyarrow is imported here (:func:`convert_in_child`).
+
+    Returns
+    -------
+    str
+        ``"child"`` or ``"here"``: where it ran.
+
+    Raises
+    ------
+    OSError
+        The file could not be written (errno and file name as the writer raised them), or
+        the child failed otherwise or was killed (naming ``parquet_path``).
+    """
+    if where not in ("auto", "child", "here"):
+        raise ValueError(f"where={where!r}: expected 'auto', 'child' or 'here'")
+    if where == "here" or (where == "auto" and not convert_in_child()):
+        from .columnar_files import stream_to_parquet
+
+        stream_to_parquet(stream_path, parquet_path)
+        return "here"
+    _convert_in_child(Path(stream_path), Path(parquet_path))
+    return "child"
+
+
+def _convert_in_child(stream_path: Path, parquet_path: Path) -> None:
+    cmd = [sys.executable, "-c", CHILD_CODE, str(PACKAGE_ROOT), str(stream_path), str(parquet_path)]
+    try:
+        proc = subprocess.run(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                              text=True)
+    except OSError as exc:  # no Python to start (cannot happen in a running interpreter, but a full /tmp can)
+        raise OSError(exc.errno, f"could not start the Parquet conversion: {exc.strerror}", str(parquet_path)) from exc
+    if proc.returncode == 0:
+        return
+    said = proc.stderr.strip()
+    if proc.returncode == EXIT_OS_ERROR:
+        try:
+            fields = json.loads(said.splitlines()[-1])
+            raise OSError(fields["errno"], fields["strerror"], fields["filename"] or str(parquet_path))
+        except (ValueError, KeyError, IndexError, TypeError):
+            pass
+    how = (f"was killed by signal {-proc.returncode}" if proc.returncode < 0
+           else f"ended with exit status {proc.returncode}")
+    last = said.splitlines()[-1] if said else "nothing on stderr"
+    raise OSError(None, f"the Parquet conversion of {stream_path.name} {how}: {last}", str(parquet_path))
+
+
+def main(argv: list[str]) -> int:
+    """The child: convert ``argv[0]`` (stream) to ``argv[1]`` (Parquet); 0, or :data:`EXIT_OS_ERROR` with JSON."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the run's to handle; the conversion is short
+    from .columnar_files import stream_to_parquet
+
+    stream_path, parquet_path = argv
+    try:
+        stream_to_parquet(stream_path, parquet_path)
+    except OSError as exc:
+        print(json.dumps({"errno": exc.errno, "strerror": exc.strerror or str(exc),
+                          "filename": None if exc.filename is None else str(exc.filename)}), file=sys.stderr)
+        return EXIT_OS_ERROR
+    return 0

@@ -1,0 +1,111 @@
+"""The stream -> Parquet conversion in a child process: the same file, errors with their errno, pyarrow kept out."""
+
+from __future__ import annotations
+
+import errno
+import json
+import re
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+
+from orchestrator.arrow_stream import record_batch_message, schema_message
+from orchestrator.columnar_files import ARROW_END_OF_STREAM, read_columnar
+from orchestrator.parquet_conversion import PACKAGE_ROOT, convert_stream
+from orchestrator.run.writers import Column
+
+COLUMNS = [Column("time", "s"), Column("gearbox.omega_out", "rad/s"), Column("gen.tripped", "", "Boolean")]
+
+
+def write_stream(path, batches: int = 3, n: int = 100):
+    parts = [schema_message(COLUMNS)]
+    for k in range(batches):
+        t = (k * n + np.arange(n)) * 1e-3
+        parts.append(record_batch_message(COLUMNS, t, np.column_stack([np.sin(t), t > 0.1])))
+    path.write_bytes(b"".join(parts) + ARROW_END_OF_STREAM)
+    return path
+
+
+def test_the_child_writes_the_file_this_process_writes(tmp_path):
+    stream = write_stream(tmp_path / "timeseries.parquet.partial")
+    assert convert_stream(stream, tmp_path / "child.parquet", where="child") == "child"
+    assert convert_stream(stream, tmp_path / "here.parquet", where="here") == "here"
+    assert (tmp_path / "child.parquet").read_bytes() == (tmp_path / "here.parquet").read_bytes()
+    table = read_columnar(tmp_path / "child.parquet")
+    assert table.names == ["time", "gearbox.omega_out", "gen.tripped"] and table.data.shape == (300, 3)
+    np.testing.assert_array_equal(table.data[:, 1], np.sin(np.arange(300) * 1e-3))
+    assert convert_stream(stream, tmp_path / "auto.parquet") == "here"  # pyarrow is imported in this process now
+
+
+def test_a_run_process_that_never_imported_pyarrow_converts_in_a_child_and_stays_without_it(tmp_path):
+    code = textwrap.dedent(f"""
+        import sys, numpy as np
+        sys.path.insert(0, {str(PACKAGE_ROOT)!r})
+        from orchestrator.run.parquet_writer import ParquetWriter
+        from orchestrator.run.writers import Column
+        w = ParquetWriter({str(tmp_path / "timeseries.parquet")!r})
+        w.open([Column("x", "N")])
+        w.append(np.arange(5) * 0.1, np.arange(5.0).reshape(5, 1))
+        w.close()
+        print(w.converted_in, "pyarrow" in sys.modules)
+    """)
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.split() == ["child", "False"]
+    np.testing.assert_array_equal(read_columnar(tmp_path / "timeseries.parquet").data[:, 1], np.arange(5.0))
+
+
+def test_a_missing_folder_is_an_os_error_with_its_errno_and_file_name(tmp_path):
+    stream = write_stream(tmp_path / "s.partial")
+    target = tmp_path / "gone" / "timeseries.parquet"
+    with pytest.raises(OSError, match="gone") as info:
+        convert_stream(stream, target, where="child")
+    assert info.value.errno == errno.ENOENT
+
+
+def test_a_file_size_limit_during_the_conversion_is_efbig_naming_the_parquet_file(tmp_path):
+    stream = write_stream(tmp_path / "s.partial", batches=20)  # ~50 kB; the limit is set after it is written
+    target = tmp_path / "timeseries.parquet"
+    code = textwrap.dedent(f"""
+        import json, resource, sys
+        sys.path.insert(0, {str(PACKAGE_ROOT)!r})
+        from orchestrator.parquet_conversion import convert_stream
+        resource.setrlimit(resource.RLIMIT_FSIZE, (8192, 8192))
+        try:
+            convert_stream({str(stream)!r}, {str(target)!r}, where="child")
+        except OSError as exc:
+            print(json.dumps([exc.errno, exc.strerror, exc.filename]))
+    """)
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    code_, message, filename = json.loads(proc.stdout)
+    assert code_ == errno.EFBIG and "too large" in message and filename == str(target)
+
+
+def test_a_child_that_fails_otherwise_is_an_os_error_saying_how_it_ended(tmp_path):
+    stream = write_stream(tmp_path / "s.partial")
+    target = tmp_path / "timeseries.parquet"
+    code = textwrap.dedent(f"""
+        import json, resource, sys
+        sys.path.insert(0, {str(PACKAGE_ROOT)!r})
+        from orchestrator.parquet_conversion import convert_stream
+        resource.setrlimit(resource.RLIMIT_AS, (150_000_000, 150_000_000))  # too little for numpy and pyarrow
+        try:
+            convert_stream({str(stream)!r}, {str(target)!r}, where="child")
+        except OSError as exc:
+            print(json.dumps([exc.errno, exc.strerror, exc.filename]))
+    """)
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    code_, message, filename = json.loads(proc.stdout)
+    assert re.match(r"the Parquet conversion of s.partial (ended with exit status \d+|was killed by signal \d+): ",
+                    message), message
+    assert code_ is None and filename == str(target) and not target.exists()
+
+
+def test_where_must_be_one_of_three():
+    with pytest.raises(ValueError, match=r"where='elsewhere': expected 'auto', 'child' or 'here'"):
+        convert_stream("a", "b", where="elsewhere")
