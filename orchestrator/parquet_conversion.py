@@ -39,8 +39,12 @@ Where = Literal["auto", "child", "here"]
 
 
 def convert_in_child() -> bool:
-    """True where :func:`convert_stream` with ``where="auto"`` starts a child: pyarrow not imported here."""
-    return "pyarrow" not in sys.modules
+    """True where :func:`convert_stream` with ``where="auto"`` starts a child.
+
+    That is where pyarrow is not imported in this process and there is a Python to
+    start (``sys.executable`` is empty in an embedded interpreter).
+    """
+    return "pyarrow" not in sys.modules and bool(sys.executable)
 
 
 def convert_stream(stream_path: str | Path, parquet_path: str | Path, where: Where = "auto") -> str:
@@ -52,7 +56,7 @@ def convert_stream(stream_path: str | Path, parquet_path: str | Path, where: Whe
         The (complete) stream and the file to write.
     where : {"auto", "child", "here"}
         ``"child"``: in a child Python process; ``"here"``: in this process;
-        ``"auto"``: a child unless pyarrow is imported here (:func:`convert_in_child`).
+        ``"auto"``: a child where :func:`convert_in_child` says so, else here.
 
     Returns
     -------
@@ -67,7 +71,9 @@ def convert_stream(stream_path: str | Path, parquet_path: str | Path, where: Whe
     """
     if where not in ("auto", "child", "here"):
         raise ValueError(f"where={where!r}: expected 'auto', 'child' or 'here'")
-    if where == "here" or (where == "auto" and not convert_in_child()):
+    if where == "auto" and not convert_in_child():
+        where = "here"
+    if where == "here":
         from .columnar_files import stream_to_parquet
 
         stream_to_parquet(stream_path, parquet_path)
@@ -81,8 +87,9 @@ def _convert_in_child(stream_path: Path, parquet_path: Path) -> None:
     try:
         proc = subprocess.run(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
                               text=True)
-    except OSError as exc:  # no Python to start (cannot happen in a running interpreter, but a full /tmp can)
-        raise OSError(exc.errno, f"could not start the Parquet conversion: {exc.strerror}", str(parquet_path)) from exc
+    except OSError as exc:  # no process to start (the process limit, no memory to fork)
+        raise OSError(exc.errno, f"could not start the Parquet conversion of {stream_path.name}: {exc.strerror}",
+                      str(parquet_path)) from exc
     if proc.returncode == 0:
         return
     said = proc.stderr.strip()

@@ -106,6 +106,22 @@ def test_a_child_that_fails_otherwise_is_an_os_error_saying_how_it_ended(tmp_pat
     assert code_ is None and filename == str(target) and not target.exists()
 
 
+def test_without_a_python_to_start_auto_converts_here(tmp_path):
+    stream = write_stream(tmp_path / "s.partial")
+    code = textwrap.dedent(f"""
+        import sys
+        sys.path.insert(0, {str(PACKAGE_ROOT)!r})
+        from orchestrator.parquet_conversion import convert_in_child, convert_stream
+        before = convert_in_child()
+        sys.executable = ""  # as in an embedded interpreter
+        print(before, convert_in_child(), convert_stream({str(stream)!r}, {str(tmp_path / "t.parquet")!r}))
+    """)
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.split() == ["True", "False", "here"]
+    assert read_columnar(tmp_path / "t.parquet").data.shape == (300, 3)
+
+
 def test_where_must_be_one_of_three():
     with pytest.raises(ValueError, match=r"where='elsewhere': expected 'auto', 'child' or 'here'"):
         convert_stream("a", "b", where="elsewhere")
