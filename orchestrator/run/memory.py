@@ -1,17 +1,17 @@
 """Handing freed memory back between the phases of a run (co-simulation, results file, analyses, plots).
 
-A whole run holds its samples, the FMUs' code (numba's LLVM for the compiled gearbox
-kernel), pyarrow and matplotlib in one process; what a phase allocates and frees
-would otherwise stay in the process and add to the next phase's peak:
+A whole run holds its samples, the FMUs' code and matplotlib in one process (numba's
+LLVM too where the kernels run just in time; pyarrow only where the caller imported
+it: :mod:`orchestrator.parquet_conversion`); what a phase allocates and frees would
+otherwise stay in the process and add to the next phase's peak:
 
 * matplotlib figures are reference cycles (figure <-> canvas <-> renderer), so their
   pixel buffers go only when the cyclic garbage collector runs;
 * glibc's ``malloc`` keeps freed heap memory mapped (``malloc_trim`` returns it);
-  the results files' buffers come from it too (pyarrow's own pool would keep them:
-  :func:`orchestrator.columnar_files._memory_pool`).
+  the results files' buffers come from it too.
 
 :func:`release_memory` does both; it changes no result. A full collection costs about
-0.1 s in a run's process (numba, matplotlib and pyarrow loaded), so a run calls it
+0.1 s in a run's process (matplotlib loaded), so a run calls it
 only when it holds many samples (:func:`release_between_phases`), where it lowers the
 peak of a 600 s paper run by ~20 MB (``bench_long_run.py``).
 """
