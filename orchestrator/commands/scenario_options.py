@@ -16,10 +16,13 @@ from ..inputs.master_options import ALGORITHMS, EXTRAPOLATIONS
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    """``--step``, ``--stop``, ``--output-interval``, ``--algorithm``, ``--extrapolation``, ``--set``."""
+    """``--step``, ``--stop``, ``--window``, ``--output-interval``, ``--algorithm``, ``--extrapolation``, ``--set``."""
     p.add_argument("--step", type=float, default=None, metavar="H", help="override the communication step [s]")
     p.add_argument("--stop", type=float, default=None, metavar="T",
-                   help="override the stop time [s] (a window beyond it is clipped, with a warning)")
+                   help="override the stop time [s] (a window beyond it is clipped, a window that ended at the "
+                        "scenario's stop follows a later one; both with a warning)")
+    p.add_argument("--window", type=float, nargs=2, default=None, metavar=("START", "END"),
+                   help="override the analysis window [s] (statistics, fatigue, contact loss)")
     p.add_argument("--output-interval", type=float, default=None, metavar="DT", help="override the sampling interval [s]")
     p.add_argument("--algorithm", choices=ALGORITHMS, default=None, help="override the master algorithm")
     p.add_argument("--extrapolation", choices=EXTRAPOLATIONS, default=None, help="override the input extrapolation")
@@ -47,7 +50,7 @@ def apply(scenario, args: argparse.Namespace, command: str):
     )
 
     overrides = SimulationOverrides(stop_s=args.stop, step_s=args.step, output_interval_s=args.output_interval,
-                                    algorithm=args.algorithm, extrapolation=args.extrapolation)
+                                    window_s=args.window, algorithm=args.algorithm, extrapolation=args.extrapolation)
     scenario, notes = overrides.apply(scenario)
     for note in notes:
         print(f"dtcosim {command}: warning: {note}", file=sys.stderr)
@@ -61,6 +64,8 @@ def given_overrides(args: argparse.Namespace) -> list[str]:
                           ("--algorithm", args.algorithm), ("--extrapolation", args.extrapolation)):
         if value is not None:
             out.append(f"{option} {value:g}" if isinstance(value, float) else f"{option} {value}")
+    if args.window is not None:
+        out.append(f"--window {args.window[0]:g} {args.window[1]:g}")
     out += [f"--set {item.strip()}" for item in args.set]
     return out
 

@@ -9,8 +9,10 @@ and parameter values) change a scenario the same way:
   it is a whole multiple of the step, and becomes the step otherwise;
 * the analysis window, unless given, is kept if it lies inside the new run, and
   clipped to it otherwise: it ends at ``min(end, stop)`` and begins where it did
-  if that is still inside, else at the start. The change is reported as a note,
-  which the commands print as a warning;
+  if that is still inside, else at the start. A window that ended at the
+  scenario's stop follows a later stop (``paper-60s`` run to 600 s analyses
+  [5, 600] s, not [5, 60] s). The change is reported as a note, which the commands
+  print as a warning;
 * parameter values are set by ``component.parameter`` and checked against the
   FMUs like the scenario's own.
 """
@@ -85,7 +87,12 @@ class SimulationOverrides:
             start = changes.get("start_s", sim.start_s)
             stop = changes.get("stop_s", sim.stop_s)
             w0, w1 = sim.window_s
-            if not (start <= w0 < w1 <= stop):
+            if "stop_s" in changes and w1 == sim.stop_s < stop:  # the window ended at the stop: it follows it
+                window = (w0 if start <= w0 < stop else start, stop)
+                changes["window_s"] = window
+                notes.append(f"analysis window moved from [{w0:g}, {w1:g}] s to [{window[0]:g}, {window[1]:g}] s: "
+                             f"it ended at the stop ({sim.stop_s:g} s) and follows the new one")
+            elif not (start <= w0 < w1 <= stop):
                 end = min(w1, stop)
                 window = (w0 if start <= w0 < end else start, end)
                 changes["window_s"] = window
