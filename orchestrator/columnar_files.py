@@ -157,20 +157,34 @@ def read_columnar(path: str | Path) -> ColumnarTable:
     return _table_of(reader.schema, batches, whole)
 
 
+def _naming(exc: OSError, path: str | Path) -> OSError:
+    """``exc`` naming ``path``: its ``filename`` set where missing; pyarrow's, which have no errno, re-worded."""
+    if exc.errno is None:  # pyarrow's own I/O errors: the text alone ("Invalid flatbuffers message.")
+        return OSError(f"{path}: {exc}")
+    if exc.filename is None:
+        exc.filename = str(path)
+    return exc
+
+
 def stream_to_parquet(stream_path: str | Path, parquet_path: str | Path) -> None:
     """Convert an Arrow IPC stream to a Parquet file, :data:`ROW_GROUP_ROWS` rows per row group.
 
     Reads batch by batch (bounded memory); the metadata of the stream's schema
-    goes into the Parquet file. Raises ``OSError`` (naming ``parquet_path``) if the
-    file cannot be written.
+    goes into the Parquet file. Raises ``OSError`` naming ``stream_path`` if the
+    stream cannot be opened, else naming ``parquet_path`` (the file cannot be
+    written, or a batch of the stream cannot be read).
     """
     import pyarrow as pa
     import pyarrow.ipc as ipc
     import pyarrow.parquet as pq
 
     pool = pa.system_memory_pool()  # the C library's malloc: pyarrow's own pool keeps freed memory
-    with pa.OSFile(str(stream_path)) as src:
+    try:
+        src = pa.OSFile(str(stream_path))
         reader = ipc.open_stream(src, memory_pool=pool)
+    except OSError as exc:
+        raise _naming(exc, stream_path) from exc
+    with src:
         try:
             writer = pq.ParquetWriter(str(parquet_path), reader.schema, memory_pool=pool, **PARQUET_OPTIONS)
             try:
@@ -186,6 +200,4 @@ def stream_to_parquet(stream_path: str | Path, parquet_path: str | Path) -> None
             finally:
                 writer.close()
         except OSError as exc:
-            if exc.filename is None:
-                exc.filename = str(parquet_path)
-            raise
+            raise _naming(exc, parquet_path) from exc

@@ -12,8 +12,9 @@ child's peak adds to the run's only while it runs, when the run holds the least
 
 Errors keep their meaning across the process boundary: an ``OSError`` of the
 child (a full disk, a file-size limit) is raised here with its errno, message and
-file name; a child that fails otherwise or is killed raises ``OSError`` naming the
-Parquet file and what the child said. The stream is never removed here
+file name (pyarrow's own, which have no errno, with their text, which names the
+file); a child that fails otherwise or is killed raises ``OSError`` whose text
+names the Parquet file, how the child ended and its last line on stderr. The stream is never removed here
 (:class:`orchestrator.run.parquet_writer.ParquetWriter` removes it after a
 conversion that succeeded).
 """
@@ -96,13 +97,16 @@ def _convert_in_child(stream_path: Path, parquet_path: Path) -> None:
     if proc.returncode == EXIT_OS_ERROR:
         try:
             fields = json.loads(said.splitlines()[-1])
-            raise OSError(fields["errno"], fields["strerror"], fields["filename"] or str(parquet_path))
+            error = (OSError(fields["text"]) if fields["errno"] is None
+                     else OSError(fields["errno"], fields["strerror"], fields["filename"] or str(parquet_path)))
         except (ValueError, KeyError, IndexError, TypeError):
-            pass
+            error = None
+        if error is not None:
+            raise error
     how = (f"was killed by signal {-proc.returncode}" if proc.returncode < 0
            else f"ended with exit status {proc.returncode}")
     last = said.splitlines()[-1] if said else "nothing on stderr"
-    raise OSError(None, f"the Parquet conversion of {stream_path.name} {how}: {last}", str(parquet_path))
+    raise OSError(f"{parquet_path}: the Parquet conversion of {stream_path.name} {how}: {last}")
 
 
 def main(argv: list[str]) -> int:
@@ -114,7 +118,7 @@ def main(argv: list[str]) -> int:
     try:
         stream_to_parquet(stream_path, parquet_path)
     except OSError as exc:
-        print(json.dumps({"errno": exc.errno, "strerror": exc.strerror or str(exc),
+        print(json.dumps({"errno": exc.errno, "strerror": exc.strerror, "text": str(exc),
                           "filename": None if exc.filename is None else str(exc.filename)}), file=sys.stderr)
         return EXIT_OS_ERROR
     return 0

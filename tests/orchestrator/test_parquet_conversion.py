@@ -96,14 +96,30 @@ def test_a_child_that_fails_otherwise_is_an_os_error_saying_how_it_ended(tmp_pat
         try:
             convert_stream({str(stream)!r}, {str(target)!r}, where="child")
         except OSError as exc:
-            print(json.dumps([exc.errno, exc.strerror, exc.filename]))
+            print(json.dumps([exc.errno, str(exc), exc.filename]))
     """)
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr
     code_, message, filename = json.loads(proc.stdout)
-    assert re.match(r"the Parquet conversion of s.partial (ended with exit status \d+|was killed by signal \d+): ",
-                    message), message
-    assert code_ is None and filename == str(target) and not target.exists()
+    assert re.match(re.escape(str(target)) + r": the Parquet conversion of s.partial "
+                    r"(ended with exit status \d+|was killed by signal \d+): ", message), message
+    assert code_ is None and not target.exists() and "[Errno None]" not in message
+
+
+@pytest.mark.parametrize("where", ["child", "here"])
+def test_an_error_without_an_errno_names_the_file_and_says_what_failed(tmp_path, where):
+    bad = tmp_path / "s.partial"
+    bad.write_bytes(b"\xff\xff\xff\xff\x10\x00\x00\x00" + b"not a flatbuffer")
+    with pytest.raises(OSError, match=r"^" + re.escape(str(bad)) + r": .*flatbuffer") as info:
+        convert_stream(bad, tmp_path / "timeseries.parquet", where=where)
+    assert "[Errno None]" not in str(info.value)
+
+
+@pytest.mark.parametrize("where", ["child", "here"])
+def test_a_missing_stream_is_named(tmp_path, where):
+    with pytest.raises(OSError, match="gone.partial") as info:
+        convert_stream(tmp_path / "gone.partial", tmp_path / "timeseries.parquet", where=where)
+    assert info.value.errno == errno.ENOENT
 
 
 def test_without_a_python_to_start_auto_converts_here(tmp_path):
