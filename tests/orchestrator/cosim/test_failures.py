@@ -71,6 +71,8 @@ def test_ctrl_c_stops_the_run_and_writes_partial_results(fmu_dir, tmp_path):
     proc = subprocess.Popen([str(exe), "run", "--fmu-dir", str(fmu_dir), "--out", str(out), "--no-plots",
                              "--stop", "600", "--step", "0.001", "--output-interval", "0.001"],
                             cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    note = proc.stderr.readline()  # the scenario's window [5, 60] s ended at its stop: it follows the new one
+    assert "analysis window moved from [5, 60] s to [5, 600] s" in note, note
     header = proc.stderr.readline()  # printed before the FMUs are instantiated
     assert "3 FMUs" in header, header
     time.sleep(8.0)  # past instantiation (numba's cache load included) and initialisation, well before 600 s
