@@ -191,8 +191,8 @@ def numpy_fmu(path: Path, initial: dict[str, float]) -> LowLevelFmu:
 PRE_ISSUE_REVISION = "2597187^"
 
 
-def build_baseline_fmu(revision: str, out_dir: Path) -> Path:
-    """The Gearbox FMU of git ``revision``, built in a temporary worktree of this repository."""
+def build_baseline_fmu(revision: str, out_dir: Path, preset: str) -> Path:
+    """The Gearbox FMU (drivetrain ``preset``) of git ``revision``, built in a temporary worktree of this repository."""
     repo = Path(__file__).resolve().parents[1]
     tree = out_dir / "baseline-tree"
     subprocess.run(["git", "-C", str(repo), "worktree", "add", "--detach", "-f", str(tree), revision],
@@ -201,15 +201,11 @@ def build_baseline_fmu(revision: str, out_dir: Path) -> Path:
         code = ("import sys; sys.path.insert(0, sys.argv[1]); from fmus.build import build_fmu; "
                 "print(build_fmu('Gearbox', sys.argv[2], sys.argv[3]).path)")
         env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
-        out = subprocess.run([sys.executable, "-c", code, str(tree), str(out_dir / "baseline"), PRESET_OF_RUN[0]],
+        out = subprocess.run([sys.executable, "-c", code, str(tree), str(out_dir / "baseline"), preset],
                              check=True, capture_output=True, text=True, cwd=tree, env=env)
         return Path(out.stdout.strip().splitlines()[-1])
     finally:
         subprocess.run(["git", "-C", str(repo), "worktree", "remove", "--force", str(tree)], capture_output=True)
-
-
-#: the preset of this run (set by main; the baseline is built with the same)
-PRESET_OF_RUN = ["table6"]
 
 
 def interleaved_blocks(runners: dict, inputs: np.ndarray, warmup: int, steps: int, repeat: int) -> dict[str, list[float]]:
@@ -233,7 +229,6 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--baseline", nargs="?", const=PRE_ISSUE_REVISION, default=None, metavar="REV",
                         help=f"also run the Gearbox FMU of git revision REV (default {PRE_ISSUE_REVISION})")
     args = parser.parse_args(argv)
-    PRESET_OF_RUN[0] = args.preset
 
     warmup = int(round(args.warmup / STEP_S))
     n_total = warmup + args.steps * args.repeat
@@ -252,12 +247,12 @@ def main(argv: list[str] | None = None) -> int:
             "model_numpy": DirectModel(args.preset, initial, kernel="numpy"),
         }
         if args.baseline:
-            runners["baseline"] = LowLevelFmu(build_baseline_fmu(args.baseline, tmp), INPUTS, "shaft_torque",
+            runners["baseline"] = LowLevelFmu(build_baseline_fmu(args.baseline, tmp, args.preset), INPUTS, "shaft_torque",
                                               fmu_initial)
         times = interleaved_blocks(runners, inputs, warmup, args.steps, args.repeat)
-        for name in ("gearbox", "gearbox_numpy", "trivial", "baseline"):
-            if name in runners:
-                runners[name].close()
+        for runner in runners.values():
+            if isinstance(runner, LowLevelFmu):
+                runner.close()
     med = {name: statistics.median(v) for name, v in times.items()}
     layer = statistics.median(a - b for a, b in zip(times["gearbox"], times["model"]))
 

@@ -9,7 +9,8 @@ Two parts:
    ``numpy``), printing wall and CPU time of the run, the peak resident memory of the
    process (``ru_maxrss``: everything, imports and the FMUs included), for Parquet the peak of
    the child process that converts the stream (:mod:`orchestrator.parquet_conversion`) and that
-   peak plus the run's resident memory while the child ran, and the size of the results file, against the targets of issue 14: <= 10 s wall including writing results
+   peak plus the run's resident memory while the child ran, and the size of the results file,
+   against the targets of issue 14: <= 10 s wall including writing results
    and plots, <= 150 MB peak memory, results file <= 60 MB.
 2. **Imports** (``--imports``): the peak resident memory of a fresh process that imports
    one package (or loads the compiled gearbox kernel from its disk cache), the footprint
@@ -30,6 +31,7 @@ import json
 import os
 import re
 import resource
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -37,6 +39,14 @@ import time
 from pathlib import Path
 
 _STATUS = Path("/proc/self/status")
+
+
+def _read_kb(path: Path) -> int:
+    """The number in ``path`` (written by the converter child); its folder is removed."""
+    try:
+        return int(path.read_text())
+    finally:
+        shutil.rmtree(path.parent, ignore_errors=True)
 
 
 def _cpu_s() -> float:
@@ -135,7 +145,7 @@ def child_main(args) -> None:
             "start_up_s": prepared_s, "cosimulation_s": report.outcome.wall_time_s,
             "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
             "pyarrow_imported": "pyarrow" in sys.modules,
-            "converter_peak_mb": int(hwm_file.read_text()) / 1024.0 if hwm_file.exists() else None,
+            "converter_peak_mb": _read_kb(hwm_file) / 1024.0 if hwm_file.exists() else None,
             "converting_from_mb": converting_from_mb[0] if converting_from_mb else None,
             "results_file": results.name, "results_mb": results.stat().st_size / 1e6,
             "samples": report.summary["samples"], "steps": report.outcome.steps,

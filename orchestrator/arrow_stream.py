@@ -30,8 +30,8 @@ from typing import Protocol, Sequence
 import flatbuffers
 import numpy as np
 
-#: the continuation marker that starts every encapsulated message
-CONTINUATION = b"\xff\xff\xff\xff"
+from .columnar_files import ARROW_STREAM_MAGIC as CONTINUATION  # the marker that starts every message
+
 #: alignment of the flatbuffer's end and of every body buffer [bytes]
 ALIGNMENT = 8
 #: ``MetadataVersion.V5`` of Schema.fbs
@@ -63,9 +63,14 @@ def schema_metadata(columns: Sequence[StreamColumn]) -> dict[str, str]:
     return {"dtcosim": json.dumps({"columns": described}), "PANDAS_ATTRS": json.dumps(attrs)}
 
 
+def _aligned(size: int) -> int:
+    """``size`` rounded up to a multiple of :data:`ALIGNMENT`."""
+    return -(-size // ALIGNMENT) * ALIGNMENT
+
+
 def _encapsulate(builder: flatbuffers.Builder, body: bytes = b"") -> bytes:
     meta = bytes(builder.Output())
-    size = -(-(len(meta) + 8) // ALIGNMENT) * ALIGNMENT - 8  # the body starts 8-byte aligned
+    size = _aligned(len(meta) + 8) - 8  # after the marker and the length: the body starts 8-byte aligned
     return CONTINUATION + size.to_bytes(4, "little", signed=True) + meta + bytes(size - len(meta)) + body
 
 
@@ -180,7 +185,7 @@ def record_batch_message(columns: Sequence[StreamColumn], time_s: np.ndarray, va
                                text.get(j - 1) if c.fmi_type == "String" else None)
         buffers.append((offset, 0))  # validity: no nulls
         for chunk in data:
-            padded = -(-len(chunk) // ALIGNMENT) * ALIGNMENT
+            padded = _aligned(len(chunk))
             buffers.append((offset, len(chunk)))
             body.append(chunk + bytes(padded - len(chunk)))
             offset += padded

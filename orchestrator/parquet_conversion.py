@@ -14,9 +14,9 @@ Errors keep their meaning across the process boundary: an ``OSError`` of the
 child (a full disk, a file-size limit) is raised here with its errno, message and
 file name (pyarrow's own, which have no errno, with their text, which names the
 file); a child that fails otherwise or is killed raises ``OSError`` whose text
-names the Parquet file, how the child ended and its last line on stderr. The stream is never removed here
-(:class:`orchestrator.run.parquet_writer.ParquetWriter` removes it after a
-conversion that succeeded).
+names the Parquet file, how the child ended and its last line on stderr. The
+stream is never removed here (:class:`orchestrator.run.parquet_writer.ParquetWriter`
+removes it after a conversion that succeeded).
 """
 
 from __future__ import annotations
@@ -67,8 +67,9 @@ def convert_stream(stream_path: str | Path, parquet_path: str | Path, where: Whe
     Raises
     ------
     OSError
-        The file could not be written (errno and file name as the writer raised them), or
-        the child failed otherwise or was killed (naming ``parquet_path``).
+        As :func:`orchestrator.columnar_files.stream_to_parquet` raises it (the stream
+        cannot be read, the file cannot be written: errno and file name kept), or the
+        child failed otherwise or was killed (naming ``parquet_path``).
     """
     if where not in ("auto", "child", "here"):
         raise ValueError(f"where={where!r}: expected 'auto', 'child' or 'here'")
