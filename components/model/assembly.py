@@ -301,9 +301,16 @@ class Assembly:
         self._port_meshes = bool(np.any(self.A_port))
         if self.ports.size > 1:
             raise ParameterError("ports", self.ports.size, "at most one prescribed port")
-        port_q = self._port_Q[0][:, 0] if self.ports.size else np.zeros(self.n_dof)
-        port_v = self._port_Q[1][:, 0] if self.ports.size else np.zeros(self.n_dof)
-        # acceleration = [force, q, v, port_angle, port_speed, alpha_in] @ _fast_matrix
+        if self.ports.size:  # the port input u is the port's deviation angle, u_dot its speed
+            port_q, port_v = self._port_Q[0][:, 0], self._port_Q[1][:, 0]
+        else:  # u is the counter torque braking the output body (e.g. the generator) [N m]; u_dot unused
+            port_q, port_v = np.zeros(self.n_dof), np.zeros(self.n_dof)
+            if self.output_dof is not None:
+                port_q[self.output_dof] = -1.0
+        #: the port input's weights on the mesh deflections and shaft twists (zero without a port)
+        self.port_deflection = self.A_port[:, 0].copy() if self.ports.size else np.zeros(self.n_mesh)
+        self.port_twist = self.S_port[:, 0].copy() if self.ports.size else np.zeros(self.n_shaft)
+        # acceleration = [force, q, v, u, u_dot, alpha_in] @ _fast_matrix (u, u_dot: the port input, see above)
         self._fast_matrix = np.ascontiguousarray(
             np.vstack([self._neg_B, self._shaft_QY, port_q[None, :], port_v[None, :], -self.kinematic_ratio[None, :]])
             * np.append(self.inv_inertia[None, :].repeat(self._neg_B.shape[0] + 2 * self.n_dof + 2, 0), [np.ones(self.n_dof)], 0)
@@ -458,7 +465,9 @@ class Assembly:
         y : ndarray, shape (2 n_dof,)
             State ``[q, v]``: deviation angles [rad] and speeds [rad/s].
         port_angle_rad, port_speed_rad_s : float
-            Deviation angle [rad] and speed [rad/s] of the (single) prescribed port; 0 without one.
+            The port input ``u``, ``u_dot``: deviation angle [rad] and speed [rad/s] of the (single)
+            prescribed port; without a port, ``u`` is the counter torque braking the output body [N m]
+            (the generator: an uncut assembly steps the generator inertia itself) and ``u_dot`` is unused.
         driver_acceleration : float
             Driver acceleration alpha_in [rad/s^2].
         stiffness_factor : ndarray or float

@@ -32,10 +32,11 @@ from .kernel_layout import (  # noqa: F401 - re-exported: the module is the kern
     A_T, A_PORT, FAST, CONTACT, FORCE_W, DEFL_W, ACC_W, BT, STKS, STCS, STKS_PORT, STCS_PORT, INV_M, FD_W, FV_W,
     PHASING, KAPPA, FORCE_ROWS, FACTOR_W, SLOPE_W, SENS_W, F0, F1, FN, K1, K2, K3, Y1, YN, RHS, W_HDT, DA, NZ_INDEX,
     NZ_VALUE, COS_ALPHA, CONTROL, ISTATE, DQ, DV, WINV, W_BASIS, PORT_JAC, LAST_ACC, LAST_FORCE, LAST_DEFL, Y,
-    BACKUP, DRIVER, PORT, SCALARS, TWIST_Q, OUTPUT_MATRIX, OUTPUTS, STATE_FIRST, STATE_LAST, SCALAR_NAMES, S_TIME,
+    BACKUP, DRIVER, PORT, SCALARS, TWIST_Q, OUTPUT_MATRIX, OUTPUTS, ANCHOR, STATE_FIRST, STATE_LAST, SCALAR_NAMES, S_TIME,
     S_DRIVER_ANGLE, S_DRIVER_SPEED, S_DRIVER_ACCEL, S_PORT_ANGLE, S_PORT_SPEED, S_LAST_STEP, S_LAST_OMEGA_ROTOR,
     S_LAST_OMEGA_GEN, S_SHAFT_TORQUE_AVG, S_OUTPUT_TWIST, S_ALPHA_OUT_AVG, S_ANGLE0, S_LAST_ALPHA, S_KX,
-    S_TWIST_PORT, S_SHAFT_K, S_SHAFT_C, D_N, D_M, D_TVS, D_SQRT_CFS, D_EXTRAPOLATE, D_END_TORQUE, NON_FINITE_INPUT,
+    S_TWIST_PORT, S_SHAFT_K, S_SHAFT_C, D_N, D_M, D_TVS, D_SQRT_CFS, D_EXTRAPOLATE, D_END_TORQUE, D_GEN_DOF,
+    D_ROTOR_DERIVATIVES, N_DIMS, NON_FINITE_INPUT,
 )
 from .numba_cache import enable_stable_cache
 
@@ -702,36 +703,62 @@ def outputs(buf, lay, dims):
 
 
 @njit(cache=False)
-def gearbox_step(buf, lay, dims, t, h, omega_rotor, phi_rotor, omega_gen, phi_gen):
+def gearbox_step(buf, lay, dims, t, h, omega_rotor, phi_rotor, omega_gen, phi_gen, counter_torque, alpha_rotor,
+                 jerk_rotor):
     """``GearboxModel.step`` from ``t`` to ``t + h`` on the state in ``buf``; outputs into the ``outputs`` slot.
 
     Returns ``(status, local time, step size, error norm)`` as :func:`advance`, or ``NON_FINITE_INPUT``;
     on failure the buffer is as it was at ``t``.
     """
     n = dims[D_N]
+    m = dims[D_M]
+    gdof = dims[D_GEN_DOF]
     sc = _vec(buf, lay, SCALARS)
     y = _vec(buf, lay, Y)
     control = _vec(buf, lay, CONTROL)
     out_kin = control[OUT_KINEMATIC]
     out_idx = int(control[OUT_RATE_INDEX])
-    if dims[D_EXTRAPOLATE] != 0 and sc[S_LAST_STEP] > 0.0:
-        alpha_rotor = (omega_rotor - sc[S_LAST_OMEGA_ROTOR]) / sc[S_LAST_STEP]
-        alpha_gen = (omega_gen - sc[S_LAST_OMEGA_GEN]) / sc[S_LAST_STEP]
+    extrapolate = dims[D_EXTRAPOLATE] != 0 and sc[S_LAST_STEP] > 0.0
+    alpha_gen = (omega_gen - sc[S_LAST_OMEGA_GEN]) / sc[S_LAST_STEP] if extrapolate and gdof < 0 else 0.0
+    if dims[D_ROTOR_DERIVATIVES] != 0:
+        angle1 = phi_rotor + h * (omega_rotor + h * (0.5 * alpha_rotor + h * (jerk_rotor / 6.0)))
+        speed1 = omega_rotor + h * (alpha_rotor + h * (0.5 * jerk_rotor))
     else:
-        alpha_rotor = 0.0
-        alpha_gen = 0.0
+        alpha = (omega_rotor - sc[S_LAST_OMEGA_ROTOR]) / sc[S_LAST_STEP] if extrapolate else 0.0
+        angle1 = phi_rotor + h * (omega_rotor + 0.5 * h * alpha)
+        speed1 = omega_rotor + h * alpha
     kx = sc[S_KX]
-    angle1 = phi_rotor + h * (omega_rotor + 0.5 * h * alpha_rotor)
-    speed1 = omega_rotor + h * alpha_rotor
-    port1 = phi_gen + h * (omega_gen + 0.5 * h * alpha_gen) - kx * angle1
-    port_speed1 = omega_gen + h * alpha_gen - kx * speed1
-    if not math.isfinite(port1 + port_speed1):
+    dv = 0.0
+    if gdof >= 0:  # inertia interface: the port input is the held counter torque
+        port0 = counter_torque
+        port_speed0 = 0.0
+        port1 = port0
+        port_speed1 = 0.0
+        dv = omega_gen - kx * sc[S_DRIVER_SPEED] - y[n + gdof]
+        if not math.isfinite(dv + port0):
+            return NON_FINITE_INPUT, 0.0, h, 0.0
+    else:
+        port0 = sc[S_PORT_ANGLE]
+        port_speed0 = sc[S_PORT_SPEED]
+        port1 = phi_gen + h * (omega_gen + 0.5 * h * alpha_gen) - kx * angle1
+        port_speed1 = omega_gen + h * alpha_gen - kx * speed1
+    if not math.isfinite(angle1 + speed1 + port1 + port_speed1):
         return NON_FINITE_INPUT, 0.0, h, 0.0
     driver = _vec(buf, lay, DRIVER)
     port = _vec(buf, lay, PORT)
     sc[S_ANGLE0] = sc[S_DRIVER_ANGLE]
     _fit(driver, h, 0.0, sc[S_DRIVER_SPEED], angle1 - sc[S_DRIVER_ANGLE], speed1)
-    _fit(port, h, sc[S_PORT_ANGLE], sc[S_PORT_SPEED], port1, port_speed1)
+    _fit(port, h, port0, port_speed0, port1, port_speed1)
+    last_acc = _vec(buf, lay, LAST_ACC)
+    anchor = _vec(buf, lay, ANCHOR)
+    if gdof >= 0:  # re-anchor the generator speed; the loads follow linearly (the generator is in no mesh)
+        fast = _mat(buf, lay, FAST, m + 2 * n + 3)
+        d_torque = port0 - sc[S_PORT_ANGLE]
+        anchor[0] = y[n + gdof]
+        y[n + gdof] += dv
+        for j in range(n):
+            anchor[1 + j] = last_acc[j]
+            last_acc[j] += dv * fast[m + n + gdof, j] + d_torque * fast[m + 2 * n, j]
     twist_start = sc[S_OUTPUT_TWIST]
     speed_start = out_kin * sc[S_DRIVER_SPEED] + y[out_idx]
     twist_q = _vec(buf, lay, TWIST_Q)
@@ -743,6 +770,10 @@ def gearbox_step(buf, lay, dims, t, h, omega_rotor, phi_rotor, omega_gen, phi_ge
         _vec(buf, lay, BACKUP), twist_q, sc[S_TWIST_PORT],
     )
     if status != OK:
+        if gdof >= 0:  # undo the re-anchoring (advance restored the state it was given)
+            y[n + gdof] = anchor[0]
+            for j in range(n):
+                last_acc[j] = anchor[1 + j]
         return status, tau, h_fail, err
     sc[S_TIME] = t + h
     sc[S_DRIVER_ANGLE] = angle1
@@ -828,7 +859,7 @@ def _step_signature() -> tuple:
     from numba import types  # optional requirement: the compiled gearbox kernel
 
     vector, index = types.float64[::1], types.int64[::1]
-    return (vector, index, index) + (types.float64,) * 6
+    return (vector, index, index) + (types.float64,) * 9
 
 
 def ensure_compiled() -> None:
@@ -848,7 +879,7 @@ def step_entry_point():
     """:func:`gearbox_step` for its one signature, without the dispatcher's per-call type resolution.
 
     The compiled overload's own entry point (numba's ``overloads[signature].entry_point``) takes
-    the same arguments (a float64 buffer, two int64 index arrays, six floats) and saves ~0.2 us
+    the same arguments (a float64 buffer, two int64 index arrays, nine floats) and saves ~0.2 us
     per call. Falls back to the dispatcher itself if that attribute is not there (numba internals).
     """
     ensure_compiled()
@@ -864,7 +895,7 @@ DISPATCHERS = (_sign, contact_force, stiffness_factors, _hermite, _hermite_rate,
 #: entry points of the ahead-of-time compiled module (:mod:`components.model.aot`) and their signatures:
 #: what a communication step calls (the monolithic reference's functions stay JIT-compiled)
 AOT_EXPORTS = {
-    "gearbox_step": "Tuple((i8, f8, f8, f8))(f8[::1], i8[::1], i8[::1], f8, f8, f8, f8, f8, f8)",
+    "gearbox_step": "Tuple((i8, f8, f8, f8))(f8[::1], i8[::1], i8[::1], f8, f8, f8, f8, f8, f8, f8, f8, f8)",
     "outputs": "void(f8[::1], i8[::1], i8[::1])",
 }
 #: True when the machine code is cached on disk (see :mod:`components.model.numba_cache`)

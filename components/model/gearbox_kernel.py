@@ -19,6 +19,8 @@ buffer costs 0.4 us per call, the ~50 separate arrays several microseconds.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..errors import ParameterError, SolverError
@@ -69,10 +71,14 @@ def mesh_sparsity(assembly: Assembly) -> tuple[np.ndarray, np.ndarray]:
     return index, value
 
 
-def slot_shapes(n: int, m: int, n_shaft: int, module, width: int = 3) -> dict[str, tuple[int, ...]]:
-    """Shape of every slot of the buffer for ``n`` degrees of freedom and ``m`` meshes."""
+def slot_shapes(n: int, m: int, n_shaft: int, module, width: int = 3,
+                n_speeds: int | None = None) -> dict[str, tuple[int, ...]]:
+    """Shape of every slot of the buffer for ``n`` degrees of freedom and ``m`` meshes.
+
+    ``n_speeds``: the body speeds among the outputs (default ``n``; the inertia interface's generator is not one).
+    """
     n2 = 2 * n
-    n_linear = 3 + m + n_shaft + n
+    n_linear = 3 + m + n_shaft + (n if n_speeds is None else n_speeds)
     shapes = {
         "a_t": (n, m), "a_port": (m,), "fast": (m + n2 + 3, n), "contact": (m, module.N_CONTACT_COLUMNS),
         "force_w": (m,), "defl_w": (2, m), "acc_w": (n,), "bt": (n, m), "stks": (n, n), "stcs": (n, n),
@@ -84,7 +90,7 @@ def slot_shapes(n: int, m: int, n_shaft: int, module, width: int = 3) -> dict[st
         "winv": (2, n2, n2), "w_basis": (2, n2, 3),  # the active W^-1 and the one kept (istate[ACTIVE])
         "port_jac": (2, n), "last_acc": (n,), "last_force": (m,), "last_defl": (2, m),
         "y": (n2,), "driver": (4,), "port": (4,), "scalars": (len(module.SCALAR_NAMES),), "twist_q": (n2,),
-        "output_matrix": (m + n2 + 4, n_linear), "outputs": (n_linear + 4,),
+        "output_matrix": (m + n2 + 4, n_linear), "outputs": (n_linear + 4,), "anchor": (n + 1,),
     }
     state = module.SLOTS[module.STATE_FIRST:module.STATE_LAST + 1]
     shapes["backup"] = (sum(int(np.prod(shapes[name])) for name in state),)
@@ -137,14 +143,14 @@ class CompiledGearboxModel(GearboxModel):
         module.ensure_compiled()
         a = self.assembly
         self._sparsity = mesh_sparsity(a)
-        self._kb = KernelBuffer(slot_shapes(a.n_dof, a.n_mesh, a.n_shaft, module, self._sparsity[0].shape[1]),
-                                module.SLOTS)
+        shapes = slot_shapes(a.n_dof, a.n_mesh, a.n_shaft, module, self._sparsity[0].shape[1], len(self.gearbox_dofs))
+        self._kb = KernelBuffer(shapes, module.SLOTS)
         v = self._kb.views
         self._scalars = v["scalars"]
         self._istate = v["istate"]
         self._y_view = v["y"]
         self._outputs_view = v["outputs"]
-        self._dims = np.zeros(6, dtype=np.int64)
+        self._dims = np.zeros(module.N_DIMS, dtype=np.int64)
         self._kernel_step = module.step_entry_point()
         self._compiled_stale = True
 
@@ -153,7 +159,7 @@ class CompiledGearboxModel(GearboxModel):
         a = self.assembly
         v = self._kb.views
         v["a_t"][:] = a._A_T
-        v["a_port"][:] = a.A_port[:, 0]
+        v["a_port"][:] = a.port_deflection
         v["fast"][:] = a._fast_matrix
         v["contact"][:] = contact_table(a, mod)
         v["bt"][:] = a.BT
@@ -161,8 +167,8 @@ class CompiledGearboxModel(GearboxModel):
         v["cos_alpha"][:] = a.cos_alpha
         v["stks"][:] = a.STkS
         v["stcs"][:] = a.STcS
-        v["stks_port"][:] = a.STkS_port[:, 0]
-        v["stcs_port"][:] = a.STcS_port[:, 0]
+        v["stks_port"][:] = a.STkS_port[:, 0] if a.ports.size else 0.0
+        v["stcs_port"][:] = a.STcS_port[:, 0] if a.ports.size else 0.0
         v["inv_m"][:] = a.inv_inertia
         v["phasing"][:] = phasing_table(a)
         v["kappa"][:] = a.kinematic_ratio
@@ -186,6 +192,8 @@ class CompiledGearboxModel(GearboxModel):
         dims[mod.D_SQRT_CFS] = int(law._sqrt_law and not law._any_impact)
         dims[mod.D_EXTRAPOLATE] = int(self.extrapolate)
         dims[mod.D_END_TORQUE] = int(self.shaft_torque_mode == "end")
+        dims[mod.D_GEN_DOF] = -1 if self.generator_dof is None else self.generator_dof
+        dims[mod.D_ROTOR_DERIVATIVES] = int(self.rotor_derivatives)
 
     # the numpy model's scalar state lives in the buffer
     time_s = _buffer_scalar(0, "Current time [s].")
@@ -289,7 +297,8 @@ class CompiledGearboxModel(GearboxModel):
         self._compiled_stale = True
 
     # ------------------------------------------------------------ stepping
-    def step(self, t: float, h: float, omega_rotor: float, phi_rotor: float, omega_gen: float, phi_gen: float) -> None:
+    def step(self, t: float, h: float, omega_rotor: float, phi_rotor: float, omega_gen: float, phi_gen: float,
+             counter_torque_nm: float = 0.0, alpha_rotor: float = 0.0, jerk_rotor: float = 0.0) -> None:
         """Advance from ``t`` to ``t + h`` [s] (as :meth:`GearboxModel.step`, in the compiled kernel).
 
         Hot path (every communication step): one check, one call of the kernel's compiled entry
@@ -299,27 +308,30 @@ class CompiledGearboxModel(GearboxModel):
         """
         if self._compiled_stale:
             if not self.initialized:
-                self.initialize(t, omega_rotor, phi_rotor, omega_gen, phi_gen)
+                self.initialize(t, omega_rotor, phi_rotor, omega_gen, phi_gen, counter_torque_nm)
             if not h > 0.0:
                 raise ParameterError("step_size", h, "> 0")
             self._load_compiled()
         elif not h > 0.0:
             raise ParameterError("step_size", h, "> 0")
         kb = self._kb
-        status, tau, h_fail, err = self._kernel_step(kb.buffer, kb.offsets, self._dims, t, h,
-                                                     omega_rotor, phi_rotor, omega_gen, phi_gen)
+        status, tau, h_fail, err = self._kernel_step(kb.buffer, kb.offsets, self._dims, t, h, omega_rotor, phi_rotor,
+                                                     omega_gen, phi_gen, counter_torque_nm, alpha_rotor, jerk_rotor)
         if status:  # OK is 0
-            self._step_failed(status, t, tau, h_fail, err, omega_rotor, phi_rotor, omega_gen, phi_gen)
+            self._step_failed(status, t, tau, h_fail, err, (omega_rotor, phi_rotor, omega_gen, phi_gen,
+                                                            counter_torque_nm, alpha_rotor, jerk_rotor))
 
-    def _step_failed(self, status: int, t: float, tau: float, h_fail: float, err: float, omega_rotor: float,
-                     phi_rotor: float, omega_gen: float, phi_gen: float) -> None:
+    def _step_failed(self, status: int, t: float, tau: float, h_fail: float, err: float, inputs: tuple) -> None:
         """Raise the SolverError of a failed kernel step (the buffer is as it was at ``t``)."""
         mod = self._module
         if status != mod.OK:
             c = self._integrator.control
             if status == mod.NON_FINITE_INPUT:
-                raise SolverError(f"non-finite input (omega_rotor={omega_rotor!r}, phi_rotor={phi_rotor!r}, "
-                                  f"omega_gen={omega_gen!r}, phi_gen={phi_gen!r})", t)
+                names = ("omega_rotor", "phi_rotor", "omega_gen", "phi_gen", "counter_torque", "alpha_rotor",
+                         "jerk_rotor")
+                pairs = [f"{name}={value!r}" for name, value in zip(names, inputs)]
+                text = ", ".join(p for p, v in zip(pairs, inputs) if not math.isfinite(v)) or ", ".join(pairs)
+                raise SolverError(f"non-finite input ({text})", t)
             if status == mod.STEP_TOO_SMALL:
                 message = f"step size {h_fail:.3g} s below h_min {c.h_min:.3g} s (error norm {err:.3g})"
             else:

@@ -32,6 +32,8 @@ from .integrators import Rosenbrock23, StepControl
 from .kernel import choose_kernel
 
 SHAFT_TORQUE_MODES = ("average", "end")
+#: how the generator end of shaft 3 moves within a communication step (see :class:`GearboxModel`)
+GENERATOR_INTERFACES = ("motion", "inertia")
 
 
 class _Hermite:
@@ -84,7 +86,7 @@ class _StepSystem:
     def __init__(self, assembly: Assembly) -> None:
         self.assembly = assembly
         self.driver = _Hermite()  # theta_in(tau) - theta_in(0)
-        self.port = _Hermite()  # q_port(tau) = theta_gen - kappa_gen theta_in
+        self.port = _Hermite()  # the port input: q_port(tau) = theta_gen - kappa_gen theta_in, or the counter torque
         self.angle0 = 0.0  # theta_in(0), absolute [rad]
         n = assembly.n_dof
         self.port_jacobian = np.zeros((2, n))  # d a / d q_port, d a / d v_port (from the last Jacobian)
@@ -119,6 +121,11 @@ class _StepSystem:
     def jacobian(self, tau: float, y: np.ndarray):
         a = self.assembly
         n = a.n_dof
+        if not a.ports.size:  # the port input is a torque: the accelerations are linear in it, no loads depend on it
+            loads = a.loads(y[:n], y[n:], stiffness_factor=self.stiffness_factor(tau))
+            dq, dv, _, _ = a.acceleration_jacobian(loads)
+            self.port_jacobian = np.zeros((2, n))
+            return dq, dv
         qx = np.array([self.port.value(tau)])
         vx = np.array([self.port.rate(tau)])
         loads = a.loads(y[:n], y[n:], qx, vx, self.stiffness_factor(tau))
@@ -183,6 +190,25 @@ class GearboxModel:
     extrapolate : bool
         Estimate the input slopes from the last two inputs (True) or hold the
         input speeds over the step (False).
+    generator_interface : {"motion", "inertia"}
+        ``motion``: the generator end of shaft 3 follows the Hermite curve of the
+        generator-motion inputs (above). ``inertia`` (an interface model): the
+        generator rotor's inertia (the drivetrain's ``generator.inertia_kgm2``) is a
+        degree of freedom of the step, driven by shaft 3 against the counter-torque
+        input held over the step, ``I_g omega_g' = T_3 - T_c``; at every
+        communication point its speed is set to the generator-speed input, so the
+        generator component stays the owner of the generator's speed (with the
+        step-averaged shaft torque and the same held counter torque, both integrate
+        the same impulse: the speeds agree). Its angle stays the gearbox's own: the
+        generator component's angle integrates a step-mean torque, and anchoring to
+        it would twist shaft 3 by that error at every communication point. Within the
+        step the generator answers the shaft torque at once instead of one step
+        later, so the gearbox - generator loop adds no coupling error.
+    rotor_derivatives : bool
+        Extrapolate the rotor motion over the step from the inputs ``alpha_rotor``
+        and ``jerk_rotor`` (the source's acceleration and jerk at ``t_n``: a third-order
+        Taylor target, ``phi_n + omega_n h + alpha h^2 / 2 + j h^3 / 6``) instead of
+        the acceleration estimated from the last two speed inputs.
     kernel : {"auto", "numpy", "compiled"}, optional
         Implementation of the step (:mod:`components.model.kernel`; default:
         ``$DTCOSIM_KERNEL``, else ``auto``). Both give the same results to round-off.
@@ -218,16 +244,27 @@ class GearboxModel:
         shaft_torque_mode: str = "average",
         extrapolate: bool = True,
         kernel: str | None = None,
+        generator_interface: str = "motion",
+        rotor_derivatives: bool = False,
     ) -> None:
-        self.assembly = a = Assembly(drivetrain, cut_at_generator=True)
+        self.generator_interface = one_of("generator_interface", generator_interface, GENERATOR_INTERFACES)
+        inertia = self.generator_interface == "inertia"
+        if inertia and drivetrain.generator is None:
+            raise ParameterError("generator_interface", "inertia", "a drivetrain with a generator")
+        self.assembly = a = Assembly(drivetrain, cut_at_generator=not inertia)
+        #: the generator's degree of freedom (inertia interface) or None (motion interface: it is the port)
+        self.generator_dof = a.output_dof if inertia else None
+        #: the bodies whose speeds are outputs: the gearbox's (the generator's is not, with either interface)
+        self.gearbox_dofs = np.array([j for j in range(a.n_dof) if j != self.generator_dof], dtype=int)
         self.kernel, self.kernel_note = choose_kernel(kernel)
         self._compiled_stale = True  # (compiled model) the buffer must be loaded from the numpy-side state
         self._allocate()
         self.shaft_torque_mode = one_of("shaft_torque_mode", shaft_torque_mode, SHAFT_TORQUE_MODES)
         self.extrapolate = bool(extrapolate)
+        self.rotor_derivatives = bool(rotor_derivatives)
         self.system = _StepSystem(a)
         self._integrator = Rosenbrock23(self.system, a.n_dof, control)
-        self._kx = float(a.port_ratio[0])
+        self._kx = float(a.port_ratio[0] if not inertia else a.kinematic_ratio[self.generator_dof])
         self._out_member = a.dof_index(a.stage_members[drivetrain.stages[-1].name]["output"])
         self.initialized = False
         self.y = np.zeros(2 * a.n_dof)
@@ -248,7 +285,7 @@ class GearboxModel:
         self._twist_qv = np.stack((self._twist_q, np.concatenate((np.zeros(a.n_dof), a.S[-1]))))
         #: (time, twist, twist rate, integral of the twist) at the last accepted internal step of the current step
         self._twist_accumulator = [0.0, 0.0, 0.0, 0.0]
-        self._twist_port = float(a.S_port[-1, 0])
+        self._twist_port = float(a.port_twist[-1])
         self._out_shaft_kc = (float(a.shaft_k[-1]), float(a.shaft_c[-1]))  # shaft 3 stiffness, damping
         self._output_matrix = self._build_output_matrix()
         self._out_kinematic = float(a.kinematic_ratio[self._out_member])
@@ -282,8 +319,8 @@ class GearboxModel:
         a = self.assembly
         n = a.n_dof
         qv = self.y.reshape(2, n) @ a.S.T
-        qv[0] += a.S_port[:, 0] * self.port_angle_rad
-        qv[1] += a.S_port[:, 0] * self.port_speed_rad_s
+        qv[0] += a.port_twist * self.port_angle_rad
+        qv[1] += a.port_twist * self.port_speed_rad_s
         return qv
 
     @property
@@ -359,7 +396,7 @@ class GearboxModel:
             ["shaft_torque", "shaft_torque_avg", "shaft_torque_end", "omega_out", "torque_rotor"]
             + a.mesh_names
             + [f"{s}.torque" for s in a.shaft_names]
-            + [f"{b}.omega" for b in a.dof_names]
+            + [f"{a.dof_names[j]}.omega" for j in self.gearbox_dofs]
             + ["alpha_out", "alpha_out_max"]
         )
 
@@ -376,8 +413,8 @@ class GearboxModel:
         shafts = np.zeros((rows, ns))
         shafts[m : m + n] = (a.shaft_k[:, None] * a.S).T
         shafts[m + n : m + 2 * n] = (a.shaft_c[:, None] * a.S).T
-        shafts[m + 2 * n] = a.shaft_k * a.S_port[:, 0]
-        shafts[m + 2 * n + 1] = a.shaft_c * a.S_port[:, 0]
+        shafts[m + 2 * n] = a.shaft_k * a.port_twist
+        shafts[m + 2 * n + 1] = a.shaft_c * a.port_twist
         speeds = np.zeros((rows, n))
         speeds[m + n : m + 2 * n] = np.eye(n)
         speeds[m + 2 * n + 2] = a.kinematic_ratio
@@ -386,7 +423,8 @@ class GearboxModel:
         rotor = shafts @ a.s_driver  # shaft reactions on the driven carrier
         rotor[:m] += a.BT_driver  # mesh reactions
         rotor[m + 2 * n + 3] += a.driver_inertia_kgm2  # carrier (and orbital planet) inertia
-        return np.column_stack((shafts[:, -1], speeds[:, self._out_member], rotor, forces, shafts, speeds))
+        return np.column_stack((shafts[:, -1], speeds[:, self._out_member], rotor, forces, shafts,
+                                speeds[:, self.gearbox_dofs]))
 
     def output_vector(self) -> np.ndarray:
         """Every output at the current time in one pass, ordered as :attr:`output_names`.
@@ -418,7 +456,8 @@ class GearboxModel:
         return (self.port_angle_rad, self.port_speed_rad_s, self.driver_speed_rad_s, self.driver_accel_rad_s2)
 
     # ------------------------------------------------------------ stepping
-    def initialize(self, t0: float, omega_rotor: float, phi_rotor: float, omega_gen: float, phi_gen: float) -> None:
+    def initialize(self, t0: float, omega_rotor: float, phi_rotor: float, omega_gen: float, phi_gen: float,
+                   counter_torque_nm: float = 0.0) -> None:
         """Kinematically consistent start with zero deflection at time ``t0`` [s].
 
         Parameters
@@ -427,16 +466,27 @@ class GearboxModel:
             Rotor speed [rad/s] and angle [rad] at ``t0``.
         omega_gen, phi_gen : float
             Generator speed [rad/s] and angle [rad] at ``t0``.
+        counter_torque_nm : float
+            Counter torque on the generator rotor [N m] (used by the ``inertia`` interface only).
         """
         self.time_s = finite("start_time", t0)
-        for name, val in (("omega_rotor", omega_rotor), ("phi_rotor", phi_rotor), ("omega_gen", omega_gen), ("phi_gen", phi_gen)):
+        for name, val in (("omega_rotor", omega_rotor), ("phi_rotor", phi_rotor), ("omega_gen", omega_gen),
+                          ("phi_gen", phi_gen), ("counter_torque", counter_torque_nm)):
             finite(name, val)
-        self.y = np.zeros(2 * self.assembly.n_dof)
+        n = self.assembly.n_dof
+        self.y = np.zeros(2 * n)
         self.driver_angle_rad = float(phi_rotor)
         self.driver_speed_rad_s = float(omega_rotor)
         self.driver_accel_rad_s2 = 0.0
-        self.port_angle_rad = float(phi_gen - self._kx * phi_rotor)
-        self.port_speed_rad_s = float(omega_gen - self._kx * omega_rotor)
+        port_angle = float(phi_gen - self._kx * phi_rotor)
+        port_speed = float(omega_gen - self._kx * omega_rotor)
+        if self.generator_dof is None:  # the port input is the generator end's deviation motion
+            self.port_angle_rad, self.port_speed_rad_s = port_angle, port_speed
+        else:  # the generator is a degree of freedom; the port input is its counter torque
+            y = self.y
+            y[self.generator_dof], y[n + self.generator_dof] = port_angle, port_speed
+            self.y = y
+            self.port_angle_rad, self.port_speed_rad_s = float(counter_torque_nm), 0.0
         self.last_omega_rotor = float(omega_rotor)
         self.last_omega_gen = float(omega_gen)
         self.last_step_s = 0.0
@@ -453,49 +503,76 @@ class GearboxModel:
         self.shaft_torque_average_nm = self.shaft_torque_end_nm
         self.initialized = True
 
-    def step(self, t: float, h: float, omega_rotor: float, phi_rotor: float, omega_gen: float, phi_gen: float) -> None:
+    def step(self, t: float, h: float, omega_rotor: float, phi_rotor: float, omega_gen: float, phi_gen: float,
+             counter_torque_nm: float = 0.0, alpha_rotor: float = 0.0, jerk_rotor: float = 0.0) -> None:
         """Advance from ``t`` to ``t + h`` [s] with the inputs received at ``t``.
 
-        On failure the state is left as it was at ``t`` and :class:`SolverError` is raised.
+        ``counter_torque_nm`` [N m] is held over the step (``inertia`` interface; ignored by ``motion``);
+        ``phi_gen`` is not used by ``inertia``. ``alpha_rotor`` [rad/s^2] and ``jerk_rotor`` [rad/s^3] are
+        used with ``rotor_derivatives`` only. On failure the state is left as it was at ``t`` and
+        :class:`SolverError` is raised.
         """
         if not self.initialized:
-            self.initialize(t, omega_rotor, phi_rotor, omega_gen, phi_gen)
+            self.initialize(t, omega_rotor, phi_rotor, omega_gen, phi_gen, counter_torque_nm)
         if not h > 0.0:
             raise ParameterError("step_size", h, "> 0")
-        if self.extrapolate and self.last_step_s > 0.0:
-            alpha_rotor = (omega_rotor - self.last_omega_rotor) / self.last_step_s
-            alpha_gen = (omega_gen - self.last_omega_gen) / self.last_step_s
+        inertia = self.generator_dof is not None
+        extrapolate = self.extrapolate and self.last_step_s > 0.0
+        alpha_gen = (omega_gen - self.last_omega_gen) / self.last_step_s if extrapolate and not inertia else 0.0
+        if self.rotor_derivatives:  # Taylor to third order from the source's derivatives
+            angle1 = phi_rotor + h * (omega_rotor + h * (0.5 * alpha_rotor + h * (jerk_rotor / 6.0)))
+            speed1 = omega_rotor + h * (alpha_rotor + h * (0.5 * jerk_rotor))
         else:
-            alpha_rotor = alpha_gen = 0.0
+            alpha = (omega_rotor - self.last_omega_rotor) / self.last_step_s if extrapolate else 0.0
+            angle1 = phi_rotor + h * (omega_rotor + 0.5 * h * alpha)
+            speed1 = omega_rotor + h * alpha
         kx = self._kx
-        angle1 = phi_rotor + h * (omega_rotor + 0.5 * h * alpha_rotor)
-        speed1 = omega_rotor + h * alpha_rotor
-        port1 = phi_gen + h * (omega_gen + 0.5 * h * alpha_gen) - kx * angle1
-        port_speed1 = omega_gen + h * alpha_gen - kx * speed1
-        if not math.isfinite(port1 + port_speed1):
-            raise SolverError(f"non-finite input (omega_rotor={omega_rotor!r}, phi_rotor={phi_rotor!r}, "
-                              f"omega_gen={omega_gen!r}, phi_gen={phi_gen!r})", t)
         a = self.assembly
         sysm = self.system
+        y = self.y
+        correction = None
+        if inertia:  # the port input is the counter torque, held; the generator speed re-anchored on its input
+            port0, port_speed0 = float(counter_torque_nm), 0.0
+            port1, port_speed1 = port0, 0.0
+            g, n, m = self.generator_dof, a.n_dof, a.n_mesh
+            dv = omega_gen - kx * self.driver_speed_rad_s - y[n + g]
+            if not math.isfinite(dv + port0):
+                raise SolverError(f"non-finite input (omega_gen={omega_gen!r}, counter_torque={counter_torque_nm!r})", t)
+            y = y.copy()
+            y[n + g] += dv
+            # the generator is in no mesh: the accelerations are linear in its speed and in the torque
+            fast = a._fast_matrix
+            correction = dv * fast[m + n + g] + (port0 - self.port_angle_rad) * fast[m + 2 * n]
+        else:
+            port0, port_speed0 = self.port_angle_rad, self.port_speed_rad_s
+            port1 = phi_gen + h * (omega_gen + 0.5 * h * alpha_gen) - kx * angle1
+            port_speed1 = omega_gen + h * alpha_gen - kx * speed1
+        if not math.isfinite(angle1 + speed1 + port1 + port_speed1):
+            raise SolverError(f"non-finite input (omega_rotor={omega_rotor!r}, phi_rotor={phi_rotor!r}, "
+                              f"omega_gen={omega_gen!r}, phi_gen={phi_gen!r})", t)
         sysm.angle0 = self.driver_angle_rad
         sysm.driver.fit(h, 0.0, self.driver_speed_rad_s, angle1 - self.driver_angle_rad, speed1)
-        sysm.port.fit(h, self.port_angle_rad, self.port_speed_rad_s, port1, port_speed1)
-        twist_start = self.output_twist_rad
-        speed_start = self.output_speed_rad_s
-        rate_start = self._twist_and_rate(self.y, self.port_angle_rad, self.port_speed_rad_s)[1]
-        self._twist_accumulator[:] = (0.0, twist_start, rate_start, 0.0)
+        sysm.port.fit(h, port0, port_speed0, port1, port_speed1)
         # first stage reuses the loads at the end of the previous step: the prescribed
-        # motions are C1, so only the driver-acceleration term changes
+        # motions are C1, so only the driver-acceleration term changes (and the re-anchoring's, above)
         a0 = sysm.last_acceleration + a.kinematic_ratio * (sysm.last_alpha - sysm.driver.accel(0.0))
+        if correction is not None:
+            a0 = a0 + correction
+        twist_start = self.output_twist_rad  # (the re-anchored generator speed leaves the twist)
+        rate_start = self._twist_and_rate(y, port0, port_speed0)[1]
+        out_index = self._out_rate_index
+        speed_start = self._out_kinematic * self.driver_speed_rad_s + y.item(out_index)
+        self._twist_accumulator[:] = (0.0, twist_start, rate_start, 0.0)
         saved = (self._integrator.snapshot(), sysm.cache(), sysm.port_jacobian, self.alpha_out_max_rad_s2)
         try:
-            self.y, _ = self._integrator.advance(0.0, self.y, h, a0=a0)
+            y_end, _ = self._integrator.advance(0.0, y, h, a0=a0)
         except SolverError as exc:
             self._integrator.restore(saved[0])
             sysm.restore(saved[1])
             sysm.port_jacobian = saved[2]
             self.alpha_out_max_rad_s2 = saved[3]
             raise SolverError(str(exc).rsplit(" (at t =", 1)[0], t + exc.time_s) from None
+        self.y = y_end
         self.time_s = t + h
         self.driver_angle_rad = angle1
         self.driver_speed_rad_s = speed1

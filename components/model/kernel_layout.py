@@ -34,12 +34,14 @@ SLOTS = (
     # the state a failed step restores: contiguous, so that saving it is one copy into "backup"
     "istate", "dq", "dv", "winv", "w_basis", "port_jac", "last_acc", "last_force", "last_defl", "y",
     "backup", "driver", "port", "scalars", "twist_q", "output_matrix", "outputs",
+    # the generator speed and the loads before the inertia interface's re-anchoring (restored on failure)
+    "anchor",
 )
 (A_T, A_PORT, FAST, CONTACT, FORCE_W, DEFL_W, ACC_W, BT, STKS, STCS, STKS_PORT, STCS_PORT, INV_M, FD_W, FV_W,
  PHASING, KAPPA, FORCE_ROWS, FACTOR_W, SLOPE_W, SENS_W, F0, F1, FN, K1, K2, K3, Y1, YN, RHS, W_HDT, DA, NZ_INDEX,
  NZ_VALUE, COS_ALPHA, CONTROL,
  ISTATE, DQ, DV, WINV, W_BASIS, PORT_JAC, LAST_ACC, LAST_FORCE, LAST_DEFL, Y, BACKUP, DRIVER, PORT, SCALARS,
- TWIST_Q, OUTPUT_MATRIX, OUTPUTS) = range(len(SLOTS))
+ TWIST_Q, OUTPUT_MATRIX, OUTPUTS, ANCHOR) = range(len(SLOTS))
 #: first and last slot of the restorable state
 STATE_FIRST, STATE_LAST = ISTATE, Y
 
@@ -54,6 +56,8 @@ SCALAR_NAMES = (
  S_LAST_OMEGA_GEN, S_SHAFT_TORQUE_AVG, S_OUTPUT_TWIST, S_ALPHA_OUT_AVG, S_ANGLE0, S_LAST_ALPHA, S_KX, S_TWIST_PORT,
  S_SHAFT_K, S_SHAFT_C) = range(len(SCALAR_NAMES))
 
-# entries of the integer vector ``dims``
-D_N, D_M, D_TVS, D_SQRT_CFS, D_EXTRAPOLATE, D_END_TORQUE = range(6)
+# entries of the integer vector ``dims``: sizes, flags, the generator's degree of freedom (-1: the motion
+# interface, the generator is the port) and whether the rotor motion is extrapolated from its derivative inputs
+D_N, D_M, D_TVS, D_SQRT_CFS, D_EXTRAPOLATE, D_END_TORQUE, D_GEN_DOF, D_ROTOR_DERIVATIVES = range(8)
+N_DIMS = 8
 NON_FINITE_INPUT = 3

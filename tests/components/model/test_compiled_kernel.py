@@ -65,21 +65,37 @@ def _relative(a: np.ndarray, b: np.ndarray, scale: np.ndarray) -> float:
     return float(np.max(np.abs(a - b) / scale))
 
 
+#: the generator interface and the rotor extrapolation: the default, and the interface model with the
+#: rotor's derivative inputs
+INTERFACES = {"motion": {}, "inertia": {"generator_interface": "inertia", "rotor_derivatives": True}}
+
+
+def _jerk(wind: RotorSpeedProcess, t: float) -> float:
+    return (wind.acceleration(t + 1e-6) - wind.acceleration(t - 1e-6)) / 2e-6
+
+
+@pytest.mark.parametrize("interface", list(INTERFACES))
 @pytest.mark.parametrize("name", list(VARIANTS))
-def test_one_communication_step_matches_the_numpy_path(name):
+def test_one_communication_step_matches_the_numpy_path(name, interface):
     dt = VARIANTS[name]
     wind = RotorSpeedProcess(WindParameters())
     h = 2e-3
-    numpy_model = GearboxModel(dt, kernel="numpy")
-    compiled = GearboxModel(dt, kernel="compiled")
+    options = INTERFACES[interface]
+    # time-varying stiffness with the generator as a degree of freedom: ~3000 internal steps per 2 ms step with
+    # a third rejected (counters identical in both paths); round-off in the generator's small net torque
+    # (shaft torque - counter torque) reaches 2e-8 of the force scale there
+    tolerance = 5e-8 if (interface, name) == ("inertia", "table6-stiffness-variation") else 1e-9
+    numpy_model = GearboxModel(dt, kernel="numpy", **options)
+    compiled = GearboxModel(dt, kernel="compiled", **options)
     assert (numpy_model.kernel, compiled.kernel) == ("numpy", "compiled")
     w0, p0 = wind.speed(0.0), wind.angle(0.0)
-    numpy_model.initialize(0.0, w0, p0, numpy_model.ratio * w0, numpy_model.ratio * p0)
-    gen = GeneratorRotor(dt.generator, numpy_model.output_speed_rad_s, numpy_model.ratio * p0)
+    gen = GeneratorRotor(dt.generator, numpy_model.ratio * w0, numpy_model.ratio * p0)
+    numpy_model.initialize(0.0, w0, p0, gen.speed_rad_s, gen.angle_rad, gen.counter_torque(0.0))
     samples, outputs = [], []
     for k in range(150):
         t = k * h
-        inputs = (wind.speed(t), wind.angle(t), gen.speed_rad_s, gen.angle_rad)
+        inputs = (wind.speed(t), wind.angle(t), gen.speed_rad_s, gen.angle_rad, gen.counter_torque(t),
+                  wind.acceleration(t), _jerk(wind, t))
         state = json.dumps(numpy_model.get_state()) if k % 5 == 0 else None
         numpy_model.step(t, h, *inputs)
         outputs.append(numpy_model.output_vector())
@@ -91,8 +107,8 @@ def test_one_communication_step_matches_the_numpy_path(name):
     for t, inputs, state, expected, y, counters in samples:
         compiled.set_state(json.loads(state))
         compiled.step(t, h, *inputs)
-        assert _relative(compiled.output_vector(), expected, scale) < 1e-9, (name, t)
-        assert _relative(compiled.y, y, np.abs(y).max() + 1e-300) < 1e-9, (name, t)
+        assert _relative(compiled.output_vector(), expected, scale) < tolerance, (name, t)
+        assert _relative(compiled.y, y, np.abs(y).max() + 1e-300) < tolerance, (name, t)
         got = compiled.get_state()["integrator"]
         assert [got[k] for k in ("accepted", "rejected", "jacobians")] == [
             counters[k] for k in ("accepted", "rejected", "jacobians")], (name, t)
@@ -148,19 +164,24 @@ def test_stiffness_factors_match_mesh_phasing():
         np.testing.assert_allclose(slope, want_s, rtol=0, atol=1e-9 * np.abs(want_s).max() + 1e-12)
 
 
-def test_failed_compiled_step_leaves_the_state_untouched():
+@pytest.mark.parametrize("kernel", ["compiled", "numpy"])
+@pytest.mark.parametrize("interface", list(INTERFACES))
+def test_failed_step_leaves_the_state_untouched(interface, kernel):
     dt = cosim_preset("table6")
     wind = RotorSpeedProcess(WindParameters())
-    model = GearboxModel(dt, control=StepControl(max_steps=2), kernel="compiled")
+    model = GearboxModel(dt, control=StepControl(max_steps=30), kernel=kernel, **INTERFACES[interface])
     gen = GeneratorRotor(dt.generator, initial_speed_rad_s=dt.ratio * wind.speed(0.0))
     model.initialize(0.0, wind.speed(0.0), wind.angle(0.0), gen.speed_rad_s, gen.angle_rad)
-    model.step(0.0, 1e-4, wind.speed(0.0), wind.angle(0.0), gen.speed_rad_s, gen.angle_rad)
+    model.step(0.0, 1e-4, wind.speed(0.0), wind.angle(0.0), gen.speed_rad_s, gen.angle_rad, 2.0e4)
     before = json.dumps(model.get_state())
-    with pytest.raises(SolverError, match=r"more than 2 steps.*at t ="):
-        model.step(1e-4, 0.5, wind.speed(0.0), wind.angle(0.0), gen.speed_rad_s + 50.0, gen.angle_rad)
+    with pytest.raises(SolverError, match=r"more than 30 steps.*at t ="):
+        model.step(1e-4, 0.5, wind.speed(0.0), wind.angle(0.0), gen.speed_rad_s + 50.0, gen.angle_rad, 3.0e4)
     assert json.dumps(model.get_state()) == before
-    with pytest.raises(SolverError, match="non-finite input"):
+    with pytest.raises(SolverError, match="non-finite input.*omega_rotor=nan"):
         model.step(1e-4, 1e-3, math.nan, 0.0, 0.0, 0.0)
+    with pytest.raises(SolverError, match="non-finite input.*omega_gen=nan"):
+        model.step(1e-4, 1e-3, 1.0, 0.0, math.nan, 0.0)
+    assert json.dumps(model.get_state()) == before
 
 
 def test_states_move_between_the_two_paths():
