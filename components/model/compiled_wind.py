@@ -45,11 +45,24 @@ def rotate_and_sum(z, rotation, amplitudes, amplitudes_over_f):
     return speed_sum, angle_sum
 
 
-DISPATCHERS = (phasor_sums, rotate_and_sum)
+@njit(cache=False)
+def derivative_sums(z, amplitudes_times_f, amplitudes_times_f2):
+    """``(sum Im(z) W f, sum Re(z) W f^2)`` in index order: minus the acceleration and minus the jerk."""
+    alpha_sum = 0.0
+    jerk_sum = 0.0
+    for k in range(z.shape[0]):
+        v = z[k]
+        alpha_sum += v.imag * amplitudes_times_f[k]
+        jerk_sum += v.real * amplitudes_times_f2[k]
+    return alpha_sum, jerk_sum
+
+
+DISPATCHERS = (phasor_sums, rotate_and_sum, derivative_sums)
 #: entry points of the ahead-of-time compiled module (:mod:`components.model.aot`) and their signatures
 AOT_EXPORTS = {
     "phasor_sums": "UniTuple(f8, 2)(c16[::1], f8[::1], f8[::1])",
     "rotate_and_sum": "UniTuple(f8, 2)(c16[::1], c16[::1], f8[::1], f8[::1])",
+    "derivative_sums": "UniTuple(f8, 2)(c16[::1], f8[::1], f8[::1])",
 }
 #: True when the machine code is cached on disk (see :mod:`components.model.numba_cache`)
 DISK_CACHE = enable_stable_cache(DISPATCHERS, __file__, __name__)

@@ -157,6 +157,7 @@ class RotorSpeedProcess:
         self.phases_rad = rng.uniform(0.0, 2.0 * np.pi, n)
         self._w_over_f = w / f
         self._w_times_f = w * f
+        self._w_times_f2 = w * f * f
         self._angle_offset = float(np.sum(self._w_over_f * np.sin(self.phases_rad)))
 
     @property
@@ -203,6 +204,10 @@ class RotorSpeedProcess:
     def acceleration(self, t: float | np.ndarray) -> float | np.ndarray:
         """Rotor acceleration d omega / dt [rad/s^2]."""
         return self._evaluate(t, lambda ph: -(np.sin(ph) @ self._w_times_f), 0.0)
+
+    def jerk(self, t: float | np.ndarray) -> float | np.ndarray:
+        """Rotor jerk d^2 omega / dt^2 [rad/s^3]."""
+        return self._evaluate(t, lambda ph: -(np.cos(ph) @ self._w_times_f2), 0.0)
 
     def kinematics(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Angle [rad], speed [rad/s] and acceleration [rad/s^2] at many times.
@@ -291,6 +296,8 @@ class PhasorStepper:
         self._w_over_f = process._w_over_f.astype(complex)
         self._w_real = np.ascontiguousarray(process.amplitudes_rad_s, dtype=float)  # the compiled sums'
         self._w_over_f_real = np.ascontiguousarray(process._w_over_f, dtype=float)
+        self._w_times_f = np.ascontiguousarray(process._w_times_f, dtype=float)  # the derivatives' weights
+        self._w_times_f2 = np.ascontiguousarray(process._w_times_f2, dtype=float)
         self._offset = process._angle_offset
         self._w0 = process.params.mean_speed_rad_s
         self.time_s = 0.0
@@ -345,6 +352,17 @@ class PhasorStepper:
         speed_sum = complex(z.dot(self._w))
         angle_sum = complex(z.dot(self._w_over_f))
         return (self._w0 + speed_sum.real, self._w0 * self.time_s + (angle_sum.imag - self._offset))
+
+    def acceleration_and_jerk(self) -> tuple[float, float]:
+        """Acceleration [rad/s^2] and jerk [rad/s^3] at the current time, ``-Im(z) . W f`` and ``-Re(z) . W f^2``.
+
+        Two more sums over the phasors, formed when called: one compiled loop, or two numpy dot products.
+        """
+        if self._compiled is not None:
+            alpha_sum, jerk_sum = self._compiled.derivative_sums(self._z, self._w_times_f, self._w_times_f2)
+            return -alpha_sum, -jerk_sum
+        z = self._z
+        return -float(z.imag.dot(self._w_times_f)), -float(z.real.dot(self._w_times_f2))
 
     def get_state(self) -> dict:
         """Complete state (JSON-serialisable, exact float round trip)."""

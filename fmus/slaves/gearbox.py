@@ -20,6 +20,7 @@ e.g. ``omega_out = ratio * omega_rotor``.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from operator import itemgetter
 from typing import Any, Hashable, Iterable, Mapping
 
@@ -29,9 +30,9 @@ from components.errors import ParameterError
 from components.model.assembly import Assembly
 from components.model.description import build
 from components.model.drivetrain import Drivetrain
-from components.model.gearbox_model import SHAFT_TORQUE_MODES, GearboxModel
+from components.model.gearbox_model import GENERATOR_INTERFACES, SHAFT_TORQUE_MODES, GearboxModel
 from components.model.integrators import StepControl
-from components.validation import choice_bounds
+from components.validation import choice_bounds, positive
 
 from .base import DtcosimSlave
 from .gearbox_parameters import (
@@ -47,6 +48,7 @@ from .interface import (
     integer_parameter,
     real_input,
     real_output,
+    real_parameter,
 )
 from .record import GEARBOX
 
@@ -91,10 +93,25 @@ class Gearbox(DtcosimSlave):
             boolean_parameter("extrapolate_inputs", True,
                               "extrapolate the input speeds over a step with the slope of the last two inputs "
                               "(false: hold them)"),
+            integer_parameter("generator_interface", 0,
+                              f"how the generator end of shaft 3 moves within a step: "
+                              f"{enumeration_text(GENERATOR_INTERFACES)} (motion: along the generator-motion "
+                              "inputs; inertia: an interface model, the generator inertia generator_inertia "
+                              "integrated in the step against the input counter_torque, its speed set to "
+                              "omega_gen at every communication point)"),
+            real_parameter("generator_inertia", template.generator.inertia_kgm2, "kg.m2",
+                           "generator rotor inertia of the inertia interface (the generator component's)"),
+            boolean_parameter("rotor_derivatives", False,
+                              "extrapolate the rotor motion over a step from the inputs alpha_rotor and jerk_rotor "
+                              "(third-order Taylor) instead of the slope of the last two speed inputs"),
             real_input("omega_rotor", omega0, "rad/s", "rotor speed driving the stage-1 carrier"),
             real_input("phi_rotor", 0.0, "rad", "rotor angle"),
             real_input("omega_gen", ratio * omega0, "rad/s", "generator speed (far end of shaft 3)"),
-            real_input("phi_gen", 0.0, "rad", "generator angle (far end of shaft 3)"),
+            real_input("phi_gen", 0.0, "rad", "generator angle (far end of shaft 3; not used by the inertia interface)"),
+            real_input("counter_torque", template.generator.counter_torque_nm, "N.m",
+                       "counter torque on the generator rotor, held over a step (inertia interface only)"),
+            real_input("alpha_rotor", 0.0, "rad/s2", "rotor acceleration (with rotor_derivatives only)"),
+            real_input("jerk_rotor", 0.0, "rad/s3", "rotor jerk (with rotor_derivatives only)"),
             real_output("shaft_torque", "N.m",
                         "torque of shaft 3 on the generator, per shaft_torque_mode (default: step average)",
                         "generator_shaft_torque"),
@@ -132,8 +149,10 @@ class Gearbox(DtcosimSlave):
         super().__init__(**kwargs)
         self._template = template_of(self.model)
         vr = self.vr
-        self._vr_inputs = tuple(vr[n] for n in ("omega_rotor", "phi_rotor", "omega_gen", "phi_gen"))
-        self._inputs = itemgetter(*self._vr_inputs)  # values list -> the four inputs, in one C call
+        # in GearboxModel.step's order
+        self._vr_inputs = tuple(vr[n] for n in ("omega_rotor", "phi_rotor", "omega_gen", "phi_gen", "counter_torque",
+                                                "alpha_rotor", "jerk_rotor"))
+        self._inputs = itemgetter(*self._vr_inputs)  # values list -> the inputs, in one C call
         names = GearboxModel(self._template).output_names
         self._vr_outputs = [vr[n] for n in names]
         # the outputs usually occupy one range of value references, not in the model's order (shaft_torque_end
@@ -155,16 +174,24 @@ class Gearbox(DtcosimSlave):
         if not 0 <= mode < len(SHAFT_TORQUE_MODES):
             text = enumeration_text(SHAFT_TORQUE_MODES)
             raise ParameterError("shaft_torque_mode", mode, text, choice_bounds(SHAFT_TORQUE_MODES, text))
+        interface = self.value("generator_interface")
+        if not 0 <= interface < len(GENERATOR_INTERFACES):
+            text = enumeration_text(GENERATOR_INTERFACES)
+            raise ParameterError("generator_interface", interface, text, choice_bounds(GENERATOR_INTERFACES, text))
         drivetrain = drivetrain_from_values(self._template, self.value)
+        inertia = positive("generator_inertia", self.value("generator_inertia"))
+        drivetrain = replace(drivetrain, generator=replace(drivetrain.generator, inertia_kgm2=inertia))
         control = control_from_values(self.value)
-        self.model = GearboxModel(drivetrain, control, SHAFT_TORQUE_MODES[mode], bool(self.value("extrapolate_inputs")))
+        self.model = GearboxModel(drivetrain, control, SHAFT_TORQUE_MODES[mode], bool(self.value("extrapolate_inputs")),
+                                  generator_interface=GENERATOR_INTERFACES[interface],
+                                  rotor_derivatives=bool(self.value("rotor_derivatives")))
         if self.model.kernel_note and not self._kernel_reported:  # once per instance: the host sees why it is slower
             self._report(f"Gearbox: {self.model.kernel_note}", Fmi2Status.warning)
             self._kernel_reported = True
 
     def _initialize(self, start_time: float) -> None:
         values = self._values
-        self.model.initialize(start_time, *(values[i] for i in self._vr_inputs))
+        self.model.initialize(start_time, *(values[i] for i in self._vr_inputs[:5]))
 
     def _step(self, time: float, step_size: float) -> None:
         self.model.step(time, step_size, *self._inputs(self._values))

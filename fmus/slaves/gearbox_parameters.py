@@ -6,7 +6,8 @@ sun-planet and ring-planet meshes of a planetary stage share one set of mesh
 parameters while they are equal, else ``stageK.sun_mesh.<field>`` and
 ``stageK.ring_mesh.<field>``), per shaft ``shaftK.stiffness`` and ``shaftK.damping``; start values
 are the template's (the build preset's) values. The generator's parameters
-belong to the GeneratorRotor FMU and are not exposed. Integrator tolerances are
+belong to the GeneratorRotor FMU and are not exposed (the inertia interface's
+copy of its inertia is the Gearbox parameter ``generator_inertia``, :mod:`fmus.slaves.gearbox`). Integrator tolerances are
 ``solver.<field>`` (:class:`~components.model.integrators.StepControl`).
 """
 

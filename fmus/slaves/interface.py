@@ -55,6 +55,7 @@ UNITS: dict[str, UnitDefinition] = {
         _unit("rad", {"rad": 1}, deg=180.0 / math.pi),
         _unit("rad/s", {"rad": 1, "s": -1}, rpm=60.0 / (2.0 * math.pi)),
         _unit("rad/s2", {"rad": 1, "s": -2}),
+        _unit("rad/s3", {"rad": 1, "s": -3}),
         _unit("N", {"kg": 1, "m": 1, "s": -2}, kN=1.0e-3),
         _unit("N.m", {"kg": 1, "m": 2, "s": -2}, **{"kN.m": 1.0e-3}),
         _unit("N.m/rad", {"kg": 1, "m": 2, "s": -2, "rad": -1}),

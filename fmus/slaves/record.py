@@ -39,7 +39,7 @@ ROLES = (WIND_SOURCE, GEARBOX, GENERATOR, TIME_SERIES, ROTOR, TORQUE_CONTROLLER)
 
 #: signal kinds an output can be declared as, per role; ``many``: any number of variables, else at most one
 SIGNALS: dict[str, dict[str, bool]] = {
-    WIND_SOURCE: {"rotor_speed": False, "rotor_angle": False},
+    WIND_SOURCE: {"rotor_speed": False, "rotor_angle": False, "rotor_acceleration": False, "rotor_jerk": False},
     GEARBOX: {"contact_force": True, "shaft_torque": True, "body_speed": True, "output_speed": False,
               "rotor_torque": False, "generator_shaft_torque": True, "output_acceleration_peak": False},
     GENERATOR: {"generator_speed": False, "generator_angle": False, "generator_torque": False},

@@ -43,7 +43,7 @@ class WindSource(DtcosimSlave):
 
     description = "dtcosim WindSource: stochastic rotor speed omega(t) and angle phi(t) of eq. 13-14 (SI units)"
     role = WIND_SOURCE
-    eager_output_groups = frozenset({"motion"})
+    eager_output_groups = frozenset({"motion", "derivatives"})  # read every step by the Gearbox (rotor_derivatives)
     _kernel_reported = False
 
     @classmethod
@@ -63,10 +63,14 @@ class WindSource(DtcosimSlave):
                               f"amplitude convention: {amplitude} (W_k = sqrt(2 S df) or the paper's S df)"),
             real_output("omega", "rad/s", "rotor speed omega(t) (eq. 13)", "rotor_speed"),
             real_output("phi", "rad", "rotor angle phi(t), the integral of omega from t = 0", "rotor_angle"),
+            real_output("alpha", "rad/s2", "rotor acceleration d omega / dt (exact, from the same harmonics)",
+                        "rotor_acceleration"),
+            real_output("jerk", "rad/s3", "rotor jerk d^2 omega / dt^2 (exact; with alpha, the Gearbox's "
+                        "rotor_derivatives extrapolation)", "rotor_jerk"),
         )
 
     def output_group(self, name: str) -> Hashable:
-        return "motion"
+        return "derivatives" if name in ("alpha", "jerk") else "motion"
 
     def _configure(self) -> None:
         values = {name: self.value(name) for name in (*WIND_FIELDS, "amplitude")}
@@ -77,6 +81,7 @@ class WindSource(DtcosimSlave):
             self._kernel_reported = True
         self._vr_omega = self.vr["omega"]
         self._vr_phi = self.vr["phi"]
+        self._vr_derivatives = (self.vr["alpha"], self.vr["jerk"])
 
     def _initialize(self, start_time: float) -> None:
         self.stepper.reset(start_time)
@@ -90,7 +95,11 @@ class WindSource(DtcosimSlave):
         stepper = self.stepper
         if stepper.time_s != self._time:  # e.g. outputs read in initialisation mode at another start time
             stepper.reset(self._time)
-        self._values[self._vr_omega], self._values[self._vr_phi] = stepper.speed_and_angle()
+        if group == "derivatives":
+            i_alpha, i_jerk = self._vr_derivatives
+            self._values[i_alpha], self._values[i_jerk] = stepper.acceleration_and_jerk()
+        else:
+            self._values[self._vr_omega], self._values[self._vr_phi] = stepper.speed_and_angle()
 
     def _component_state(self) -> dict:
         return self.stepper.get_state()
