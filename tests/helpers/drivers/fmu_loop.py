@@ -62,11 +62,13 @@ class Instance:
     def set(self, **values: float) -> None:
         self.fmu.setReal([self.vr[n] for n in values], list(values.values()))
 
-    def set_parameters(self, values: dict[str, float | int]) -> None:
-        """Set parameter values of any type the paper scenario uses (Real, Integer)."""
+    def set_parameters(self, values: dict[str, float | int | bool]) -> None:
+        """Set parameter values of any type the paper scenario uses (Real, Integer, Boolean)."""
         for name, value in values.items():
             if self.type[name] == "Integer":
                 self.fmu.setInteger([self.vr[name]], [int(value)])
+            elif self.type[name] == "Boolean":
+                self.fmu.setBoolean([self.vr[name]], [bool(value)])
             else:
                 self.fmu.setReal([self.vr[name]], [float(value)])
 
@@ -124,11 +126,13 @@ def run(fmu_dir: str | Path, t_end: float, step: float, init: str = "zero-twist"
     for inst in instances.values():
         inst.fmu.exitInitializationMode()
 
-    set_gearbox = gearbox.setter("omega_rotor", "phi_rotor", "omega_gen", "phi_gen")
+    # the paper scenario's connections (the interface model's too: unused inputs with the FMUs' defaults)
+    set_gearbox = gearbox.setter("omega_rotor", "phi_rotor", "alpha_rotor", "jerk_rotor", "omega_gen", "phi_gen",
+                                 "counter_torque")
     get_torque = gearbox.getter("shaft_torque")
     set_torque = generator.setter("shaft_torque")
-    get_wind = wind.getter("omega", "phi")
-    get_generator = generator.getter("omega", "phi")
+    get_wind = wind.getter("omega", "phi", "alpha", "jerk")
+    get_generator = generator.getter("omega", "phi", "generator_torque")
     recorded = [(f, v) for f, v in RECORDED if v in instances[f].vr]  # e.g. no F_sp in a parallel-only preset
     recorders = [instances[f].getter(v) for f, v in recorded]
 

@@ -17,11 +17,11 @@ from tests.helpers.scenarios import dtcosim
 pytestmark = pytest.mark.slow
 
 DATA = Path(__file__).resolve().parents[2] / "data" / "drivetrains"
-#: the Table 7 run (preset table6, default scenario: H = 5 ms, Gearbox tolerances 10 x its defaults):
-#: gearbox.stage1.F_sp[1] over [5, 60] s (900822.8980071074 / 8170.6632816650435 while the step-average shaft
-#: torque took the trapezoid of the two end twists instead of the twist integrated along the internal steps;
-#: the coupling study: all within 1e-4 of the monolithic reference)
-TABLE7_STAGE1_F_SP1 = (900822.8985906718, 8170.510280449017)
+#: the Table 7 run (preset table6, default scenario: H = 20 ms, the Gearbox's inertia interface with the rotor's
+#: derivative inputs, tolerances 0.3 x its defaults): gearbox.stage1.F_sp[1] over [5, 60] s (900822.8985906718 /
+#: 8170.510280449017 with the motion interface at H = 5 ms; the coupling study: all within 1e-4 of the monolithic
+#: reference)
+TABLE7_STAGE1_F_SP1 = (900822.8804545203, 8169.500932949844)
 
 
 @pytest.fixture(scope="module")

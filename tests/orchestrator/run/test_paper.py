@@ -116,14 +116,30 @@ def _coupling_errors(fmu_dir, steps, **gearbox):
     return out
 
 
+#: the Gearbox's interface before the interface model: generator motion prescribed, rotor slope from two speeds
+MOTION_INTERFACE = {"generator_interface": 0, "rotor_derivatives": False}
+
+
 def test_coupling_error_shrinks_with_the_communication_step(fmu_dir):
+    """The classic coupling error (motion interface) falls faster than first order in H."""
     steps = (10e-3, 5e-3, 2e-3, 1e-3)
-    errors = _coupling_errors(fmu_dir, steps)
+    errors = _coupling_errors(fmu_dir, steps, **MOTION_INTERFACE)
     for name in ("generator.omega", "gearbox.stage1.F_sp[1]"):
         e = [row[name] for row in errors]
         print(name, " ".join(f"H={h * 1e3:g} ms: {x:.3e}" for h, x in zip(steps, e)))
         assert e[0] > e[1] > e[2] > e[3], (name, e)
         assert e[0] / e[3] > 10.0, (name, e)  # faster than first order over a factor 10 in H
+
+
+def test_the_interface_model_at_10_ms_is_closer_than_the_motion_interface_at_2_ms(fmu_dir):
+    """paper-60s's Gearbox interface (inertia, rotor derivatives) against the motion interface, [1, 3] s."""
+    interface_model = _coupling_errors(fmu_dir, (10e-3,))[0]
+    motion = _coupling_errors(fmu_dir, (10e-3, 2e-3), **MOTION_INTERFACE)
+    print("RMS difference to monolithic: interface model at 10 ms", interface_model, "motion interface at 10, 2 ms",
+          motion)
+    for name in interface_model:
+        assert interface_model[name] < motion[1][name] < motion[0][name], (name, interface_model, motion)
+        assert interface_model[name] < 0.05 * motion[0][name], (name, interface_model, motion)
 
 
 def test_step_averaged_shaft_torque_beats_end_of_step(fmu_dir):

@@ -115,7 +115,7 @@ def test_the_scenario_and_the_size_choose_the_writer(tmp_path):
     assert scenario.results_format == "auto"
     sim = scenario.simulation
     assert isinstance(results_writer("auto", tmp_path, sim, 22), CsvWriter)
-    long = scenario.with_simulation(stop_s=600.0).simulation
+    long = scenario.with_simulation(stop_s=3600.0).simulation  # 180 001 samples x 22: above the 2 million values
     writer = results_writer("auto", tmp_path, long, 22)
     assert isinstance(writer, ParquetWriter) and writer.format == "parquet"
     assert writer.path == tmp_path / "timeseries.parquet"
