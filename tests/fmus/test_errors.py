@@ -40,6 +40,9 @@ DISCARD = 2
     ("Gearbox", {"shaft3.damping": -1.0}, "invalid parameter shaft3.damping = -1.0: expected >= 0"),
     ("Gearbox", {"solver.rtol": 0.0}, "invalid parameter solver.rtol = 0.0: expected > 0"),
     ("Gearbox", {"shaft_torque_mode": 2}, "invalid parameter shaft_torque_mode = 2"),
+    ("Gearbox", {"generator_interface": 2}, "invalid parameter generator_interface = 2: expected 0 = motion, 1 = inertia"),
+    ("Gearbox", {"generator_interface": 1, "generator_inertia": -3.0},
+     "invalid parameter generator_inertia = -3.0: expected > 0"),
     ("Gearbox", {"omega_rotor": math.inf}, "invalid parameter omega_rotor = inf: expected a finite real number"),
     ("GeneratorRotor", {"inertia": 0.0}, "invalid parameter inertia = 0.0: expected > 0"),
     ("GeneratorRotor", {"event3.kind": 1, "event3.duration": -1.0}, "invalid parameter event3.duration = -1.0: expected > 0"),
@@ -98,17 +101,26 @@ def test_solver_failure_discards_the_step_and_keeps_the_state(fmu_path):
     inst.free()
 
 
-@pytest.mark.parametrize("name, bad_input", [
-    ("Gearbox", {"omega_rotor": math.nan}),
-    ("GeneratorRotor", {"shaft_torque": math.inf}),
+#: the Gearbox's interface model with the rotor's derivative inputs (paper-60s)
+INTERFACE_MODEL = {"generator_interface": 1, "rotor_derivatives": True}
+
+
+@pytest.mark.parametrize("name, parameters, bad_input", [
+    ("Gearbox", {}, {"omega_rotor": math.nan}),
+    ("Gearbox", INTERFACE_MODEL, {"counter_torque": math.nan}),
+    ("Gearbox", INTERFACE_MODEL, {"jerk_rotor": math.inf}),
+    ("GeneratorRotor", {}, {"shaft_torque": math.inf}),
 ])
-def test_non_finite_input_discards_the_step_and_the_next_step_is_unaffected(fmu_path, name, bad_input):
+def test_non_finite_input_discards_the_step_and_the_next_step_is_unaffected(fmu_path, name, parameters, bad_input):
     def good_inputs(t):
-        return gearbox_motion(t, RATIO) if name == "Gearbox" else {"shaft_torque": 2.0e4}
+        if name != "Gearbox":
+            return {"shaft_torque": 2.0e4}
+        extra = {"counter_torque": 2.54e4, "alpha_rotor": 0.0, "jerk_rotor": 0.0} if parameters else {}
+        return {**gearbox_motion(t, RATIO), **extra}
 
     inst, clean = Instance(fmu_path(name), "hit"), Instance(fmu_path(name), "clean")
     for i in (inst, clean):
-        i.initialize(**good_inputs(0.0))
+        i.initialize(**parameters, **good_inputs(0.0))
     inst.set(**bad_input)
     with pytest.raises(FMICallException) as failure:
         inst.step(0.0, 1e-3)

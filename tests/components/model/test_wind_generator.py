@@ -55,6 +55,8 @@ def test_angle_and_acceleration_are_consistent_with_speed():
     integral = np.concatenate([[0.0], np.cumsum(0.5 * (w[1:] + w[:-1]) * np.diff(t))])
     np.testing.assert_allclose(phi, integral, atol=1e-8)
     np.testing.assert_allclose(proc.acceleration(t[1:-1]), (w[2:] - w[:-2]) / (t[2:] - t[:-2]), atol=1e-6)
+    a = proc.acceleration(t)
+    np.testing.assert_allclose(proc.jerk(t[1:-1]), (a[2:] - a[:-2]) / (t[2:] - t[:-2]), atol=1e-5)
     assert proc.speed(1.234) == pytest.approx(proc.speed(np.array([1.234]))[0])
 
 
@@ -118,6 +120,10 @@ def test_phasor_stepper_follows_the_closed_form(kernel):
     np.testing.assert_allclose(got[:, 0], speed, rtol=0, atol=1e-12)
     np.testing.assert_allclose(got[:, 1], angle, rtol=1e-14, atol=1e-12)
     assert stepper.steps_since_anchor < PhasorStepper.REANCHOR_STEPS
+    # the derivatives the Gearbox's rotor_derivatives extrapolation reads, from the same phasors
+    alpha, jerk = stepper.acceleration_and_jerk()
+    assert alpha == pytest.approx(process.acceleration(t[-1]), rel=0, abs=1e-12)
+    assert jerk == pytest.approx(process.jerk(t[-1]), rel=0, abs=1e-11)
 
 
 @pytest.mark.parametrize("kernel", _wind_kernels())
