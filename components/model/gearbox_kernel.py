@@ -19,13 +19,11 @@ buffer costs 0.4 us per call, the ~50 separate arrays several microseconds.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from ..errors import ParameterError, SolverError
 from .assembly import Assembly
-from .gearbox_model import GearboxModel
+from .gearbox_model import GearboxModel, non_finite_input
 from .kernel import compiled_module
 
 
@@ -327,11 +325,7 @@ class CompiledGearboxModel(GearboxModel):
         if status != mod.OK:
             c = self._integrator.control
             if status == mod.NON_FINITE_INPUT:
-                names = ("omega_rotor", "phi_rotor", "omega_gen", "phi_gen", "counter_torque", "alpha_rotor",
-                         "jerk_rotor")
-                pairs = [f"{name}={value!r}" for name, value in zip(names, inputs)]
-                text = ", ".join(p for p, v in zip(pairs, inputs) if not math.isfinite(v)) or ", ".join(pairs)
-                raise SolverError(f"non-finite input ({text})", t)
+                raise SolverError(non_finite_input(inputs), t)
             if status == mod.STEP_TOO_SMALL:
                 message = f"step size {h_fail:.3g} s below h_min {c.h_min:.3g} s (error norm {err:.3g})"
             else:

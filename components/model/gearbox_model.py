@@ -36,6 +36,18 @@ SHAFT_TORQUE_MODES = ("average", "end")
 GENERATOR_INTERFACES = ("motion", "inertia")
 
 
+#: the inputs of :meth:`GearboxModel.step`, in order
+STEP_INPUTS = ("omega_rotor", "phi_rotor", "omega_gen", "phi_gen", "counter_torque", "alpha_rotor", "jerk_rotor")
+
+
+def non_finite_input(inputs: tuple[float, ...]) -> str:
+    """``"non-finite input (jerk_rotor=inf)"``: the message of a step refused for its inputs (all of them if
+    every one is finite and only their combination overflowed)."""
+    pairs = [(f"{name}={value!r}", value) for name, value in zip(STEP_INPUTS, inputs)]
+    named = [text for text, value in pairs if not math.isfinite(value)] or [text for text, _ in pairs]
+    return f"non-finite input ({', '.join(named)})"
+
+
 class _Hermite:
     """Cubic ``x(tau)`` on [0, h] with given value and slope at both ends."""
 
@@ -537,7 +549,8 @@ class GearboxModel:
             g, n, m = self.generator_dof, a.n_dof, a.n_mesh
             dv = omega_gen - kx * self.driver_speed_rad_s - y[n + g]
             if not math.isfinite(dv + port0):
-                raise SolverError(f"non-finite input (omega_gen={omega_gen!r}, counter_torque={counter_torque_nm!r})", t)
+                raise SolverError(non_finite_input((omega_rotor, phi_rotor, omega_gen, phi_gen, counter_torque_nm,
+                                                    alpha_rotor, jerk_rotor)), t)
             y = y.copy()
             y[n + g] += dv
             # the generator is in no mesh: the accelerations are linear in its speed and in the torque
@@ -548,8 +561,8 @@ class GearboxModel:
             port1 = phi_gen + h * (omega_gen + 0.5 * h * alpha_gen) - kx * angle1
             port_speed1 = omega_gen + h * alpha_gen - kx * speed1
         if not math.isfinite(angle1 + speed1 + port1 + port_speed1):
-            raise SolverError(f"non-finite input (omega_rotor={omega_rotor!r}, phi_rotor={phi_rotor!r}, "
-                              f"omega_gen={omega_gen!r}, phi_gen={phi_gen!r})", t)
+            raise SolverError(non_finite_input((omega_rotor, phi_rotor, omega_gen, phi_gen, counter_torque_nm,
+                                                alpha_rotor, jerk_rotor)), t)
         sysm.angle0 = self.driver_angle_rad
         sysm.driver.fit(h, 0.0, self.driver_speed_rad_s, angle1 - self.driver_angle_rad, speed1)
         sysm.port.fit(h, port0, port_speed0, port1, port_speed1)

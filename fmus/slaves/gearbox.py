@@ -30,7 +30,7 @@ from components.errors import ParameterError
 from components.model.assembly import Assembly
 from components.model.description import build
 from components.model.drivetrain import Drivetrain
-from components.model.gearbox_model import GENERATOR_INTERFACES, SHAFT_TORQUE_MODES, GearboxModel
+from components.model.gearbox_model import GENERATOR_INTERFACES, SHAFT_TORQUE_MODES, STEP_INPUTS, GearboxModel
 from components.model.integrators import StepControl
 from components.validation import choice_bounds, positive
 
@@ -149,9 +149,7 @@ class Gearbox(DtcosimSlave):
         super().__init__(**kwargs)
         self._template = template_of(self.model)
         vr = self.vr
-        # in GearboxModel.step's order
-        self._vr_inputs = tuple(vr[n] for n in ("omega_rotor", "phi_rotor", "omega_gen", "phi_gen", "counter_torque",
-                                                "alpha_rotor", "jerk_rotor"))
+        self._vr_inputs = tuple(vr[n] for n in STEP_INPUTS)  # in GearboxModel.step's order
         self._inputs = itemgetter(*self._vr_inputs)  # values list -> the inputs, in one C call
         names = GearboxModel(self._template).output_names
         self._vr_outputs = [vr[n] for n in names]
