@@ -115,9 +115,10 @@ class Gearbox(DtcosimSlave):
             real_output("shaft_torque", "N.m",
                         "torque of shaft 3 on the generator, per shaft_torque_mode (default: step average)",
                         "generator_shaft_torque"),
-            real_output("shaft_torque_end", "N.m", "torque of shaft 3 on the generator at the end of the last step",
-                        "generator_shaft_torque"),
+            # the outputs in GearboxModel.output_names's order: one slice assignment per refresh, no reordering
             real_output("shaft_torque_avg", "N.m", "torque of shaft 3 on the generator averaged over the last step",
+                        "generator_shaft_torque"),
+            real_output("shaft_torque_end", "N.m", "torque of shaft 3 on the generator at the end of the last step",
                         "generator_shaft_torque"),
             real_output("omega_out", "rad/s", f"speed of the output member {assembly.stage_members[template.stages[-1].name]['output']}",
                         "output_speed"),
@@ -153,8 +154,8 @@ class Gearbox(DtcosimSlave):
         self._inputs = itemgetter(*self._vr_inputs)  # values list -> the inputs, in one C call
         names = GearboxModel(self._template).output_names
         self._vr_outputs = [vr[n] for n in names]
-        # the outputs usually occupy one range of value references, not in the model's order (shaft_torque_end
-        # and _avg are swapped): one slice assignment of the reordered list (itemgetter: one C call) per refresh
+        # the outputs occupy one range of value references in the model's order (build_interface): one slice
+        # assignment per refresh; an interface in another order is reordered (itemgetter: one C call)
         first, n = min(self._vr_outputs), len(names)
         contiguous = sorted(self._vr_outputs) == list(range(first, first + n))
         self._output_slice = slice(first, first + n) if contiguous else None
