@@ -18,12 +18,13 @@ process); the runners take turns block by block, so load changes on a shared
 machine hit them alike.
 
 Targets (issue 14): compiled <= 20 us per step; numpy fallback no slower than
-before the issue (82 us on the machine of that day). ``--baseline REV`` measures
-that comparison on this machine: it builds the Gearbox FMU of git revision ``REV``
+before the issue (82 us on the machine of that day). Both are figures of that
+machine (the shared VM's speed varies 2x from day to day); ``--baseline REV``
+measures them on this one, as ratios: it builds the Gearbox FMU of git revision ``REV``
 (default :data:`PRE_ISSUE_REVISION`, the last commit before issue 14's work) in a
 temporary ``git worktree`` and runs it block by block with the others (its own
 package name keeps its code apart from today's in this process), then prints the
-fallback's ratio to it.
+fallback's ratio to it and the compiled FMU's speed-up over it (target 82 / 20 = 4.1).
 
 Usage::
 
@@ -60,6 +61,10 @@ from fmus.build import build_fmu
 
 STEP_S = 1.0e-3
 INPUTS = ("omega_rotor", "phi_rotor", "omega_gen", "phi_gen")
+# issue 14's figures, measured on the machine of that day: the Gearbox FMU per step before the issue and the
+# compiled target; on another machine --baseline compares the speed-up over that FMU with their ratio
+BEFORE_ISSUE_US = 82.0
+TARGET_COMPILED_US = 20.0
 
 TRIVIAL_SLAVE = textwrap.dedent('''
     from pythonfmu import Fmi2Causality, Fmi2Slave, Real
@@ -274,15 +279,22 @@ def main(argv: list[str] | None = None) -> int:
     print(f"  Gearbox FMU {kernel} / trivial FMU  {med['gearbox'] / med['trivial']:6.2f}")
     print(f"  FMU layer + FMI round trip ({kernel}): {layer:.1f} us/step (median of blockwise differences)")
     if kernel == "compiled":
-        print(f"  target compiled <= 20 us/step -> {'met' if med['gearbox'] <= 20.0 else 'NOT met'}")
+        print(f"  target compiled <= {TARGET_COMPILED_US:g} us/step (that day's machine) -> "
+              f"{'met' if med['gearbox'] <= TARGET_COMPILED_US else 'NOT met'}")
+        if args.baseline:  # the same target on this machine: the speed-up over the FMU of before the issue
+            speedup, needed = med["baseline"] / med["gearbox"], BEFORE_ISSUE_US / TARGET_COMPILED_US
+            print(f"  the FMU of {args.baseline} / Gearbox FMU {kernel}: {speedup:.2f} (blockwise: "
+                  f"{', '.join(f'{b / a:.2f}' for a, b in zip(times['gearbox'], times['baseline']))}); "
+                  f"target >= {needed:.2f} ({BEFORE_ISSUE_US:g} -> {TARGET_COMPILED_US:g} us/step on that day's "
+                  f"machine) -> {'met' if speedup >= needed else 'NOT met'}")
     if args.baseline:
         ratio = med["gearbox_numpy"] / med["baseline"]
         print(f"  Gearbox FMU numpy / the FMU of {args.baseline}: {ratio:.2f} "
               f"(blockwise: {', '.join(f'{a / b:.2f}' for a, b in zip(times['gearbox_numpy'], times['baseline']))})")
         print(f"  target numpy fallback no slower than before issue 14 -> {'met' if ratio <= 1.0 else 'NOT met'}")
     else:
-        print(f"  target numpy fallback <= 82 us/step (before issue 14, that day's machine) -> "
-              f"{'met' if med['gearbox_numpy'] <= 82.0 else 'NOT met'}; --baseline measures it here")
+        print(f"  target numpy fallback <= {BEFORE_ISSUE_US:g} us/step (before issue 14, that day's machine) -> "
+              f"{'met' if med['gearbox_numpy'] <= BEFORE_ISSUE_US else 'NOT met'}; --baseline measures it here")
     return 0
 
 
