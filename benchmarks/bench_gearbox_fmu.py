@@ -265,6 +265,10 @@ def main(argv: list[str] | None = None) -> int:
         v = times[name]
         return f"  {label:<34} {med[name]:7.1f} us/step   (best block {min(v):.1f}; blocks {', '.join(f'{x:.1f}' for x in v)})"
 
+    def blockwise(numerator: str, denominator: str) -> str:
+        """The ratio of two runners block by block (they took turns), as printed."""
+        return ", ".join(f"{a / b:.2f}" for a, b in zip(times[numerator], times[denominator]))
+
     print(f"setReal(4) + doStep + getReal(1) at H = {STEP_S * 1e3:g} ms, preset {args.preset}, "
           f"after {args.warmup:g} s start-up; CPU time, median of {args.repeat} blocks of {args.steps} steps")
     print(line(f"Gearbox FMU ({kernel} kernel)", "gearbox"))
@@ -284,13 +288,13 @@ def main(argv: list[str] | None = None) -> int:
         if args.baseline:  # the same target on this machine: the speed-up over the FMU of before the issue
             speedup, needed = med["baseline"] / med["gearbox"], BEFORE_ISSUE_US / TARGET_COMPILED_US
             print(f"  the FMU of {args.baseline} / Gearbox FMU {kernel}: {speedup:.2f} (blockwise: "
-                  f"{', '.join(f'{b / a:.2f}' for a, b in zip(times['gearbox'], times['baseline']))}); "
+                  f"{blockwise('baseline', 'gearbox')}); "
                   f"target >= {needed:.2f} ({BEFORE_ISSUE_US:g} -> {TARGET_COMPILED_US:g} us/step on that day's "
                   f"machine) -> {'met' if speedup >= needed else 'NOT met'}")
     if args.baseline:
         ratio = med["gearbox_numpy"] / med["baseline"]
         print(f"  Gearbox FMU numpy / the FMU of {args.baseline}: {ratio:.2f} "
-              f"(blockwise: {', '.join(f'{a / b:.2f}' for a, b in zip(times['gearbox_numpy'], times['baseline']))})")
+              f"(blockwise: {blockwise('gearbox_numpy', 'baseline')})")
         print(f"  target numpy fallback no slower than before issue 14 -> {'met' if ratio <= 1.0 else 'NOT met'}")
     else:
         print(f"  target numpy fallback <= {BEFORE_ISSUE_US:g} us/step (before issue 14, that day's machine) -> "
