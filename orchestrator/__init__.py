@@ -9,6 +9,7 @@ Base modules
 ------------
 errors          every user-facing error class (names file, key, value, expectation)
 frozen_map      immutable, picklable mappings for the frozen input objects
+import_safe_signals  signal handlers that never interrupt an import
 plotting        figure, envelope and backlash-shading helpers shared by every plot
 result_files    CSV series, JSON summaries, the versions a result depends on
 

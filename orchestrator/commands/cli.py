@@ -9,13 +9,18 @@ from __future__ import annotations
 
 import argparse
 import atexit
+import contextlib
 import importlib
 import os
 import signal
 import sys
 import threading
+from collections.abc import Iterator
 
 from components.errors import DtcosimError
+
+from ..cosim.stop_requests import STOP_SIGNALS
+from ..import_safe_signals import outside_imports
 
 #: modules providing subcommands, in help order
 COMMAND_MODULES = (
@@ -70,36 +75,60 @@ def _raise_interrupt(signum, frame) -> None:
     raise RunInterrupted(signum, "the command")
 
 
+@contextlib.contextmanager
+def _command_signals() -> Iterator[None]:
+    """The command's stop-signal handlers, each kept out of imports, for the ``with`` block.
+
+    SIGINT keeps its handler (Python's KeyboardInterrupt, or the caller's);
+    SIGTERM and SIGHUP raise :class:`~orchestrator.errors.RunInterrupted`. A
+    signal the process ignores (SIGHUP under ``nohup``) stays ignored. Every
+    handler runs only outside imports (:func:`~orchestrator.import_safe_signals.outside_imports`),
+    so a Ctrl-C during start-up is one line too, not an ImportError.
+    """
+    previous = {}
+    if threading.current_thread() is threading.main_thread():
+        for signum in STOP_SIGNALS:
+            handler = signal.getsignal(signum)
+            if handler is signal.SIG_IGN or (signum == signal.SIGINT and not callable(handler)):
+                continue
+            own = handler if signum == signal.SIGINT else _raise_interrupt
+            previous[signum] = signal.signal(signum, outside_imports(own))
+    try:
+        yield
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
+
+
+def _prog(args: argparse.Namespace) -> str:
+    """``dtcosim run``: who speaks in an error line."""
+    return f"dtcosim {args.command}" if args.command else "dtcosim"
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run one ``dtcosim`` command; returns its exit status.
 
     SIGTERM and SIGHUP end a command like Ctrl-C does (the run command stops
     cleanly, see :mod:`orchestrator.cosim.stop_requests`): one line on stderr and
-    the status ``128 + signal`` (130 for Ctrl-C), at any stage.
+    the status ``128 + signal`` (130 for Ctrl-C), at any stage, start-up included.
     """
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    if not getattr(args, "func", None):
-        parser.print_help()
-        return 2
-    previous = {}
-    if threading.current_thread() is threading.main_thread():
-        for name in ("SIGTERM", "SIGHUP"):
-            if hasattr(signal, name):
-                previous[getattr(signal, name)] = signal.signal(getattr(signal, name), _raise_interrupt)
-    try:
-        return int(args.func(args) or 0)
-    except DtcosimError as exc:
-        print(f"dtcosim {args.command}: error: {exc}", file=sys.stderr)
-        return 1
-    except KeyboardInterrupt as exc:
-        signum = getattr(exc, "signum", signal.SIGINT)
-        text = str(exc) if getattr(exc, "signum", None) is not None else "interrupted by the user (Ctrl-C)"
-        print(f"dtcosim {args.command}: {text}", file=sys.stderr)
-        return 128 + int(signum)
-    finally:
-        for signum, handler in previous.items():
-            signal.signal(signum, handler)
+    with _command_signals():
+        args = argparse.Namespace(command=None)
+        try:
+            parser = build_parser()
+            args = parser.parse_args(argv)
+            if not getattr(args, "func", None):
+                parser.print_help()
+                return 2
+            return int(args.func(args) or 0)
+        except DtcosimError as exc:
+            print(f"{_prog(args)}: error: {exc}", file=sys.stderr)
+            return 1
+        except KeyboardInterrupt as exc:
+            signum = getattr(exc, "signum", signal.SIGINT)
+            text = str(exc) if getattr(exc, "signum", None) is not None else "interrupted by the user (Ctrl-C)"
+            print(f"{_prog(args)}: {text}", file=sys.stderr)
+            return 128 + int(signum)
 
 
 def end_process(status: int) -> None:

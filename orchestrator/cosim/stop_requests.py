@@ -22,6 +22,7 @@ import signal
 import threading
 
 from ..errors import RunInterrupted, reason_of, signal_name
+from ..import_safe_signals import outside_imports
 
 #: the signals that ask a run to stop
 STOP_SIGNALS = tuple(s for s in (signal.SIGINT, getattr(signal, "SIGTERM", None), getattr(signal, "SIGHUP", None))
@@ -55,7 +56,8 @@ class StopRequests:
     def __enter__(self) -> "StopRequests":
         if self.enabled and threading.current_thread() is threading.main_thread():
             for signum in STOP_SIGNALS:
-                self._previous[signum] = signal.signal(signum, self._handler)
+                if signal.getsignal(signum) is not signal.SIG_IGN:  # SIGHUP under nohup stays ignored
+                    self._previous[signum] = signal.signal(signum, outside_imports(self._handler))
         return self
 
     def __exit__(self, *exc) -> None:

@@ -1,0 +1,121 @@
+"""Stop signals kept out of imports: a Ctrl-C during start-up is one line and 130, never an ImportError."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+from orchestrator.import_safe_signals import inside_import
+
+ROOT = Path(__file__).resolve().parents[2]
+
+# a module whose import receives a signal and then runs Python code for a while, as numpy's does
+SIGNALLED_MODULE = textwrap.dedent("""
+    import os, signal, time
+    signal.raise_signal(getattr(signal, os.environ["SIGNAL"]))
+    total = 0
+    end = time.monotonic() + 0.2
+    while time.monotonic() < end:
+        total += 1
+    IMPORTED = True
+""")
+
+
+def _python(code: str, tmp_path: Path, signame: str = "SIGINT") -> subprocess.CompletedProcess:
+    (tmp_path / "signalled.py").write_text(SIGNALLED_MODULE)
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), str(ROOT)]), "SIGNAL": signame}
+    return subprocess.run([sys.executable, "-c", textwrap.dedent(code)], cwd=tmp_path, env=env,
+                          capture_output=True, text=True, timeout=30)
+
+
+def test_inside_import_sees_the_import_machinery(tmp_path, monkeypatch):
+    (tmp_path / "probe_import_frame.py").write_text(
+        "import sys\nfrom orchestrator.import_safe_signals import inside_import\nSEEN = inside_import(sys._getframe())\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    import probe_import_frame
+
+    assert probe_import_frame.SEEN is True
+    assert inside_import(sys._getframe()) is False
+    assert inside_import(None) is False
+
+
+@pytest.mark.parametrize("wrapped, expected", [
+    (True, "interrupted after the import: True"),  # delivered again once the import is over
+    (False, "interrupted inside the import"),      # what the wrapper prevents: the import breaks off
+])
+def test_a_signal_during_an_import_is_delivered_after_it(tmp_path, wrapped, expected):
+    proc = _python(f"""
+        import signal, sys, time
+        from orchestrator.import_safe_signals import outside_imports
+        if {wrapped}:
+            signal.signal(signal.SIGINT, outside_imports(signal.default_int_handler))
+        try:
+            import signalled
+        except KeyboardInterrupt:
+            print("interrupted inside the import")
+            sys.exit(0)
+        try:
+            time.sleep(60)  # the signal must wake the main thread: the test times out otherwise
+        except KeyboardInterrupt:
+            print("interrupted after the import:", signalled.IMPORTED)
+    """, tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip() == expected
+
+
+# a subcommand whose module is imported while the parser is built and receives the signal there
+SLEEP_COMMAND = textwrap.dedent("""
+    import time
+    import signalled  # the stop signal lands in this import
+
+    def register(sub):
+        p = sub.add_parser("sleep")
+        p.set_defaults(func=lambda args: time.sleep(60) or 0)
+""")
+
+
+@pytest.mark.parametrize("signame, status, line", [
+    ("SIGINT", 130, "dtcosim sleep: interrupted by the user (Ctrl-C)"),
+    ("SIGTERM", 143, "dtcosim sleep: interrupted by SIGTERM during the command"),
+])
+def test_a_stop_signal_during_start_up_is_one_line_and_its_status(tmp_path, signame, status, line):
+    (tmp_path / "sleep_command.py").write_text(SLEEP_COMMAND)
+    proc = _python("""
+        from orchestrator.commands import cli
+        cli.COMMAND_MODULES = cli.COMMAND_MODULES + ("sleep_command",)
+        cli.end_process(cli.main(["sleep"]))
+    """, tmp_path, signame)
+    assert proc.returncode == status, proc.stderr
+    assert proc.stderr.strip() == line
+
+
+def test_a_signal_the_process_ignores_stays_ignored_during_a_command(monkeypatch):
+    from orchestrator.commands import cli
+
+    seen = {}
+
+    class Command:
+        @staticmethod
+        def register(sub):
+            p = sub.add_parser("probe")
+            p.set_defaults(func=lambda args: seen.update(hup=signal.getsignal(signal.SIGHUP),
+                                                         term=signal.getsignal(signal.SIGTERM)) or 0)
+
+    monkeypatch.setattr(cli, "COMMAND_MODULES", ("probe_command",))
+    monkeypatch.setitem(sys.modules, "probe_command", Command)
+    before_term = signal.getsignal(signal.SIGTERM)
+    previous = signal.signal(signal.SIGHUP, signal.SIG_IGN)  # as under nohup
+    try:
+        assert cli.main(["probe"]) == 0
+        assert signal.getsignal(signal.SIGHUP) is signal.SIG_IGN
+    finally:
+        signal.signal(signal.SIGHUP, previous)
+    assert seen["hup"] is signal.SIG_IGN
+    assert seen["term"].wrapped is cli._raise_interrupt  # a handler that ends the command, kept out of imports
+    assert signal.getsignal(signal.SIGTERM) is before_term  # restored afterwards
