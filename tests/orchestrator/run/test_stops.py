@@ -27,13 +27,25 @@ pytestmark = pytest.mark.slow
 EXE = str(Path(sys.executable).parent / "dtcosim")
 
 
+def _as_from_a_terminal(then=None):
+    """The child's stop signals at their defaults, as a shell's job has them (CI may run under nohup)."""
+
+    def preexec():
+        for signum in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+            signal.signal(signum, signal.SIG_DFL)
+        if then is not None:
+            then()
+
+    return preexec
+
+
 def start(fmu_dir, out, *extra, preexec_fn=None) -> subprocess.Popen:
     """``dtcosim run`` of the paper's scenario in the background."""
     # at H = 1 ms, every step sampled: one row per step, blocks of 250 rows
     return subprocess.Popen([EXE, "run", "--fmu-dir", str(fmu_dir), "--out", str(out), "--no-plots", "-q",
                              "--step", "0.001", "--output-interval", "0.001", *extra],
                             cwd=out.parent, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            preexec_fn=preexec_fn)
+                            preexec_fn=_as_from_a_terminal(preexec_fn))
 
 
 def wait_until_stepping(proc: subprocess.Popen, out: Path, rows: int = 600, timeout: float = 300.0) -> None:
@@ -211,7 +223,7 @@ def test_ctrl_c_at_any_stage_exits_130_with_one_line(fmu_dir, tmp_path, delay_s)
     # at H = 1 ms the run lasts long enough for every delay to land before its end
     proc = subprocess.Popen([EXE, "run", "--fmu-dir", str(fmu_dir), "--out", str(out), "-q", "--step", "0.001",
                              "--output-interval", "0.001"], cwd=tmp_path,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, preexec_fn=_as_from_a_terminal())
     time.sleep(delay_s)  # start-up, imports, FMU loading, instantiation, stepping: wherever it is
     proc.send_signal(signal.SIGINT)
     _, stderr = proc.communicate(timeout=120)
