@@ -36,6 +36,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 from ..cosim.stop_requests import STOP_SIGNALS
+from ..import_safe_signals import outside_imports
 from ..inputs.study import StudyError
 from .engine import FAILED, OK, PointTask, run_point
 from .journal import JOURNAL_FILE, Journal, latest_by_key, read_journal
@@ -104,7 +105,11 @@ def pending_points(prepared: PreparedStudy, records: list[dict], retry_failed: b
 
 
 class _Interrupts:
-    """SIGINT, SIGTERM and SIGHUP handling that never splits a journal write: a signal during a write is raised after it."""
+    """SIGINT, SIGTERM and SIGHUP handling that never splits a journal write: a signal during a write is raised after it.
+
+    Nor an import: a signal that lands in one is delivered again after it
+    (:func:`~orchestrator.import_safe_signals.outside_imports`).
+    """
 
     def __init__(self) -> None:
         self.critical = False
@@ -115,7 +120,8 @@ class _Interrupts:
     def __enter__(self) -> "_Interrupts":
         if threading.current_thread() is threading.main_thread():
             for signum in STOP_SIGNALS:
-                self.previous[signum] = signal.signal(signum, self._handler)
+                if signal.getsignal(signum) is not signal.SIG_IGN:  # SIGHUP under nohup stays ignored
+                    self.previous[signum] = signal.signal(signum, outside_imports(self._handler))
         return self
 
     def __exit__(self, *exc) -> None:
