@@ -11,13 +11,15 @@ almost any stage.
 :func:`outside_imports` wraps a handler: a signal that arrives while an
 import is running is delivered again :data:`REDELIVERY_S` later, until it
 lands outside every import, where the wrapped handler runs (and may raise).
+:func:`install` puts such handlers in place for the signals a process does
+not ignore, and :func:`restore` puts the previous ones back.
 """
 
 from __future__ import annotations
 
 import signal
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from types import FrameType
 
 #: the import machinery's own frames
@@ -75,3 +77,34 @@ def outside_imports(handler: Handler) -> Handler:
 
     deferring.wrapped = handler  # type: ignore[attr-defined]
     return deferring
+
+
+def install(handlers: Mapping[int, Handler]) -> dict[int, object]:
+    """Put each handler in place, kept out of imports (:func:`outside_imports`).
+
+    Only in the main thread (elsewhere Python cannot set handlers: nothing is
+    changed), and not for a signal the process ignores (SIGHUP under ``nohup``
+    stays ignored).
+
+    Parameters
+    ----------
+    handlers : mapping of int to callable
+        Signal number -> Python handler ``handler(signum, frame)``.
+
+    Returns
+    -------
+    dict
+        The handlers replaced, for :func:`restore`.
+    """
+    previous: dict[int, object] = {}
+    if threading.current_thread() is threading.main_thread():
+        for signum, handler in handlers.items():
+            if signal.getsignal(signum) is not signal.SIG_IGN:
+                previous[signum] = signal.signal(signum, outside_imports(handler))
+    return previous
+
+
+def restore(previous: Mapping[int, object]) -> None:
+    """Put back the handlers :func:`install` replaced."""
+    for signum, handler in previous.items():
+        signal.signal(signum, handler)

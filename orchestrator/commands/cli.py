@@ -14,13 +14,12 @@ import importlib
 import os
 import signal
 import sys
-import threading
 from collections.abc import Iterator
 
 from components.errors import DtcosimError
 
 from ..cosim.stop_requests import STOP_SIGNALS
-from ..import_safe_signals import outside_imports
+from ..import_safe_signals import install, restore
 
 #: modules providing subcommands, in help order
 COMMAND_MODULES = (
@@ -82,22 +81,18 @@ def _command_signals() -> Iterator[None]:
     SIGINT keeps its handler (Python's KeyboardInterrupt, or the caller's);
     SIGTERM and SIGHUP raise :class:`~orchestrator.errors.RunInterrupted`. A
     signal the process ignores (SIGHUP under ``nohup``) stays ignored. Every
-    handler runs only outside imports (:func:`~orchestrator.import_safe_signals.outside_imports`),
+    handler runs only outside imports (:func:`~orchestrator.import_safe_signals.install`),
     so a Ctrl-C during start-up is one line too, not an ImportError.
     """
-    previous = {}
-    if threading.current_thread() is threading.main_thread():
-        for signum in STOP_SIGNALS:
-            handler = signal.getsignal(signum)
-            if handler is signal.SIG_IGN or (signum == signal.SIGINT and not callable(handler)):
-                continue
-            own = handler if signum == signal.SIGINT else _raise_interrupt
-            previous[signum] = signal.signal(signum, outside_imports(own))
+    handlers = dict.fromkeys(STOP_SIGNALS, _raise_interrupt)
+    handlers[signal.SIGINT] = signal.getsignal(signal.SIGINT)
+    if not callable(handlers[signal.SIGINT]):  # SIG_DFL or SIG_IGN: no Python handler to keep out of imports
+        del handlers[signal.SIGINT]
+    previous = install(handlers)
     try:
         yield
     finally:
-        for signum, handler in previous.items():
-            signal.signal(signum, handler)
+        restore(previous)
 
 
 def _prog(args: argparse.Namespace) -> str:

@@ -19,10 +19,9 @@ SIGINT, 143 for SIGTERM, 129 for SIGHUP (:func:`exit_status`).
 from __future__ import annotations
 
 import signal
-import threading
 
 from ..errors import RunInterrupted, reason_of, signal_name
-from ..import_safe_signals import outside_imports
+from ..import_safe_signals import install, restore
 
 #: the signals that ask a run to stop
 STOP_SIGNALS = tuple(s for s in (signal.SIGINT, getattr(signal, "SIGTERM", None), getattr(signal, "SIGHUP", None))
@@ -54,16 +53,13 @@ class StopRequests:
         self._previous: dict[int, object] = {}
 
     def __enter__(self) -> "StopRequests":
-        if self.enabled and threading.current_thread() is threading.main_thread():
-            for signum in STOP_SIGNALS:
-                if signal.getsignal(signum) is not signal.SIG_IGN:  # SIGHUP under nohup stays ignored
-                    self._previous[signum] = signal.signal(signum, outside_imports(self._handler))
+        if self.enabled:
+            self._previous = install(dict.fromkeys(STOP_SIGNALS, self._handler))
         return self
 
     def __exit__(self, *exc) -> None:
-        for signum, handler in self._previous.items():
-            signal.signal(signum, handler)
-        self._previous.clear()
+        restore(self._previous)
+        self._previous = {}
 
     def _handler(self, signum, frame) -> None:
         if self.signum is None:

@@ -28,7 +28,6 @@ import contextlib
 import datetime as _dt
 import math
 import signal
-import threading
 import time
 import uuid
 from dataclasses import dataclass, field
@@ -36,7 +35,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 from ..cosim.stop_requests import STOP_SIGNALS
-from ..import_safe_signals import outside_imports
+from ..import_safe_signals import install, restore
 from ..inputs.study import StudyError
 from .engine import FAILED, OK, PointTask, run_point
 from .journal import JOURNAL_FILE, Journal, latest_by_key, read_journal
@@ -108,7 +107,7 @@ class _Interrupts:
     """SIGINT, SIGTERM and SIGHUP handling that never splits a journal write: a signal during a write is raised after it.
 
     Nor an import: a signal that lands in one is delivered again after it
-    (:func:`~orchestrator.import_safe_signals.outside_imports`).
+    (:func:`~orchestrator.import_safe_signals.install`).
     """
 
     def __init__(self) -> None:
@@ -118,15 +117,11 @@ class _Interrupts:
         self.signum: int | None = None
 
     def __enter__(self) -> "_Interrupts":
-        if threading.current_thread() is threading.main_thread():
-            for signum in STOP_SIGNALS:
-                if signal.getsignal(signum) is not signal.SIG_IGN:  # SIGHUP under nohup stays ignored
-                    self.previous[signum] = signal.signal(signum, outside_imports(self._handler))
+        self.previous = install(dict.fromkeys(STOP_SIGNALS, self._handler))
         return self
 
     def __exit__(self, *exc) -> None:
-        for signum, handler in self.previous.items():
-            signal.signal(signum, handler)
+        restore(self.previous)
 
     def _handler(self, signum, frame) -> None:
         self.signum = self.signum or signum
