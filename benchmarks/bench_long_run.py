@@ -5,7 +5,7 @@ Two parts:
 1. **Whole runs** (default): ``run_scenario`` (what ``dtcosim run`` does: stream the samples
    into the results file, analyses, plots, summary) in a fresh process per results format
    (``csv``, ``parquet``) and per Gearbox kernel (``compiled``: compiled ahead of time where
-   built, :mod:`components.model.aot`; ``jit``: numba just in time, ``DTCOSIM_AOT=0``;
+   built, :mod:`components.compile.aot`; ``jit``: numba just in time, ``DTCOSIM_AOT=0``;
    ``numpy``), printing wall and CPU time of the run, the peak resident memory of the
    process (``ru_maxrss``: everything, imports and the FMUs included), for Parquet the peak of
    the child process that converts the stream (:mod:`orchestrator.parquet_conversion`) and that
@@ -199,7 +199,7 @@ def _converter(r: dict) -> str:
 
 #: environment of a whole run per --kernels entry
 KERNEL_ENVIRONMENTS = {
-    "compiled": {"DTCOSIM_KERNEL": "compiled"},  # ahead of time where built (components.model.aot), else JIT
+    "compiled": {"DTCOSIM_KERNEL": "compiled"},  # ahead of time where built (components.compile.aot), else JIT
     "jit": {"DTCOSIM_KERNEL": "compiled", "DTCOSIM_AOT": "0"},
     "numpy": {"DTCOSIM_KERNEL": "numpy"},
 }
@@ -215,12 +215,12 @@ IMPORTS = {
     "llvmlite.binding": "import llvmlite.binding",
     "numba": "import numba",
     "numba + the compiled gearbox kernel from its disk cache": (
-        "from components.model import compiled_kernel as k; k.ensure_compiled()"),
+        "from components.model.kernel import jit_gearbox; jit_gearbox()"),
     "numba + kernel, numba's own cache load (context refresh)": (
-        "from components.model import compiled_kernel as k; from numba.core.registry import cpu_target; "
-        "cpu_target.target_context.refresh(); k.ensure_compiled()"),
+        "from numba.core.registry import cpu_target; cpu_target.target_context.refresh(); "
+        "from components.model.kernel import jit_gearbox; jit_gearbox()"),
     "the compiled gearbox kernel ahead of time (no numba)": (
-        "from components.model.kernel import compiled_module; m = compiled_module()[0]; "
+        "from components.model.kernel import gearbox; m = gearbox('compiled')[0]; "
         "assert getattr(m, 'AHEAD_OF_TIME', None), 'not built: dtcosim build'"),
     "pyarrow": "import pyarrow",
     "pyarrow.parquet": "import pyarrow.parquet",

@@ -214,7 +214,7 @@ def static_equilibrium(
                 f"static equilibrium not found after {it} Newton iterations (residual {norm:.3g} N m)"
             )
         it += 1
-        dq, _, _, _ = a.acceleration_jacobian(loads)
+        dq, _, _, _ = a.acceleration_jacobian(q, zeros, stiffness_factor=stiffness_factor)
         stiffness = -(a.inertia_kgm2[:, None] * dq)
         try:
             step = np.linalg.solve(stiffness, r)
@@ -291,8 +291,7 @@ def linearise(drivetrain: Drivetrain, operating_point: OperatingPoint, stiffness
         raise ParameterError("operating_point", operating_point, "an OperatingPoint")
     a = Assembly(drivetrain)
     eq = static_equilibrium(a, operating_point.output_torque_nm, stiffness_factor)
-    loads = a.loads(eq.q_rad, np.zeros(a.n_dof), stiffness_factor=stiffness_factor)
-    dq, dv, _, _ = a.acceleration_jacobian(loads)
+    dq, dv, _, _ = a.acceleration_jacobian(eq.q_rad, np.zeros(a.n_dof), stiffness_factor=stiffness_factor)
     m = a.inertia_kgm2
     k = -(m[:, None] * dq)
     c = -(m[:, None] * dv)

@@ -42,8 +42,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
+from . import kernel as model_kernel
 from .contact import ContactLaw, MeshContact
 from .drivetrain import Drivetrain
+from .kernel.stiffness import N_PHASING_ROWS
+from .mesh_stiffness import MeshPhasing
 from .stages import PlanetaryStage
 
 
@@ -143,7 +146,7 @@ class InternalLoads:
 
 
 class Assembly:
-    """Matrices and vectorised force/Jacobian evaluation of a drivetrain.
+    """The matrices of a drivetrain (the kernel's constants) and their evaluation over arrays of states.
 
     Parameters
     ----------
@@ -268,7 +271,6 @@ class Assembly:
         self.inertia_all_kgm2 = np.array([b.inertia_kgm2 for b in bodies])
         self.inertia_kgm2 = self.inertia_all_kgm2[free]
         self.inv_inertia = 1.0 / self.inertia_kgm2
-        self._neg_inv_inertia_column = -self.inv_inertia[:, None]
         self.driver_inertia_kgm2 = bodies[driver].inertia_kgm2
         self.law = ContactLaw([m.contact for m in self.meshes])
         self.cos_alpha = np.array([math.cos(m.contact.pressure_angle_rad) for m in self.meshes])
@@ -294,11 +296,10 @@ class Assembly:
         self.output_body = bodies[output_index].name
         self.time_varying_stiffness = any(m.contact.stiffness_variation > 0.0 for m in self.meshes)
         # matrices for the single-state fast path (mesh forces + shafts folded into constant matrices)
-        self._A_T = np.ascontiguousarray(self.A.T)  # (n_dof, n_mesh)
+        self.A_T = np.ascontiguousarray(self.A.T)  # (n_dof, n_mesh)
         self._neg_B = np.ascontiguousarray(-(self.cos_alpha[:, None] * self.A))  # (n_mesh, n_dof)
         self._shaft_QY = np.ascontiguousarray(-np.vstack([self.STkS.T, self.STcS.T]))  # y = [q, v] -> shaft torques on dofs
         self._port_Q = -np.stack([self.STkS_port, self.STcS_port])  # (2, n_dof, n_port)
-        self._port_meshes = bool(np.any(self.A_port))
         if self.ports.size > 1:
             raise ParameterError("ports", self.ports.size, "at most one prescribed port")
         if self.ports.size:  # the port input u is the port's deviation angle, u_dot its speed
@@ -310,22 +311,42 @@ class Assembly:
         #: the port input's weights on the mesh deflections and shaft twists (zero without a port)
         self.port_deflection = self.A_port[:, 0].copy() if self.ports.size else np.zeros(self.n_mesh)
         self.port_twist = self.S_port[:, 0].copy() if self.ports.size else np.zeros(self.n_shaft)
-        # acceleration = [force, q, v, u, u_dot, alpha_in] @ _fast_matrix (u, u_dot: the port input, see above)
-        self._fast_matrix = np.ascontiguousarray(
+        #: the folded matrix: q_ddot = [force, q, v, u, u_dot, alpha_in] @ fast_matrix (u, u_dot: the port input,
+        #: see above); what the kernel (:func:`components.model.kernel.dynamics.acceleration`) evaluates
+        self.fast_matrix = np.ascontiguousarray(
             np.vstack([self._neg_B, self._shaft_QY, port_q[None, :], port_v[None, :], -self.kinematic_ratio[None, :]])
             * np.append(self.inv_inertia[None, :].repeat(self._neg_B.shape[0] + 2 * self.n_dof + 2, 0), [np.ones(self.n_dof)], 0)
         )
-        self._fast_extra = np.zeros(3)
         self._mesh_rate = np.array([m.teeth_per_driver_rad for m in self.meshes])
         self._mesh_offset = np.array([m.phase_offset_rad for m in self.meshes])
         self._mesh_variation = np.array([m.contact.stiffness_variation for m in self.meshes])
         self._mesh_contact_ratio = np.array([m.contact.contact_ratio for m in self.meshes])
         self.phasing = None
         if self.time_varying_stiffness:
-            from .mesh_stiffness import MeshPhasing
-
             self.phasing = MeshPhasing(self._mesh_rate, self._mesh_offset, self._mesh_contact_ratio, self._mesh_variation)
-        self._force_rows = np.ascontiguousarray(self._fast_matrix[: self.n_mesh])  # d q_ddot / d F, (n_mesh, n_dof)
+        #: the kernel's phasing table (zeros when the stiffness is constant), shape (7, n_mesh)
+        self.phasing_table = self.phasing.table if self.phasing is not None else np.zeros((N_PHASING_ROWS, self.n_mesh))
+        #: d q_ddot / d F, shape (n_mesh, n_dof): the force rows of the folded matrix
+        self.force_rows = np.ascontiguousarray(self.fast_matrix[: self.n_mesh])
+        self.nz_index, self.nz_value = self._mesh_sparsity()
+
+    def _mesh_sparsity(self) -> tuple[np.ndarray, np.ndarray]:
+        """Nonzero columns of every mesh row of ``A`` (free bodies) and their entries, padded with -1 / 0.
+
+        Returns
+        -------
+        index, value : ndarray, shape (n_mesh, width)
+            ``width`` is the largest number of free bodies one mesh touches (at least 1); the kernel's
+            Jacobian sums over these only.
+        """
+        rows = [np.flatnonzero(row) for row in self.A]
+        width = max([1] + [r.size for r in rows])
+        index = np.full((self.n_mesh, width), -1.0)
+        value = np.zeros((self.n_mesh, width))
+        for i, cols in enumerate(rows):
+            index[i, : cols.size] = cols
+            value[i, : cols.size] = self.A[i, cols]
+        return index, value
 
     # ------------------------------------------------------------------ names
     @property
@@ -352,60 +373,16 @@ class Assembly:
 
     # ------------------------------------------------------------- stiffness
     def stiffness_factor(self, driver_angle_rad: float | np.ndarray) -> np.ndarray | float:
-        """Time-varying mesh-stiffness multiplier at a driver angle (1 when the option is off).
+        """Time-varying mesh-stiffness multiplier at one driver angle (n_mesh,) or many (N, n_mesh); 1 when off.
 
-        See :func:`components.model.mesh_stiffness.stiffness_factor`.
+        See :mod:`components.model.mesh_stiffness`.
         """
         if not self.time_varying_stiffness:
             return 1.0
         if np.ndim(driver_angle_rad) == 0:
             return self.phasing.factor(float(driver_angle_rad))
-        from .mesh_stiffness import stiffness_factor
-
-        phase = np.multiply.outer(driver_angle_rad, self._mesh_rate) + self._mesh_offset
-        return stiffness_factor(phase, self._mesh_contact_ratio, self._mesh_variation)
-
-    def _mesh_deflections(self, y: np.ndarray, port_angle_rad: float, port_speed_rad_s: float) -> np.ndarray:
-        """Mesh deflections [m] (row 0) and their rates [m/s] (row 1) of state ``[q, v]``, shape (2, n_mesh)."""
-        D = np.dot(y.reshape(2, self.n_dof), self._A_T)  # np.dot: the same product as @, cheaper on tiny arrays
-        if self._port_meshes:
-            D[0] += self.A_port[:, 0] * port_angle_rad
-            D[1] += self.A_port[:, 0] * port_speed_rad_s
-        return D
-
-    def stiffness_rate_acceleration(
-        self,
-        y: np.ndarray,
-        port_angle_rad: float,
-        port_speed_rad_s: float,
-        stiffness_factor: np.ndarray,
-        stiffness_factor_rate: np.ndarray,
-    ) -> np.ndarray:
-        """Rate of change of ``q_ddot`` at a fixed state caused by the mesh stiffness varying in time.
-
-        ``(dF/df * df/dt) @ dq_ddot/dF``: the part of the partial time derivative of the
-        acceleration that the time-varying mesh stiffness adds (analytic, for the
-        Rosenbrock integrator of the co-simulation gearbox).
-
-        Parameters
-        ----------
-        y : ndarray, shape (2 n_dof,)
-            State ``[q, v]`` [rad, rad/s].
-        port_angle_rad, port_speed_rad_s : float
-            Deviation angle [rad] and speed [rad/s] of the prescribed port (0 without one).
-        stiffness_factor : ndarray, shape (n_mesh,)
-            Current stiffness multiplier f [-].
-        stiffness_factor_rate : ndarray, shape (n_mesh,)
-            Its time derivative df/dt [1/s].
-
-        Returns
-        -------
-        ndarray, shape (n_dof,)
-            [rad/s^3].
-        """
-        D = self._mesh_deflections(y, port_angle_rad, port_speed_rad_s)
-        sensitivity = self.law.stiffness_sensitivity(D[0], D[1], stiffness_factor)
-        return (sensitivity * stiffness_factor_rate) @ self._force_rows
+        angles = np.asarray(driver_angle_rad, dtype=float)
+        return self.phasing.factors(angles.ravel())[0].reshape(angles.shape + (self.n_mesh,))
 
     # ----------------------------------------------------------------- loads
     def loads(
@@ -446,53 +423,6 @@ class Assembly:
         cf = self.law.evaluate(d, dd, stiffness_factor)
         return InternalLoads(d, dd, cf.force, cf.d_force_d_deflection, cf.d_force_d_rate, cf.elastic, s, sd, torque)
 
-    def fast_acceleration(
-        self,
-        y: np.ndarray,
-        port_angle_rad: float = 0.0,
-        port_speed_rad_s: float = 0.0,
-        driver_acceleration: float = 0.0,
-        stiffness_factor: np.ndarray | float = 1.0,
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Deviation accelerations of one state without derivatives (co-simulation hot path).
-
-        Everything linear (inverse inertia, shafts, the port, the driver
-        acceleration) is folded into one constant matrix, so one evaluation is
-        a deflection product, the contact law and one more product.
-
-        Parameters
-        ----------
-        y : ndarray, shape (2 n_dof,)
-            State ``[q, v]``: deviation angles [rad] and speeds [rad/s].
-        port_angle_rad, port_speed_rad_s : float
-            The port input ``u``, ``u_dot``: deviation angle [rad] and speed [rad/s] of the (single)
-            prescribed port; without a port, ``u`` is the counter torque braking the output body [N m]
-            (the generator: an uncut assembly steps the generator inertia itself) and ``u_dot`` is unused.
-        driver_acceleration : float
-            Driver acceleration alpha_in [rad/s^2].
-        stiffness_factor : ndarray or float
-            Mesh stiffness multiplier.
-
-        Returns
-        -------
-        acceleration : ndarray, shape (n_dof,)
-            q_ddot [rad/s^2].
-        force : ndarray, shape (n_mesh,)
-            Contact forces [N].
-        deflection : ndarray, shape (2, n_mesh)
-            Deflections [m] (row 0) and their rates [m/s] (row 1).
-        """
-        D = np.dot(y.reshape(2, self.n_dof), self._A_T)  # as _mesh_deflections (inlined: hot path)
-        if self._port_meshes:
-            D[0] += self.A_port[:, 0] * port_angle_rad
-            D[1] += self.A_port[:, 0] * port_speed_rad_s
-        force = self.law.force(D[0], D[1], stiffness_factor)
-        extra = self._fast_extra
-        extra[0] = port_angle_rad
-        extra[1] = port_speed_rad_s
-        extra[2] = driver_acceleration
-        return np.dot(np.concatenate((force, y, extra)), self._fast_matrix), force, D
-
     def generalised_forces(self, loads: InternalLoads) -> np.ndarray:
         """Generalised torques on the free bodies from meshes and shafts [N m], shape (..., n_dof)."""
         return -(loads.contact_force_n @ self.BT.T) - loads.shaft_torque_nm @ self.S
@@ -530,8 +460,27 @@ class Assembly:
             Q[self.output_dof] -= output_torque_nm
         return self.inv_inertia * Q - self.kinematic_ratio * driver_acceleration
 
-    def acceleration_jacobian(self, loads: InternalLoads) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """Jacobians of ``q_ddot`` for a single state.
+    def acceleration_jacobian(
+        self,
+        q: np.ndarray,
+        v: np.ndarray,
+        q_port: np.ndarray | None = None,
+        v_port: np.ndarray | None = None,
+        stiffness_factor: np.ndarray | float = 1.0,
+        kernel: str | None = None,
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Jacobians of ``q_ddot`` at one state (:func:`components.model.kernel.dynamics.jacobian`).
+
+        Parameters
+        ----------
+        q, v : ndarray, shape (n_dof,)
+            Deviation angles [rad] and speeds [rad/s].
+        q_port, v_port : ndarray, shape (n_port,), optional
+            The port's deviation angle [rad] and speed [rad/s].
+        stiffness_factor : ndarray or float
+            Mesh stiffness multiplier.
+        kernel : {"auto", "numpy", "compiled"}, optional
+            Form of the kernel.
 
         Returns
         -------
@@ -539,18 +488,21 @@ class Assembly:
             [1/s^2], [1/s].
         dA_dqport, dA_dvport : ndarray, shape (n_dof, n_port)
         """
-        bt_fd = self.BT * loads.d_force_d_deflection
-        bt_fv = self.BT * loads.d_force_d_rate
-        neg_inv_m = self._neg_inv_inertia_column  # -inv_m, (n_dof, 1)
-        dot = np.dot  # the same products as @, cheaper on small arrays
-        dq = neg_inv_m * (dot(bt_fd, self.A) + self.STkS)
-        dv = neg_inv_m * (dot(bt_fv, self.A) + self.STcS)
-        if self.ports.size:
-            dqp = neg_inv_m * (dot(bt_fd, self.A_port) + self.STkS_port)
-            dvp = neg_inv_m * (dot(bt_fv, self.A_port) + self.STcS_port)
-        else:
-            dqp = dvp = np.zeros((self.n_dof, 0))
-        return dq, dv, dqp, dvp
+        n, m = self.n_dof, self.n_mesh
+        y = np.ascontiguousarray(np.concatenate((q, v)), dtype=float)
+        port = float(q_port[0]) if self.ports.size and q_port is not None else 0.0
+        port_rate = float(v_port[0]) if self.ports.size and v_port is not None else 0.0
+        factor = np.ascontiguousarray(np.broadcast_to(np.asarray(stiffness_factor, dtype=float), (m,)))
+        dq, dv, port_jac = np.zeros((n, n)), np.zeros((n, n)), np.zeros((2, n))
+        stks_port = self.STkS_port[:, 0].copy() if self.ports.size else np.zeros(n)
+        stcs_port = self.STcS_port[:, 0].copy() if self.ports.size else np.zeros(n)
+        model_kernel.monolithic(kernel)[0].jacobian(
+            y, port, port_rate, factor, self.A_T, self.port_deflection, self.law.table, np.zeros((2, m)), self.nz_index,
+            self.nz_value, self.cos_alpha, self.STkS, self.STcS, stks_port, stcs_port, self.inv_inertia, np.zeros(m),
+            np.zeros(m), dq, dv, port_jac)
+        if not self.ports.size:
+            return dq, dv, np.zeros((n, 0)), np.zeros((n, 0))
+        return dq, dv, port_jac[0][:, None], port_jac[1][:, None]
 
     # -------------------------------------------------------------- energy
     def kinetic_energy(self, speeds_rad_s: np.ndarray, driver_speed_rad_s: np.ndarray | float) -> np.ndarray:

@@ -1,9 +1,9 @@
-"""Gear contact laws: CFS (eq. 2-4) and the MSC.Adams-style impact law (eq. 1).
+"""Gear contact: the parameters of a mesh (:class:`MeshContact`, SI) and the laws evaluated over many states.
 
-A mesh is described by :class:`MeshContact` (SI units). :class:`ContactLaw`
-evaluates the normal contact force of *all* meshes of an assembly at once,
-together with its derivatives with respect to deflection and deflection rate,
-so the drivetrain can assemble an analytic Jacobian.
+The laws themselves - CFS (eq. 2-4) and the MSC.Adams-style impact law (eq. 1) - are written
+once, in :mod:`components.model.kernel.contact`; :func:`contact_table` turns the meshes'
+parameters into the rows that code reads, and :class:`ContactLaw` evaluates it for arrays of
+states (analyses, the energy audit, tests), compiled or interpreted like every kernel.
 
 Sign of the contact force
 -------------------------
@@ -31,15 +31,20 @@ branch (zero on the clipped branch). The impact law is clipped the same way.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Sequence
 
 import numpy as np
 
 from .. import units
 from ..validation import finite, in_range, non_negative, one_of, positive, set_fields
+from . import kernel
+from .kernel.contact import (
+    CMAX, DAMPING, DEEP, DMAX, EXPONENT, HALF_JT, K0, LAMBDA, LAW, LAWS, N_CONTACT_COLUMNS,
+)
 
-CONTACT_LAWS = ("cfs", "impact")
+#: the contact laws by name, in the order of their codes in the kernel's contact table
+CONTACT_LAWS = LAWS
 #: Contact-force magnitude below which a mesh counts as "inside the backlash" (out of contact) [N].
 CONTACT_LOSS_THRESHOLD_N = 1.0
 
@@ -159,6 +164,23 @@ class MeshContact:
         return self.impact_damping
 
 
+def contact_table(meshes: Sequence[MeshContact]) -> np.ndarray:
+    """The kernel's contact table: one row per mesh (columns of :mod:`components.model.kernel.contact`), shape (m, 9)."""
+    table = np.zeros((len(meshes), N_CONTACT_COLUMNS))
+    for row, mesh in zip(table, meshes):
+        half_jt = 0.5 * mesh.backlash_circumferential_m
+        row[K0] = mesh.stiffness
+        row[EXPONENT] = mesh.exponent
+        row[DAMPING] = mesh.damping
+        row[LAMBDA] = mesh.regularisation
+        row[HALF_JT] = half_jt
+        row[LAW] = CONTACT_LAWS.index(mesh.law)
+        row[DMAX] = mesh.impact_depth_m
+        row[CMAX] = mesh.impact_damping_max
+        row[DEEP] = half_jt + 20.0 / mesh.regularisation  # |d| beyond which tanh(lambda (|d| -+ j_t/2)) == 1
+    return table
+
+
 @dataclass(frozen=True)
 class ContactForces:
     """Forces of all meshes and their partial derivatives, each shape ``(..., n_mesh)``.
@@ -181,101 +203,38 @@ class ContactForces:
     elastic: np.ndarray
 
 
-@dataclass(frozen=True)
 class ContactLaw:
-    """Vectorised contact law over a fixed set of meshes.
+    """The contact laws of a fixed set of meshes, evaluated over arrays of states.
 
     Parameters
     ----------
     meshes : sequence of MeshContact
         One entry per mesh, in assembly order.
+    kernel : {"auto", "numpy", "compiled"}, optional
+        Form of the kernel that evaluates it (:func:`components.model.kernel.monolithic`).
+
+    Attributes
+    ----------
+    table : ndarray, shape (n_mesh, 9)
+        The kernel's contact table (:func:`contact_table`).
     """
 
-    meshes: Sequence[MeshContact]
-    _k: np.ndarray = field(init=False, repr=False)
-    _e: np.ndarray = field(init=False, repr=False)
-    _c: np.ndarray = field(init=False, repr=False)
-    _lam: np.ndarray = field(init=False, repr=False)
-    _half_jt: np.ndarray = field(init=False, repr=False)
-    _impact: np.ndarray = field(init=False, repr=False)
-    _dmax: np.ndarray = field(init=False, repr=False)
-    _cmax: np.ndarray = field(init=False, repr=False)
-
-    def __post_init__(self) -> None:
-        m = tuple(self.meshes)
-        set_fields(
-            self,
-            meshes=m,
-            _k=np.array([x.stiffness for x in m], dtype=float),
-            _e=np.array([x.exponent for x in m], dtype=float),
-            _c=np.array([x.damping for x in m], dtype=float),
-            _lam=np.array([x.regularisation for x in m], dtype=float),
-            _half_jt=np.array([0.5 * x.backlash_circumferential_m for x in m], dtype=float),
-            _impact=np.array([x.law == "impact" for x in m], dtype=bool),
-            _dmax=np.array([x.impact_depth_m for x in m], dtype=float),
-            _cmax=np.array([x.impact_damping_max for x in m], dtype=float),
-        )
-        set_fields(self, _any_impact=bool(self._impact.any()), _all_impact=bool(self._impact.all()))
-        # stacked (2, n_mesh) constants for the derivative-free fast path
-        set_fields(
-            self,
-            _pm_half_jt=np.vstack([-self._half_jt, self._half_jt]),
-            _lam2=np.vstack([self._lam, self._lam]),
-            _sqrt_law=bool(np.all(self._e == 1.5)),
-            # |delta| beyond which tanh(lambda (|delta| -+ j_t/2)) == 1 in double precision
-            _deep=self._half_jt + 20.0 / self._lam,
-            _zeros=np.zeros(len(m)),  # clipping bound (an array operand is cheaper than the scalar 0)
-        )
+    def __init__(self, meshes: Sequence[MeshContact], kernel: str | None = None) -> None:
+        self.meshes = tuple(meshes)
+        self.table = contact_table(self.meshes)
+        self._kernel = kernel
 
     @property
     def size(self) -> int:
         """Number of meshes."""
         return len(self.meshes)
 
-    def backlash_deflection(self, deflection: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Regularised indentation d_BL of eq. 3-4 and its first two derivatives.
+    def _many(self) -> object:
+        return kernel.monolithic(self._kernel)[0]
 
-        Parameters
-        ----------
-        deflection : ndarray, shape (..., n_mesh)
-            Linearised tooth distance delta [m] at the pitch radius.
-
-        Returns
-        -------
-        d_bl, d_bl_prime, d_bl_second : ndarray
-            d_BL [m], d d_BL / d delta [-], d^2 d_BL / d delta^2 [1/m].
-        """
-        h = self._half_jt
-        abs_d = np.abs(deflection)
-        if not np.count_nonzero(abs_d < self._deep):  # all deep in flank contact: tanh saturated exactly
-            flank = np.sign(deflection)
-            return deflection - flank * h, np.ones_like(abs_d), np.zeros_like(abs_d)
-        lam = self._lam
-        x1 = deflection - h
-        x2 = deflection + h
-        u1 = lam * x1
-        u2 = lam * x2
-        t1 = np.tanh(u1)
-        t2 = np.tanh(u2)
-        d_bl = deflection + 0.5 * (x1 * t1 - x2 * t2)  # eq. 3, 4
-        s1 = 1.0 - t1 * t1
-        s2 = 1.0 - t2 * t2
-        d_bl_prime = 1.0 + 0.5 * (t1 + u1 * s1 - t2 - u2 * s2)
-        d_bl_second = lam * (s1 * (1.0 - u1 * t1) - s2 * (1.0 - u2 * t2))
-        return d_bl, d_bl_prime, d_bl_second
-
-    def hard_backlash(self, deflection: np.ndarray) -> np.ndarray:
-        """Penetration with a sharp backlash: 0 inside ``|delta| < j_t/2`` [m]."""
-        h = self._half_jt
-        return np.where(deflection > h, deflection - h, np.where(deflection < -h, deflection + h, 0.0))
-
-    def evaluate(
-        self,
-        deflection: np.ndarray,
-        rate: np.ndarray,
-        stiffness_factor: np.ndarray | float = 1.0,
-    ) -> ContactForces:
-        """Contact forces of all meshes.
+    def evaluate(self, deflection: np.ndarray, rate: np.ndarray,
+                 stiffness_factor: np.ndarray | float = 1.0) -> ContactForces:
+        """Contact forces of all meshes and their derivatives.
 
         Parameters
         ----------
@@ -286,178 +245,39 @@ class ContactLaw:
             Deflection rate [m/s].
         stiffness_factor : ndarray or float
             Multiplier on k0 (time-varying mesh stiffness); 1 for the paper's model.
-
-        Returns
-        -------
-        ContactForces
         """
-        k = self._k if type(stiffness_factor) is float and stiffness_factor == 1.0 else self._k * stiffness_factor
-        e = self._e
-        if self._all_impact:
-            return self._impact_law(deflection, rate, k)
-        d_bl, d_bl_p, d_bl_pp = self.backlash_deflection(deflection)
-        abs_bl = np.abs(d_bl)
-        sgn = np.sign(d_bl)
-        pow_em1 = abs_bl ** (e - 1.0)
-        elastic = k * sgn * pow_em1 * abs_bl  # k0 sgn(d_BL) |d_BL|^e (eq. 2)
-        d_elastic = k * e * pow_em1
-        rate_bl = d_bl_p * rate
-        c = self._c
-        damping = c * abs_bl * rate_bl  # c0 |d_BL| d_BL_dot (eq. 2, 9)
-        force = elastic + damping
-        dF_dd = (d_elastic + c * sgn * rate_bl) * d_bl_p + c * abs_bl * d_bl_pp * rate
-        dF_dv = c * abs_bl * d_bl_p
-        # flank-consistent clipping: a flank pushes, never pulls (see module docstring)
-        active = force * np.sign(deflection) > 0.0
-        force = np.where(active, force, 0.0)
-        dF_dd = np.where(active, dF_dd, 0.0)
-        dF_dv = np.where(active, dF_dv, 0.0)
-        if self._any_impact:
-            imp = self._impact_law(deflection, rate, k)
-            sel = self._impact
-            force = np.where(sel, imp.force, force)
-            dF_dd = np.where(sel, imp.d_force_d_deflection, dF_dd)
-            dF_dv = np.where(sel, imp.d_force_d_rate, dF_dv)
-            elastic = np.where(sel, imp.elastic, elastic)
-        return ContactForces(force, dF_dd, dF_dv, elastic)
+        d, r, f = np.broadcast_arrays(np.asarray(deflection, dtype=float), np.asarray(rate, dtype=float),
+                                      np.asarray(stiffness_factor, dtype=float))
+        shape = d.shape
+        flat = [np.ascontiguousarray(x, dtype=float).reshape(-1, self.size) for x in (d, r, f)]
+        out = [np.empty_like(flat[0]) for _ in range(4)]
+        self._many().contact_forces_many(*flat, self.table, *out)
+        return ContactForces(*(o.reshape(shape) for o in out))
 
-    def force_and_elastic(
-        self, deflection: np.ndarray, rate: np.ndarray, stiffness_factor: np.ndarray | float = 1.0
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """Contact force [N] and its elastic part [N] at one or many states, without derivatives.
+    def force_and_elastic(self, deflection: np.ndarray, rate: np.ndarray,
+                          stiffness_factor: np.ndarray | float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+        """Contact force [N] and its elastic part [N] (as :meth:`evaluate`)."""
+        cf = self.evaluate(deflection, rate, stiffness_factor)
+        return cf.force, cf.elastic
 
-        The same numbers as ``evaluate(...).force`` and ``evaluate(...).elastic`` (same
-        operations in the same order) for callers that need no Jacobian: the monolithic
-        right-hand side and the evaluation of recorded results.
-
-        Parameters
-        ----------
-        deflection, rate : ndarray, shape (..., n_mesh)
-            Deflection [m] and its rate [m/s].
-        stiffness_factor : ndarray or float
-            Multiplier on k0.
-        """
-        if self._any_impact:
-            cf = self.evaluate(deflection, rate, stiffness_factor)
-            return cf.force, cf.elastic
-        k = self._k * stiffness_factor
-        d_bl, d_bl_p, _ = self.backlash_deflection(deflection)
-        abs_bl = np.abs(d_bl)
-        sgn = np.sign(d_bl)
-        pow_em1 = np.sqrt(abs_bl) if self._sqrt_law else abs_bl ** (self._e - 1.0)
-        elastic = k * sgn * pow_em1 * abs_bl  # eq. 2
-        force = elastic + self._c * abs_bl * (d_bl_p * rate)  # eq. 2, 9
-        return np.where(force * np.sign(deflection) > 0.0, force, 0.0), elastic  # flank-consistent clipping
-
-    def force(self, deflection: np.ndarray, rate: np.ndarray, stiffness_factor: np.ndarray | float = 1.0) -> np.ndarray:
-        """Contact forces only (no derivatives) for one state, shape (n_mesh,) [N].
-
-        Same values as ``evaluate(...).force``; written with few numpy calls
-        because it sits on the co-simulation hot path.
-        """
-        if self._any_impact:
-            return self.evaluate(deflection, rate, stiffness_factor).force
-        abs_d = np.abs(deflection)
-        # (count_nonzero: the same test as .any(), without the reduction machinery)
-        if self._sqrt_law and not np.count_nonzero(abs_d < self._deep):
-            # every mesh deep in flank contact: d_BL = delta - sgn(delta) j_t/2 and d d_BL/d delta = 1 exactly.
-            # Here delta != 0, so sgn(delta) = +-1 and, c0 and the clipped force being >= 0, the products
-            # c0 sgn(delta) and sgn(delta) max(., 0) are exactly copysign(., delta) (one numpy call less)
-            pen = abs_d - self._half_jt
-            k = self._k if type(stiffness_factor) is float and stiffness_factor == 1.0 else self._k * stiffness_factor
-            signed = pen * (k * np.sqrt(pen) + np.copysign(self._c, deflection) * rate)
-            return np.copysign(np.maximum(signed, self._zeros), deflection)
-        d_bl, rate_bl = self._regularised(deflection, rate)
-        abs_bl = np.abs(d_bl)
-        sgn = np.sign(d_bl)
-        root = np.sqrt(abs_bl) if self._sqrt_law else abs_bl ** (self._e - 1.0)
-        flank = np.sign(deflection)
-        signed = flank * abs_bl * (self._k * stiffness_factor * sgn * root + self._c * rate_bl)  # sgn(delta) * eq. 2
-        return flank * np.maximum(signed, self._zeros)  # flank-consistent clipping
-
-    def stiffness_sensitivity(
-        self, deflection: np.ndarray, rate: np.ndarray, stiffness_factor: np.ndarray | float = 1.0
-    ) -> np.ndarray:
-        """``dF / d(stiffness factor)`` of every mesh at one state [N], shape (n_mesh,).
-
-        The force is linear in the stiffness multiplier ``f`` on ``k0`` (time-varying
-        mesh stiffness) wherever the flank is in contact, ``dF/df = k0 sgn(d_BL)
-        |d_BL|^e``, and 0 where the flank-consistent clipping applies.
-
-        Parameters
-        ----------
-        deflection, rate : ndarray, shape (n_mesh,)
-            Deflection [m] and its rate [m/s].
-        stiffness_factor : ndarray or float
-            Current multiplier f [-] (decides which meshes are clipped).
-        """
-        if self._any_impact or not self._sqrt_law:
-            cf = self.evaluate(deflection, rate, stiffness_factor)
-            return np.where(cf.force != 0.0, cf.elastic / stiffness_factor, 0.0)
-        d_bl, rate_bl = self._regularised(deflection, rate)
-        abs_bl = np.abs(d_bl)
-        elastic = self._k * np.sign(d_bl) * abs_bl * np.sqrt(abs_bl)  # per unit stiffness factor
-        flank = np.sign(deflection)
-        active = flank * (elastic * stiffness_factor + self._c * abs_bl * rate_bl) > 0.0
-        return np.where(active, elastic, 0.0)
-
-    def _regularised(self, deflection: np.ndarray, rate: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Backlash-regularised deflection d_BL [m] (eq. 3, 4) and its rate [m/s], shapes (n_mesh,).
-
-        The two tanh terms (delta -/+ j_t / 2) are evaluated as the rows of one array.
-        """
-        X = deflection + self._pm_half_jt  # rows: delta - j_t/2, delta + j_t/2
-        U = X * self._lam2
-        T = np.tanh(U)
-        XT = X * T
-        UST = U * (1.0 - T * T) + T  # d(X tanh(lambda X))/dX, per row
-        return deflection + 0.5 * (XT[0] - XT[1]), (1.0 + 0.5 * (UST[0] - UST[1])) * rate
-
-    def _impact_law(self, deflection: np.ndarray, rate: np.ndarray, k: np.ndarray) -> ContactForces:
-        """Eq. 1 with a sharp backlash and the cubic STEP damping of MSC.Adams."""
-        p = self.hard_backlash(deflection)
-        abs_p = np.abs(p)
-        sgn = np.sign(p)
-        e = self._e
-        pow_em1 = abs_p ** (e - 1.0)
-        elastic = k * sgn * pow_em1 * abs_p
-        s = np.clip(abs_p / self._dmax, 0.0, 1.0)
-        step = self._cmax * s * s * (3.0 - 2.0 * s)  # STEP(p, 0, 0, d_max, c_max)
-        d_step = self._cmax * 6.0 * s * (1.0 - s) / self._dmax
-        force = elastic + step * rate
-        dF_dd = k * e * pow_em1 + d_step * sgn * rate
-        dF_dv = step
-        active = force * sgn > 0.0
-        return ContactForces(
-            np.where(active, force, 0.0),
-            np.where(active, dF_dd, 0.0),
-            np.where(active, dF_dv, 0.0),
-            elastic,
-        )
+    def backlash_deflection(self, deflection: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Regularised indentation d_BL [m] of eq. 3-4 and its first two derivatives [-], [1/m], shape (..., n_mesh)."""
+        d = np.ascontiguousarray(np.broadcast_to(np.asarray(deflection, dtype=float), np.shape(deflection)))
+        flat = d.reshape(-1, self.size)
+        out = [np.empty_like(flat) for _ in range(3)]
+        self._many().regularised_many(flat, self.table, *out)
+        return tuple(o.reshape(d.shape) for o in out)
 
     def potential_energy(self, deflection: np.ndarray, nodes: int = 64) -> np.ndarray:
-        """Elastic energy stored in each mesh, ``V = int_0^delta F_el d delta`` [N m].
+        """Elastic energy stored in each mesh, ``V = int_0^delta F_el d delta`` [N m], shape (n_mesh,).
 
-        Multiply by ``cos(alpha)`` to get the energy of the generalised forces
-        (the moment arm is the base radius). Integrated by Gauss-Legendre
-        quadrature on the pieces between 0, the backlash edges and ``delta``,
-        vectorised over all meshes.
-
-        Parameters
-        ----------
-        deflection : ndarray, shape (n_mesh,)
-            Deflection [m].
-        nodes : int
-            Gauss-Legendre nodes per piece.
-
-        Returns
-        -------
-        ndarray, shape (n_mesh,)
+        Multiply by ``cos(alpha)`` to get the energy of the generalised forces (the moment arm is
+        the base radius). Integrated by Gauss-Legendre quadrature on the pieces between 0, the
+        backlash edges and ``delta`` (an edge is a kink), vectorised over all meshes.
         """
         d = np.asarray(deflection, dtype=float)
         x, w = np.polynomial.legendre.leggauss(nodes)
-        h = self._half_jt
-        # pieces [0, min(|d|, h)] and [min(|d|, h), |d|] on the side of d (an edge is a kink)
+        h = self.table[:, HALF_JT]
         s = np.where(d < 0.0, -1.0, 1.0)
         edge = s * np.minimum(np.abs(d), h)
         total = np.zeros(self.size)

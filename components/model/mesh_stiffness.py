@@ -58,6 +58,8 @@ import math
 import numpy as np
 
 from ..errors import ParameterError
+from . import kernel as model_kernel
+from .kernel.stiffness import CYCLE0, CYCLES_PER_RAD, HALF_P, INV_W, N_PHASING_ROWS, SLOPE_SCALE, VARIATION, VP
 
 #: Width of each smoothed transition between pair counts, as a fraction of one mesh cycle [-].
 TRANSITION_FRACTION = 0.05
@@ -78,11 +80,6 @@ def pair_fraction(contact_ratio: float | np.ndarray) -> np.ndarray:
     return np.where(p < 1e-12, 0.0, p)
 
 
-def _smootherstep(s: np.ndarray) -> np.ndarray:
-    s = np.clip(s, 0.0, 1.0)
-    return s * s * s * (s * (6.0 * s - 15.0) + 10.0)
-
-
 def multi_pair_indicator(
     phase_rad: np.ndarray, contact_ratio: float | np.ndarray, transition: float = TRANSITION_FRACTION
 ) -> np.ndarray:
@@ -101,18 +98,12 @@ def multi_pair_indicator(
     -------
     ndarray
         1 inside ``[0, 2 pi p)`` (mod ``2 pi``), 0 outside, smooth ramps of width
-        ``transition`` centred on the two edges; mean over a cycle exactly ``p``.
+        ``transition`` centred on the two edges; mean over a cycle exactly ``p``
+        (``f - 1 + p`` of :func:`stiffness_factor` with ``v = 1``).
     """
-    if not 0.0 < transition <= 0.5:
-        raise ParameterError("transition", transition, "within (0, 0.5] mesh cycles")
-    p = pair_fraction(contact_ratio)
-    x = np.asarray(phase_rad, dtype=float) / (2.0 * math.pi)
-    # signed position relative to the middle of the multi-pair zone, in [-1/2, 1/2) cycles
-    y = np.mod(x - 0.5 * p + 0.5, 1.0) - 0.5
-    w = np.minimum(transition, np.minimum(p, 1.0 - p))
-    safe_w = np.where(w > 0.0, w, 1.0)
-    ramp = _smootherstep((0.5 * p - np.abs(y)) / safe_w + 0.5)
-    return np.where(w > 0.0, ramp, np.where(np.abs(y) < 0.5 * p, 1.0, 0.0))
+    phase = np.asarray(phase_rad, dtype=float)
+    p = np.broadcast_to(pair_fraction(contact_ratio), phase.shape[-1:] if phase.ndim else ())
+    return _factor_by_phase(phase, contact_ratio, 1.0, transition, True) - 1.0 + p
 
 
 def stiffness_factor(
@@ -123,8 +114,10 @@ def stiffness_factor(
 ) -> np.ndarray:
     """Multiplier of the contact stiffness ``k0`` at a mesh-cycle phase [-].
 
-    ``f = 1 + v (r(phase) - p)`` with ``r`` from :func:`multi_pair_indicator`; the
-    cycle mean of ``f`` is 1 and its peak-to-peak value is ``v`` (module docstring).
+    ``f = 1 + v (r(phase) - p)`` with ``r`` the smoothed indicator of the multi-pair zone; the
+    cycle mean of ``f`` is 1 and its peak-to-peak value is ``v`` (module docstring). Evaluated
+    by the kernel (:func:`components.model.kernel.stiffness.stiffness_factors`), one mesh per
+    column with a phase rate of 1 rad/rad.
 
     Parameters
     ----------
@@ -134,7 +127,8 @@ def stiffness_factor(
         Contact ratio epsilon [-] (Table 1: 1.62 sun-planet).
     variation : float or ndarray, shape broadcastable to (..., n_mesh)
         Peak-to-peak stiffness variation relative to the mean, ``(k_max - k_min) /
-        k_mean`` [-], in [0, 1 / p) so that the stiffness stays positive.
+        k_mean`` [-], in [0, 1 / p) so that the stiffness stays positive (1 is allowed for
+        :func:`multi_pair_indicator`).
     transition : float
         Width of each smoothed transition [mesh cycles].
 
@@ -143,23 +137,32 @@ def stiffness_factor(
     ndarray, shape (..., n_mesh)
         Stiffness multiplier (1 where ``variation`` is 0).
     """
-    v = np.asarray(variation, dtype=float)
-    p = pair_fraction(contact_ratio)
-    if np.any(~np.isfinite(v)) or np.any(v < 0.0) or np.any(v * p >= 1.0):
-        raise ParameterError("stiffness_variation", variation, ">= 0 and < 1 / (epsilon - floor(epsilon))")
-    return 1.0 + v * (multi_pair_indicator(phase_rad, contact_ratio, transition) - p)
+    return _factor_by_phase(phase_rad, contact_ratio, variation, transition, False)
+
+
+def _factor_by_phase(phase_rad, contact_ratio, variation, transition: float, allow_unit_variation: bool) -> np.ndarray:
+    """:func:`stiffness_factor`, optionally with ``v`` up to 1 (:func:`multi_pair_indicator`)."""
+    phase = np.atleast_1d(np.asarray(phase_rad, dtype=float))
+    m = phase.shape[-1]
+    columns = np.broadcast_to(np.asarray(contact_ratio, dtype=float), (m,)), \
+        np.broadcast_to(np.asarray(variation, dtype=float), (m,))
+    out = np.empty(phase.shape)
+    flat_phase = phase.reshape(-1, m)
+    flat_out = out.reshape(-1, m)
+    for i in range(m):
+        one = MeshPhasing([1.0], [0.0], [columns[0][i]], [columns[1][i]], transition, allow_unit_variation)
+        flat_out[:, i] = one.factors(flat_phase[:, i])[0][:, 0]
+    return out.reshape(np.shape(phase_rad)) if np.ndim(phase_rad) else out[0]
 
 
 class MeshPhasing:
     """Stiffness factors of all meshes as a function of the driver (rotor) angle, with their slope.
 
-    The same model as :func:`stiffness_factor` (``phase = rate * angle + offset`` per
-    mesh, see :class:`~components.model.assembly.Mesh`), with the parameters validated and
-    the per-mesh constants formed once: this sits on the integrators' hot path, where
-    :func:`stiffness_factor`'s checks cost more than the arithmetic. The slope
-    ``d f / d angle`` is analytic (the smootherstep's derivative ``30 s^2 (1 - s)^2``),
-    so an integrator can form the partial time derivative ``d f / d t = slope x driver
-    speed`` without differencing.
+    The phasing table of the kernel (:mod:`components.model.kernel.stiffness`): ``phase = rate *
+    angle + offset`` per mesh (see :class:`~components.model.assembly.Mesh`), with the parameters
+    validated and the per-mesh constants formed once. The slope ``d f / d angle`` is analytic
+    (the smootherstep's derivative ``30 s^2 (1 - s)^2``), so an integrator forms the partial time
+    derivative ``d f / d t = slope x driver speed`` without differencing.
 
     Parameters
     ----------
@@ -173,43 +176,54 @@ class MeshPhasing:
         Peak-to-peak stiffness variation relative to the mean [-] (0: constant).
     transition : float
         Width of each smoothed transition [mesh cycles].
+    allow_unit_variation : bool
+        Accept ``v p < 1`` up to ``v = 1`` (the indicator of :func:`multi_pair_indicator`).
+
+    Attributes
+    ----------
+    table : ndarray, shape (7, n_mesh)
+        The kernel's phasing table (rows of :mod:`components.model.kernel.stiffness`).
     """
 
-    def __init__(self, rate, offset, contact_ratio, variation, transition: float = TRANSITION_FRACTION) -> None:
+    def __init__(self, rate, offset, contact_ratio, variation, transition: float = TRANSITION_FRACTION,
+                 allow_unit_variation: bool = False) -> None:
         if not 0.0 < transition <= 0.5:
             raise ParameterError("transition", transition, "within (0, 0.5] mesh cycles")
         p = pair_fraction(contact_ratio)
         v = np.asarray(variation, dtype=float)
-        if np.any(~np.isfinite(v)) or np.any(v < 0.0) or np.any(v * p >= 1.0):
+        too_large = v > 1.0 if allow_unit_variation else v * p >= 1.0
+        if np.any(~np.isfinite(v)) or np.any(v < 0.0) or np.any(too_large):
             raise ParameterError("stiffness_variation", variation, ">= 0 and < 1 / (epsilon - floor(epsilon))")
         w = np.minimum(transition, np.minimum(p, 1.0 - p))
         # an integer contact ratio (p = 0, w = 0) has a constant pair count: factor exactly 1
-        self._v = np.where(w > 0.0, v, 0.0)
-        self._p = p
-        self._half_p = 0.5 * p
-        self._inv_w = 1.0 / np.where(w > 0.0, w, 1.0)
-        self._cycles_per_rad = np.asarray(rate, dtype=float) / (2.0 * math.pi)
-        self._cycle0 = np.asarray(offset, dtype=float) / (2.0 * math.pi) - 0.5 * p + 0.5
-        self._vp = self._v * p
-        self._slope_scale = -30.0 * self._v * self._inv_w * self._cycles_per_rad
+        v = np.where(w > 0.0, v, 0.0)
+        inv_w = 1.0 / np.where(w > 0.0, w, 1.0)
+        cycles_per_rad = np.asarray(rate, dtype=float) / (2.0 * math.pi)
+        self.table = np.zeros((N_PHASING_ROWS, cycles_per_rad.size))
+        self.table[CYCLES_PER_RAD] = cycles_per_rad
+        self.table[CYCLE0] = np.asarray(offset, dtype=float) / (2.0 * math.pi) - 0.5 * p + 0.5
+        self.table[HALF_P] = 0.5 * p
+        self.table[INV_W] = inv_w
+        self.table[VARIATION] = v
+        self.table[VP] = v * p
+        self.table[SLOPE_SCALE] = -30.0 * v * inv_w * cycles_per_rad
 
-    def _ramp_argument(self, driver_angle_rad: float) -> tuple[np.ndarray, np.ndarray]:
-        y = np.mod(self._cycle0 + self._cycles_per_rad * driver_angle_rad, 1.0) - 0.5
-        s = np.minimum(np.maximum((self._half_p - np.abs(y)) * self._inv_w + 0.5, 0.0), 1.0)  # np.clip is slower
-        return s, y
+    def factors(self, driver_angles_rad: np.ndarray, kernel: str | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Multipliers [-] and their slopes [1/rad] at many driver angles, each shape (N, n_mesh)."""
+        angles = np.ascontiguousarray(np.atleast_1d(np.asarray(driver_angles_rad, dtype=float)))
+        factor = np.empty((angles.size, self.table.shape[1]))
+        slope = np.empty_like(factor)
+        model_kernel.monolithic(kernel)[0].stiffness_factors_many(angles, self.table, factor, slope)
+        return factor, slope
 
     def factor(self, driver_angle_rad: float) -> np.ndarray:
         """Stiffness multiplier of every mesh at a driver angle [-], shape (n_mesh,)."""
-        s, _ = self._ramp_argument(driver_angle_rad)
-        return 1.0 - self._vp + self._v * (s * s * s * (s * (6.0 * s - 15.0) + 10.0))
+        return self.factors(driver_angle_rad)[0][0]
 
     def factor_and_slope(self, driver_angle_rad: float) -> tuple[np.ndarray, np.ndarray]:
         """Stiffness multiplier [-] and its derivative with respect to the driver angle [1/rad], each (n_mesh,)."""
-        s, y = self._ramp_argument(driver_angle_rad)
-        s2 = s * s
-        f = 1.0 - self._vp + self._v * (s2 * s * (s * (6.0 * s - 15.0) + 10.0))
-        u = s - s2  # s (1 - s): the smootherstep's slope 30 s^2 (1 - s)^2 vanishes outside the ramps
-        return f, self._slope_scale * np.sign(y) * (u * u)
+        factor, slope = self.factors(driver_angle_rad)
+        return factor[0], slope[0]
 
 
 def mesh_frequency_hz(teeth_per_driver_revolution: float | np.ndarray, rotor_speed_rad_s: float | np.ndarray) -> np.ndarray:

@@ -23,21 +23,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import lru_cache
-from pathlib import Path
-from types import ModuleType
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .. import units
 from ..errors import ParameterError
-from .aot import AotKernel, compiled_or_jit, required
-from .kernel_request import compiled_or_numpy
-from .shared_module import shared_name, try_load_shared
-
-if TYPE_CHECKING:  # what an FMU's source closure follows: the module is loaded by load_shared
-    from . import compiled_wind  # noqa: F401
+from . import kernel as model_kernel
 from ..validation import (
     finite,
     integer_at_least,
@@ -265,16 +256,16 @@ class PhasorStepper:
     whenever a step does not start where the last one ended, the phasors are recomputed in
     closed form, so round-off cannot accumulate (measured: |difference| to the closed form
     below 1e-13 rad/s over 600 s at H = 1 ms). The complete state is :meth:`get_state`; a
-    restored state continues bit-identically. Where numba imports, the rotation and both sums
-    are one compiled loop (:mod:`components.model.compiled_wind`, ~0.6 instead of ~2.5 us for
-    256 harmonics); its sums run in index order, so the two paths differ in the last bits.
+    restored state continues bit-identically. The rotation and the sums are the wind kernel's
+    (:mod:`components.model.kernel.wind`): one compiled loop (~0.6 us for 256 harmonics) or numpy
+    (~2.5 us); the loop sums in index order, so the two forms differ in the last bits.
 
     Parameters
     ----------
     process : RotorSpeedProcess
         The realisation (frequencies, amplitudes, phases).
     kernel : {None, "auto", "numpy", "compiled"}
-        The implementation (:func:`components.model.kernel_request.requested_kernel`; None:
+        The kernel's form (:func:`components.compile.choice.requested_kernel`; None:
         ``$DTCOSIM_KERNEL``, else ``auto``).
 
     Attributes
@@ -290,10 +281,7 @@ class PhasorStepper:
 
     def __init__(self, process: RotorSpeedProcess, kernel: str | None = None) -> None:
         self.process = process
-        self._compiled, self.kernel_note = compiled_or_numpy(kernel, _compiled_wind_module, "compiled wind step")
-        self.kernel = "numpy" if self._compiled is None else "compiled"
-        self._w = process.amplitudes_rad_s.astype(complex)  # complex copies: z . w is one BLAS call
-        self._w_over_f = process._w_over_f.astype(complex)
+        self._kernel, self.kernel, self.kernel_note = model_kernel.wind(kernel)
         self._w_real = np.ascontiguousarray(process.amplitudes_rad_s, dtype=float)  # the compiled sums'
         self._w_over_f_real = np.ascontiguousarray(process._w_over_f, dtype=float)
         self._w_times_f = np.ascontiguousarray(process._w_times_f, dtype=float)  # the derivatives' weights
@@ -303,7 +291,7 @@ class PhasorStepper:
         self.time_s = 0.0
         self.steps_since_anchor = 0
         self._z = np.ones(process.params.n_harmonics, dtype=complex)
-        self._sums: tuple[float, float] | None = None  # (speed sum, angle sum) of the compiled path
+        self._sums = (0.0, 0.0)  # (speed sum, angle sum) at the current time
         self._step_s = math.nan
         self._rotation = self._z
         self.reset(0.0)
@@ -316,9 +304,8 @@ class PhasorStepper:
         self._form_sums()
 
     def _form_sums(self) -> None:
-        """The compiled path's sums of phasors it did not rotate itself (the same summation as a step's)."""
-        if self._compiled is not None:
-            self._sums = self._compiled.phasor_sums(self._z, self._w_real, self._w_over_f_real)
+        """The sums of phasors the stepper did not rotate itself (the same summation as a step's)."""
+        self._sums = self._kernel.phasor_sums(self._z, self._w_real, self._w_over_f_real)
 
     def advance(self, t: float, h: float) -> None:
         """Move the phasors from ``t`` to ``t + h`` [s] (closed form if ``t`` is not where they are)."""
@@ -331,38 +318,22 @@ class PhasorStepper:
         if h != self._step_s:
             self._rotation = np.exp(1j * (self.process.frequencies_rad_s * h))
             self._step_s = h
-        if self._compiled is not None:  # rotation and both sums in one compiled loop
-            self._sums = self._compiled.rotate_and_sum(self._z, self._rotation, self._w_real, self._w_over_f_real)
-        else:
-            self._z *= self._rotation
+        self._sums = self._kernel.rotate_and_sum(self._z, self._rotation, self._w_real, self._w_over_f_real)
         self.time_s = t1
         self.steps_since_anchor = steps
 
     def speed_and_angle(self) -> tuple[float, float]:
-        """Speed [rad/s] and angle [rad] at the current time.
-
-        numpy path: two dot products (one BLAS call each; one matrix product for both would sum
-        in another order and change the last bits of the signal), taken to Python numbers at
-        once. Compiled path: the sums its step formed (:mod:`components.model.compiled_wind`).
-        """
-        if self._sums is not None:
-            speed_sum, angle_sum = self._sums
-            return (self._w0 + speed_sum, self._w0 * self.time_s + (angle_sum - self._offset))
-        z = self._z
-        speed_sum = complex(z.dot(self._w))
-        angle_sum = complex(z.dot(self._w_over_f))
-        return (self._w0 + speed_sum.real, self._w0 * self.time_s + (angle_sum.imag - self._offset))
+        """Speed [rad/s] and angle [rad] at the current time (from the sums the last step formed)."""
+        speed_sum, angle_sum = self._sums
+        return (self._w0 + speed_sum, self._w0 * self.time_s + (angle_sum - self._offset))
 
     def acceleration_and_jerk(self) -> tuple[float, float]:
         """Acceleration [rad/s^2] and jerk [rad/s^3] at the current time, ``-Im(z) . W f`` and ``-Re(z) . W f^2``.
 
-        Two more sums over the phasors, formed when called: one compiled loop, or two numpy dot products.
+        Two more sums over the phasors, formed when called (:mod:`components.model.kernel.wind`).
         """
-        if self._compiled is not None:
-            alpha_sum, jerk_sum = self._compiled.derivative_sums(self._z, self._w_times_f, self._w_times_f2)
-            return -alpha_sum, -jerk_sum
-        z = self._z
-        return -float(z.imag.dot(self._w_times_f)), -float(z.real.dot(self._w_times_f2))
+        alpha_sum, jerk_sum = self._kernel.derivative_sums(self._z, self._w_times_f, self._w_times_f2)
+        return -alpha_sum, -jerk_sum
 
     def get_state(self) -> dict:
         """Complete state (JSON-serialisable, exact float round trip)."""
@@ -379,34 +350,6 @@ class PhasorStepper:
         self.time_s = float(state["time"])
         self.steps_since_anchor = int(state["steps_since_anchor"])
         self._form_sums()
-
-
-_WIND_SOURCE = Path(__file__).with_name("compiled_wind.py")
-_WIND_DEPENDENCIES = ("numba_cache.py",)
-
-
-def _jit_wind_module() -> tuple[ModuleType | None, str | None]:
-    """:mod:`components.model.compiled_wind` just in time, or None and why it cannot be imported (tried once).
-
-    One module (and one compiled cache) per source version, whichever copy asks.
-    """
-    return try_load_shared(_WIND_SOURCE, __package__, _WIND_DEPENDENCIES)
-
-
-def _jit_wind_kernel_module() -> ModuleType:
-    """The ahead-of-time builder's provider: :func:`_jit_wind_module` or its ImportError."""
-    return required(_jit_wind_module)
-
-
-@lru_cache(maxsize=None)  # once per source file: an FMU's extracted copy may be gone by its next instance
-def aot_wind_kernel(source: Path = _WIND_SOURCE) -> AotKernel:
-    """The compiled wind step as :mod:`components.model.aot` builds and finds it (``source``: a copy of its file)."""
-    return AotKernel(shared_name(source, _WIND_DEPENDENCIES), f"{__name__}:_jit_wind_kernel_module", source)
-
-
-def _compiled_wind_module() -> tuple[ModuleType | None, str | None]:
-    """The compiled wind step: its ahead-of-time module where built, else :func:`_jit_wind_module`."""
-    return compiled_or_jit(aot_wind_kernel(), _jit_wind_module)
 
 
 @dataclass(frozen=True)

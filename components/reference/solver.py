@@ -24,8 +24,7 @@ from scipy.integrate import odeint
 from ..errors import ParameterError, SolverError, WallTimeLimitError
 from ..model.assembly import Assembly
 from ..model.drivetrain import Drivetrain
-from ..model.kernel import jit_module
-from ..model.kernel_request import compiled_or_numpy
+from ..model import kernel as model_kernel
 from ..validation import finite, non_negative, positive
 from .results import EnergyAudit, SimulationResult
 
@@ -82,9 +81,9 @@ class MonolithicSystem:
 
     The right-hand side evaluates the driver once per call (its ``motion(t)`` where it
     has one: angle, speed and acceleration from one set of phases) and the contact forces
-    without their derivatives; the Jacobian evaluates the derivatives. With the compiled
-    kernel (:mod:`components.model.kernel`) both run in
-    :func:`components.model.compiled_kernel.monolithic_rhs` / ``monolithic_jacobian``.
+    without their derivatives; the Jacobian evaluates the derivatives. Both are the kernel's
+    :func:`components.model.kernel.monolithic.monolithic_rhs` / ``monolithic_jacobian`` (the
+    co-simulation gearbox's equations), compiled by numba or interpreted.
 
     Parameters
     ----------
@@ -112,35 +111,31 @@ class MonolithicSystem:
         self.deadline = math.inf  # time.perf_counter() value past which rhs raises (see start_clock)
         self.wall_time_limit_s = 0.0
         self._motion = getattr(driver, "motion", None)
-        # the monolithic right-hand side is not compiled ahead of time: numba's just-in-time kernel
-        module, self.kernel_note = compiled_or_numpy(kernel, jit_module, "compiled gearbox kernel")
-        self.kernel = "numpy" if module is None else "compiled"
-        self._compiled = None if module is None else self._compiled_arrays(module)
+        # the monolithic right-hand side is not compiled ahead of time: numba's just-in-time kernel, or interpreted
+        self._module, self.kernel, self.kernel_note = model_kernel.monolithic(kernel)
+        self._rhs_args, self._jac_args = self._kernel_arrays()
 
-    def _compiled_arrays(self, module):
-        from ..model.gearbox_kernel import contact_table, mesh_sparsity
-
+    def _kernel_arrays(self) -> tuple[tuple, tuple]:
+        """The constant and work arrays of the kernel's right-hand side and Jacobian (after ``y`` and the factors)."""
         a = self.assembly
         n, m = a.n_dof, a.n_mesh
         c = np.ascontiguousarray
-        self._module = module
         self._ones = np.ones(m)
         self._rhs_out = np.zeros(2 * n + 3)
         rhs_args = (
-            self._out, self._kappa_out, float(a.driver_inertia_kgm2), c(a._A_T), np.zeros(m), c(a._fast_matrix),
-            contact_table(a, module), c(a.S), c(a.shaft_k, dtype=float), c(a.shaft_c, dtype=float), c(a.BT_driver),
-            c(a.s_driver), c(a.cos_alpha), c(a.inv_inertia), np.zeros(m), np.zeros(m), np.zeros((2, m)), np.zeros(n),
-            self._rhs_out,
+            self._out, self._kappa_out, float(a.driver_inertia_kgm2), c(a.A_T), np.zeros(m), c(a.fast_matrix),
+            a.law.table, c(a.S), c(a.shaft_k, dtype=float), c(a.shaft_c, dtype=float), c(a.BT_driver),
+            c(a.s_driver), c(a.cos_alpha), c(a.inv_inertia), np.zeros(m), np.zeros(m), np.zeros((2, m)),
+            np.zeros(m + 2 * n + 4), np.zeros(n), self._rhs_out,
         )
-        nz_index, nz_value = mesh_sparsity(a)
         jac_args = (
-            c(a._A_T), np.zeros(m), contact_table(a, module), np.zeros((2, m)), nz_index, nz_value, c(a.cos_alpha),
+            c(a.A_T), np.zeros(m), a.law.table, np.zeros((2, m)), a.nz_index, a.nz_value, c(a.cos_alpha),
             c(a.STkS), c(a.STcS), np.zeros(n), np.zeros(n), c(a.inv_inertia), np.zeros(m), np.zeros(m),
             np.zeros((n, n)), np.zeros((n, n)), np.zeros((2, n)), self._jac,
         )
         # compile or load from the disk cache now, not inside the timed integration
-        module.monolithic_rhs(np.zeros(2 * n + 3), 0.0, 0.0, self._ones, 0.0, *rhs_args)
-        module.monolithic_jacobian(np.zeros(2 * n + 3), self._ones, *jac_args)
+        self._module.monolithic_rhs(np.zeros(2 * n + 3), 0.0, 0.0, self._ones, 0.0, *rhs_args)
+        self._module.monolithic_jacobian(np.zeros(2 * n + 3), self._ones, *jac_args)
         return rhs_args, jac_args
 
     def start_clock(self, wall_time_limit_s: float) -> None:
@@ -170,44 +165,18 @@ class MonolithicSystem:
         if time.perf_counter() > self.deadline:
             raise WallTimeLimitError(self.wall_time_limit_s, t)
         omega_in, alpha_in, kfac = self._driver_state(t)
-        if self._compiled is not None:
-            factor = self._ones if type(kfac) is float else np.ascontiguousarray(kfac, dtype=float)
-            self._module.monolithic_rhs(np.ascontiguousarray(y, dtype=float), omega_in, alpha_in, factor,
-                                        self.load_torque_nm, *self._compiled[0])
-            return self._rhs_out.copy()
-        a = self.assembly
-        n = self.n
-        q = y[:n]
-        v = y[n : 2 * n]
-        loads = a.loads(q, v, stiffness_factor=kfac, derivatives=False)
-        Q = a.generalised_forces(loads)
-        Q[self._out] -= self.load_torque_nm
-        acc = a.inv_inertia * Q - a.kinematic_ratio * alpha_in
-        rotor_torque = a.driver_torque(loads, alpha_in)
-        out = np.empty(2 * n + 3)
-        out[:n] = v
-        out[n : 2 * n] = acc
-        out[2 * n] = rotor_torque * omega_in
-        out[2 * n + 1] = self.load_torque_nm * (self._kappa_out * omega_in + v[self._out])
-        out[2 * n + 2] = a.dissipation_power(loads)
-        return out
+        factor = self._ones if type(kfac) is float else np.ascontiguousarray(kfac, dtype=float)
+        self._module.monolithic_rhs(np.ascontiguousarray(y, dtype=float), omega_in, alpha_in, factor,
+                                    self.load_torque_nm, *self._rhs_args)
+        return self._rhs_out.copy()
 
     def jacobian(self, t: float, y: np.ndarray) -> np.ndarray:
         """d(dy/dt)/dy; the quadrature rows are left zero (they do not feed back)."""
         self.jac_calls += 1
-        a = self.assembly
-        n = self.n
         kfac = self._stiffness_factor(t)
-        if self._compiled is not None:
-            factor = self._ones if type(kfac) is float else np.ascontiguousarray(kfac, dtype=float)
-            self._module.monolithic_jacobian(np.ascontiguousarray(y, dtype=float), factor, *self._compiled[1])
-            return self._jac
-        loads = a.loads(y[:n], y[n : 2 * n], stiffness_factor=kfac)
-        dq, dv, _, _ = a.acceleration_jacobian(loads)
-        J = self._jac
-        J[n : 2 * n, :n] = dq
-        J[n : 2 * n, n : 2 * n] = dv
-        return J
+        factor = self._ones if type(kfac) is float else np.ascontiguousarray(kfac, dtype=float)
+        self._module.monolithic_jacobian(np.ascontiguousarray(y, dtype=float), factor, *self._jac_args)
+        return self._jac
 
 
 def simulate_monolithic(

@@ -1,8 +1,8 @@
 """``dtcosim cache [--prune]``: what the per-user cache of compiled kernels holds, and removing what is stale.
 
-The cache (:func:`components.model.numba_cache.user_cache_root`, ``~/.cache/dtcosim``) keeps
+The cache (:func:`components.compile.user_cache.user_cache_root`, ``~/.cache/dtcosim``) keeps
 the kernels compiled ahead of time (``aot/<python tag>-numpy<version>/``, one module per
-kernel version: :mod:`components.model.aot`) and numba's just-in-time machine code
+kernel version: :mod:`components.compile.aot`) and numba's just-in-time machine code
 (``numba-<numba version>/<source hash>/``). Every new version of a kernel's sources adds
 entries and nothing removes the old ones: ``--prune`` deletes every entry that the
 installed dtcosim, Python, numpy and numba would not load (FMUs carry their own compiled
@@ -16,8 +16,10 @@ import shutil
 from dataclasses import dataclass
 from pathlib import Path
 
-from components.model.aot import aot_directory
-from components.model.numba_cache import source_hash, user_cache_root
+from components.compile.aot import aot_directory
+from components.compile.numba_cache import source_hash
+from components.compile.user_cache import user_cache_root
+from components.model.kernel import KERNELS
 
 from ..cosim.compiled_kernels import aot_kernels
 
@@ -43,7 +45,8 @@ def _jit_keys() -> tuple[str | None, set[str]]:
         import numba  # optional requirement: only to name the current just-in-time cache
     except ImportError:
         return None, set()
-    return f"numba-{numba.__version__}", {source_hash(k.source)[:16] for k in aot_kernels() if k.source is not None}
+    files = {f for k in KERNELS for f in k.files} | {k.source for k in aot_kernels() if k.source is not None}
+    return f"numba-{numba.__version__}", {source_hash(f)[:16] for f in files}
 
 
 def cache_entries(root: Path | None = None) -> list[CacheEntry]:

@@ -1,6 +1,6 @@
 """The kernels a run steps, compiled ahead of time once per machine: the Gearbox's, the wind source's, the loop's.
 
-:mod:`components.model.aot` compiles each kernel's entry points into an extension module
+:mod:`components.compile.aot` compiles each kernel's entry points into an extension module
 that imports without numba, so a run's process (host and in-process FMUs) carries no numba
 and llvmlite (~75 MB less resident memory, ~0.5 s less start-up: ``bench_long_run.py``).
 :func:`ensure_compiled_kernels` builds the missing ones in a child process; ``dtcosim
@@ -12,20 +12,19 @@ from __future__ import annotations
 
 from typing import Callable
 
-from components.model.aot import AotKernel, aot_directory, build_in_subprocess, enabled, failed_before, missing
-from components.model.kernel import aot_kernel
-from components.model.wind import aot_wind_kernel
+from components.compile.aot import AotKernel, aot_directory, build_in_subprocess, enabled, failed_before, missing
+from components.model.kernel import AHEAD_OF_TIME
 
 from .compiled_loop import aot_loop_kernel
 
 
 def aot_kernels() -> tuple[AotKernel, ...]:
     """Every kernel compiled ahead of time, keyed by the installed sources."""
-    return aot_kernel(), aot_wind_kernel(), aot_loop_kernel()
+    return (*(AotKernel.of(source) for source in AHEAD_OF_TIME), aot_loop_kernel())
 
 
 def ensure_compiled_kernels(report: Callable[[str], None] | None = None, retry: bool = False) -> str | None:
-    """Build the kernels missing in :func:`~components.model.aot.aot_directory`.
+    """Build the kernels missing in :func:`~components.compile.aot.aot_directory`.
 
     A kernel version whose build failed on this machine before (no C compiler, say) is not
     retried on every run, only with ``retry`` (``dtcosim build``) or once its sources change.

@@ -7,7 +7,7 @@ module runs the same block of communication steps in one compiled function
 (:func:`~orchestrator.cosim.compiled_loop_kernel.run_block`): the FMI functions are called through their addresses
 (an indirect call, as a C host makes it), the system's layout is data (:func:`loop_plan`), so the function is
 compiled once per machine and kept in numba's disk cache
-(:mod:`components.model.numba_cache`; no per-system compilation).
+(:mod:`components.compile.numba_cache`; no per-system compilation).
 
 Same calls, same values, same order, same arithmetic as the generated loop (the
 tests compare the recorded values exactly). Used by the master (``step_loop =
@@ -31,8 +31,8 @@ from typing import Callable
 
 import numpy as np
 
-from components.model.aot import AotKernel, compiled_or_jit
-from components.model.shared_module import shared_name
+from components.compile.aot import AotKernel, compiled_or_jit
+from components.compile.sources import KernelSource
 
 from .compiled_loop_layout import (
     FUNCTIONS,
@@ -57,7 +57,6 @@ _import_error: str | None = None
 
 
 _SOURCE = Path(__file__).with_name("compiled_loop_kernel.py")
-_DEPENDENCIES = ("compiled_loop_layout.py",)
 
 
 def _jit_kernel_module() -> ModuleType:
@@ -69,8 +68,8 @@ def _jit_kernel_module() -> ModuleType:
 
 @lru_cache(maxsize=None)  # once per source file: an FMU's extracted copy may be gone by its next instance
 def aot_loop_kernel() -> AotKernel:
-    """The compiled stepping loop as :mod:`components.model.aot` builds and finds it."""
-    return AotKernel(shared_name(_SOURCE, _DEPENDENCIES), f"{__name__}:_jit_kernel_module", _SOURCE)
+    """The compiled stepping loop as :mod:`components.compile.aot` builds and finds it."""
+    return AotKernel(KernelSource("loop", _SOURCE).shared_name, f"{__name__}:_jit_kernel_module", _SOURCE)
 
 
 def _jit_module() -> tuple[ModuleType | None, str | None]:

@@ -12,7 +12,7 @@ from llvmlite import ir  # optional requirement (comes with numba)
 from numba import njit, types  # optional requirement: without numba the generated loop runs
 from numba.extending import intrinsic
 
-from components.model.numba_cache import enable_stable_cache
+from components.compile.numba_cache import enable_stable_cache
 
 from .compiled_loop_layout import (
     F_COLUMN,
@@ -123,12 +123,12 @@ def run_block(k_start, k_end, t0, h, plan, feeds, coefficients, in_bufs, ring, d
                 data[row, j] = flat[src + j]
     return k_end
 
-#: entry point of the ahead-of-time compiled module (:mod:`components.model.aot`) and its signature
+#: entry point of the ahead-of-time compiled module (:mod:`components.compile.aot`) and its signature
 AOT_EXPORTS = {
     "run_block": "i8(i8, i8, f8, f8, i8[:, ::1], i8[:, ::1], f8[:, ::1], f8[::1], f8[:, ::1], f8[:, ::1], i8, i8, "
                  "b1, b1, i8[::1])",
 }
-#: True when the machine code is cached on disk (see :mod:`components.model.numba_cache`)
+#: True when the machine code is cached on disk (see :mod:`components.compile.numba_cache`)
 DISK_CACHE = enable_stable_cache((run_block,), __file__, __name__)
 
 

@@ -1,4 +1,4 @@
-"""The Gearbox FMU and the host use one compiled kernel module per process (components.model.shared_module)."""
+"""The Gearbox FMU and the host use one compiled kernel per process (components.compile.jit, components.compile.aot)."""
 
 from __future__ import annotations
 
@@ -6,28 +6,29 @@ import sys
 
 import pytest
 
-from components.model.kernel import aot_kernel, compiled_module
+from components.model import kernel
 
 
-def _kernel_modules() -> list[str]:
-    """The kernel modules in this process: shared ones, and build-specific or host copies imported by name."""
-    return sorted(name for name in sys.modules
-                  if name.endswith(".model.compiled_kernel") or name.startswith("_dtcosim_compiled_kernel_"))
+def _compiled_kernel_modules() -> list[str]:
+    """The compiled gearbox kernel's modules in this process (numba's and the ahead-of-time one)."""
+    return sorted(name for name in sys.modules if name.startswith("_dtcosim_kernel_gearbox_"))
 
 
-def test_the_gearbox_fmu_runs_on_the_hosts_kernel_module(fmu_path):
+def test_the_gearbox_fmu_runs_on_the_hosts_compiled_kernel(fmu_path):
     from fmpy import simulate_fmu
 
-    host, reason = compiled_module()
-    if host is None:
+    host, form, reason = kernel.gearbox()
+    if form != "compiled":
         pytest.skip(f"compiled kernel unavailable: {reason}")
     result = simulate_fmu(str(fmu_path("Gearbox")), stop_time=0.01, step_size=1e-3, output=["shaft_torque"])
     assert len(result) == 11
-    # no build-specific copy (``_dtcosim_gearbox_<id>.components.model.compiled_kernel``) was imported: only the
-    # shared module of these sources (just in time, and its ahead-of-time twin ``<shared>_aot`` where built)
-    shared = aot_kernel().shared
-    assert _kernel_modules() and all(name in (shared, f"{shared}_aot") for name in _kernel_modules()), _kernel_modules()
-    assert compiled_module()[0] is host
+    # the FMU's copy of the kernel sources compiled nothing of its own: the only compiled modules are those of
+    # these sources (just in time, and the ahead-of-time twin ``<shared>_aot`` where built)
+    shared = kernel.GEARBOX.shared_name
+    names = _compiled_kernel_modules()
+    assert names and all(name == shared or name.startswith(shared + ".") or name == f"{shared}_aot"
+                         for name in names), names
+    assert kernel.gearbox()[0] is host
 
 
 @pytest.mark.parametrize("name, output", [("Gearbox", "shaft_torque"), ("WindSource", "omega")])

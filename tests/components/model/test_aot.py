@@ -1,4 +1,4 @@
-"""The kernels compiled ahead of time (components.model.aot): same results as numba's just-in-time kernels, no numba.
+"""The kernels compiled ahead of time (components.compile.aot): same results as numba's just-in-time kernels, no numba.
 
 The extension modules are built once per machine by ``ensure_compiled_kernels`` (the
 session fixture ``built_fmus`` and ``dtcosim build``/``run`` call it); the tests that use
@@ -16,34 +16,37 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import components.model.gearbox_kernel as gearbox_kernel
-from components.model import aot
-from components.model.aot import AotKernel, facade, load_module
+from components.compile import aot
+from components.compile.aot import AotKernel, facade, load_module
+from components.compile.jit import load_compiled, try_compiled
+from components.compile.sources import KernelSource
+from components.model import kernel
 from components.model.gearbox_model import GearboxModel
 from components.model.generator import GeneratorRotor
-from components.model.kernel import aot_kernel, compiled_module, jit_module
 from components.model.presets import cosim_preset
-from components.model.wind import PhasorStepper, RotorSpeedProcess, WindParameters, aot_wind_kernel
+from components.model.wind import PhasorStepper, RotorSpeedProcess, WindParameters
 from orchestrator.cosim.compiled_kernels import ensure_compiled_kernels
+
+GEARBOX_AOT, WIND_AOT = AotKernel.of(kernel.GEARBOX), AotKernel.of(kernel.WIND)
 
 
 @pytest.fixture(scope="module")
 def built():
     """The ahead-of-time modules of this machine (built if missing), or skip."""
     problem = ensure_compiled_kernels()
-    if problem is not None or aot.missing([aot_kernel(), aot_wind_kernel()]) or jit_module()[0] is None:
+    if problem is not None or aot.missing([GEARBOX_AOT, WIND_AOT]) or try_compiled(kernel.GEARBOX)[0] is None:
         pytest.skip(f"kernels not compiled ahead of time here ({problem})")
-    return load_module(aot_kernel())
+    return load_module(GEARBOX_AOT)
 
 
 def _run(dt, module, steps=1500, h=5e-3):
     """Contact forces and outputs of a coupled run whose Gearbox steps through ``module``."""
-    original = gearbox_kernel.compiled_module
-    gearbox_kernel.compiled_module = lambda: (module, None)
+    original = kernel.gearbox
+    kernel.gearbox = lambda form=None: (module, "compiled", None)
     try:
         model = GearboxModel(dt, kernel="compiled")
     finally:
-        gearbox_kernel.compiled_module = original
+        kernel.gearbox = original
     wind = RotorSpeedProcess(WindParameters())
     w0, p0 = wind.speed(0.0), wind.angle(0.0)
     model.initialize(0.0, w0, p0, model.ratio * w0, model.ratio * p0)
@@ -54,7 +57,7 @@ def _run(dt, module, steps=1500, h=5e-3):
         model.step(t, h, wind.speed(t), wind.angle(t), gen.speed_rad_s, gen.angle_rad)
         gen.step(t, h, model.shaft_torque_nm)
         out.append(model.output_vector())
-    return np.array(out), model.get_state()["integrator"]
+    return np.array(out), model.integrator
 
 
 @pytest.mark.parametrize("make", [lambda: cosim_preset("table6"), lambda: cosim_preset("table5"),
@@ -62,9 +65,9 @@ def _run(dt, module, steps=1500, h=5e-3):
                          ids=["table6", "table5-planetary", "table6-impact-tvms"])
 def test_the_ahead_of_time_kernel_steps_bit_for_bit_as_the_just_in_time_one(built, make):
     dt = make()
-    front = compiled_module()[0]
+    front = kernel.gearbox("compiled")[0]
     assert front.AHEAD_OF_TIME == built.__file__
-    jit = jit_module()[0]
+    jit = load_compiled(kernel.GEARBOX)
     got, got_counters = _run(dt, front)
     expected, expected_counters = _run(dt, jit)
     np.testing.assert_array_equal(got, expected)
@@ -75,20 +78,20 @@ def test_the_ahead_of_time_kernel_steps_bit_for_bit_as_the_just_in_time_one(buil
 def test_the_wind_step_is_bit_for_bit_the_just_in_time_one(built):
     process = RotorSpeedProcess(WindParameters())
     stepper = PhasorStepper(process, kernel="compiled")  # whatever DTCOSIM_KERNEL says
-    assert getattr(stepper._compiled, "AHEAD_OF_TIME", None), "the wind step is not the ahead-of-time module"
-    jit = stepper._compiled.__getattr__("rotate_and_sum")  # the just-in-time function behind the facade
+    assert getattr(stepper._kernel, "AHEAD_OF_TIME", None), "the wind step is not the ahead-of-time module"
+    jit = load_compiled(kernel.WIND).rotate_and_sum  # the just-in-time function
     z = np.exp(1j * np.linspace(0.0, 3.0, 256))
     rotation = np.exp(1j * 1e-3 * np.arange(1, 257))
     w, w_f = np.linspace(0.1, 1.0, 256), np.linspace(1.0, 0.1, 256)
     z_aot, z_jit = z.copy(), z.copy()
-    assert stepper._compiled.rotate_and_sum(z_aot, rotation, w, w_f) == jit(z_jit, rotation, w, w_f)
+    assert stepper._kernel.rotate_and_sum(z_aot, rotation, w, w_f) == jit(z_jit, rotation, w, w_f)
     np.testing.assert_array_equal(z_aot, z_jit)
 
 
 def test_the_facade_takes_other_names_from_the_just_in_time_module(built):
-    front = compiled_module()[0]
-    assert front.SLOTS == gearbox_kernel.compiled_module()[0].SLOTS and front.N_ISTATE == 11  # kernel_layout
-    assert front.monolithic_rhs is jit_module()[0].monolithic_rhs
+    front = kernel.gearbox("compiled")[0]
+    assert front.OK == 0 and front.AOT_EXPORTS == kernel.gearbox("numpy")[0].AOT_EXPORTS  # constants of the source
+    assert front.advance is load_compiled(kernel.GEARBOX).advance  # a function not exported: numba's
     with pytest.raises(AttributeError, match="no_such_function"):
         front.no_such_function  # noqa: B018
 
@@ -114,13 +117,16 @@ def test_a_missing_damaged_or_disabled_module_is_not_loaded(tmp_path, monkeypatc
 
 
 def test_the_key_follows_the_kernel_sources(tmp_path):
-    from components.model.shared_module import shared_name
-
-    source = tmp_path / "compiled_thing.py"
-    source.write_text("x = 1\n")
-    first = shared_name(source, ())
-    source.write_text("x = 2\n")
-    assert shared_name(source, ()) != first  # a changed kernel never loads an old module
+    entry, helper, other = tmp_path / "thing.py", tmp_path / "helper.py", tmp_path / "other.py"
+    entry.write_text("from .helper import x\n")
+    helper.write_text("x = 1\n")
+    other.write_text("y = 1\n")
+    first = KernelSource("thing", entry).shared_name
+    assert KernelSource("thing", entry).files == (helper, entry)
+    other.write_text("y = 2\n")
+    assert KernelSource("thing", entry).shared_name == first  # a module the kernel does not import
+    helper.write_text("x = 2\n")
+    assert KernelSource("thing", entry).shared_name != first  # a changed kernel never loads an old module
 
 
 _CHILD = textwrap.dedent("""
@@ -133,16 +139,16 @@ _CHILD = textwrap.dedent("""
         stepper.advance(k * 1e-3, 1e-3)
         values.append(stepper.speed_and_angle())
     print(json.dumps({"numba": "numba" in sys.modules, "kernel": stepper.kernel,
-                      "aot": getattr(stepper._compiled, "AHEAD_OF_TIME", None), "values": values}))
+                      "aot": getattr(stepper._kernel, "AHEAD_OF_TIME", None), "values": values}))
 """)
 
 
 @pytest.mark.slow
 def test_a_module_built_here_runs_without_numba_and_as_the_jit_kernel(tmp_path):
     """``build_module`` into an empty cache (what a new machine does), then a process that never imports numba."""
-    kernel = aot_wind_kernel()
+    wind = WIND_AOT
     env_cache = {"DTCOSIM_CACHE_DIR": str(tmp_path), "DTCOSIM_KERNEL": "auto"}
-    build = subprocess.run([sys.executable, "-m", "components.model.aot", f"{kernel.shared}={kernel.provider}"],
+    build = subprocess.run([sys.executable, "-m", "components.compile.aot", f"{wind.shared}={wind.provider}"],
                            capture_output=True, text=True, timeout=600, env={**__import__("os").environ, **env_cache})
     if build.returncode != 0 and "CompileError" in build.stderr + build.stdout:
         pytest.skip("no C compiler for numba.pycc")
@@ -162,10 +168,10 @@ def test_a_module_built_here_runs_without_numba_and_as_the_jit_kernel(tmp_path):
 def test_the_fmus_carry_the_modules_of_their_kernel_sources(built, fmu_path):
     import zipfile
 
-    for fmu, kernels in (("Gearbox", [aot_kernel(), aot_wind_kernel()]), ("WindSource", [aot_wind_kernel()])):
+    for fmu in ("Gearbox", "WindSource"):
         with zipfile.ZipFile(fmu_path(fmu)) as archive:
-            carried = {Path(n).name for n in archive.namelist() if f"/model/{aot.BUNDLE_FOLDER}/" in n}
-        assert carried == {k.file().name for k in kernels}, fmu
+            carried = {Path(n).name for n in archive.namelist() if f"/kernel/{aot.BUNDLE_FOLDER}/" in n}
+        assert carried == {GEARBOX_AOT.file().name, WIND_AOT.file().name}, fmu
 
 
 def test_a_failing_build_says_why_in_one_line_and_is_not_retried_on_every_run(tmp_path, monkeypatch):

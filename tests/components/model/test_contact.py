@@ -92,18 +92,6 @@ def test_derivatives_match_finite_differences(contact_law, d_over_h):
     np.testing.assert_allclose(cf.d_force_d_rate, fd_v, rtol=1e-5)
 
 
-def test_fast_force_path_equals_full_evaluation():
-    cl = law(regularisation=2e4)
-    rng = np.random.default_rng(3)
-    for scale in (0.5, 1.0, 2.0, 10.0):
-        d = rng.normal(size=50) * HALF_JT * scale
-        v = rng.normal(size=50) * 1e-3
-        for di, vi in zip(d, v):
-            assert cl.force(np.array([di]), np.array([vi]))[0] == pytest.approx(
-                cl.evaluate(np.array([di]), np.array([vi])).force[0], rel=1e-12, abs=1e-9
-            )
-
-
 def test_impact_law_step_damping_reaches_cmax_at_dmax():
     dmax, cmax = 1.0e-4, 5.0e4
     cl = law(law="impact", impact_depth_m=dmax, impact_damping=cmax)

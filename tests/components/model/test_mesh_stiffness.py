@@ -171,7 +171,7 @@ def test_time_varying_stiffness_keeps_the_mean_force(stage3_varying_run):
 
 
 def test_mesh_phasing_matches_the_stiffness_factor_and_its_slope_is_the_derivative():
-    """The integrators' fast path (validated once, analytic slope) is the same model as stiffness_factor."""
+    """The phasing table the kernel reads (validated once, analytic slope) is the same model as stiffness_factor."""
     from components.model.mesh_stiffness import MeshPhasing
 
     dt = table6_gearbox().with_meshes(stiffness_variation=0.3)
@@ -193,31 +193,36 @@ def test_mesh_phasing_matches_the_stiffness_factor_and_its_slope_is_the_derivati
         MeshPhasing(a._mesh_rate, a._mesh_offset, a._mesh_contact_ratio, np.full(a.n_mesh, 2.0))
 
 
-def test_gearbox_step_system_time_derivative_is_analytic_with_tvms():
-    """da/dt of the co-simulation gearbox (stiffness varying with the driver angle) against a central
-    difference of the acceleration in time at a fixed state, inside a stage-3 stiffness transition."""
-    from components.model.gearbox_model import GearboxModel
+def test_the_kernels_stiffness_rate_is_the_time_derivative_of_the_acceleration():
+    """da/dt of the gearbox at a fixed state with the stiffness varying with the driver angle
+    (:func:`components.model.kernel.dynamics.stiffness_rate`) against a central difference of the kernel's
+    acceleration in time, inside a stage-3 stiffness transition."""
+    from components.model.kernel import dynamics
 
     base = table6_gearbox()
     dt = with_stage(base, 2, mesh=replace(base.stages[2].mesh, stiffness_variation=0.3))
-    gb = GearboxModel(dt)
-    w = units.rpm(16.0)
-    gb.initialize(0.0, w, 0.0, gb.ratio * w, 0.0)
-    gb.step(0.0, 1e-3, w, 0.0, gb.ratio * w, 0.0)
+    a = Assembly(dt, cut_at_generator=True)
+    n, m = a.n_dof, a.n_mesh
     # loaded state: the static equilibrium of the whole drivetrain, generator (the port) removed
     eq = static_equilibrium(dt, dt.generator.counter_torque_nm)
     names = Assembly(dt).dof_names
-    keep = [names.index(b) for b in gb.assembly.dof_names]
-    gb.y = np.concatenate((eq.q_rad[keep], np.zeros(len(keep))))
-    sysm = gb.system
-    sysm.port.fit(1e-3, eq.q_rad[names.index("generator")], 0.0, eq.q_rad[names.index("generator")], 0.0)
-    sysm.jacobian(0.0, gb.y)  # port part of da/dt uses the current Jacobian
-    # a local time inside the rising stage-3 transition of this step
-    taus = np.linspace(0.0, 1e-3, 20001)
-    slope = np.array([gb.assembly.phasing.factor_and_slope(sysm.angle0 + sysm.driver.value(t))[1][-1] for t in taus])
-    tau = float(taus[np.argmax(np.abs(slope))])
-    h = 1e-9
-    fd = (sysm.acceleration(tau + h, gb.y) - sysm.acceleration(tau - h, gb.y)) / (2 * h)
-    analytic = sysm.time_derivative(tau, gb.y)
+    y = np.concatenate((eq.q_rad[[names.index(b) for b in a.dof_names]], np.zeros(n)))
+    port = float(eq.q_rad[names.index("generator")])
+    speed = units.rpm(16.0)
+    angles = np.linspace(0.0, speed * 1e-3, 20001)
+    tau_angle = float(angles[np.argmax(np.abs(a.phasing.factors(angles)[1][:, -1]))])  # steepest stage-3 ramp
+
+    def acc(angle):
+        out, z, defl = np.zeros(n), np.zeros(m + 2 * n + 4), np.zeros((2, m))
+        dynamics.acceleration(y, port, 0.0, 0.0, a.stiffness_factor(angle), a.A_T, a.port_deflection, a.fast_matrix,
+                              a.law.table, z, defl, out)
+        return out
+
+    h = 1e-9 * speed
+    fd = (acc(tau_angle + h) - acc(tau_angle - h)) / (2 * h / speed)
+    analytic = np.zeros(n)
+    dynamics.stiffness_rate(y, n, tau_angle, speed, port, 0.0, a.A_T, a.port_deflection, a.law.table,
+                            a.phasing_table, a.force_rows, np.zeros(m), np.zeros(m), np.zeros((2, m)), np.zeros(m),
+                            analytic)
     assert np.abs(analytic).max() > 1e3  # the stiffness term dominates here
     np.testing.assert_allclose(analytic, fd, rtol=1e-4, atol=1e-5 * np.abs(fd).max())

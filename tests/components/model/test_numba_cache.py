@@ -1,9 +1,9 @@
 """The compiled kernel's disk cache: a fresh process loads the machine code without numba's compilation context.
 
 numba's own cache load imports and installs every lowering registry and compiles its
-runtime's LLVM module (~45 MB resident); :func:`components.model.numba_cache.register_runtime_symbols`
+runtime's LLVM module (~45 MB resident); :func:`components.compile.numba_cache.register_runtime_symbols`
 registers only the runtime's C helpers. The fresh process must hit the cache, must not
-have imported numba's lowerings, and its compiled steps must match the numpy path.
+have imported numba's lowerings, and its compiled steps must match the interpreted kernel.
 """
 
 from __future__ import annotations
@@ -16,10 +16,11 @@ import textwrap
 
 import pytest
 
-from components.model.aot import ENVIRONMENT_VARIABLE
-from components.model.kernel import jit_module
+from components.compile.aot import ENVIRONMENT_VARIABLE
+from components.compile.jit import try_compiled
+from components.model.kernel import GEARBOX, jit_gearbox
 
-ck, _reason = jit_module()
+ck, _reason = try_compiled(GEARBOX)
 pytestmark = pytest.mark.skipif(ck is None, reason=f"compiled kernel unavailable: {_reason}")
 
 #: modules numba imports when it refreshes its compilation context (numba.core.cpu.load_additional_registries)
@@ -32,9 +33,10 @@ _CHILD = textwrap.dedent("""
     from components.model.generator import GeneratorRotor
     from components.model.presets import cosim_preset
     from components.model.wind import RotorSpeedProcess, WindParameters
-    from components.model.kernel import jit_module
+    from components.compile.jit import load_compiled
+    from components.model.kernel import GEARBOX
 
-    # one communication step of the compiled kernel from states of a numpy-path run (start-up impacts included)
+    # one communication step of the compiled kernel from states of an interpreted run (start-up impacts included)
     dt = cosim_preset("table6")
     wind = RotorSpeedProcess(WindParameters())
     h = 2e-3
@@ -58,7 +60,7 @@ _CHILD = textwrap.dedent("""
         compiled.set_state(json.loads(state))
         compiled.step(t, h, *inputs)
         difference = max(difference, float(np.max(np.abs(compiled.output_vector() - expected) / scale)))
-    ck = jit_module()[0]  # the module GearboxModel used (one per process for the same sources)
+    ck = load_compiled(GEARBOX)  # the module GearboxModel used (one per process for the same sources)
     print(json.dumps({
         "disk_cache": ck.DISK_CACHE,
         "hits": sum(ck.gearbox_step.stats.cache_hits.values()),
@@ -72,7 +74,7 @@ _CHILD = textwrap.dedent("""
 def test_a_fresh_process_runs_the_cached_kernel_without_numba_lowerings():
     if not ck.DISK_CACHE:
         pytest.skip("numba's cache classes are not as expected: the kernel compiles in memory")
-    ck.ensure_compiled()  # writes the cache if this process compiled it
+    jit_gearbox()  # writes the cache if this process compiled it
     # the just-in-time kernel's cache (not the module compiled ahead of time)
     proc = subprocess.run([sys.executable, "-c", _CHILD], capture_output=True, text=True, timeout=300,
                           env={**os.environ, ENVIRONMENT_VARIABLE: "0"})
@@ -80,7 +82,7 @@ def test_a_fresh_process_runs_the_cached_kernel_without_numba_lowerings():
     got = json.loads(proc.stdout.strip().splitlines()[-1])
     assert got["disk_cache"] and (got["hits"], got["misses"]) == (1, 0), got
     assert got["lowerings"] == [], got
-    assert got["difference"] < 1e-9, got
+    assert got["difference"] < 1e-12, got
 
 
 _SYMBOLS = textwrap.dedent("""
@@ -90,7 +92,7 @@ _SYMBOLS = textwrap.dedent("""
     add_symbol = ll.add_symbol
     ll.add_symbol = lambda name, address: (registered.append(name), add_symbol(name, address))[1]
     from numba.core.registry import cpu_target
-    from components.model.numba_cache import register_runtime_symbols
+    from components.compile.numba_cache import register_runtime_symbols
     context = cpu_target.target_context
     start = len(registered)
     assert register_runtime_symbols()

@@ -114,7 +114,7 @@ def test_jacobian_matches_finite_differences():
     rng = np.random.default_rng(1)
     v = rng.normal(size=a.n_dof) * 1e-3
     qx, vx = np.array([4.4]), np.array([0.01])
-    dq, dv, dqx, dvx = a.acceleration_jacobian(a.loads(q, v, qx, vx))
+    dq, dv, dqx, dvx = a.acceleration_jacobian(q, v, qx, vx)
 
     def acc(q_, v_, qx_=qx, vx_=vx):
         return a.acceleration(q_, v_, 0.0, 0.0, qx_, vx_)
@@ -128,13 +128,22 @@ def test_jacobian_matches_finite_differences():
     np.testing.assert_allclose(dvx[:, 0], (acc(q, v, qx, vx + 1e-7) - acc(q, v, qx, vx - 1e-7)) / 2e-7, rtol=1e-5, atol=1e-6)
 
 
-def test_fast_acceleration_equals_reference_evaluation():
+@pytest.mark.parametrize("form", ["numpy", "compiled"])
+def test_the_kernels_folded_acceleration_equals_the_matrix_form(form):
+    """The kernel evaluates the folded matrix (inverse inertias, moment arms, shafts, port, driver in one);
+    :meth:`Assembly.acceleration` the equations of motion term by term."""
+    from components.model import kernel
+
+    step = kernel.step if form == "numpy" else pytest.importorskip("components.compile.jit").load_compiled(kernel.GEARBOX)
     a = Assembly(table6_gearbox(), cut_at_generator=True)
+    m, n = a.n_mesh, a.n_dof
     rng = np.random.default_rng(2)
     for scale in (1e-4, 1e-3, 1e-2):
-        y = rng.normal(size=2 * a.n_dof) * scale
-        acc, force, _ = a.fast_acceleration(y, 0.3, 0.02, 0.7)
-        ref = a.acceleration(y[: a.n_dof], y[a.n_dof :], 0.7, 0.0, np.array([0.3]), np.array([0.02]))
+        y = rng.normal(size=2 * n) * scale
+        acc, z, defl = np.zeros(n), np.zeros(m + 2 * n + 4), np.zeros((2, m))
+        step.acceleration(y, 0.3, 0.02, 0.7, np.ones(m), a.A_T, a.port_deflection, a.fast_matrix, a.law.table, z, defl,
+                          acc)
+        ref = a.acceleration(y[:n], y[n:], 0.7, 0.0, np.array([0.3]), np.array([0.02]))
         np.testing.assert_allclose(acc, ref, rtol=1e-10, atol=1e-9 * np.abs(ref).max())
 
 

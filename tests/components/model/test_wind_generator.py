@@ -95,10 +95,11 @@ def test_generator_integrates_through_an_event_exactly():
 
 
 def _wind_kernels() -> list:
-    """Both paths of the phasor step; the compiled one skipped where numba does not import."""
-    from components.model.wind import _compiled_wind_module
+    """Both forms of the phasor step; the compiled one skipped where it cannot load."""
+    from components.compile.choice import compiled_module
+    from components.model.kernel import WIND
 
-    reason = _compiled_wind_module()[1]
+    reason = compiled_module(WIND)[1]
     return ["numpy", pytest.param("compiled", marks=pytest.mark.skipif(reason is not None, reason=str(reason)))]
 
 

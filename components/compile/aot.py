@@ -1,28 +1,28 @@
 """Ahead-of-time compiled kernels: numba's machine code in a plain extension module that runs without numba.
 
-The compiled kernels (:mod:`components.model.compiled_kernel`, :mod:`components.model.compiled_wind`,
-the master's stepping loop) are numba functions. Used just in time, they bring numba and
+The compiled kernels (:mod:`components.model.kernel`: the gearbox step and the wind's phasor
+step; the master's stepping loop) are numba functions. Used just in time, they bring numba and
 llvmlite into every process that steps them: ~75 MB of resident memory and ~0.5 s of
 imports even when the machine code comes from numba's disk cache (``bench_long_run.py
---imports``). Each kernel module therefore also declares ``AOT_EXPORTS`` (entry point ->
+--imports``). A kernel's entry module therefore also declares ``AOT_EXPORTS`` (entry point ->
 numba signature), and :func:`build_module` compiles those entry points with ``numba.pycc``
 into an extension module that imports with numpy alone (the same numba lowering of the same
 source: the tests compare its results with the just-in-time functions bit for bit).
 
 * **Name**: ``<shared name>_aot``, the shared name keyed by the kernel's sources
-  (:func:`components.model.shared_module.shared_name`), so a module built from other sources
-  is never loaded; the directory (:func:`aot_directory`) is keyed by the Python ABI and the
-  numpy version it was built against.
+  (:attr:`components.compile.sources.KernelSource.shared_name`), so a module built from other
+  sources is never loaded; the directory (:func:`aot_directory`) is keyed by the Python ABI and
+  the numpy version it was built against.
 * **Building** needs numba and a C compiler (setuptools' compiler: gcc or clang, MSVC on
   Windows): ~10 s and ~1 MB per kernel, once per machine and source version. It runs in a
   child process (:func:`build_in_subprocess`), so the builder's numba stays out of the run.
 * **Loading** (:func:`load_module`) needs only the file, carried by an FMU beside its copy of
-  the kernel's source or found in the user cache: where it is missing, cannot be imported or
+  the kernel's sources or found in the user cache: where it is missing, cannot be imported or
   ``DTCOSIM_AOT=0``, the kernel's owner uses the just-in-time module as before.
 
-:func:`facade` joins the extension module's entry points, the kernel's layout constants and,
-for anything else (the monolithic reference's functions, test helpers), the just-in-time
-module, loaded only when such a name is asked for.
+:func:`facade` joins the extension module's entry points, the kernel's constants and, for any
+other function (the monolithic reference's, test helpers), the just-in-time module, loaded only
+when such a name is asked for.
 """
 
 from __future__ import annotations
@@ -40,7 +40,10 @@ from types import ModuleType
 from typing import Callable, Sequence
 
 from .numba_cache import user_cache_root
+from .sources import KernelSource
 
+#: prefix of a provider that names a kernel source (:meth:`AotKernel.of`)
+_KERNEL_PROVIDER = "kernel:"
 #: ``DTCOSIM_AOT=0``: never load ahead-of-time modules (the just-in-time kernels run instead)
 ENVIRONMENT_VARIABLE = "DTCOSIM_AOT"
 
@@ -52,17 +55,23 @@ class AotKernel:
     Attributes
     ----------
     shared : str
-        Its shared name (:func:`~components.model.shared_module.shared_name`): the key of the module.
+        Its shared name (:attr:`~components.compile.sources.KernelSource.shared_name`): the key of the module.
     provider : str
-        ``"package.module:function"``: a function returning the just-in-time kernel module (which
-        defines ``AOT_EXPORTS``), called by the builder process.
+        How the builder process gets the just-in-time kernel module (which defines ``AOT_EXPORTS``):
+        ``"kernel:<name>=<entry file>"`` for a :class:`~components.compile.sources.KernelSource`
+        (:meth:`of`), or ``"package.module:function"``, a function returning that module.
     source : pathlib.Path or None
-        The kernel's source file (numba's just-in-time cache is keyed by its hash).
+        The kernel's entry file: an FMU carries the extension module in :data:`BUNDLE_FOLDER` beside it.
     """
 
     shared: str
     provider: str
     source: Path | None = None
+
+    @classmethod
+    def of(cls, source: KernelSource) -> "AotKernel":
+        """The ahead-of-time form of a kernel package's entry module."""
+        return cls(source.shared_name, f"{_KERNEL_PROVIDER}{source.name}={source.entry}", Path(source.entry))
 
     @property
     def module_name(self) -> str:
@@ -135,8 +144,9 @@ def facade(module: ModuleType, name: str, constants: ModuleType | None,
     first use); where that cannot load, the attribute error says why.
     """
     front = ModuleType(name, f"ahead-of-time kernel {module.__name__} ({module.__file__})")
-    if constants is not None:
-        front.__dict__.update({k: v for k, v in vars(constants).items() if not k.startswith("_")})
+    if constants is not None:  # its constants only: a function of it may be an interpreted one
+        front.__dict__.update({k: v for k, v in vars(constants).items()
+                               if not k.startswith("_") and not callable(v) and not isinstance(v, ModuleType)})
     front.__dict__.update({k: v for k, v in vars(module).items() if not k.startswith("_")})
     front.__dict__.update(extra)
     front.AHEAD_OF_TIME = module.__file__
@@ -189,8 +199,7 @@ def build_module(kernel: AotKernel, directory: Path | None = None) -> Path:
     """
     from numba.pycc import CC  # optional requirement: only the builder needs numba
 
-    provider_module, function = kernel.provider.split(":")
-    jit = getattr(importlib.import_module(provider_module), function)()
+    jit = _jit_module_of(kernel.provider)
     directory = Path(directory or aot_directory())
     directory.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(dir=directory, prefix=".build-") as tmp:
@@ -206,6 +215,17 @@ def build_module(kernel: AotKernel, directory: Path | None = None) -> Path:
         target = kernel.file(directory)
         os.replace(built, target)
     return target
+
+
+def _jit_module_of(provider: str) -> ModuleType:
+    """The just-in-time module a provider string names (see :class:`AotKernel`)."""
+    if provider.startswith(_KERNEL_PROVIDER):
+        from .jit import load_compiled
+
+        name, _, entry = provider[len(_KERNEL_PROVIDER):].partition("=")
+        return load_compiled(KernelSource(name, Path(entry)))
+    provider_module, function = provider.rsplit(":", 1)
+    return getattr(importlib.import_module(provider_module), function)()
 
 
 def missing(kernels: Sequence[AotKernel]) -> list[AotKernel]:
@@ -272,7 +292,7 @@ def build_in_subprocess(kernels: Sequence[AotKernel], timeout_s: float = 600.0) 
 
 
 def main(argv: Sequence[str]) -> int:
-    """``python -m components.model.aot SHARED=module:function ...``: build each kernel."""
+    """``python -m components.compile.aot SHARED=PROVIDER ...``: build each kernel (providers: see :class:`AotKernel`)."""
     for item in argv:
         shared, _, provider = item.partition("=")
         path = build_module(AotKernel(shared, provider))

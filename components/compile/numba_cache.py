@@ -13,7 +13,7 @@ the kernel's dispatchers a locator whose directory is
 the same hash: any copy of the same kernel source, wherever it was extracted,
 finds the machine code compiled by the first run. The module name is part of
 the key because numba's cache refers to the module by name; the kernels are
-loaded under a name keyed by their sources (:mod:`components.model.shared_module`),
+loaded under a name keyed by their sources (:mod:`components.compile.jit`),
 the same for the host and every FMU build, so a machine compiles each version once.
 Nothing else numba caches in the process is affected.
 
@@ -33,22 +33,9 @@ from __future__ import annotations
 import hashlib
 import importlib
 import os
-import sys
 from pathlib import Path
 
-
-def user_cache_root() -> Path:
-    """Per-user cache directory of dtcosim (not created here)."""
-    explicit = os.environ.get("DTCOSIM_CACHE_DIR")
-    if explicit:
-        return Path(explicit)
-    if sys.platform == "win32":
-        base = Path(os.environ.get("LOCALAPPDATA") or Path.home() / "AppData" / "Local")
-    elif sys.platform == "darwin":
-        base = Path.home() / "Library" / "Caches"
-    else:
-        base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
-    return base / "dtcosim"
+from .user_cache import user_cache_root
 
 
 def source_hash(path: str | os.PathLike) -> str:

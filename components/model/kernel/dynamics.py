@@ -1,0 +1,103 @@
+"""The drivetrain's equations of motion from its assembled matrices: deflections, accelerations, Jacobian.
+
+The stage kinds are assembled into constant matrices once
+(:class:`components.model.assembly.Assembly`): mesh deflections ``d = A q + a_port u`` (eq. 8,
+10 and the parallel mesh in deviation angles), shaft twists ``S q``, and the folded matrix
+``fast`` with ``q_ddot = [F, q, v, u, u_dot, alpha_in] @ fast``, which holds the inverse
+inertias, the mesh moment arms ``-r_b = -r cos(alpha)`` (eq. 5-7), the shafts, the port input
+``u`` and the driver acceleration. Here they are evaluated for one state ``y = [q, v]``.
+"""
+
+from __future__ import annotations
+
+from .contact import contact_force, stiffness_sensitivity
+from .linalg import axpy, copy, vecmat
+from .stiffness import stiffness_factors
+
+
+def deflections(y, n, a_t, a_port, port, port_rate, out):
+    """Mesh deflections [m] (row 0) and their rates [m/s] (row 1) of ``y = [q, v, ...]`` and the port input."""
+    vecmat(y[:n], a_t, out[0])
+    vecmat(y[n:2 * n], a_t, out[1])
+    axpy(port, a_port, out[0])
+    axpy(port_rate, a_port, out[1])
+
+
+def acceleration(y, port, port_rate, alpha, factor, a_t, a_port, fast, contact, z, defl, acc):
+    """Deviation accelerations ``q_ddot`` [rad/s^2] into ``acc``.
+
+    Writes the deflections into ``defl`` and the forces [N] into ``z[:n_mesh]``; ``z`` starts with
+    ``[F, q, v, u, u_dot, alpha_in]`` afterwards.
+    """
+    m = defl.shape[1]
+    n2 = y.shape[0]
+    deflections(y, n2 // 2, a_t, a_port, port, port_rate, defl)
+    for i in range(m):
+        z[i] = contact_force(defl[0, i], defl[1, i], factor[i], contact[i])[0]
+    copy(y, z[m:m + n2])
+    z[m + n2] = port
+    z[m + n2 + 1] = port_rate
+    z[m + n2 + 2] = alpha
+    vecmat(z[:m + n2 + 3], fast, acc)
+
+
+def jacobian(y, port, port_rate, factor, a_t, a_port, contact, defl, nz_index, nz_value, cos_alpha, stks, stcs,
+             stks_port, stcs_port, inv_m, fd, fv, dq, dv, port_jac):
+    """Jacobian blocks of ``q_ddot``: ``dq``, ``dv`` (n x n) and the port columns (rows of ``port_jac``).
+
+    ``dq = -M^-1 (sum_i cos(alpha_i) dF_i/dd a_i a_i^T + S^T k S)`` summed over the few bodies each
+    mesh row ``a_i`` touches (``nz_index``, ``nz_value``: its nonzero columns and entries, index < 0
+    for padding); ``dv`` likewise with dF/d(rate) and ``S^T c S``.
+    """
+    n = dq.shape[0]
+    m = fd.shape[0]
+    width = nz_index.shape[1]
+    deflections(y, n, a_t, a_port, port, port_rate, defl)
+    for i in range(m):
+        _, fd[i], fv[i], _ = contact_force(defl[0, i], defl[1, i], factor[i], contact[i])
+    dq[:, :] = stks
+    dv[:, :] = stcs
+    port_jac[0, :] = stks_port
+    port_jac[1, :] = stcs_port
+    for i in range(m):
+        cq = cos_alpha[i] * fd[i]
+        cv = cos_alpha[i] * fv[i]
+        for p in range(width):
+            jp = int(nz_index[i, p])
+            if jp < 0:
+                break
+            bq = cq * nz_value[i, p]
+            bv = cv * nz_value[i, p]
+            for q in range(width):
+                jq = int(nz_index[i, q])
+                if jq < 0:
+                    break
+                dq[jp, jq] += bq * nz_value[i, q]
+                dv[jp, jq] += bv * nz_value[i, q]
+            port_jac[0, jp] += bq * a_port[i]
+            port_jac[1, jp] += bv * a_port[i]
+    for j in range(n):
+        s = -inv_m[j]
+        dq[j, :] *= s
+        dv[j, :] *= s
+        port_jac[0, j] *= s
+        port_jac[1, j] *= s
+
+
+def stiffness_rate(y, n, angle, speed, port, port_rate, a_t, a_port, contact, phasing, force_rows, factor, slope,
+                   defl, sens, out):
+    """``out += (dF/df df/dt) @ d q_ddot/dF``: the partial time derivative of ``q_ddot`` that a time-varying
+    mesh stiffness adds at driver angle ``angle`` [rad] and speed ``speed`` [rad/s] (its factor ``f`` moves
+    with the driver angle). Leaves the factors at ``angle`` in ``factor``."""
+    stiffness_factors(angle, phasing, factor, slope)
+    deflections(y, n, a_t, a_port, port, port_rate, defl)
+    for i in range(sens.shape[0]):
+        sens[i] = stiffness_sensitivity(defl[0, i], defl[1, i], factor[i], contact[i]) * (slope[i] * speed)
+    for j in range(out.shape[0]):
+        s = 0.0
+        for i in range(sens.shape[0]):
+            s += sens[i] * force_rows[i, j]
+        out[j] += s
+
+
+INLINE = ("deflections", "acceleration")

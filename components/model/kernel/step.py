@@ -1,0 +1,227 @@
+"""One communication step of the gearbox (the co-simulation cut at the generator) and its outputs.
+
+:func:`gearbox_step` advances the state held in the model's buffer (:mod:`.layout`) from ``t``
+to ``t + h`` with the inputs received at ``t``; :func:`outputs` writes every output. The inputs
+are interpreted as described in :mod:`.motion`: the driver (rotor) follows a cubic from the
+motion it had to the target extrapolated from the rotor inputs (linear acceleration estimate, or
+the source's acceleration and jerk with ``rotor_derivatives``); the port is either the
+generator end of the output shaft following its own curve (``motion`` interface) or the
+counter torque held over the step with the generator rotor a degree of freedom whose speed is
+re-anchored on the generator-speed input (``inertia`` interface).
+
+This is the gearbox kernel's entry module: run interpreted, compiled by numba, or ahead of time
+(``AOT_EXPORTS``) - see :mod:`components.compile`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import namedtuple
+
+from .dynamics import acceleration
+from .integrator import advance
+from .layout import (
+    A_PORT, A_T, ACC, ANCHOR, BACKUP, CONTACT, CONTROL, COS_ALPHA, D_END_TORQUE, D_EXTRAPOLATE, D_GEN_DOF, D_M, D_N,
+    D_ROTOR_DERIVATIVES, D_TVS, DA, DEFL, DQ, DRIVER, DV, F0, F1, FAST, FD, FN, FACTOR, FORCE_ROWS, FV,
+    INV_M, ISTATE, K1, K2, K3, KAPPA, LAST_ACC, LAST_DEFL, LAST_FORCE, NON_FINITE_INPUT, NZ_INDEX, NZ_VALUE, OK,
+    OUT_KINEMATIC, OUT_RATE_INDEX, OUTPUT_MATRIX, OUTPUTS, PHASING, PORT, PORT_JAC, RHS, S_ALPHA_OUT_AVG,
+    S_DRIVER_ACCEL, S_DRIVER_ANGLE, S_DRIVER_SPEED, S_KX, S_LAST_ALPHA, S_LAST_OMEGA_GEN, S_LAST_OMEGA_ROTOR,
+    S_LAST_STEP, S_OUTPUT_TWIST, S_PORT_ANGLE, S_PORT_SPEED, S_SHAFT_C, S_SHAFT_K, S_SHAFT_TORQUE_AVG, S_TIME,
+    S_TWIST_PORT, SCALARS, SENS, SLOPE, STATE_FIRST, STATE_LAST, STCS, STCS_PORT, STKS, STKS_PORT, TWIST_Q, W_BASES,
+    W_HDT, WINVS, Y, Y1, YN, Z, ALPHA_OUT_MAX,
+)
+from .linalg import copy, vecmat
+from .motion import accel, fit, linear_target, taylor_target
+from .stiffness import stiffness_factors
+
+#: everything :func:`~.integrator.advance` reads and writes: views of the buffer
+Gearbox = namedtuple("Gearbox", (
+    "a_t", "a_port", "fast", "contact", "stks", "stcs", "stks_port", "stcs_port", "inv_m", "phasing", "kappa",
+    "force_rows", "nz_index", "nz_value", "cos_alpha", "control",
+    "z", "defl", "acc", "fd", "fv", "factor", "slope", "sens", "f0", "f1", "fn", "k1", "k2", "k3", "y1", "yn", "rhs",
+    "w_hdt", "da",
+    "istate", "dq", "dv", "winvs", "w_bases", "port_jac", "last_acc", "last_force", "last_defl", "state", "backup",
+    "tvs",
+))
+
+
+def vector(buf, lay, slot):
+    """The slot as a 1-D view of the buffer."""
+    return buf[lay[slot]:lay[slot + 1]]
+
+
+def matrix(buf, lay, slot, rows):
+    """The slot as a 2-D view with ``rows`` rows."""
+    v = buf[lay[slot]:lay[slot + 1]]
+    return v.reshape((rows, v.shape[0] // rows))
+
+
+def views(buf, lay, dims):
+    """The :class:`Gearbox` views of a buffer."""
+    n = dims[D_N]
+    m = dims[D_M]
+    n2 = 2 * n
+    winvs = vector(buf, lay, WINVS).reshape((2, n2, n2))
+    w_bases = vector(buf, lay, W_BASES).reshape((2, 3, n2))
+    return Gearbox(
+        matrix(buf, lay, A_T, n), vector(buf, lay, A_PORT), matrix(buf, lay, FAST, m + n2 + 3),
+        matrix(buf, lay, CONTACT, m), matrix(buf, lay, STKS, n), matrix(buf, lay, STCS, n),
+        vector(buf, lay, STKS_PORT), vector(buf, lay, STCS_PORT), vector(buf, lay, INV_M),
+        matrix(buf, lay, PHASING, 7), vector(buf, lay, KAPPA), matrix(buf, lay, FORCE_ROWS, m),
+        matrix(buf, lay, NZ_INDEX, m), matrix(buf, lay, NZ_VALUE, m), vector(buf, lay, COS_ALPHA),
+        vector(buf, lay, CONTROL),
+        vector(buf, lay, Z), matrix(buf, lay, DEFL, 2), vector(buf, lay, ACC), vector(buf, lay, FD),
+        vector(buf, lay, FV), vector(buf, lay, FACTOR), vector(buf, lay, SLOPE), vector(buf, lay, SENS),
+        vector(buf, lay, F0), vector(buf, lay, F1), vector(buf, lay, FN), vector(buf, lay, K1), vector(buf, lay, K2),
+        vector(buf, lay, K3), vector(buf, lay, Y1), vector(buf, lay, YN), vector(buf, lay, RHS),
+        vector(buf, lay, W_HDT), vector(buf, lay, DA),
+        vector(buf, lay, ISTATE), matrix(buf, lay, DQ, n), matrix(buf, lay, DV, n), winvs, w_bases,
+        matrix(buf, lay, PORT_JAC, 2), vector(buf, lay, LAST_ACC), vector(buf, lay, LAST_FORCE),
+        matrix(buf, lay, LAST_DEFL, 2), buf[lay[STATE_FIRST]:lay[STATE_LAST + 1]], vector(buf, lay, BACKUP),
+        dims[D_TVS] != 0,
+    )
+
+
+def outputs(buf, lay, dims):
+    """Every output at the current time into the ``outputs`` slot.
+
+    ``[shaft torque (average or end), average, then the linear outputs, alpha_out average, alpha_out max]``;
+    the linear outputs are ``[F, q, v, port angle, port speed, driver speed, driver accel] @ output_matrix``.
+    """
+    n = dims[D_N]
+    m = dims[D_M]
+    sc = vector(buf, lay, SCALARS)
+    out = vector(buf, lay, OUTPUTS)
+    z = vector(buf, lay, Z)
+    y = vector(buf, lay, Y)
+    force = vector(buf, lay, LAST_FORCE)
+    for i in range(m):
+        z[i] = force[i]
+    for i in range(2 * n):
+        z[m + i] = y[i]
+    z[m + 2 * n] = sc[S_PORT_ANGLE]
+    z[m + 2 * n + 1] = sc[S_PORT_SPEED]
+    z[m + 2 * n + 2] = sc[S_DRIVER_SPEED]
+    z[m + 2 * n + 3] = sc[S_DRIVER_ACCEL]
+    cols = out.shape[0] - 4
+    vecmat(z, matrix(buf, lay, OUTPUT_MATRIX, m + 2 * n + 4), out[2:2 + cols])
+    avg = sc[S_SHAFT_TORQUE_AVG]
+    out[0] = out[2] if dims[D_END_TORQUE] != 0 else avg
+    out[1] = avg
+    out[2 + cols] = sc[S_ALPHA_OUT_AVG]
+    out[3 + cols] = vector(buf, lay, ISTATE)[ALPHA_OUT_MAX]
+
+
+def current_loads(buf, lay, dims):
+    """The accelerations, forces and deflections at the current state and inputs (the start of the next step),
+    then every output. Called after the state was set from outside (initialisation)."""
+    k = views(buf, lay, dims)
+    sc = vector(buf, lay, SCALARS)
+    m = dims[D_M]
+    if k.tvs:
+        stiffness_factors(sc[S_DRIVER_ANGLE], k.phasing, k.factor, k.slope)
+    else:
+        k.factor[:] = 1.0
+    acceleration(vector(buf, lay, Y), sc[S_PORT_ANGLE], sc[S_PORT_SPEED], sc[S_LAST_ALPHA], k.factor, k.a_t,
+                 k.a_port, k.fast, k.contact, k.z, k.defl, k.acc)
+    copy(k.acc, k.last_acc)
+    copy(k.z[:m], k.last_force)
+    copy(k.defl[0], k.last_defl[0])
+    copy(k.defl[1], k.last_defl[1])
+    outputs(buf, lay, dims)
+
+
+def gearbox_step(buf, lay, dims, t, h, omega_rotor, phi_rotor, omega_gen, phi_gen, counter_torque, alpha_rotor,
+                 jerk_rotor):
+    """Advance the state in ``buf`` from ``t`` to ``t + h`` [s] with the inputs received at ``t``; outputs into the buffer.
+
+    Returns ``(status, local time, step size, error norm)`` (:func:`~.integrator.advance`), or
+    ``NON_FINITE_INPUT``; on failure the buffer is as it was at ``t``.
+    """
+    n = dims[D_N]
+    m = dims[D_M]
+    gdof = dims[D_GEN_DOF]
+    k = views(buf, lay, dims)
+    sc = vector(buf, lay, SCALARS)
+    y = vector(buf, lay, Y)
+    out_kin = k.control[OUT_KINEMATIC]
+    out_idx = int(k.control[OUT_RATE_INDEX])
+    extrapolate = dims[D_EXTRAPOLATE] != 0 and sc[S_LAST_STEP] > 0.0
+    alpha_gen = (omega_gen - sc[S_LAST_OMEGA_GEN]) / sc[S_LAST_STEP] if extrapolate and gdof < 0 else 0.0
+    if dims[D_ROTOR_DERIVATIVES] != 0:  # third-order Taylor from the source's derivatives
+        angle1, speed1 = taylor_target(h, phi_rotor, omega_rotor, alpha_rotor, jerk_rotor)
+    else:  # the acceleration estimated from the last two speed inputs
+        alpha = (omega_rotor - sc[S_LAST_OMEGA_ROTOR]) / sc[S_LAST_STEP] if extrapolate else 0.0
+        angle1, speed1 = linear_target(h, phi_rotor, omega_rotor, alpha)
+    kx = sc[S_KX]
+    dv = 0.0
+    if gdof >= 0:  # inertia interface: the port input is the held counter torque
+        port0 = counter_torque
+        port_speed0 = 0.0
+        port1 = port0
+        port_speed1 = 0.0
+        dv = omega_gen - kx * sc[S_DRIVER_SPEED] - y[n + gdof]
+        if not math.isfinite(dv + port0):
+            return NON_FINITE_INPUT, 0.0, h, 0.0
+    else:  # motion interface: the port is the generator end's deviation from the kinematic motion
+        port0 = sc[S_PORT_ANGLE]
+        port_speed0 = sc[S_PORT_SPEED]
+        gen_angle1, gen_speed1 = linear_target(h, phi_gen, omega_gen, alpha_gen)
+        port1 = gen_angle1 - kx * angle1
+        port_speed1 = gen_speed1 - kx * speed1
+    if not math.isfinite(angle1 + speed1 + port1 + port_speed1):
+        return NON_FINITE_INPUT, 0.0, h, 0.0
+    driver = vector(buf, lay, DRIVER)
+    port = vector(buf, lay, PORT)
+    angle0 = sc[S_DRIVER_ANGLE]
+    fit(driver, h, 0.0, sc[S_DRIVER_SPEED], angle1 - sc[S_DRIVER_ANGLE], speed1)
+    fit(port, h, port0, port_speed0, port1, port_speed1)
+    anchor = vector(buf, lay, ANCHOR)
+    last_acc = k.last_acc
+    if gdof >= 0:  # re-anchor the generator speed; the loads follow linearly (the generator is in no mesh)
+        d_torque = port0 - sc[S_PORT_ANGLE]
+        anchor[0] = y[n + gdof]
+        y[n + gdof] += dv
+        for j in range(n):
+            anchor[1 + j] = last_acc[j]
+            last_acc[j] += dv * k.fast[m + n + gdof, j] + d_torque * k.fast[m + 2 * n, j]
+    twist_start = sc[S_OUTPUT_TWIST]
+    speed_start = out_kin * sc[S_DRIVER_SPEED] + y[out_idx]
+    twist_q = vector(buf, lay, TWIST_Q)
+    status, tau, h_fail, err, twist_integral = advance(
+        k, y, h, sc[S_LAST_ALPHA] - accel(driver, 0.0), driver, port, angle0, twist_q, sc[S_TWIST_PORT])
+    if status != OK:
+        if gdof >= 0:  # undo the re-anchoring (advance restored the state it was given)
+            y[n + gdof] = anchor[0]
+            for j in range(n):
+                last_acc[j] = anchor[1 + j]
+        return status, tau, h_fail, err
+    sc[S_TIME] = t + h
+    sc[S_DRIVER_ANGLE] = angle1
+    sc[S_DRIVER_SPEED] = speed1
+    sc[S_DRIVER_ACCEL] = accel(driver, h)
+    sc[S_LAST_ALPHA] = sc[S_DRIVER_ACCEL]
+    sc[S_PORT_ANGLE] = port1
+    sc[S_PORT_SPEED] = port_speed1
+    sc[S_LAST_OMEGA_ROTOR] = omega_rotor
+    sc[S_LAST_OMEGA_GEN] = omega_gen
+    sc[S_LAST_STEP] = h
+    twist_end = 0.0
+    for i in range(2 * n):
+        twist_end += twist_q[i] * y[i]
+    twist_end += sc[S_TWIST_PORT] * port1
+    sc[S_OUTPUT_TWIST] = twist_end
+    # (1/h) int T dt = k mean(twist) + c (twist_end - twist_start) / h: conserves the exchanged impulse
+    sc[S_SHAFT_TORQUE_AVG] = sc[S_SHAFT_K] * twist_integral / h + sc[S_SHAFT_C] * (twist_end - twist_start) / h
+    sc[S_ALPHA_OUT_AVG] = (out_kin * speed1 + y[out_idx] - speed_start) / h
+    outputs(buf, lay, dims)
+    return OK, tau, h, 0.0
+
+
+INLINE = ("vector", "matrix")
+#: entry points of the ahead-of-time compiled module (:mod:`components.compile.aot`) and their signatures
+AOT_EXPORTS = {
+    "gearbox_step": "Tuple((i8, f8, f8, f8))(f8[::1], i8[::1], i8[::1], f8, f8, f8, f8, f8, f8, f8, f8, f8)",
+    "outputs": "void(f8[::1], i8[::1], i8[::1])",
+    "current_loads": "void(f8[::1], i8[::1], i8[::1])",
+}
