@@ -71,7 +71,7 @@ def compiled_or_numpy(kernel: str | None, load: Callable[[], tuple[ModuleType | 
         return module, None
     if wanted == "compiled":
         raise ParameterError("kernel", "compiled", f"a compiled kernel: an ahead-of-time module or numba ({reason})")
-    return None, f"{what} unavailable ({reason}); using the numpy path"
+    return None, f"{what} unavailable ({reason}); running it interpreted (numpy)"
 
 
 def compiled_module(source: KernelSource, interpreted: ModuleType | None = None,

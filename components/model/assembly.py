@@ -317,13 +317,14 @@ class Assembly:
             np.vstack([self._neg_B, self._shaft_QY, port_q[None, :], port_v[None, :], -self.kinematic_ratio[None, :]])
             * np.append(self.inv_inertia[None, :].repeat(self._neg_B.shape[0] + 2 * self.n_dof + 2, 0), [np.ones(self.n_dof)], 0)
         )
-        self._mesh_rate = np.array([m.teeth_per_driver_rad for m in self.meshes])
-        self._mesh_offset = np.array([m.phase_offset_rad for m in self.meshes])
-        self._mesh_variation = np.array([m.contact.stiffness_variation for m in self.meshes])
-        self._mesh_contact_ratio = np.array([m.contact.contact_ratio for m in self.meshes])
+        #: per mesh: mesh-cycle phase per driver radian [rad/rad], its offset [rad], stiffness variation, contact ratio
+        self.mesh_phase_rate = np.array([m.teeth_per_driver_rad for m in self.meshes])
+        self.mesh_phase_offset = np.array([m.phase_offset_rad for m in self.meshes])
+        self.mesh_stiffness_variation = np.array([m.contact.stiffness_variation for m in self.meshes])
+        self.mesh_contact_ratio = np.array([m.contact.contact_ratio for m in self.meshes])
         self.phasing = None
         if self.time_varying_stiffness:
-            self.phasing = MeshPhasing(self._mesh_rate, self._mesh_offset, self._mesh_contact_ratio, self._mesh_variation)
+            self.phasing = MeshPhasing(self.mesh_phase_rate, self.mesh_phase_offset, self.mesh_contact_ratio, self.mesh_stiffness_variation)
         #: the kernel's phasing table (zeros when the stiffness is constant), shape (7, n_mesh)
         self.phasing_table = self.phasing.table if self.phasing is not None else np.zeros((N_PHASING_ROWS, self.n_mesh))
         #: d q_ddot / d F, shape (n_mesh, n_dof): the force rows of the folded matrix

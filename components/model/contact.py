@@ -40,11 +40,12 @@ from .. import units
 from ..validation import finite, in_range, non_negative, one_of, positive, set_fields
 from . import kernel
 from .kernel.contact import (
-    CMAX, DAMPING, DEEP, DMAX, EXPONENT, HALF_JT, K0, LAMBDA, LAW, LAWS, N_CONTACT_COLUMNS,
+    CMAX, DAMPING, DEEP, DMAX, EXPONENT, HALF_JT, K0, LAMBDA, LAW, LAW_DESCRIPTIONS, LAWS, N_CONTACT_COLUMNS,
 )
 
-#: the contact laws by name, in the order of their codes in the kernel's contact table
+#: the contact laws by name, in the order of their codes in the kernel's contact table, and what each is
 CONTACT_LAWS = LAWS
+CONTACT_LAW_DESCRIPTIONS = LAW_DESCRIPTIONS
 #: Contact-force magnitude below which a mesh counts as "inside the backlash" (out of contact) [N].
 CONTACT_LOSS_THRESHOLD_N = 1.0
 

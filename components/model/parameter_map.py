@@ -49,7 +49,7 @@ from typing import Mapping
 
 from ..errors import ParameterError
 from ..validation import choice_bounds
-from .contact import CONTACT_LAWS, MeshContact
+from .contact import CONTACT_LAW_DESCRIPTIONS, CONTACT_LAWS, MeshContact
 from .drivetrain import Drivetrain
 from .generator import EVENT_KINDS, GeneratorParameters, LoadEvent
 from .stages import PlanetaryStage, Shaft
@@ -89,7 +89,7 @@ DESCRIPTIONS: dict[str, str] = {
     "drive_inertia": "drive-gear inertia", "driven_inertia": "driven-gear inertia",
     "k0": "Hertzian contact stiffness k0 (eq. 2)", "exponent": "contact force exponent e",
     "c0": "contact damping c0, damping = c0 |delta_BL| (eq. 2, 9)", "lambda": "backlash regularisation factor (eq. 4)",
-    "backlash": "normal backlash j_n", "pressure_angle": "pressure angle", "contact_law": "0 = CFS (eq. 2-4), 1 = impact (eq. 1)",
+    "backlash": "normal backlash j_n", "pressure_angle": "pressure angle", "contact_law": ", ".join(f"{code} = {law}" for code, law in enumerate(CONTACT_LAW_DESCRIPTIONS)),
     "impact_depth": "penetration d_max of full impact damping", "impact_damping": "impact damping c_max (< 0: c0 * d_max)",
     "contact_ratio": "contact ratio (time-varying stiffness)", "stiffness_variation": "relative mesh-stiffness variation (0: off)",
     "stiffness": "torsional stiffness", "damping": "torsional damping", "inertia": "rotor inertia",

@@ -122,7 +122,7 @@ def peak_output_acceleration(
 
         a = system.assembly
         omega_max = float(np.max(np.abs(np.asarray(driver.speed(np.linspace(t0, t1, 2001)), dtype=float))))
-        max_step = min(max_step, max_step_s(a._mesh_rate, a._mesh_variation, 1.05 * omega_max))
+        max_step = min(max_step, max_step_s(a.mesh_phase_rate, a.mesh_stiffness_variation, 1.05 * omega_max))
 
     def alpha(t: float, y: np.ndarray) -> float:
         return float(system.rhs(t, y)[n + j] + kappa * float(driver.acceleration(t)))

@@ -264,7 +264,7 @@ def simulate_monolithic(
         from ..model.mesh_stiffness import max_step_s
 
         omega_max = float(np.max(np.abs(np.asarray(driver.speed(np.linspace(t0, t1, 2001)), dtype=float))))
-        cap = max_step_s(a._mesh_rate, a._mesh_variation, 1.05 * omega_max)
+        cap = max_step_s(a.mesh_phase_rate, a.mesh_stiffness_variation, 1.05 * omega_max)
         hmax = cap if hmax <= 0.0 else min(hmax, cap)
     breaks = [t for t in system.schedule.event_times if t0 < t < t1]
     edges = [t0, *breaks, t1]

@@ -11,6 +11,7 @@ from typing import Any, Literal
 
 from pydantic import Field
 
+from components.model.contact import CONTACT_LAWS
 from components.model.stages import STEEL_DENSITY_KG_M3
 
 from ..errors import EntryError
@@ -42,7 +43,7 @@ class UnitsTable(Table):
 class MeshTable(Table):
     """Contact law and parameters of a mesh; missing entries come from the file's ``[mesh]``."""
 
-    law: Literal["cfs", "impact"] | None = None
+    law: Literal[CONTACT_LAWS] | None = None  # the laws of components.model.kernel.contact
     k0: float | None = Field(None, gt=0, description="a number > 0: contact stiffness k0 [contact_stiffness unit]")
     exponent: float | None = Field(None, ge=1, le=3, description="a number in [1, 3]: the force exponent e")
     c0: float | None = Field(None, ge=0, description="a number >= 0: contact damping c0 [contact_damping unit]")

@@ -9,9 +9,9 @@ import zipfile
 import numpy as np
 import pytest
 
-from components.model.aot import ENVIRONMENT_VARIABLE as AOT_VARIABLE
-from components.model.aot import missing
-from components.model.kernel_request import requested_kernel
+from components.compile.aot import ENVIRONMENT_VARIABLE as AOT_VARIABLE
+from components.compile.aot import missing
+from components.compile.choice import requested_kernel
 from fmus.model_description import rewrite_archive
 from fmus.selftest import environment_python, run_fmus
 from orchestrator.cosim.compiled_kernels import aot_kernels

@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 from fmpy import read_model_description
 
-from components.model.aot import ENVIRONMENT_VARIABLE as AOT_VARIABLE
-from components.model.aot import missing
+from components.compile.aot import ENVIRONMENT_VARIABLE as AOT_VARIABLE
+from components.compile.aot import missing
 from components.model.gearbox_model import GearboxModel
 from components.model.generator import GeneratorRotor
 from components.model.presets import cosim_preset

@@ -13,7 +13,7 @@ its columns named below. The force acts along the line of action; a positive def
   wherever it would point against the flank in contact; the literal eq. 2 would let the
   damping term glue separating teeth (the paper's sign rule).
 
-Adding a law: a code in :data:`LAWS`, its columns if it needs new ones, a branch in
+Adding a law: a code in :data:`LAWS` and :data:`LAW_DESCRIPTIONS`, its columns if it needs new ones, a branch in
 :func:`contact_force` (and :func:`stiffness_sensitivity` if its force is not linear in ``k0``).
 """
 
@@ -21,8 +21,9 @@ from __future__ import annotations
 
 import math
 
-#: contact laws by code (the column ``LAW`` of a mesh's row)
+#: contact laws by code (the column ``LAW`` of a mesh's row), and what each is
 LAWS = ("cfs", "impact")
+LAW_DESCRIPTIONS = ("CFS (eq. 2-4)", "impact (eq. 1)")
 CFS, IMPACT = range(len(LAWS))
 #: columns of a mesh's row of the contact table
 K0, EXPONENT, DAMPING, LAMBDA, HALF_JT, LAW, DMAX, CMAX, DEEP = range(9)

@@ -133,8 +133,8 @@ def test_step_cap_is_half_a_transition_of_the_fastest_varying_mesh():
     a = Assembly(table6_gearbox().with_meshes(stiffness_variation=0.3))
     w = units.rpm(16.0)
     period = 1.0 / (20 * 80 * 16 / 60)  # stage-3 mesh period
-    assert max_step_s(a._mesh_rate, a._mesh_variation, w) == pytest.approx(0.5 * TRANSITION_FRACTION * period)
-    assert max_step_s(a._mesh_rate, np.zeros(a.n_mesh), w) == math.inf
+    assert max_step_s(a.mesh_phase_rate, a.mesh_stiffness_variation, w) == pytest.approx(0.5 * TRANSITION_FRACTION * period)
+    assert max_step_s(a.mesh_phase_rate, np.zeros(a.n_mesh), w) == math.inf
 
 
 @pytest.fixture(scope="module")
@@ -177,12 +177,12 @@ def test_mesh_phasing_matches_the_stiffness_factor_and_its_slope_is_the_derivati
     dt = table6_gearbox().with_meshes(stiffness_variation=0.3)
     dt = with_stage(dt, 2, mesh=replace(dt.stages[2].mesh, contact_ratio=2.0))  # integer ratio: constant
     a = Assembly(dt)
-    ph = MeshPhasing(a._mesh_rate, a._mesh_offset, a._mesh_contact_ratio, a._mesh_variation)
+    ph = MeshPhasing(a.mesh_phase_rate, a.mesh_phase_offset, a.mesh_contact_ratio, a.mesh_stiffness_variation)
     eps = 1e-9
-    largest_slope = 0.3 * 30 / 16 / TRANSITION_FRACTION * a._mesh_rate.max() / (2 * math.pi)  # v S'(1/2) / w x cycles/rad
+    largest_slope = 0.3 * 30 / 16 / TRANSITION_FRACTION * a.mesh_phase_rate.max() / (2 * math.pi)  # v S'(1/2) / w x cycles/rad
     for angle in np.linspace(0.0, 0.05, 997):  # many stage-1/2 mesh transitions
-        phase = angle * a._mesh_rate + a._mesh_offset
-        expected = stiffness_factor(phase, a._mesh_contact_ratio, a._mesh_variation)
+        phase = angle * a.mesh_phase_rate + a.mesh_phase_offset
+        expected = stiffness_factor(phase, a.mesh_contact_ratio, a.mesh_stiffness_variation)
         f, slope = ph.factor_and_slope(angle)
         np.testing.assert_allclose(ph.factor(angle), expected, rtol=0, atol=1e-12)
         np.testing.assert_allclose(f, expected, rtol=0, atol=1e-12)
@@ -190,7 +190,7 @@ def test_mesh_phasing_matches_the_stiffness_factor_and_its_slope_is_the_derivati
         np.testing.assert_allclose(slope, fd, rtol=1e-5, atol=1e-6 * largest_slope)
     assert np.all(ph.factor(0.0123)[-1] == 1.0)  # the integer-ratio stage-3 mesh
     with pytest.raises(ParameterError, match="stiffness_variation"):
-        MeshPhasing(a._mesh_rate, a._mesh_offset, a._mesh_contact_ratio, np.full(a.n_mesh, 2.0))
+        MeshPhasing(a.mesh_phase_rate, a.mesh_phase_offset, a.mesh_contact_ratio, np.full(a.n_mesh, 2.0))
 
 
 def test_the_kernels_stiffness_rate_is_the_time_derivative_of_the_acceleration():

@@ -169,17 +169,18 @@ def test_compiled_phasor_step_agrees_with_the_numpy_path_to_round_off(kernel):
 
 
 def test_phasor_stepper_without_numba_falls_back_or_refuses(monkeypatch):
-    from components.model import wind
+    from components.compile import choice
     from components.model.wind import PhasorStepper
 
-    monkeypatch.setattr(wind, "_compiled_wind_module", lambda: (None, "ModuleNotFoundError: No module named 'numba'"))
+    monkeypatch.setattr(choice, "compiled_module",
+                        lambda *args, **kwargs: (None, "ModuleNotFoundError: No module named 'numba'"))
     process = RotorSpeedProcess(WindParameters())
     stepper = PhasorStepper(process, "auto")
     assert stepper.kernel == "numpy"
     assert stepper.kernel_note == ("compiled wind step unavailable (ModuleNotFoundError: No module named 'numba'); "
-                                   "using the numpy path")
+                                   "running it interpreted (numpy)")
     assert PhasorStepper(process, "numpy").kernel_note is None
-    with pytest.raises(ParameterError, match=r"kernel = 'compiled'.*an importable numba \(ModuleNotFoundError"):
+    with pytest.raises(ParameterError, match=r"kernel = 'compiled'.*a compiled kernel: .*numba \(ModuleNotFoundError"):
         PhasorStepper(process, "compiled")
     with pytest.raises(ParameterError, match="kernel = 'fast'.*one of auto, numpy, compiled"):
         PhasorStepper(process, "fast")

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from components.model.aot import aot_directory
-from components.model.numba_cache import source_hash
+from components.compile.aot import aot_directory
+from components.compile.numba_cache import source_hash
 from orchestrator.commands.cli import main
 from orchestrator.cosim.compiled_kernels import aot_kernels
 
