@@ -38,7 +38,7 @@ def run_recipe(work: Path, fmu_dir: Path, recipe: str, extra_env: dict | None = 
     """Run ``recipe`` with bash in ``work``, in this virtual environment (its bin/ first on PATH)."""
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "LD_PRELOAD")}
     env["PATH"] = f"{Path(sys.executable).parent}{os.pathsep}{env.get('PATH', '')}"
-    env["DTCOSIM_FMU_DIR"] = str(fmu_dir)  # the session's FMUs (else export-ssp builds them into ./fmus)
+    env["DTCOSIM_FMU_DIR"] = str(fmu_dir)  # the session's FMUs (else export-ssp builds them into the per-user cache)
     env.update(extra_env or {})
     return subprocess.run(["bash", "-euo", "pipefail", "-c", recipe], cwd=work, env=env, capture_output=True,
                           text=True, timeout=900)
