@@ -18,11 +18,9 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import Protocol
 
 from components.model.numba_cache import user_cache_root
-
-from ..inputs.drivetrain_file import DrivetrainSpec
-from ..inputs.series_spec import SeriesSpec
 
 #: environment variable naming the FMU folder
 FMU_DIR_VARIABLE = "DTCOSIM_FMU_DIR"
@@ -30,6 +28,18 @@ FMU_DIR_VARIABLE = "DTCOSIM_FMU_DIR"
 DRIVETRAIN_FOLDER = "drivetrains"
 #: folder of the FMU folder with the FMUs built from load records, one subfolder per selected content
 SERIES_FOLDER = "series"
+
+
+class ContentKeyed(Protocol):
+    """What an FMU is built from, named by its content: a drivetrain file or a load record selection.
+
+    (:class:`orchestrator.inputs.drivetrain_file.DrivetrainSpec`,
+    :class:`orchestrator.inputs.series_spec.SeriesSpec`; not imported here, to keep this module light.)
+    """
+
+    @property
+    def key(self) -> str:
+        """``<name>-<sha256[:16]>`` of the content."""
 
 
 def default_fmu_dir() -> Path:
@@ -40,11 +50,11 @@ def default_fmu_dir() -> Path:
     return user_cache_root() / "fmus"
 
 
-def drivetrain_fmu_dir(fmu_dir: Path, spec: DrivetrainSpec) -> Path:
+def drivetrain_fmu_dir(fmu_dir: Path, spec: ContentKeyed) -> Path:
     """Where the FMUs built from a drivetrain file live: ``<fmu_dir>/drivetrains/<name>-<sha256[:16]>/``."""
     return Path(fmu_dir) / DRIVETRAIN_FOLDER / spec.key
 
 
-def series_fmu_dir(fmu_dir: Path, spec: SeriesSpec) -> Path:
+def series_fmu_dir(fmu_dir: Path, spec: ContentKeyed) -> Path:
     """Where the TimeSeriesSource built from a load record lives: ``<fmu_dir>/series/<stem>-<sha256[:16]>/``."""
     return Path(fmu_dir) / SERIES_FOLDER / spec.key
