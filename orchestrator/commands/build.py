@@ -1,10 +1,10 @@
-"""``dtcosim build``: build the FMUs WindSource, Gearbox and GeneratorRotor (from a preset or a drivetrain file)."""
+"""``dtcosim build``: build the project's FMUs (from a preset, a drivetrain file or a scenario)."""
 
 from __future__ import annotations
 
 import argparse
 
-from fmus.build import add_arguments, run as run_preset
+from fmus.build import PRESET_FMU_NAMES, add_arguments, run as run_preset
 
 from ..cosim.fmu_folder import default_fmu_dir
 
@@ -13,8 +13,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``build`` subcommand."""
     p = sub.add_parser(
         "build",
-        help="build the FMUs WindSource, Gearbox and GeneratorRotor",
-        description=("Build the self-contained pythonfmu FMUs WindSource.fmu, Gearbox.fmu and GeneratorRotor.fmu. "
+        help=f"build the FMUs {', '.join(PRESET_FMU_NAMES)}",
+        description=(f"Build the self-contained pythonfmu FMUs {', '.join(n + '.fmu' for n in PRESET_FMU_NAMES)}. "
                      "With --drivetrain FILE: Gearbox.fmu and GeneratorRotor.fmu of that drivetrain file, by default "
                      "into the FMU directory's folder of the file's content (drivetrains/<name>-<sha256>/), where "
                      "scenarios naming the file find them."),
