@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
-"""Build the dtcosim FMUs: ``python build_fmus.py [--out DIR] [--preset table6|table5|table3]``.
+"""Build the dtcosim FMUs from a checkout: ``python build_fmus.py [--out DIR] [--preset table6|table5|table3]``.
 
-Writes WindSource.fmu, Gearbox.fmu and GeneratorRotor.fmu (default: into ``fmus/``
-next to this script). The build logic is :mod:`fmus.build` (also ``dtcosim build``).
+The same as ``dtcosim build`` (:mod:`orchestrator.commands.build`): writes the FMUs into
+the FMU folder ``dtcosim run`` searches (``$DTCOSIM_FMU_DIR``, else ``fmus/`` in the
+per-user cache, ``~/.cache/dtcosim/fmus``) or into ``--out``; never into the checkout.
 """
 
 import sys
@@ -10,7 +11,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from fmus.build import main  # noqa: E402
+from orchestrator.commands.cli import end_process, main  # noqa: E402
 
 if __name__ == "__main__":
-    sys.exit(main(default_out=Path(__file__).resolve().parent / "fmus"))
+    end_process(main(["build", *sys.argv[1:]]))

@@ -37,7 +37,7 @@ from pathlib import Path
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--fmu-dir", type=Path, default=None, help="FMU directory (default: the project's fmus/, built if missing)")
+    parser.add_argument("--fmu-dir", type=Path, default=None, help="FMU directory (default: the FMU folder `dtcosim run` uses, $DTCOSIM_FMU_DIR or ~/.cache/dtcosim/fmus; built if missing)")
     parser.add_argument("--stop", type=float, default=60.0, help="stop time [s] (default 60)")
     parser.add_argument("--step", type=float, default=None, help="communication step [s] (default: the scenario's)")
     parser.add_argument("--repeat", type=int, default=3, help="measured runs of each (default 3)")

@@ -31,7 +31,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_sweep import free_cores  # noqa: E402
 
 from orchestrator.inputs.load_cases import load_cases_from_dict  # noqa: E402
-from orchestrator.study.lifetime_results import store_run_data, write_lifetime_outputs  # noqa: E402
+from orchestrator.study.lifetime_outputs import write_lifetime_outputs  # noqa: E402
+from orchestrator.study.lifetime_results import store_run_data  # noqa: E402
 from orchestrator.study.load_cases import prepare_load_cases  # noqa: E402
 from orchestrator.study.sweep import run_sweep  # noqa: E402
 

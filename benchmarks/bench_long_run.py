@@ -275,7 +275,7 @@ def phases_main(args) -> None:
     phases = Phases()
 
     def imports():
-        from orchestrator.cosim.fmu_store import ensure_fmus  # noqa: F401
+        from orchestrator.provision.project_fmus import ensure_fmus  # noqa: F401
         from orchestrator.run import runner  # noqa: F401
 
     phases.run("imports", imports)

@@ -295,7 +295,7 @@ def main() -> None:
     parser.add_argument("--interfaces", action="store_true", help="also the table of the Gearbox's interface "
                         "options (generator_interface, rotor_derivatives) at every H")
     parser.add_argument("--variants", action="store_true", help="compare master variants instead")
-    parser.add_argument("--fmu-dir", default=None, help="FMU directory (default: the project's fmus/)")
+    parser.add_argument("--fmu-dir", default=None, help="FMU directory (default: the FMU folder `dtcosim run` uses, $DTCOSIM_FMU_DIR or ~/.cache/dtcosim/fmus)")
     args = parser.parse_args()
     if args.steps is None:
         args.steps = "10,5,2,1" if args.variants else "1,2,5,10,20"

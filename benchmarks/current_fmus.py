@@ -11,8 +11,9 @@ from pathlib import Path
 
 
 def current_fmu_paths(scenario, fmu_dir: str | Path | None = None) -> dict[str, Path]:
-    """:func:`orchestrator.cosim.fmu_store.ensure_fmus`, then exit naming every stale project FMU."""
-    from orchestrator.cosim.fmu_store import ensure_fmus, stale_project_fmus
+    """:func:`orchestrator.provision.project_fmus.ensure_fmus`, then exit naming every stale project FMU."""
+    from orchestrator.provision.project_fmus import ensure_fmus
+    from orchestrator.provision.staleness import stale_project_fmus
 
     paths = ensure_fmus(scenario, fmu_dir)
     stale = stale_project_fmus(paths)

@@ -1,14 +1,22 @@
-"""``documentation/index.html`` of each FMU (FMI 2.0's place for it), written at build time.
+"""What each FMU's documentation says: its ``documentation/index.html`` and the tables of ``docs/fmus.md``.
+
+The variable rows (:func:`variable_rows`, generated from the slave classes) feed both
+the Markdown tables of ``docs/fmus.md`` and the HTML table of each FMU's
+``documentation/index.html`` (FMI 2.0's place for it), written at build time.
+
+``python -m fmus.documentation --update docs/fmus.md`` rewrites the blocks between
+``<!-- BEGIN GENERATED <FMU> -->`` and ``<!-- END GENERATED <FMU> -->``; a test checks
+that the committed document matches the code.
 
 One self-contained HTML page (no scripts, no external files) per FMU:
 
 * what the component is and its equations with the paper's equation numbers
-  (hand-written per FMU in ``fmus/doc_content/<FMU>.html``);
+  (hand-written per FMU, :attr:`fmus.registry.FmuKind.documentation_page`);
 * a table of every variable (value reference, causality, type, unit, default,
   accepted range, description) generated from the slave's interface
-  (:func:`fmus.docs.variable_rows`, the rows of ``docs/fmus.md`` too) and the
+  (:func:`variable_rows`, the rows of ``docs/fmus.md`` too) and the
   parameter validation (:func:`fmus.parameter_ranges.accepted_ranges`);
-* the initialisation order, the error semantics, the runtime requirements
+* the initialisation order (:attr:`fmus.registry.FmuKind.init_note`), the error semantics, the runtime requirements
   and the preload recipe for C/C++ hosts, which hosts were tried, and the
   platforms whose binaries the FMU carries and which were tested
   (``fmus/doc_content/hosts.html`` with the build's values filled in).
@@ -16,19 +24,22 @@ One self-contained HTML page (no scripts, no external files) per FMU:
 
 from __future__ import annotations
 
+import argparse
 import html
+import re
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 from string import Template
-from typing import Any, Mapping
+from typing import Any, Mapping, Sequence
 
 import pythonfmu
 
-from .docs import start_text, unit_text, variable_rows
+from . import registry
 from .parameter_ranges import accepted_ranges
 from .runtime_guard import RuntimeRequirements
+from .slaves.interface import REAL, Variable
 
-CONTENT_DIR = Path(__file__).with_name("doc_content")
 INDEX = "index.html"
 #: Id of the variable table (tests parse it).
 VARIABLE_TABLE_ID = "variables-table"
@@ -40,28 +51,68 @@ TESTED_PLATFORMS = {
 }
 UNTESTED = "no: carried as pythonfmu ships it, never run by dtcosim"
 
-#: What each FMU's part of the initialisation order is.
-INIT_NOTES = {
-    "WindSource": "it has no inputs and comes first; its outputs at the start time depend on its parameters only, "
-                  "and after each step they are the values at t + h computed in the FMU.",
-    "Gearbox": "set omega_rotor and phi_rotor before reading omega_out; omega_gen and phi_gen come from the "
-               "GeneratorRotor (or, standalone, must advance consistently with each other: angles held while speeds "
-               "are not zero twist the shafts).",
-    "GeneratorRotor": "set initial_speed (the Gearbox's omega_out) and initial_angle before "
-                      "fmi2ExitInitializationMode; its input shaft_torque is used from the first fmi2DoStep on.",
-    "Rotor": "set initial_speed (and aero_torque, which sets a main shaft's initial twist) before "
-             "fmi2ExitInitializationMode; its outputs omega and phi drive the Gearbox's omega_rotor and phi_rotor, "
-             "the Gearbox's torque_rotor comes back as gearbox_torque from the first fmi2DoStep on.",
-    "TorqueController": "set generator_speed (the generator's initial speed) and pitch before "
-                        "fmi2ExitInitializationMode: they set the filter state and the initial torque.",
-    "TimeSeriesSource": "it has no inputs and comes first; set time_offset so that the run lies inside the "
-                        "record (out_of_record = error refuses a start outside it in fmi2ExitInitializationMode).",
-}
-
 _STYLE = """body{font-family:sans-serif;max-width:72em;margin:1em auto;padding:0 1em;line-height:1.4}
 table{border-collapse:collapse;margin:0.5em 0}td,th{border:1px solid #bbb;padding:2px 6px;vertical-align:top;text-align:left}
 th{background:#eee}pre{background:#f6f6f6;padding:0.5em;overflow-x:auto}code{font-size:95%}
 td.name{white-space:nowrap;font-family:monospace}"""
+
+
+_CAUSALITY_ORDER = {"input": 0, "output": 1, "parameter": 2}
+
+
+def interface(name: str, preset: str = "table6", model: Mapping[str, Any] | None = None) -> tuple[Variable, ...]:
+    """Variables of FMU ``name`` built from the FMU record's ``model`` (default: that of ``preset``), in value-reference order."""
+    kind = registry.kind(name)
+    return kind.slave_class().interface(model if model is not None
+                                        else kind.model(registry.drivetrain_of_preset(preset)))
+
+
+def start_text(var: Variable, exact: bool = False) -> str:
+    """Start value as text: ``""`` for outputs, ``true``/``false``, integers, reals with 6 digits
+    (``exact``: the shortest text that reads back as the same double, as in modelDescription.xml)."""
+    if var.start is None:
+        return ""
+    if isinstance(var.start, bool):
+        return "true" if var.start else "false"
+    if isinstance(var.start, int):
+        return str(var.start)
+    return repr(float(var.start)) if exact else f"{var.start:.6g}"
+
+
+def unit_text(var: Variable) -> str:
+    """The unit of a Real, ``-`` for Integers and Booleans (FMI 2 gives them none)."""
+    return var.unit if var.type == REAL else "-"
+
+
+def variable_rows(name: str, preset: str = "table6",
+                  model: Mapping[str, Any] | None = None) -> list[tuple[int, Variable]]:
+    """``(value reference, variable)``: inputs, outputs, then parameters (value-reference order within each)."""
+    return sorted(enumerate(interface(name, preset, model)),
+                  key=lambda iv: (_CAUSALITY_ORDER[iv[1].causality], iv[0]))
+
+
+def markdown_table(name: str, preset: str = "table6") -> str:
+    """One Markdown table: inputs, outputs, then parameters (value-reference order within each)."""
+    lines = ["| name | causality | type | unit | start | vr | description |",
+             "| --- | --- | --- | --- | --- | --- | --- |"]
+    for vr, var in variable_rows(name, preset):
+        lines.append(f"| `{var.name}` | {var.causality} | {var.type} | {unit_text(var)} | {start_text(var)} | {vr} | "
+                     f"{var.description.replace('|', '/')} |")
+    return "\n".join(lines)
+
+
+def _block(name: str, preset: str) -> str:
+    return (f"<!-- BEGIN GENERATED {name} -->\n"
+            f"<!-- generated by `python -m fmus.documentation --update docs/fmus.md` (preset {preset}); do not edit -->\n"
+            f"{markdown_table(name, preset)}\n<!-- END GENERATED {name} -->")
+
+
+def update(text: str, preset: str = "table6") -> str:
+    """``text`` with every generated block replaced by the current table."""
+    for name in registry.names_built_from(registry.PRESET):
+        pattern = re.compile(rf"<!-- BEGIN GENERATED {name} -->.*?<!-- END GENERATED {name} -->", re.DOTALL)
+        text = pattern.sub(lambda _m, n=name: _block(n, preset), text)
+    return text
 
 
 @dataclass(frozen=True)
@@ -75,7 +126,7 @@ class BuildFacts:
     origin : str
         What the model was made from (``"preset table6"``, a drivetrain file).
     model : mapping
-        The record's model (structure and defaults the variables come from).
+        The FMU record's model (structure and defaults the variables come from).
     build_id : str
         Hash of the embedded code and configuration.
     version : str
@@ -144,9 +195,10 @@ def platforms_table(name: str, platforms: tuple[str, ...]) -> str:
 def index_html(facts: BuildFacts) -> str:
     """The whole page."""
     name, req = facts.name, facts.requirements
-    component = (CONTENT_DIR / f"{name}.html").read_text(encoding="utf-8")
-    common = Template((CONTENT_DIR / "hosts.html").read_text(encoding="utf-8")).substitute(
-        fmu=name, init_note=html.escape(INIT_NOTES[name]), pythonfmu=pythonfmu.__version__,
+    kind = registry.kind(name)
+    component = kind.documentation_page.read_text(encoding="utf-8")
+    common = Template((registry.DOC_CONTENT_DIR / "hosts.html").read_text(encoding="utf-8")).substitute(
+        fmu=name, init_note=html.escape(kind.init_note), pythonfmu=pythonfmu.__version__,
         python_specifier=html.escape(req.python_specifier), requirements_table=requirements_table(req),
         python_dll="python%d%d.dll" % req.python_minimum[:2],
         platforms_table=platforms_table(name, facts.platforms),
@@ -175,3 +227,21 @@ def write(directory: Path | str, facts: BuildFacts) -> Path:
     directory.mkdir(parents=True, exist_ok=True)
     (directory / INDEX).write_text(index_html(facts), encoding="utf-8")
     return directory
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """``python -m fmus.documentation``: print the variable tables, or ``--update`` a Markdown file's."""
+    parser = argparse.ArgumentParser(description="Print or update the FMU variable tables.")
+    parser.add_argument("--update", type=Path, help="Markdown file whose generated blocks are rewritten")
+    parser.add_argument("--preset", default="table6")
+    args = parser.parse_args(argv)
+    if args.update:
+        args.update.write_text(update(args.update.read_text(encoding="utf-8"), args.preset), encoding="utf-8")
+    else:
+        for name in registry.names_built_from(registry.PRESET):
+            print(f"## {name}\n\n{markdown_table(name, args.preset)}\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

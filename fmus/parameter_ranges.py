@@ -16,7 +16,6 @@ constraints and are left to the descriptions (and to the FMU's initialisation).
 from __future__ import annotations
 
 import functools
-import importlib
 import json
 import math
 import tempfile
@@ -26,7 +25,10 @@ from typing import Any, Mapping
 from components.errors import DtcosimError, ParameterError
 from components.validation import Bounds
 
+from . import registry
+from .records import full_record
 from .slaves.interface import BOOLEAN, INPUT, INTEGER, OUTPUT, REAL
+from .slaves.record import RECORD_FILE
 
 #: Probe values per FMI type (no large positive Integer: an uncapped size would allocate it; the error
 #: for -1e9 carries the whole range, the upper limit included).
@@ -35,14 +37,6 @@ _FINITENESS = ("a real number", "a finite real number")
 
 INPUT_RANGE = "finite (else fmi2Discard)"
 OUTPUT_RANGE = "calculated"
-
-
-def slave_class(name: str) -> type:
-    """The slave class of FMU ``name`` (from ``fmus.slaves``)."""
-    from .build import FMU_SLAVES
-
-    module, _ = FMU_SLAVES[name]
-    return getattr(importlib.import_module(f"fmus.slaves.{module}"), name)
 
 
 def _expected(instance, vr: int, value, defaults: list) -> ParameterError | None:
@@ -62,15 +56,13 @@ def _expected(instance, vr: int, value, defaults: list) -> ParameterError | None
 @functools.lru_cache(maxsize=32)
 def _probe(name: str, model_json: str) -> tuple[dict[str, str], dict[str, Bounds]]:
     """(documentation text, numeric bounds) of every variable of FMU ``name`` built from the model."""
-    from .records import full_record
-    from .slaves.record import RECORD_FILE
-
     model = json.loads(model_json)
-    cls = slave_class(name)
+    kind = registry.kind(name)
+    cls = kind.slave_class()
     texts_out: dict[str, str] = {}
     bounds_out: dict[str, Bounds] = {}
     with tempfile.TemporaryDirectory(prefix="dtcosim_ranges_") as resources:
-        (Path(resources) / RECORD_FILE).write_text(json.dumps(full_record(name, cls.role, model, "")), encoding="utf-8")
+        (Path(resources) / RECORD_FILE).write_text(json.dumps(full_record(name, kind.role, model, "")), encoding="utf-8")
         instance = cls(instance_name="ranges", resources=resources)
         defaults = list(instance._values)
         for vr, var in enumerate(instance.variables):

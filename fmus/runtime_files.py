@@ -17,6 +17,8 @@ from pathlib import Path
 from typing import Any, Iterable, Mapping
 from xml.etree import ElementTree as ET
 
+from .documentation import BuildFacts, carried_platforms
+from .documentation import write as write_documentation
 from .requirements import from_environment, imported_modules
 from .runtime_guard import REQUIREMENTS_FILE, RuntimeRequirements, format_requirements
 
@@ -59,15 +61,12 @@ def write(staging_dir: Path, name: str, origin: str, model: Mapping[str, Any], b
     name, origin : str
         FMU model name, what its model was made from.
     model : mapping
-        The record's model.
+        The FMU record's model.
     build_id, version : str
         Build id, dtcosim version.
     sources : iterable of Path
         The embedded source files (their imports decide the packages required).
     """
-    from .documentation import BuildFacts, carried_platforms
-    from .documentation import write as write_documentation
-
     out = Path(staging_dir) / "runtime"
     out.mkdir(parents=True, exist_ok=True)
     required, optional = imported_modules(sources)

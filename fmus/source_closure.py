@@ -73,6 +73,53 @@ def _imported_names(module: SourceModule, tree: ast.AST) -> list[str]:
     return out
 
 
+def _imports(module: SourceModule, tree: ast.AST) -> list[list[str]]:
+    """Per imported name of every import statement of ``tree``: the absolute names it may be, most specific first."""
+    package = module.name if module.is_package else module.name.rpartition(".")[0]
+    out: list[list[str]] = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            for alias in node.names:
+                parts = alias.name.split(".")
+                out.append([".".join(parts[:i]) for i in range(len(parts), 0, -1)])
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                parts = package.split(".")
+                parts = parts[: len(parts) - (node.level - 1)] if node.level > 1 else parts
+                base = ".".join(parts + ([node.module] if node.module else []))
+            else:
+                base = node.module or ""
+            pieces = base.split(".")
+            prefixes = [".".join(pieces[:i]) for i in range(len(pieces), 0, -1)]
+            out += [[f"{base}.{alias.name}", *prefixes] for alias in node.names if alias.name != "*"]
+            if any(alias.name == "*" for alias in node.names):
+                out.append(prefixes)
+    return out
+
+
+def direct_imports(name: str, packages: Mapping[str, Path]) -> set[str]:
+    """The modules of ``packages`` that module ``name``'s import statements name (every one, also inside functions).
+
+    Each imported name counts as the most specific module it resolves to: ``from .slaves import record``
+    is ``fmus.slaves.record``, ``from .record import RECORD_FILE`` is ``fmus.slaves.record``. Parent
+    packages run on the way are not counted (no ``__init__`` of this project imports anything).
+
+    Raises
+    ------
+    LookupError
+        If ``name`` is not a module of ``packages``.
+    """
+    mod = _locate(name, packages)
+    if mod is None:
+        raise LookupError(f"module {name!r} is not in the packages {', '.join(packages)}")
+    out = set()
+    for names in _imports(mod, ast.parse(mod.path.read_bytes(), filename=str(mod.path))):
+        found = next((dep for dep in (_locate(n, packages) for n in names) if dep is not None), None)
+        if found is not None and found.name != name:
+            out.add(found.name)
+    return out
+
+
 def import_closure(roots: Iterable[str], packages: Mapping[str, Path]) -> dict[str, SourceModule]:
     """Every module of ``packages`` reachable by import from the modules ``roots``.
 

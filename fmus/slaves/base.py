@@ -64,7 +64,7 @@ from components import __version__ as COMPONENTS_VERSION
 from components.errors import DtcosimError, ParameterError
 
 from .interface import BOOLEAN, INPUT, INTEGER, OUTPUT, PARAMETER, REAL, Value, Variable
-from .record import START_VALUES_KEY, RecordError, read_record
+from .record import START_VALUES_KEY, FmuRecordError, read_fmu_record
 from .shutdown import register_state_release
 
 #: Life-cycle phases of an instance.
@@ -144,8 +144,6 @@ class DtcosimSlave(Fmi2Slave):
 
     Class attributes
     ----------------
-    role : str
-        What the component is in a drivetrain (:data:`.record.ROLES`), declared in the record.
     build_id : str
         Hash of the code the FMU was built from (set by the build).
     echo_errors_to_stderr : bool
@@ -161,7 +159,6 @@ class DtcosimSlave(Fmi2Slave):
     copyright = "dtcosim contributors, MIT licence"
     version = COMPONENTS_VERSION
     default_experiment = DefaultExperiment(start_time=0.0, stop_time=60.0, step_size=1.0e-3)
-    role = ""
     build_id = "source"
     echo_errors_to_stderr = True
     eager_output_groups: frozenset = frozenset()
@@ -172,7 +169,7 @@ class DtcosimSlave(Fmi2Slave):
         super().__init__(**kwargs)
         register_state_release(self.resources)  # pythonfmu's exit-time use-after-free, see .shutdown
         #: the parameter set of this FMU's record (structure and defaults)
-        record = read_record(self.resources)
+        record = read_fmu_record(self.resources)
         self.model: dict[str, Any] = record["model"]
         variables = self.interface(self.model)
         self.variables: tuple[Variable, ...] = variables
@@ -240,20 +237,20 @@ class DtcosimSlave(Fmi2Slave):
 
         Raises
         ------
-        RecordError
+        FmuRecordError
             A name that is not a parameter or input of this FMU, or a value of another type.
         """
         for name, value in start_values.items():
             vr = self.vr.get(name)
             if vr is None or self.variables[vr].causality not in (PARAMETER, INPUT):
-                raise RecordError(f"resources record {START_VALUES_KEY}: {name!r} is not a parameter or input of "
+                raise FmuRecordError(f"resources record {START_VALUES_KEY}: {name!r} is not a parameter or input of "
                                   f"this FMU")
             fmi_type = self.variables[vr].type
             wrong = (isinstance(value, bool) != (fmi_type == BOOLEAN)
                      or (fmi_type == REAL and not isinstance(value, (int, float)))
                      or (fmi_type == INTEGER and not isinstance(value, int)))
             if wrong:
-                raise RecordError(f"resources record {START_VALUES_KEY}: {name} = {value!r} is not a {fmi_type} value")
+                raise FmuRecordError(f"resources record {START_VALUES_KEY}: {name} = {value!r} is not a {fmi_type} value")
             self._values[vr] = float(value) if fmi_type == REAL else value
 
     def value(self, name: str) -> Value:

@@ -50,7 +50,6 @@ from .interface import (
     real_output,
     real_parameter,
 )
-from .record import GEARBOX
 
 _MESH_KINDS = {"sun_planet": "sun-planet mesh", "ring_planet": "ring-planet mesh", "parallel": "parallel-stage mesh"}
 
@@ -75,7 +74,6 @@ class Gearbox(DtcosimSlave):
 
     description = ("dtcosim Gearbox: multi-stage planetary/parallel gearbox with CFS (or impact) gear contact "
                    "and shaft 3, driven by the rotor motion and cut at the generator (SI units)")
-    role = GEARBOX
     eager_output_groups = frozenset({_OUTPUTS})  # shaft_torque is read every step
 
     @classmethod

@@ -36,7 +36,6 @@ from .interface import (
     real_parameter,
     boolean_parameter,
 )
-from .record import GENERATOR
 
 _NAMES = {
     "generator.initial_speed": "initial_speed",
@@ -49,7 +48,6 @@ class GeneratorRotor(DtcosimSlave):
 
     description = ("dtcosim GeneratorRotor: generator inertia driven by the shaft-3 torque against a counter "
                    "torque with load events (SI units)")
-    role = GENERATOR
     eager_output_groups = frozenset({"motion"})
 
     @classmethod

@@ -51,30 +51,30 @@ SIGNALS: dict[str, dict[str, bool]] = {
 }
 
 
-class RecordError(Exception):
+class FmuRecordError(Exception):
     """The FMU's record is missing or unreadable."""
 
 
-def read_record(resources: str | Path | None) -> dict[str, Any]:
+def read_fmu_record(resources: str | Path | None) -> dict[str, Any]:
     """The record in the resources folder ``resources``.
 
     Raises
     ------
-    RecordError
+    FmuRecordError
         Naming the file and what is wrong with it.
     """
     if resources is None:
-        raise RecordError("no resources folder given: a dtcosim FMU reads its model from resources/" + RECORD_FILE)
+        raise FmuRecordError("no resources folder given: a dtcosim FMU reads its model from resources/" + RECORD_FILE)
     path = Path(resources) / RECORD_FILE
     try:
         record = json.loads(path.read_text(encoding="utf-8"))
     except OSError as exc:
-        raise RecordError(f"cannot read {path}: {exc.strerror or exc}") from None
+        raise FmuRecordError(f"cannot read {path}: {exc.strerror or exc}") from None
     except ValueError as exc:
-        raise RecordError(f"{path} is not valid JSON: {exc}") from None
+        raise FmuRecordError(f"{path} is not valid JSON: {exc}") from None
     if not isinstance(record, dict) or record.get("format") != RECORD_FORMAT or not isinstance(record.get("model"), dict):
-        raise RecordError(f"{path} is not a dtcosim record of format {RECORD_FORMAT}")
+        raise FmuRecordError(f"{path} is not a dtcosim record of format {RECORD_FORMAT}")
     if not isinstance(record.get(START_VALUES_KEY, {}), dict):
-        raise RecordError(f"{path}: {START_VALUES_KEY} must be a table of variable name -> value, "
+        raise FmuRecordError(f"{path}: {START_VALUES_KEY} must be a table of variable name -> value, "
                           f"not {record[START_VALUES_KEY]!r}")
     return record

@@ -19,13 +19,11 @@ from components.model.rotor import rotor_from_values
 
 from .base import DtcosimSlave
 from .interface import Variable, real_input, real_output, real_parameter
-from .record import ROTOR
 
 class Rotor(DtcosimSlave):
     """``J_r omega' = T_aero - T_gearbox`` (rigid) or the rotor and main shaft, as an FMU."""
 
     description = "dtcosim Rotor: torque-driven rotor inertia (optionally with a main shaft) driving the gearbox (SI)"
-    role = ROTOR
     eager_output_groups = frozenset({"motion"})
 
     @classmethod

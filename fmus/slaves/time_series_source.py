@@ -24,7 +24,6 @@ from components.validation import Bounds, choice_bounds, finite
 
 from .base import DtcosimSlave
 from .interface import Variable, enumeration_text, integer_parameter, real_output, real_parameter
-from .record import TIME_SERIES
 
 #: the packed samples inside resources/
 DATA_FILE = "series.npz"
@@ -34,7 +33,6 @@ class TimeSeriesSource(DtcosimSlave):
     """Recorded time series as FMU outputs."""
 
     description = "dtcosim TimeSeriesSource: recorded channels (SI) played back with C0/C1 interpolation"
-    role = TIME_SERIES
     eager_output_groups = frozenset({"series"})
 
     @classmethod

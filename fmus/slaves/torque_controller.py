@@ -19,7 +19,6 @@ from components.model.torque_controller import CONTROLLER_FIELDS, controller_fro
 
 from .base import DtcosimSlave
 from .interface import Variable, enumeration_text, integer_parameter, real_input, real_output, real_parameter
-from .record import TORQUE_CONTROLLER
 
 #: FMU parameter -> (field, unit, description)
 PARAMETERS = {
@@ -41,7 +40,6 @@ class TorqueController(DtcosimSlave):
     """Generator torque demand from the filtered generator speed, as an FMU."""
 
     description = "dtcosim TorqueController: NREL 5-MW baseline variable-speed generator torque law (SI)"
-    role = TORQUE_CONTROLLER
     eager_output_groups = frozenset({"torque"})
 
     @classmethod

@@ -35,14 +35,12 @@ from .interface import (
     real_output,
     real_parameter,
 )
-from .record import WIND_SOURCE
 
 
 class WindSource(DtcosimSlave):
     """Stochastic rotor speed (eq. 13-14) as an FMU with outputs ``omega`` and ``phi``."""
 
     description = "dtcosim WindSource: stochastic rotor speed omega(t) and angle phi(t) of eq. 13-14 (SI units)"
-    role = WIND_SOURCE
     eager_output_groups = frozenset({"motion", "derivatives"})  # read every step by the Gearbox (rotor_derivatives)
     _kernel_reported = False
 

@@ -9,7 +9,7 @@ import json
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``drivetrain`` subcommand (``show``)."""
     p = sub.add_parser("drivetrain", help="drivetrain description files: show the derived design table",
-                       description="Work with drivetrain description files (TOML; see the README, 'Your own gearbox').")
+                       description="Work with drivetrain description files (TOML; see docs/drivetrains.md).")
     actions = p.add_subparsers(dest="action", metavar="ACTION")
     show = actions.add_parser(
         "show", help="print the derived design table of a drivetrain file",

@@ -35,11 +35,12 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Export the scenario."""
-    from ..cosim.fmu_store import ensure_fmus, stale_project_fmus
     from ..cosim.master import CoSimulation
     from ..cosim.system import resolve_system
     from ..interop.ssp import export_ssp
     from ..interop.ssp_export import PARAMETER_SET, stale_warnings, unbaked_components
+    from ..provision.project_fmus import ensure_fmus
+    from ..provision.staleness import stale_project_fmus
 
     scenario = scenario_options.apply(scenario_options.load(args.scenario, args, "export-ssp"), args, "export-ssp")
     paths = ensure_fmus(scenario, args.fmu_dir, build=not args.no_build,

@@ -1,9 +1,9 @@
 """Where a command finds its FMUs: ``--fmu-dir`` and ``--no-build``, shared by every command that runs FMUs.
 
 One definition of the search (the scenario's own folder, then ``--fmu-dir``, else
-``$DTCOSIM_FMU_DIR`` or the project's ``fmus/``: :func:`orchestrator.cosim.fmu_folder.default_fmu_dir`)
-and of building the project's FMUs that are missing or stale
-(:func:`orchestrator.cosim.fmu_store.ensure_fmus`).
+``$DTCOSIM_FMU_DIR`` or ``fmus/`` in the per-user cache: :func:`orchestrator.provision.folders.default_fmu_dir`)
+and of building the project's FMUs that are missing or stale into that folder
+(:func:`orchestrator.provision.project_fmus.ensure_fmus`).
 """
 
 from __future__ import annotations
@@ -25,7 +25,8 @@ def add_fmu_arguments(p: argparse.ArgumentParser, whose: str = "the scenario's",
     """
     p.add_argument("--fmu-dir", type=Path, default=None,
                    help=f"directory searched for {whose} FMUs after the scenario's own folder (default: "
-                        f"$DTCOSIM_FMU_DIR or the project's fmus/)")
+                        f"$DTCOSIM_FMU_DIR, else fmus/ in the per-user cache ~/.cache/dtcosim); missing project FMUs "
+                        "are built into it")
     if build:
         p.add_argument("--no-build", action="store_true",
                        help="do not build missing or stale project FMUs (fail instead)")

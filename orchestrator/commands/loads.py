@@ -100,7 +100,8 @@ def run(args: argparse.Namespace) -> int:
 
     from ..inputs.load_cases import LoadCaseError, find_load_cases, load_load_cases
     from ..study.journal import JOURNAL_FILE, read_journal
-    from ..study.lifetime_results import check_curves, mark_missing_run_files, store_run_data, write_lifetime_outputs
+    from ..study.lifetime_outputs import write_lifetime_outputs
+    from ..study.lifetime_results import check_curves, mark_missing_run_files, store_run_data
     from ..study.load_cases import prepare_load_cases
     from ..study.report import point_records, status_counts
     from ..study.sweep import pending_points, run_sweep

@@ -79,11 +79,11 @@ def scenario_drivetrain(spec: str, fmu_dir: Path | None = None):
 
     from components.model.generator import GeneratorParameters
 
-    from ..cosim.fmu_store import ensure_fmus
     from ..cosim.physics_view import PhysicsUnavailable, physics_view
     from ..cosim.system import resolve_system
     from ..errors import ScenarioError
     from ..inputs.scenario import find_scenario
+    from ..provision.project_fmus import ensure_fmus
     from ..run.runner import load_any
 
     scenario = load_any(find_scenario(spec))

@@ -75,8 +75,9 @@ def _progress_bar(sim):
 
 def run(args: argparse.Namespace) -> int:
     """Run the scenario; write results; print a summary."""
-    from ..cosim.fmu_store import ensure_fmus, stale_project_fmus
     from ..cosim.system import resolve_system
+    from ..provision.project_fmus import ensure_fmus
+    from ..provision.staleness import stale_project_fmus
     from ..run.analyses import format_analyses
     from ..run.run_folder import RunFolder
     from ..run.runner import run_scenario

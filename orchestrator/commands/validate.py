@@ -19,7 +19,7 @@ from pathlib import Path
 from fmus.requirements import check_environment, read_from_fmu
 from fmus.validation import check_fmu, fmu_files, is_dtcosim_fmu
 
-from ..cosim.fmu_folder import default_fmu_dir
+from ..provision.folders import default_fmu_dir
 
 
 def register(sub: argparse._SubParsersAction) -> None:

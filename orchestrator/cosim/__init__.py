@@ -1,10 +1,10 @@
 """The co-simulation: FMUs read and checked through FMI only, and the fixed-step master.
 
+It only reads FMUs: finding and building them is :mod:`orchestrator.provision`'s.
+
 Modules
 -------
 fmu_interface   what an FMU's ``modelDescription.xml`` declares (nothing instantiated)
-fmu_folder      the default FMU folder (project fmus/ or a per-user cache)
-fmu_store       where a scenario's FMUs are; building the project's own when missing
 event_slots     load events placed into the FMUs' event slots
 system          a scenario checked against its FMUs (:class:`~orchestrator.cosim.system.ResolvedSystem`)
 graph           stepping and initialisation order, algebraic loops

@@ -177,7 +177,7 @@ def _bound(type_: str, text: Any) -> float | int | None:
     return value if isinstance(value, (int, float)) and not isinstance(value, bool) else None
 
 
-def read_record(path: Path, key: str) -> dict[str, Any] | None:
+def read_fmu_record(path: Path, key: str) -> dict[str, Any] | None:
     """The dtcosim record in an FMU archive, None if it has none.
 
     Raises
@@ -308,7 +308,7 @@ def read_fmu_interface(path: str | Path, key: str = "fmu") -> FmuInterface:
         sha256=file_sha256(p),
         default_step_s=default_step,
         unit_definitions=FrozenMap(units),
-        record=read_record(p, key),
+        record=read_fmu_record(p, key),
         platforms=binary_platforms(p, cs.modelIdentifier),
         default_start_s=default_start,
         default_stop_s=default_stop,

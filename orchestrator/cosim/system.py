@@ -1,6 +1,7 @@
 """A scenario checked against its FMUs' model descriptions.
 
-:func:`resolve_system` locates every FMU, reads its ``modelDescription.xml``
+:func:`resolve_system` reads every FMU's ``modelDescription.xml`` (the files it is given, found and
+built by :mod:`orchestrator.provision`, or the ones the scenario names by path)
 (nothing is instantiated) and checks what the master needs and every name the
 scenario uses: each FMU is FMI 2.0 co-simulation with a binary for this platform;
 parameters and start values exist, may be set before initialisation (FMI 2.0:
@@ -22,16 +23,15 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Mapping
+from typing import Mapping, Sequence
 
 from components.validation import is_number
 
 from ..errors import AlgebraicLoopError, ScenarioError, suggestion
 from ..frozen_map import FrozenMap
 from ..inputs.limits import MAX_RESULT_VALUES
-from ..inputs.scenario import Scenario, VariableRef
+from ..inputs.scenario import Component, Scenario, VariableRef
 from .event_slots import AssignedEvent, assign_events
-from .fmu_folder import default_fmu_dir
 from .fmu_interface import FmuInterface, FmuVariable, read_fmu_interface
 from .graph import algebraic_loop_groups, find_algebraic_loop, initialization_order, stepping_order
 from .parameter_checks import model_problem, value_problem
@@ -132,27 +132,45 @@ class ResolvedSystem:
         return values
 
 
-def resolve_fmu_paths(scenario: Scenario, fmu_dir: str | Path | None = None) -> dict[str, Path]:
-    """Absolute FMU path of every component.
+def find_fmu(scenario: Scenario, component: Component, candidates: Sequence[Path]) -> Path:
+    """The first of ``candidates`` that is a file, absolute.
 
     Raises
     ------
     ScenarioError
-        ``components.<name>.fmu`` when the file is found nowhere; the message lists
-        the places searched.
+        ``components.<name>.fmu`` when none is; the message lists the places searched.
     """
-    fmu_dir = default_fmu_dir() if fmu_dir is None else Path(fmu_dir)
+    found = next((p for p in candidates if p.is_file()), None)
+    if found is None:
+        raise ScenarioError(
+            f"components.{component.name}.fmu", str(component.fmu),
+            "an existing FMU file (looked in " + ", ".join(str(p.parent) for p in candidates) + ")",
+            scenario.source,
+        )
+    return found.resolve()
+
+
+def named_fmu_paths(scenario: Scenario) -> dict[str, Path]:
+    """The FMU of every component where the scenario names it: absolute, or relative to the scenario's folder.
+
+    An FMU built from a drivetrain file or a load record, or one in an FMU folder, is found (and built)
+    by :func:`orchestrator.provision.project_fmus.ensure_fmus`, whose paths :func:`resolve_system` takes.
+
+    Raises
+    ------
+    ScenarioError
+        ``components.<name>.fmu`` when the file is not there, or is built from a drivetrain file or a
+        load record (the co-simulation does not know where provisioning keeps those).
+    """
     out = {}
     for comp in scenario.components:
-        candidates = scenario.fmu_candidates(comp, fmu_dir)
-        found = next((p for p in candidates if p.is_file()), None)
-        if found is None:
-            raise ScenarioError(
-                f"components.{comp.name}.fmu", str(comp.fmu),
-                "an existing FMU file (looked in " + ", ".join(str(p.parent) for p in candidates) + ")",
-                scenario.source,
-            )
-        out[comp.name] = found.resolve()
+        if comp.drivetrain is not None or comp.series is not None:
+            raise ScenarioError(f"components.{comp.name}.fmu", str(comp.fmu),
+                                "the path of the FMU built from its " + ("drivetrain file" if comp.series is None
+                                                                         else "load record")
+                                + " (orchestrator.provision.project_fmus.ensure_fmus finds and builds it)",
+                                scenario.source)
+        out[comp.name] = find_fmu(scenario, comp, scenario.fmu_candidates(comp, None))
     return out
 
 
@@ -219,21 +237,16 @@ def _same_type(source: FmuVariable, target: FmuVariable, key: str, link: str, sr
         raise ScenarioError(key, link, f"variables of the same type at both ends; {problem}", src)
 
 
-def resolve_system(
-    scenario: Scenario,
-    fmu_dir: str | Path | None = None,
-    fmu_paths: Mapping[str, Path] | None = None,
-) -> ResolvedSystem:
+def resolve_system(scenario: Scenario, fmu_paths: Mapping[str, Path] | None = None) -> ResolvedSystem:
     """Check a scenario against its FMUs' model descriptions (nothing is instantiated).
 
     Parameters
     ----------
     scenario : Scenario
-    fmu_dir : path, optional
-        Directory searched for relative FMU paths after the scenario's own
-        directory (default :func:`default_fmu_dir`).
     fmu_paths : mapping of str -> path, optional
-        Already-resolved FMU files (skips the search).
+        The FMU file of every component (:func:`orchestrator.provision.project_fmus.ensure_fmus`,
+        :func:`orchestrator.provision.locate.resolve_fmu_paths`); default: where the scenario
+        names them (:func:`named_fmu_paths`).
 
     Raises
     ------
@@ -243,7 +256,7 @@ def resolve_system(
         If the connections close a direct-feedthrough loop.
     """
     src = scenario.source
-    paths = dict(fmu_paths) if fmu_paths is not None else resolve_fmu_paths(scenario, fmu_dir)
+    paths = dict(fmu_paths) if fmu_paths is not None else named_fmu_paths(scenario)
     interfaces = {c.name: read_fmu_interface(paths[c.name], f"components.{c.name}.fmu") for c in scenario.components}
     scenario, events = assign_events(scenario, interfaces)
 
@@ -425,12 +438,12 @@ def _resolve_record(scenario: Scenario, interfaces: Mapping[str, FmuInterface]) 
             seen.add((comp, var.name))
             out.append(RecordedVariable(comp, var.name, var.value_reference, var.unit, var.type))
 
-    if not scenario.record:
+    if not scenario.recorded:
         for comp in scenario.component_names:
             for name in interfaces[comp].outputs:
                 add(comp, interfaces[comp].variables[name])
         return tuple(out)
-    for i, pattern in enumerate(scenario.record):
+    for i, pattern in enumerate(scenario.recorded):
         key = f"record.variables[{i}]"
         ref = VariableRef.parse(pattern, key, src)
         comp_rx = _pattern_regex(ref.component)

@@ -9,7 +9,7 @@ derived design table (:mod:`components.model.design_table`: which masses were
 given and which derived, the geometry checks). Every mistake is a
 :class:`DrivetrainFileError` naming the file, the key path, the value and the
 expectation, raised while the file is read, before anything is built. The
-format in full is in the README ("Your own gearbox")::
+format in full is in ``docs/drivetrains.md``::
 
     name = "grc-like"                     # optional, default: file stem
     description = "..."

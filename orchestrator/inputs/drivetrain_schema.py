@@ -1,7 +1,7 @@
 """The shape of a drivetrain description file (TOML), as the schema layer's strict tables.
 
-See :mod:`orchestrator.inputs.drivetrain_file` for the format and the README ("Your own
-gearbox"). The numbers are checked here for their type and sign; what they mean together
+See :mod:`orchestrator.inputs.drivetrain_file` for the format and ``docs/drivetrains.md``.
+The numbers are checked here for their type and sign; what they mean together
 (geometry, shaft count, ...) is checked while the file is read into the model.
 """
 

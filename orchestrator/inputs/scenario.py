@@ -65,6 +65,8 @@ from typing import Any, Literal, Mapping
 from pydantic import Field
 
 from components.validation import is_number
+from fmus import registry
+from fmus.slaves.record import GENERATOR, ROLES
 
 from ..errors import ScenarioError
 from ..frozen_map import FrozenMap
@@ -84,26 +86,6 @@ from .schema import (
     read_document,
 )
 from .transformations import Transformation
-
-#: the project FMU files a drivetrain file is built into, and the generator's (which inherits the gearbox's file)
-DRIVETRAIN_FMU_FILES = ("Gearbox.fmu", "GeneratorRotor.fmu")
-GENERATOR_FMU_FILE = "GeneratorRotor.fmu"
-#: folder of the FMU directory with the FMUs built from drivetrain files, one subfolder per file content
-DRIVETRAIN_FMU_FOLDER = "drivetrains"
-#: the project FMU a recorded series is built into, and the folder of the FMU directory with them
-SERIES_FMU_FILE = "TimeSeriesSource.fmu"
-SERIES_FMU_FOLDER = "series"
-
-
-def series_fmu_dir(fmu_dir: Path, spec: SeriesSpec) -> Path:
-    """Where the TimeSeriesSource built from a series lives: ``<fmu_dir>/series/<record stem>-<sha256[:16]>/``."""
-    return Path(fmu_dir) / SERIES_FMU_FOLDER / spec.key
-
-
-def drivetrain_fmu_dir(fmu_dir: Path, spec: DrivetrainSpec) -> Path:
-    """Where the FMUs built from a drivetrain file live: ``<fmu_dir>/drivetrains/<name>-<sha256[:16]>/``."""
-    return Path(fmu_dir) / DRIVETRAIN_FMU_FOLDER / spec.key
-
 
 #: relative tolerance when checking that times are whole multiples of the step
 _MULTIPLE_RTOL = 1e-9
@@ -184,8 +166,6 @@ class Component:
     series: SeriesSpec | None = None
 
     def __post_init__(self) -> None:
-        from fmus.slaves.record import ROLES
-
         if not isinstance(self.name, str) or not NAME_PATTERN.match(self.name):
             raise ScenarioError("components", self.name, "a component name of letters, digits, '_' or '-' (no dots)")
         object.__setattr__(self, "fmu", Path(self.fmu))
@@ -204,13 +184,17 @@ class Component:
                                     "an output name or a list of output names")
             signals[kind] = tuple(names)
         object.__setattr__(self, "signals", FrozenMap(signals))
-        if self.drivetrain is not None and str(self.fmu) not in DRIVETRAIN_FMU_FILES:
+        kind = registry.of_file(self.fmu)
+        if self.drivetrain is not None and (kind is None or registry.DRIVETRAIN_FILE not in kind.built_from):
             raise ScenarioError(f"components.{self.name}.drivetrain", self.drivetrain.name,
                                 "a drivetrain file only for a project FMU built from it: fmu = "
-                                + " or ".join(f'"{f}"' for f in DRIVETRAIN_FMU_FILES) + f" (not {str(self.fmu)!r})")
-        if self.series is not None and str(self.fmu) != SERIES_FMU_FILE:
+                                + " or ".join(f'"{k.file_name}"' for k in registry.built_from(registry.DRIVETRAIN_FILE))
+                                + f" (not {str(self.fmu)!r})")
+        if self.series is not None and (kind is None or registry.LOAD_RECORD not in kind.built_from):
             raise ScenarioError(f"components.{self.name}.series", self.series.record.name,
-                                f'a series only for fmu = "{SERIES_FMU_FILE}" (not {str(self.fmu)!r})')
+                                "a series only for fmu = "
+                                + " or ".join(f'"{k.file_name}"' for k in registry.built_from(registry.LOAD_RECORD))
+                                + f" (not {str(self.fmu)!r})")
         outputs = (self.no_feedthrough,) if isinstance(self.no_feedthrough, str) else self.no_feedthrough
         if not isinstance(outputs, (list, tuple)) or not all(isinstance(n, str) and n for n in outputs):
             raise ScenarioError(f"components.{self.name}.no_feedthrough", self.no_feedthrough,
@@ -383,9 +367,9 @@ class Scenario:
         Time grid and master options.
     initial : tuple of InitialBinding
         Output -> parameter assignments made during initialisation.
-    record : tuple of str
-        Recorded variables: ``"component.name"`` or ``"component.pattern"`` with
-        ``*``/``?`` wildcards; empty means every output of every component.
+    recorded : tuple of str
+        The recorded variables (the ``[record]`` table's ``variables``): ``"component.name"`` or
+        ``"component.pattern"`` with ``*``/``?`` wildcards; empty means every output of every component.
     description : str
         Free text.
     base_dir : pathlib.Path, optional
@@ -406,7 +390,7 @@ class Scenario:
     connections: tuple[Connection, ...]
     simulation: SimulationSettings
     initial: tuple[InitialBinding, ...] = ()
-    record: tuple[str, ...] = ()
+    recorded: tuple[str, ...] = ()
     description: str = ""
     base_dir: Path | None = None
     source: str | None = None
@@ -421,7 +405,7 @@ class Scenario:
         object.__setattr__(self, "components", tuple(self.components))
         object.__setattr__(self, "connections", tuple(self.connections))
         object.__setattr__(self, "initial", tuple(self.initial))
-        object.__setattr__(self, "record", tuple(self.record))
+        object.__setattr__(self, "recorded", tuple(self.recorded))
         if not self.components:
             raise ScenarioError("components", {}, "at least one component", src)
         names = [c.name for c in self.components]
@@ -454,7 +438,7 @@ class Scenario:
             if b.target.variable in comp.parameters:
                 raise ScenarioError(f"initial[{i}].to", tgt, f"a variable without a value in components.{comp.name}.parameters", src)
             set_initially[tgt] = i
-        for i, pattern in enumerate(self.record):
+        for i, pattern in enumerate(self.recorded):
             ref = VariableRef.parse(pattern, f"record.variables[{i}]", src)
             if ref.component not in known and not any(ch in ref.component for ch in "*?"):
                 raise ScenarioError(f"record.variables[{i}]", pattern, "a variable of a declared component: " + ", ".join(names), src)
@@ -502,20 +486,14 @@ class Scenario:
             raise ScenarioError("components", component, "a declared component: " + ", ".join(self.component_names), self.source)
         return replace(self, components=comps)
 
-    def fmu_candidates(self, component: Component, fmu_dir: Path | None) -> list[Path]:
-        """Where the component's FMU is looked for, in order.
+    def fmu_candidates(self, component: Component, fmu_dir: Path | None = None) -> list[Path]:
+        """Where the FMU path a component names is looked for, in order.
 
         An absolute path is used as is; a relative one is tried against the
-        scenario's directory, then the FMU directory. A component built from a
-        drivetrain file has one place: the folder of that file's content in the FMU
-        directory (:func:`drivetrain_fmu_dir`).
+        scenario's directory, then the FMU folder ``fmu_dir``. (A component built
+        from a drivetrain file or a load record is found by provisioning instead:
+        :func:`orchestrator.provision.locate.fmu_candidates`.)
         """
-        if component.series is not None:  # built from a record: only its content-keyed folder
-            root = Path(fmu_dir) if fmu_dir is not None else Path.cwd()
-            return [series_fmu_dir(root, component.series) / component.fmu.name]
-        if component.drivetrain is not None:  # built from a drivetrain file: only its content-keyed folder
-            root = Path(fmu_dir) if fmu_dir is not None else Path.cwd()
-            return [drivetrain_fmu_dir(root, component.drivetrain) / component.fmu.name]
         if component.fmu.is_absolute():
             return [component.fmu]
         out = []
@@ -635,7 +613,7 @@ def scenario_from_dict(data: Mapping[str, Any], name: str | None = None, base_di
         path = f"components.{cname}"
         params = flatten_parameters(ctab.parameters, f"{path}.parameters", ScenarioError, source)
         spec = specs.get(cname)
-        if spec is None and inherited is not None and ctab.fmu == GENERATOR_FMU_FILE:
+        if spec is None and inherited is not None and _is_drivetrain_generator(ctab.fmu):
             spec = inherited  # the generator of a drivetrain file's gearbox takes its defaults from the same file
         series = (series_from_table(ctab.series, f"{path}.series", base_dir, source)
                   if ctab.series is not None else None)
@@ -667,13 +645,19 @@ def scenario_from_dict(data: Mapping[str, Any], name: str | None = None, base_di
         connections=links(doc.connections, "connections", Connection),
         initial=links(doc.initial, "initial", InitialBinding),
         simulation=settings,
-        record=tuple(doc.record.variables) if doc.record is not None else (),
+        recorded=tuple(doc.record.variables) if doc.record is not None else (),
         events=tuple(events),
         analysis=analysis,
         results_format=doc.record.format if doc.record is not None else "auto",
         base_dir=base_dir,
         source=source,
     )
+
+
+def _is_drivetrain_generator(fmu: str) -> bool:
+    """Whether ``fmu`` names the project's generator FMU that a drivetrain file builds."""
+    kind = registry.of_file(fmu)
+    return kind is not None and kind.role == GENERATOR and registry.DRIVETRAIN_FILE in kind.built_from
 
 
 def _drivetrain_of(spec: str, key: str, base_dir: Path | None, source: str | None) -> DrivetrainSpec:

@@ -13,7 +13,7 @@ Formats (by suffix):
 ``.csv``
     A header row of ``name [unit]`` cells, then numbers; the first column is the time [s].
 
-Every reading problem is a :class:`RecordError` naming the file, the channel and what was expected:
+Every reading problem is a :class:`LoadRecordError` naming the file, the channel and what was expected:
 an empty file, a binary file of the wrong kind, a missing channel (with "did you mean"), a unit
 with no known conversion, NaN, time that does not increase strictly.
 """
@@ -37,7 +37,7 @@ from .limits import MAX_RECORD_BYTES
 RECORD_SUFFIXES = (".outb", ".out", ".csv")
 
 
-class RecordError(EntryError):
+class LoadRecordError(EntryError):
     """A record file (OpenFAST output, CSV) or a channel selected from it is unusable."""
 
     kind = "record"
@@ -66,11 +66,11 @@ def normalised_unit(unit: str) -> str:
 
 
 def si_conversion(unit: str, channel: str, source: str) -> tuple[str, float]:
-    """(SI unit, factor) of a recorded unit; a :class:`RecordError` naming the channel if unknown."""
+    """(SI unit, factor) of a recorded unit; a :class:`LoadRecordError` naming the channel if unknown."""
     key = normalised_unit(unit)
     if key not in UNIT_CONVERSIONS:
         known = sorted({u for u in UNIT_CONVERSIONS if u})
-        raise RecordError(f"{channel}.unit", unit, "a unit with a known conversion to SI: " + ", ".join(known)
+        raise LoadRecordError(f"{channel}.unit", unit, "a unit with a known conversion to SI: " + ", ".join(known)
                           + suggestion(key, known), source)
     return UNIT_CONVERSIONS[key]
 
@@ -93,9 +93,9 @@ class Record:
     channels: Mapping[str, tuple[str, np.ndarray]]
 
     def channel(self, name: str) -> tuple[str, np.ndarray]:
-        """Unit and samples of channel ``name``; a missing one is a RecordError with "did you mean"."""
+        """Unit and samples of channel ``name``; a missing one is a LoadRecordError with "did you mean"."""
         if name not in self.channels:
-            raise RecordError("channel", name, f"a channel of the record ({len(self.channels)} channels)"
+            raise LoadRecordError("channel", name, f"a channel of the record ({len(self.channels)} channels)"
                               + suggestion(name, self.channels), self.source)
         return self.channels[name]
 
@@ -104,34 +104,34 @@ def _check_not_empty(path: Path) -> bytes:
     try:
         size = path.stat().st_size
         if size > MAX_RECORD_BYTES:  # refused before it is read
-            raise RecordError("(file)", str(path), f"a record of at most {MAX_RECORD_BYTES:,} bytes "
+            raise LoadRecordError("(file)", str(path), f"a record of at most {MAX_RECORD_BYTES:,} bytes "
                               f"({MAX_RECORD_BYTES / 2**20:.3g} MiB); the file has {size:,} bytes")
         data = path.read_bytes()
     except OSError as exc:
-        raise RecordError("(file)", str(path), f"a readable record file ({exc.strerror or exc})") from None
+        raise LoadRecordError("(file)", str(path), f"a readable record file ({exc.strerror or exc})") from None
     if not data.strip():
-        raise RecordError("(file)", str(path), "a record with channels and samples (the file is empty)")
+        raise LoadRecordError("(file)", str(path), "a record with channels and samples (the file is empty)")
     return data
 
 
 def _check_outb_header(data: bytes, source: str) -> None:
     """Refuse a file that is not an OpenFAST binary output before openfast-io decodes it."""
     if len(data) < 14:
-        raise RecordError("(file)", source, f"an OpenFAST binary output (.outb); the file has only {len(data)} bytes")
+        raise LoadRecordError("(file)", source, f"an OpenFAST binary output (.outb); the file has only {len(data)} bytes")
     file_id = struct.unpack("<h", data[:2])[0]
     if file_id not in (1, 2, 3, 4):
-        raise RecordError("(file)", source, f"an OpenFAST binary output (.outb) starting with a format id 1-4; "
+        raise LoadRecordError("(file)", source, f"an OpenFAST binary output (.outb) starting with a format id 1-4; "
                           f"it starts with bytes {data[:8]!r}, not a FAST binary file")
     at = 2 + (2 if file_id == 4 else 0)
     n_chan, n_t = struct.unpack("<ii", data[at:at + 8])
     name_len = struct.unpack("<h", data[2:4])[0] if file_id == 4 else 10
     if not (0 < n_chan < 100000 and 0 < n_t < 10 ** 9 and 0 < name_len < 1000):
-        raise RecordError("(file)", source, f"an OpenFAST binary output (.outb); its header says {n_chan} channels, "
+        raise LoadRecordError("(file)", source, f"an OpenFAST binary output (.outb); its header says {n_chan} channels, "
                           f"{n_t} time steps, not a FAST binary file")
     value_size = 8 if file_id == 3 else 2
     least = n_chan * n_t * value_size + (n_t * 4 if file_id == 1 else 0)
     if len(data) < least:
-        raise RecordError("(file)", source, f"an OpenFAST binary output with {n_chan} channels x {n_t} steps "
+        raise LoadRecordError("(file)", source, f"an OpenFAST binary output with {n_chan} channels x {n_t} steps "
                           f"(>= {least} bytes); the file has {len(data)} bytes (truncated or another kind)")
 
 
@@ -142,7 +142,7 @@ def _read_outb(path: Path, data: bytes) -> tuple[list[str], list[str], np.ndarra
     try:
         values, info, _ = load_binary_output(str(path))
     except (struct.error, ValueError, Exception) as exc:  # noqa: BLE001 - a broken file of the right id
-        raise RecordError("(file)", str(path), f"a readable OpenFAST binary output ({type(exc).__name__}: {exc})") from None
+        raise LoadRecordError("(file)", str(path), f"a readable OpenFAST binary output ({type(exc).__name__}: {exc})") from None
     return list(info["attribute_names"]), list(info["attribute_units"]), np.asarray(values, dtype=float)
 
 
@@ -150,13 +150,13 @@ def _read_out(path: Path, data: bytes) -> tuple[list[str], list[str], np.ndarray
     from openfast_io.FAST_output_reader import load_ascii_output
 
     if b"\0" in data[:4096]:
-        raise RecordError("(file)", str(path), "an OpenFAST text output (.out); the file is binary "
+        raise LoadRecordError("(file)", str(path), "an OpenFAST text output (.out); the file is binary "
                           "(an .outb renamed?)")
     text = data.decode("latin-1").replace("\u00b7", "-")
     lines = text.splitlines()
     header = next((i for i, line in enumerate(lines) if line.split() and line.split()[0] == "Time"), None)
     if header is None or header + 1 >= len(lines):
-        raise RecordError("(file)", str(path), "an OpenFAST text output with a row of channel names starting with "
+        raise LoadRecordError("(file)", str(path), "an OpenFAST text output with a row of channel names starting with "
                           "Time and a units row")
     while lines and not lines[-1].strip():  # openfast-io turns every line below the header into a row
         lines.pop()
@@ -168,7 +168,7 @@ def _read_out(path: Path, data: bytes) -> tuple[list[str], list[str], np.ndarray
             values, info = load_ascii_output(str(copy), headerLines=header + 2, descriptionLine=max(header - 2, 0),
                                              attributeLine=header, unitLine=header + 1)
         except ValueError as exc:
-            raise RecordError("(file)", str(path), f"numbers below the header ({exc})") from None
+            raise LoadRecordError("(file)", str(path), f"numbers below the header ({exc})") from None
     return list(info["attribute_names"]), list(info["attribute_units"]), np.asarray(values, dtype=float)
 
 
@@ -177,60 +177,60 @@ _CSV_HEADER = re.compile(r"^\s*(?P<name>[^\[\]]+?)\s*\[(?P<unit>[^\]]*)\]\s*$")
 
 def _read_csv(path: Path, data: bytes) -> tuple[list[str], list[str], np.ndarray]:
     if b"\0" in data[:4096]:
-        raise RecordError("(file)", str(path), "a CSV text file; the file is binary")
+        raise LoadRecordError("(file)", str(path), "a CSV text file; the file is binary")
     text = data.decode("utf-8-sig", errors="replace")
     rows = list(csv.reader(text.splitlines()))
     rows = [r for r in rows if any(c.strip() for c in r)]
     if len(rows) < 2:
-        raise RecordError("(file)", str(path), "a header row of 'name [unit]' and at least one row of numbers")
+        raise LoadRecordError("(file)", str(path), "a header row of 'name [unit]' and at least one row of numbers")
     names, units = [], []
     for i, cell in enumerate(rows[0]):
         m = _CSV_HEADER.match(cell)
         if not m:
-            raise RecordError(f"header[{i}]", cell, "a column header 'name [unit]', e.g. 'RotSpeed [rpm]'", str(path))
+            raise LoadRecordError(f"header[{i}]", cell, "a column header 'name [unit]', e.g. 'RotSpeed [rpm]'", str(path))
         names.append(m.group("name"))
         units.append(m.group("unit"))
     try:
         values = np.array([[float(c) for c in r] for r in rows[1:]], dtype=float)
     except ValueError as exc:
-        raise RecordError("(rows)", str(exc), f"{len(names)} numbers per row", str(path)) from None
+        raise LoadRecordError("(rows)", str(exc), f"{len(names)} numbers per row", str(path)) from None
     if values.ndim != 2 or values.shape[1] != len(names):
-        raise RecordError("(rows)", str(path), f"{len(names)} numbers per row, as many as header cells")
+        raise LoadRecordError("(rows)", str(path), f"{len(names)} numbers per row, as many as header cells")
     return names, units, values
 
 
-def read_record(path: str | Path) -> Record:
+def read_load_record(path: str | Path) -> Record:
     """The channels of a record file (``.outb``, ``.out``, ``.csv``; see the module docstring).
 
     Raises
     ------
-    RecordError
+    LoadRecordError
         Naming the file and what is wrong with it (empty, the wrong kind of file, no time channel,
         NaN in the time channel, time not strictly increasing).
     """
     path = Path(path)
     source = str(path)
     if path.suffix.lower() not in RECORD_SUFFIXES:
-        raise RecordError("(file)", source, "a record file ending in " + ", ".join(RECORD_SUFFIXES))
+        raise LoadRecordError("(file)", source, "a record file ending in " + ", ".join(RECORD_SUFFIXES))
     data = _check_not_empty(path)
     reader = {".outb": _read_outb, ".out": _read_out, ".csv": _read_csv}[path.suffix.lower()]
     names, units, values = reader(path, data)
     if values.ndim != 2 or values.shape[0] < 2 or values.shape[1] != len(names) or len(units) != len(names):
-        raise RecordError("(file)", source, "two or more rows of samples with one value per channel")
+        raise LoadRecordError("(file)", source, "two or more rows of samples with one value per channel")
     names = [n.strip() for n in names]
     if names[0].lower() != "time":
-        raise RecordError("channel[0]", names[0], "the time channel Time first", source)
+        raise LoadRecordError("channel[0]", names[0], "the time channel Time first", source)
     t_unit, t_factor = si_conversion(units[0], names[0], source)
     if t_unit != "s":
-        raise RecordError(f"{names[0]}.unit", units[0], "a time unit (s)", source)
+        raise LoadRecordError(f"{names[0]}.unit", units[0], "a time unit (s)", source)
     time_s = values[:, 0] * t_factor
     bad = np.flatnonzero(~np.isfinite(time_s))
     if bad.size:
-        raise RecordError("Time", f"NaN at row {int(bad[0])}", "finite times", source)
+        raise LoadRecordError("Time", f"NaN at row {int(bad[0])}", "finite times", source)
     steps = np.diff(time_s)
     if not np.all(steps > 0.0):
         i = int(np.flatnonzero(~(steps > 0.0))[0])
-        raise RecordError("Time", f"{time_s[i]:g} s then {time_s[i + 1]:g} s at rows {i}, {i + 1}",
+        raise LoadRecordError("Time", f"{time_s[i]:g} s then {time_s[i + 1]:g} s at rows {i}, {i + 1}",
                           "strictly increasing (monotonic) time", source)
     channels = {n: (u, values[:, j]) for j, (n, u) in enumerate(zip(names, units)) if j > 0}
     return Record(source, time_s, channels)

@@ -24,7 +24,7 @@ Where a record is found: a path relative to the scenario file; else relative to 
 the folders of ``$DTCOSIM_DATA`` (``os.pathsep``-separated), then ``shared/`` beside the dtcosim
 checkout (``<repo>/../shared``, where the project's OpenFAST data live). The record is read, its
 channels converted to SI and checked when the scenario is loaded, before any FMU exists; the FMU
-built from it (:mod:`orchestrator.cosim.series_fmus`) carries the converted samples and runs
+built from it (:mod:`orchestrator.provision.series_fmus`) carries the converted samples and runs
 without the file.
 """
 
@@ -43,7 +43,7 @@ from pydantic import Field
 
 from ..errors import ScenarioError
 from .schema import Table
-from .series_file import RecordError, read_record, si_conversion
+from .series_file import LoadRecordError, read_load_record, si_conversion
 
 #: environment variable with data roots
 DATA_ENV = "DTCOSIM_DATA"
@@ -229,7 +229,7 @@ class SeriesSpec:
 
 def _selected(table: SeriesTable, path: Path, key: str, source: str | None) -> tuple[list[dict], RecordedSamples]:
     """The outputs and the converted samples of ``table.channels`` in the record ``path``."""
-    record = read_record(path)
+    record = read_load_record(path)
     outputs, columns, seen = [], [], {}
     for i, ch in enumerate(table.channels):
         ckey = f"{key}.channels[{i}]"
@@ -237,7 +237,7 @@ def _selected(table: SeriesTable, path: Path, key: str, source: str | None) -> t
         si_unit, factor = si_conversion(unit, ch.channel, record.source)
         bad = np.flatnonzero(~np.isfinite(values))
         if bad.size:
-            raise RecordError(ch.channel, f"NaN at t = {record.time_s[bad[0]]:g} s (row {int(bad[0])})",
+            raise LoadRecordError(ch.channel, f"NaN at t = {record.time_s[bad[0]]:g} s (row {int(bad[0])})",
                               f"finite samples ({bad.size} of {values.size} are not)", record.source)
         quantity = ch.quantity or OPENFAST_QUANTITIES.get(ch.channel, "")
         column = len(columns)
@@ -264,9 +264,9 @@ def series_from_table(table: SeriesTable, key: str, base_dir: Path | None, sourc
 
     Raises
     ------
-    ScenarioError, RecordError
+    ScenarioError, LoadRecordError
         Neither or both of ``record`` and ``records``; a file not found; any problem of a record
-        (:func:`read_record`) or of a channel: missing (with "did you mean"), a unit with no SI
+        (:func:`read_load_record`) or of a channel: missing (with "did you mean"), a unit with no SI
         conversion, NaN, a duplicate output; a record whose channel has another SI unit than the first's.
     """
     if (table.record is None) == (table.records is None):

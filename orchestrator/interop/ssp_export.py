@@ -298,7 +298,7 @@ def system_structure(system: ResolvedSystem, initial_values: Mapping[str, float]
         settings.set("loopMaxIterations", str(sim.loop_max_iterations))
     for b in sc.initial:
         ET.SubElement(dtc, _q("dtc:Initial"), source=str(b.source), target=str(b.target))
-    for pattern in sc.record:
+    for pattern in sc.recorded:
         ET.SubElement(dtc, _q("dtc:Record"), variable=pattern)
     if sc.analysis != AnalysisSettings():
         a = sc.analysis

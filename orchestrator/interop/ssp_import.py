@@ -313,7 +313,7 @@ def import_ssp(path: str | Path, step_s: float | None = None, stop_s: float | No
             report(note)
     return Scenario(
         name=name, description=system.get("description", ""), components=components, connections=connections,
-        initial=tuple(initial), simulation=settings, record=tuple(record), analysis=analysis, base_dir=base,
+        initial=tuple(initial), simulation=settings, recorded=tuple(record), analysis=analysis, base_dir=base,
         source=source,
     )
 

@@ -24,6 +24,8 @@ from typing import Any, Mapping
 
 from components.model.drivetrain import Drivetrain
 from components.model.parameter_map import flatten, unflatten
+from fmus.registry import of_file, with_role
+from fmus.slaves.record import GEARBOX, GENERATOR
 
 from ..errors import EntryError
 from ..inputs.drivetrain_entries import with_entries
@@ -78,6 +80,12 @@ def _gearbox_values(drivetrain: Drivetrain) -> dict[str, float]:
     return {k: v for k, v in flatten(drivetrain).items() if not k.startswith(("generator.", "output_torque"))}
 
 
+def _project_role(component) -> str | None:
+    """The role of the project FMU a component names (:func:`fmus.registry.of_file`; None: not one)."""
+    kind = of_file(component.fmu)
+    return kind.role if kind is not None else None
+
+
 def drivetrain_variants(study: Study, scenario, points: list[Point], fmu_dir: Path,
                         build: bool) -> DrivetrainVariants | None:
     """The structures and per-point parameters of a study that varies drivetrain file entries (None if it does not).
@@ -88,8 +96,9 @@ def drivetrain_variants(study: Study, scenario, points: list[Point], fmu_dir: Pa
         A file entry of a component without a drivetrain file, a key path the file does not have, a
         point whose changed file is invalid, or a file entry together with an FMU parameter it would set.
     """
-    from ..cosim.drivetrain_fmus import ensure_drivetrain_fmus
-    from ..cosim.system import resolve_fmu_paths, resolve_system
+    from ..cosim.system import resolve_system
+    from ..provision.drivetrain_fmus import ensure_drivetrain_fmus
+    from ..provision.locate import resolve_fmu_paths
 
     src = study.source
     names = list(study.base.parameters) + study.varied_parameters
@@ -104,15 +113,16 @@ def drivetrain_variants(study: Study, scenario, points: list[Point], fmu_dir: Pa
             raise StudyError(_study_key(study, name, Point(0, {}, ())), name,
                              "a file entry <component>.drivetrain.<key> of a component built from a drivetrain file"
                              + (f" ({comp} names none)" if component is not None else f" (no component {comp})"), src)
-        if component.fmu.name != "Gearbox.fmu":
+        if _project_role(component) != GEARBOX:
             raise StudyError(_study_key(study, name, Point(0, {}, ())), name,
-                             f"a file entry of the gearbox component (the one whose fmu is Gearbox.fmu, not {comp})", src)
+                             f"a file entry of the gearbox component (the one whose fmu is the project's "
+                             f"{with_role(GEARBOX).file_name}, not {comp})", src)
         by_component[comp] = component.drivetrain
     if len(by_component) > 1:
         raise StudyError("axes", sorted(by_component), "file entries of one gearbox component", src)
     (gear_name, original), = by_component.items()
     users = [c for c in scenario.components if c.drivetrain is not None and c.drivetrain.sha256 == original.sha256]
-    generators = [c.name for c in users if c.fmu.name == "GeneratorRotor.fmu"]
+    generators = [c.name for c in users if _project_role(c) == GENERATOR]
     fixed = {n: v for n, v in study.base.parameters.items() if is_file_entry(n)}
 
     templates: list[tuple[str, DrivetrainSpec]] = []

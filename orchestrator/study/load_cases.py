@@ -120,7 +120,7 @@ class PreparedLoadCases:
 
 def _base_system(lcs: LoadCaseSet, fmu_dir, build: bool):
     """The base scenario with the fixed parameters and the runs' time grid, resolved against its FMUs."""
-    from ..cosim.fmu_store import ensure_fmus
+    from ..provision.project_fmus import ensure_fmus
     from ..cosim.system import resolve_system
     from ..inputs.overrides import apply_parameters
     from ..run.runner import load_any

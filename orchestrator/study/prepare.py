@@ -256,8 +256,9 @@ def _prepare_model(study: Study) -> tuple[StudyPayload, dict[str, Any]]:
 
 def _prepare_scenario(study: Study, fmu_dir,
                       build: bool) -> tuple[StudyPayload, dict[str, Any], dict[str, Path], tuple[str, ...]]:
-    from ..cosim.fmu_store import ensure_fmus
+    from ..cosim.roles import GEARBOX
     from ..cosim.system import resolve_system
+    from ..provision.project_fmus import ensure_fmus
     from ..run.runner import load_any
 
     src = study.source
@@ -294,20 +295,21 @@ def _prepare_scenario(study: Study, fmu_dir,
     _check_measure_engines(study)
 
     series_names: dict[str, str] = {}
-    gearbox = [n for n, i in system.interfaces.items() if i.model_name == "Gearbox"]
+    gearbox = system.with_role(GEARBOX)
     if study.engine == "cosim":
         extra = []
         for i, m in enumerate(study.measures):
             if m.builtin and m.name != "I_max_acc":
                 continue
             if m.name == "I_max_acc":
-                if len(gearbox) != 1:
-                    raise StudyError(f"measures[{i}]", m.name, "a base scenario with exactly one Gearbox FMU "
-                                     f"(its omega_out); found {len(gearbox)}", src)
+                signals = {s.kind: s.variable for s in gearbox[0].signals} if len(gearbox) == 1 else {}
                 # the FMU's running peak over its internal steps (eq. 11 exactly) where it has one;
-                # FMUs built before it existed: finite differences of omega_out (a lower bound)
-                peak = "alpha_out_max" in system.interfaces[gearbox[0]].variables
-                variable = f"{gearbox[0]}.{'alpha_out_max' if peak else 'omega_out'}"
+                # FMUs built before it existed: finite differences of the output speed (a lower bound)
+                output = signals.get("output_acceleration_peak") or signals.get("output_speed")
+                if output is None:
+                    raise StudyError(f"measures[{i}]", m.name, "a base scenario with exactly one gearbox that "
+                                     f"declares its output speed; found {len(gearbox)} gearbox(es)", src)
+                variable = f"{gearbox[0].component}.{output}"
                 series_names["I_max_acc"] = variable
             else:
                 variable = m.variable
@@ -317,10 +319,10 @@ def _prepare_scenario(study: Study, fmu_dir,
                 if fv is None or fv.type != "Real":
                     choices = [f"{c}.{n}" for c, f in system.interfaces.items() for n, v in f.variables.items() if v.type == "Real"]
                     raise StudyError(f"measures[{i}]", m.name, f"a Real variable of the base scenario's FMUs{suggestion(variable, choices)}", src)
-            if scenario.record and variable not in {r.column for r in system.recorded}:
+            if scenario.recorded and variable not in {r.column for r in system.recorded}:
                 extra.append(variable)
         if extra:
-            scenario = replace(scenario, record=scenario.record + tuple(dict.fromkeys(extra)))
+            scenario = replace(scenario, recorded=scenario.recorded + tuple(dict.fromkeys(extra)))
             system = resolve_system(scenario, fmu_paths=paths)
         variants = _variants(study, scenario, fmu_dir, build)
         blobs = {}
@@ -371,7 +373,7 @@ def _prepare_scenario(study: Study, fmu_dir,
 
 def _variants(study: Study, scenario, fmu_dir, build: bool):
     """The drivetrain structures of a study varying drivetrain file entries, the measures checked on each."""
-    from ..cosim.fmu_folder import default_fmu_dir
+    from ..provision.folders import default_fmu_dir
     from .drivetrain_variants import drivetrain_variants
 
     fmu_dir = default_fmu_dir() if fmu_dir is None else Path(fmu_dir)
@@ -408,7 +410,7 @@ def prepare_study(study: Study, fmu_dir: str | Path | None = None, build: bool =
     study : Study
     fmu_dir : path, optional
         Where the base scenario's FMUs are looked for (and missing project FMUs
-        built); default :func:`orchestrator.cosim.fmu_folder.default_fmu_dir`.
+        built); default :func:`orchestrator.provision.folders.default_fmu_dir`.
     build : bool
         Build missing project FMUs.
 

@@ -24,7 +24,7 @@ from fmus.build import (
     rewrite_slave_imports,
 )
 from fmus.model_description import read_member, rewrite_archive
-from fmus.records import model_of
+from fmus.registry import kind
 from fmus.runtime_files import GUARD_FILE
 from fmus.validation import check_fmu
 from orchestrator.commands.cli import main as dtcosim
@@ -135,7 +135,7 @@ def test_archive_carries_its_code_under_private_names(built_fmus, name):
 
 
 def _model(name, preset):
-    return model_of(name, drivetrain_of_preset(preset))
+    return kind(name).model(drivetrain_of_preset(preset))
 
 
 def test_code_hash_is_deterministic_and_names_the_configuration():
@@ -198,14 +198,14 @@ def test_single_stage_presets_build_and_run(tmp_path, preset):
 
 
 def test_documented_variable_tables_match_the_code():
-    from fmus.docs import update
+    from fmus.documentation import update
 
     doc = fmu_build.SourceTree.installed().components_dir.parent / "docs" / "fmus.md"
     if not doc.is_file():
         pytest.skip("docs/fmus.md is not next to the installed package")
     text = doc.read_text(encoding="utf-8")
     assert "<!-- BEGIN GENERATED Gearbox -->" in text
-    assert update(text) == text, "run: python -m fmus.docs --update docs/fmus.md"
+    assert update(text) == text, "run: python -m fmus.documentation --update docs/fmus.md"
 
 
 @pytest.fixture

@@ -11,7 +11,7 @@ from fmpy import read_model_description
 from fmus.build import PRESET_FMU_NAMES, drivetrain_of_preset
 from fmus.documentation import VARIABLE_TABLE_ID
 from fmus.parameter_ranges import INPUT_RANGE, OUTPUT_RANGE, accepted_ranges
-from fmus.records import model_of
+from fmus.registry import kind
 from fmus.requirements import read_from_fmu
 from fmus.validation import check_fmu
 from orchestrator.commands.cli import main as dtcosim
@@ -73,7 +73,7 @@ def test_html_variable_table_matches_the_model_description(fmu_path, name):
     ("GeneratorRotor", "event1.kind", "0 = none, 1 = torque_step, 2 = grid_fault, 3 = emergency_stop"),
 ])
 def test_ranges_are_what_the_validation_demands(fmu_path, name, variable, expected):
-    assert accepted_ranges(name, model_of(name, drivetrain_of_preset("table6")))[variable] == expected
+    assert accepted_ranges(name, kind(name).model(drivetrain_of_preset("table6")))[variable] == expected
     row = next(r for r in tables(page(fmu_path(name)))[0][VARIABLE_TABLE_ID] if r["name"] == variable)
     assert row["range"] == expected
 

@@ -26,7 +26,7 @@ from orchestrator.inputs.scenario import (
 @pytest.fixture(scope="module")
 def paper(fmu_dir):
     """The paper's scenario with the suite's FMUs: ``paper(values) -> resolved system``."""
-    from orchestrator.cosim.fmu_store import ensure_fmus
+    from orchestrator.provision.project_fmus import ensure_fmus
 
     base = load_scenario(find_scenario("paper-60s"))
     paths = ensure_fmus(base, fmu_dir, build=False)

@@ -16,7 +16,7 @@ import pytest
 
 from orchestrator.errors import ScenarioError
 from orchestrator.inputs.scenario import load_scenario
-from orchestrator.inputs.series_file import RecordError, read_record, si_conversion
+from orchestrator.inputs.series_file import LoadRecordError, read_load_record, si_conversion
 from tests.helpers.openfast_data import openfast_file
 
 SCENARIO = """
@@ -50,7 +50,7 @@ GOOD_CSV = "Time [s], RotSpeed [rpm], GenTq [kN-m]\n0, 12, 40\n0.5, 12.1, 41\n1.
 
 
 def test_outb_read_with_openfast_io():
-    rec = read_record(openfast_file("DLC1.1_0_NREL5MW_OC3_spar_0.outb"))
+    rec = read_load_record(openfast_file("DLC1.1_0_NREL5MW_OC3_spar_0.outb"))
     assert rec.time_s[0] == 0.0 and rec.time_s[-1] == pytest.approx(10.0) and rec.time_s.size == 801
     assert rec.channel("RotSpeed")[0] == "rpm"
     assert len(rec.channels) == 276
@@ -60,7 +60,7 @@ def test_fast_v6_text_file_that_is_not_utf8():
     path = openfast_file("DLC2.3_1.out")
     with pytest.raises(UnicodeDecodeError):
         path.read_text(encoding="utf-8")
-    rec = read_record(path)
+    rec = read_load_record(path)
     assert rec.time_s[0] == 30.0 and rec.time_s[-1] == 90.0
     unit, gen_tq = rec.channel("GenTq")
     assert unit == "kN-m"  # the Latin-1 'kN·m'
@@ -84,12 +84,12 @@ def test_csv_channels_are_converted_to_si(tmp_path):
 
 
 @pytest.mark.parametrize("text, channel, error, match", [
-    (GOOD_CSV, "RotSped", RecordError, r"channel = 'RotSped'.*did you mean RotSpeed"),
-    ("Time [s], RotSpeed [furlongs]\n0, 1\n1, 2\n", "RotSpeed", RecordError, r"RotSpeed\.unit = 'furlongs'.*known conversion"),
-    ("Time [s], RotSpeed [rpm]\n0, 1\n0.5, nan\n1, 2\n", "RotSpeed", RecordError, r"RotSpeed = 'NaN at t = 0\.5 s"),
-    ("Time [s], RotSpeed [rpm]\n0, 1\n0.6, 2\n0.5, 3\n1, 4\n", "RotSpeed", RecordError, r"strictly increasing \(monotonic\) time"),
-    ("", "RotSpeed", RecordError, r"the file is empty"),
-    ("Time, RotSpeed\n0, 1\n", "RotSpeed", RecordError, r"'name \[unit\]'"),
+    (GOOD_CSV, "RotSped", LoadRecordError, r"channel = 'RotSped'.*did you mean RotSpeed"),
+    ("Time [s], RotSpeed [furlongs]\n0, 1\n1, 2\n", "RotSpeed", LoadRecordError, r"RotSpeed\.unit = 'furlongs'.*known conversion"),
+    ("Time [s], RotSpeed [rpm]\n0, 1\n0.5, nan\n1, 2\n", "RotSpeed", LoadRecordError, r"RotSpeed = 'NaN at t = 0\.5 s"),
+    ("Time [s], RotSpeed [rpm]\n0, 1\n0.6, 2\n0.5, 3\n1, 4\n", "RotSpeed", LoadRecordError, r"strictly increasing \(monotonic\) time"),
+    ("", "RotSpeed", LoadRecordError, r"the file is empty"),
+    ("Time, RotSpeed\n0, 1\n", "RotSpeed", LoadRecordError, r"'name \[unit\]'"),
 ])
 def test_bad_csv_records(tmp_path, text, channel, error, match):
     fmus = tmp_path / "fmus"
@@ -118,14 +118,14 @@ def test_time_offset_moves_the_run_into_the_record(tmp_path):
 def test_binary_files_of_the_wrong_kind(tmp_path):
     rng = np.random.default_rng(1)
     (tmp_path / "noise.outb").write_bytes(b"\x89PNG\r\n\x1a\n" + rng.bytes(4000))
-    with pytest.raises(RecordError, match=r"not a FAST binary file"):
+    with pytest.raises(LoadRecordError, match=r"not a FAST binary file"):
         load_scenario(scenario(tmp_path, "noise.outb"))
     shutil.copy(openfast_file("DLC1.1_0_NREL5MW_OC3_spar_0.outb"), tmp_path / "renamed.out")
-    with pytest.raises(RecordError, match=r"OpenFAST text output \(\.out\); the file is binary"):
+    with pytest.raises(LoadRecordError, match=r"OpenFAST text output \(\.out\); the file is binary"):
         load_scenario(scenario(tmp_path, "renamed.out"))
     data = openfast_file("DLC1.1_0_NREL5MW_OC3_spar_0.outb").read_bytes()
     (tmp_path / "cut.outb").write_bytes(data[:20000])
-    with pytest.raises(RecordError, match=r"truncated or another kind"):
+    with pytest.raises(LoadRecordError, match=r"truncated or another kind"):
         load_scenario(scenario(tmp_path, "cut.outb"))
 
 
@@ -145,5 +145,5 @@ def test_a_record_above_the_size_limit_is_refused_before_it_is_read(tmp_path, mo
     path = tmp_path / "big.csv"
     path.write_text("Time [s],GenSpeed [rpm]\n" + "".join(f"{i * 0.1:g},{1000 + i}\n" for i in range(100)))
     monkeypatch.setattr(series_file, "MAX_RECORD_BYTES", 512)
-    with pytest.raises(RecordError, match=r"a record of at most 512 bytes \(0\.000488 MiB\); the file has 904 bytes"):
-        read_record(path)
+    with pytest.raises(LoadRecordError, match=r"a record of at most 512 bytes \(0\.000488 MiB\); the file has 904 bytes"):
+        read_load_record(path)

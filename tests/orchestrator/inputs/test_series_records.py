@@ -10,10 +10,10 @@ import fmpy
 import numpy as np
 import pytest
 
-from orchestrator.cosim.series_fmus import ensure_series_fmu
+from orchestrator.provision.series_fmus import ensure_series_fmu
 from orchestrator.errors import ScenarioError
 from orchestrator.inputs.scenario import load_scenario
-from orchestrator.inputs.series_file import RecordError
+from orchestrator.inputs.series_file import LoadRecordError
 
 SCENARIO = """
 name = "records"
@@ -92,7 +92,7 @@ def test_every_record_must_cover_the_run(tmp_path):
 def test_a_missing_channel_in_a_later_record_names_that_record(tmp_path):
     path = write(tmp_path, 'records = ["a.csv", "x.csv"]')
     (tmp_path / "x.csv").write_text("Time [s], RotSpeed [rpm]\n0, 12\n1.0, 12\n")
-    with pytest.raises(RecordError, match="x.csv.*GenTq"):
+    with pytest.raises(LoadRecordError, match="x.csv.*GenTq"):
         load_scenario(path)
 
 

@@ -1,4 +1,4 @@
-"""ecos (PyPI ``ecospy``, a C++ co-simulation engine) runs the exported SSP by the README's recipe, word for word."""
+"""ecos (PyPI ``ecospy``, a C++ co-simulation engine) runs the exported SSP by the documented recipe (docs/hosts.md), word for word."""
 
 from __future__ import annotations
 
@@ -16,14 +16,14 @@ import pytest
 from tests.helpers.fmu_hosts import DRIVERS
 from tests.helpers.scenarios import dtcosim
 
-README = Path(__file__).resolve().parents[3] / "README.md"
+HOSTS_DOC = Path(__file__).resolve().parents[3] / "docs" / "hosts.md"
 RECIPE = re.compile(r"<!-- ecos-recipe -->\n```bash\n(.*?)```", re.DOTALL)
 
 
 def readme_recipe() -> str:
-    """The bash block after ``<!-- ecos-recipe -->`` in the README, as it stands."""
-    match = RECIPE.search(README.read_text(encoding="utf-8"))
-    assert match, "README.md has no <!-- ecos-recipe --> bash block"
+    """The bash block after ``<!-- ecos-recipe -->`` in docs/hosts.md, as it stands."""
+    match = RECIPE.search(HOSTS_DOC.read_text(encoding="utf-8"))
+    assert match, "docs/hosts.md has no <!-- ecos-recipe --> bash block"
     return match.group(1)
 
 
@@ -38,7 +38,7 @@ def run_recipe(work: Path, fmu_dir: Path, recipe: str, extra_env: dict | None = 
     """Run ``recipe`` with bash in ``work``, in this virtual environment (its bin/ first on PATH)."""
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "LD_PRELOAD")}
     env["PATH"] = f"{Path(sys.executable).parent}{os.pathsep}{env.get('PATH', '')}"
-    env["DTCOSIM_FMU_DIR"] = str(fmu_dir)  # the session's FMUs (else export-ssp builds them into ./fmus)
+    env["DTCOSIM_FMU_DIR"] = str(fmu_dir)  # the session's FMUs (else export-ssp builds them into the per-user cache)
     env.update(extra_env or {})
     return subprocess.run(["bash", "-euo", "pipefail", "-c", recipe], cwd=work, env=env, capture_output=True,
                           text=True, timeout=900)
@@ -111,7 +111,7 @@ def test_readme_recipe_runs_the_exported_ssp_in_ecos(fmu_dir, tmp_path):
 
 @pytest.mark.slow
 def test_ecos_without_the_preload_crashes_silently_and_numpy_hidden_is_named_before_its_crash(fmu_dir, tmp_path):
-    """What the README documents about ecos 0.7.2: it needs the preload, and it crashes on a NULL instance."""
+    """What docs/hosts.md documents about ecos 0.7.2: it needs the preload, and it crashes on a NULL instance."""
     _ecos_available()
     recipe = readme_recipe()
     without_preload = recipe.replace('LD_PRELOAD="$LIBPYTHON" ', "")

@@ -13,6 +13,7 @@ from orchestrator.cosim.master import CoSimulation
 from orchestrator.cosim.system import resolve_system
 from orchestrator.inputs.scenario import find_scenario, load_scenario
 from orchestrator.interop.ssp import NS, PARAMETER_SET, export_ssp, import_ssp
+from orchestrator.provision.locate import resolve_fmu_paths
 from orchestrator.run.runner import load_any
 from tests.helpers.scenarios import dtcosim
 
@@ -82,7 +83,7 @@ def test_export_import_round_trip_and_identical_run(toy_scenario, tmp_path):
     assert back.name == original.name and back.description == original.description
     assert back.simulation == original.simulation
     assert back.connections == original.connections and back.initial == original.initial
-    assert back.record == original.record
+    assert back.recorded == original.recorded
     assert [(c.name, dict(c.parameters)) for c in back.components] == [(c.name, dict(c.parameters)) for c in original.components]
     run_a = CoSimulation(system).run(handle_sigint=False)
     run_b = CoSimulation(resolve_system(back)).run(handle_sigint=False)
@@ -104,7 +105,8 @@ def paper_ssp(fmu_dir, tmp_path_factory):
 @pytest.mark.slow
 def test_reimported_paper_ssp_runs_identically(paper_ssp, fmu_dir):
     stop = dict(stop_s=3.0, window_s=(1.0, 3.0))
-    from_toml = resolve_system(load_scenario(find_scenario(None)).with_simulation(**stop), fmu_dir=fmu_dir)
+    toml = load_scenario(find_scenario(None)).with_simulation(**stop)
+    from_toml = resolve_system(toml, fmu_paths=resolve_fmu_paths(toml, fmu_dir))
     from_ssp = resolve_system(load_any(paper_ssp).with_simulation(**stop))
     assert from_ssp.order == from_toml.order
     a = CoSimulation(from_toml).run(handle_sigint=False)

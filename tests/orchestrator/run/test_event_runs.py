@@ -16,6 +16,7 @@ from components.analysis.spectrum import amplitude_spectrum
 from orchestrator.commands.cli import main
 from orchestrator.cosim.system import resolve_system
 from orchestrator.inputs.scenario import find_scenario, load_scenario
+from orchestrator.provision.locate import resolve_fmu_paths
 from orchestrator.result_files import read_timeseries
 from orchestrator.run.comparison import run_reference
 from orchestrator.run.runner import run_scenario
@@ -62,7 +63,8 @@ def test_grid_fault_crosses_the_backlash_in_every_mesh_without_solver_failure(gr
 def test_grid_fault_contact_loss_matches_the_monolithic_reference(grid_fault_run, fmu_dir):
     """The reference carries the event too (from the generator's slot parameters) and counts the same."""
     _, summary, _ = grid_fault_run
-    system = resolve_system(load_scenario(find_scenario("grid-fault")), fmu_dir=fmu_dir)
+    grid_fault = load_scenario(find_scenario("grid-fault"))
+    system = resolve_system(grid_fault, fmu_paths=resolve_fmu_paths(grid_fault, fmu_dir))
     ref = run_reference(system)
     assert ref.complete
     mono = contact_loss_summary(ref, window=(5.0, 15.0))
@@ -146,7 +148,7 @@ def tvms_runs(fmu_dir, tmp_path_factory):
     for v in (0.3, 0.0):
         sc = base.with_parameters("gearbox", **{"stage3.stiffness_variation": v})
         out = tmp_path_factory.mktemp(f"tvms-{v}")
-        report = run_scenario(resolve_system(sc, fmu_dir=fmu_dir), out, handle_sigint=False, plots=v > 0)
+        report = run_scenario(resolve_system(sc, fmu_paths=resolve_fmu_paths(sc, fmu_dir)), out, handle_sigint=False, plots=v > 0)
         assert report.outcome.complete
         runs[v] = (out, report)
     return runs
@@ -197,7 +199,7 @@ def test_analysis_table_reaches_the_results(fmu_dir, tmp_path):
         "window = [5.0, 60.0]", "window = [0.5, 1.0]") + (
         '\n[analysis]\nwoehler_exponents = [4, 9]\nreference_frequency_hz = 2.0\nldd_bins = 16\nspectrum = "always"\n')
     sc = load_scenario(write_scenario(tmp_path, text))
-    report = run_scenario(resolve_system(sc, fmu_dir=fmu_dir), tmp_path / "out", handle_sigint=False, plots=False)
+    report = run_scenario(resolve_system(sc, fmu_paths=resolve_fmu_paths(sc, fmu_dir)), tmp_path / "out", handle_sigint=False, plots=False)
     s = report.summary
     assert s["analysis_settings"]["woehler_exponents"] == [4.0, 9.0]
     d = s["fatigue"]["del"]["gearbox.shaft1.torque"]

@@ -16,8 +16,8 @@ import pytest
 
 from components.model.time_series import Interpolant
 from components.model.torque_controller import TorqueLawParameters, law_torque_nm
-from orchestrator.cosim.fmu_store import ensure_fmus
-from orchestrator.cosim.series_fmus import ensure_series_fmu
+from orchestrator.provision.project_fmus import ensure_fmus
+from orchestrator.provision.series_fmus import ensure_series_fmu
 from orchestrator.cosim.system import resolve_system
 from orchestrator.errors import ScenarioError
 from orchestrator.inputs.overrides import apply_parameters

@@ -14,6 +14,7 @@ from orchestrator.cosim.master import CoSimulation
 from orchestrator.cosim.physics_view import physics_view
 from orchestrator.cosim.system import resolve_system
 from orchestrator.inputs.scenario import find_scenario, load_scenario
+from orchestrator.provision.locate import resolve_fmu_paths
 from orchestrator.result_files import read_timeseries
 from orchestrator.run.comparison import compare, run_reference
 
@@ -82,7 +83,8 @@ def test_timeseries_and_summary_format(paper_run):
 
 def test_cosimulation_agrees_with_the_monolithic_reference_at_1ms(paper_run):
     out, summary, _ = paper_run
-    system = resolve_system(load_scenario(find_scenario(None)), fmu_dir=out.parent.parent / "fmus")
+    paper = load_scenario(find_scenario(None))
+    system = resolve_system(paper, fmu_paths=resolve_fmu_paths(paper, out.parent.parent / "fmus"))
     setup = physics_view(system)
     reference = run_reference(system, setup)
     assert reference.complete
@@ -100,7 +102,7 @@ def _short(fmu_dir, step, stop=3.0, **gearbox):
                                                             output_interval_s=0.01)
     if gearbox:
         sc = sc.with_parameters("gearbox", **gearbox)
-    return resolve_system(sc, fmu_dir=fmu_dir)
+    return resolve_system(sc, fmu_paths=resolve_fmu_paths(sc, fmu_dir))
 
 
 def _coupling_errors(fmu_dir, steps, **gearbox):

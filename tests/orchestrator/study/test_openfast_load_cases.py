@@ -15,14 +15,14 @@ import pytest
 
 from orchestrator.inputs.load_cases import find_load_cases, load_load_cases
 from orchestrator.inputs.scenario import find_scenario, load_scenario
-from orchestrator.inputs.series_file import read_record
+from orchestrator.inputs.series_file import read_load_record
 from tests.helpers.openfast_data import openfast_file
 
 RECORDS = [f"DLC1.1_0_NREL5MW_OC3_spar_{i}.outb" for i in range(4)]
 
 
 def _records():
-    return [read_record(openfast_file(name)) for name in RECORDS]  # skips without the shared data
+    return [read_load_record(openfast_file(name)) for name in RECORDS]  # skips without the shared data
 
 
 def test_each_bin_plays_the_record_whose_mean_wind_speed_it_holds():

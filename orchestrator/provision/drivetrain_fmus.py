@@ -1,11 +1,11 @@
 """FMUs built from drivetrain files, kept apart by the file's content.
 
-A Gearbox (and its GeneratorRotor) built from a drivetrain file lives in
-``<FMU directory>/drivetrains/<name>-<sha256[:16]>/`` (:func:`orchestrator.inputs.scenario.drivetrain_fmu_dir`),
-so two scenarios with different drivetrains never overwrite each other's
-``Gearbox.fmu`` and a changed file gets new FMUs. The FMUs' records name the file
-and its content hash (``source``) and carry the drivetrain (``model``), which the
-reference, the comparison and ``dtcosim modes`` read.
+The FMUs built from a drivetrain file (:func:`fmus.registry.built_from` a drivetrain file: the
+Gearbox and its GeneratorRotor) live in ``<FMU folder>/drivetrains/<name>-<sha256[:16]>/``
+(:func:`orchestrator.provision.folders.drivetrain_fmu_dir`), so two scenarios with different
+drivetrains never overwrite each other's FMUs and a changed file gets new FMUs. The FMUs'
+records name the file and its content hash (``source``) and carry the drivetrain
+(``model``), which the reference, the comparison and ``dtcosim modes`` read.
 """
 
 from __future__ import annotations
@@ -13,15 +13,19 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Callable, Iterable
 
+from fmus.build import BuiltFmu, build_fmu
+from fmus.registry import DRIVETRAIN_FILE, names_built_from
+
 from ..inputs.drivetrain_file import DrivetrainSpec
-from ..inputs.scenario import drivetrain_fmu_dir
+from .folders import drivetrain_fmu_dir
+from .staleness import stale_project_fmus
 
 #: the FMUs a drivetrain file is built into
-DRIVETRAIN_FMU_NAMES = ("Gearbox", "GeneratorRotor")
+DRIVETRAIN_FMU_NAMES = names_built_from(DRIVETRAIN_FILE)
 
 
 def build_drivetrain_fmus(spec: DrivetrainSpec, out_dir: Path, names: Iterable[str] = DRIVETRAIN_FMU_NAMES,
-                          report: Callable[[str], None] | None = None, validate: bool = True) -> list:
+                          report: Callable[[str], None] | None = None, validate: bool = True) -> list[BuiltFmu]:
     """Build FMUs ``names`` from a drivetrain file into ``out_dir``.
 
     Returns
@@ -33,8 +37,6 @@ def build_drivetrain_fmus(spec: DrivetrainSpec, out_dir: Path, names: Iterable[s
     DrivetrainFileError
         The file has no generator (a Gearbox FMU is cut at the generator).
     """
-    from fmus.build import build_fmu
-
     drivetrain = spec.cosim_drivetrain()
     names = list(names)
     if report:
@@ -47,11 +49,9 @@ def ensure_drivetrain_fmus(spec: DrivetrainSpec, fmu_dir: Path, names: Iterable[
                            report: Callable[[str], None] | None = None) -> Path:
     """The folder of ``spec``'s FMUs in ``fmu_dir``, with FMUs ``names`` built if missing or stale.
 
-    Stale: built from other code than the installed dtcosim (:func:`orchestrator.cosim.fmu_store.stale_project_fmus`);
+    Stale: built from other code than the installed dtcosim (:func:`~orchestrator.provision.staleness.stale_project_fmus`);
     these folders are the project's own cache, so a stale FMU is rebuilt, not only reported.
     """
-    from .fmu_store import stale_project_fmus
-
     folder = drivetrain_fmu_dir(fmu_dir, spec)
     names = list(dict.fromkeys(names))
     paths = {n: folder / f"{n}.fmu" for n in names}

@@ -1,0 +1,60 @@
+"""Where built FMUs live: the FMU folder and its content-keyed subfolders (a light module: the CLI imports it at start-up).
+
+The FMU folder is ``$DTCOSIM_FMU_DIR`` if set, else ``fmus/`` in dtcosim's per-user
+cache (:func:`components.model.numba_cache.user_cache_root`: ``$DTCOSIM_CACHE_DIR``, else
+``$XDG_CACHE_HOME/dtcosim`` or ``~/.cache/dtcosim``), or the folder a command is given
+(``--fmu-dir``, ``dtcosim build --out``). Nothing is ever written into the installed
+package or a source checkout. Inside it:
+
+``<name>.fmu``
+    The project's FMUs built from a preset (``dtcosim build``, a run that misses them).
+``drivetrains/<drivetrain name>-<sha256[:16]>/``
+    Gearbox and GeneratorRotor built from a drivetrain file, one folder per file content.
+``series/<load record stem>-<sha256[:16]>/``
+    The TimeSeriesSource built from a scenario's load record, one folder per selected content.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Protocol
+
+from components.model.numba_cache import user_cache_root
+
+#: environment variable naming the FMU folder
+FMU_DIR_VARIABLE = "DTCOSIM_FMU_DIR"
+#: folder of the FMU folder with the FMUs built from drivetrain files, one subfolder per file content
+DRIVETRAIN_FOLDER = "drivetrains"
+#: folder of the FMU folder with the FMUs built from load records, one subfolder per selected content
+SERIES_FOLDER = "series"
+
+
+class ContentKeyed(Protocol):
+    """What an FMU is built from, named by its content: a drivetrain file or a load record selection.
+
+    (:class:`orchestrator.inputs.drivetrain_file.DrivetrainSpec`,
+    :class:`orchestrator.inputs.series_spec.SeriesSpec`; not imported here, to keep this module light.)
+    """
+
+    @property
+    def key(self) -> str:
+        """``<name>-<sha256[:16]>`` of the content."""
+
+
+def default_fmu_dir() -> Path:
+    """The FMU folder: ``$DTCOSIM_FMU_DIR`` if set, else ``<user cache>/fmus`` (not created here)."""
+    explicit = os.environ.get(FMU_DIR_VARIABLE)
+    if explicit:
+        return Path(explicit)
+    return user_cache_root() / "fmus"
+
+
+def drivetrain_fmu_dir(fmu_dir: Path, spec: ContentKeyed) -> Path:
+    """Where the FMUs built from a drivetrain file live: ``<fmu_dir>/drivetrains/<name>-<sha256[:16]>/``."""
+    return Path(fmu_dir) / DRIVETRAIN_FOLDER / spec.key
+
+
+def series_fmu_dir(fmu_dir: Path, spec: ContentKeyed) -> Path:
+    """Where the TimeSeriesSource built from a load record lives: ``<fmu_dir>/series/<stem>-<sha256[:16]>/``."""
+    return Path(fmu_dir) / SERIES_FOLDER / spec.key

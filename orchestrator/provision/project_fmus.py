@@ -1,0 +1,83 @@
+"""Every FMU a scenario needs: found, or built when missing or stale.
+
+A relative FMU path is looked up next to the scenario file, then in the FMU folder
+(:mod:`orchestrator.provision.locate`). ``dtcosim run`` builds a missing project FMU
+named by its file (``Gearbox.fmu``, ...: :func:`fmus.registry.of_file`, one the
+registry builds from a preset) into the FMU folder with :mod:`fmus.build`, and first
+the kernels they step, compiled ahead of time (:mod:`orchestrator.cosim.compiled_kernels`);
+any other missing FMU is a scenario error naming the component. A component built from a
+drivetrain file (``drivetrain = "..."``) gets its FMUs in the folder of that file's
+content (:mod:`orchestrator.provision.drivetrain_fmus`), one built from a load record
+in the folder of the selected content (:mod:`orchestrator.provision.series_fmus`), each
+built when missing or stale.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Callable
+
+from fmus.build import build_all
+from fmus.registry import PRESET, of_file
+
+from ..cosim.compiled_kernels import ensure_compiled_kernels
+from ..inputs.drivetrain_file import DrivetrainSpec
+from ..inputs.scenario import Scenario
+from .drivetrain_fmus import ensure_drivetrain_fmus
+from .folders import default_fmu_dir
+from .locate import missing_fmus, resolve_fmu_paths
+from .series_fmus import ensure_series_fmu
+
+
+def ensure_fmus(scenario: Scenario, fmu_dir: str | Path | None = None, build: bool = True,
+                report: Callable[[str], None] | None = None) -> dict[str, Path]:
+    """Resolve every FMU path, building the project's missing FMUs first.
+
+    Parameters
+    ----------
+    scenario : Scenario
+    fmu_dir : path, optional
+        The FMU folder (default :func:`orchestrator.provision.folders.default_fmu_dir`).
+    build : bool
+        Build missing project FMUs into ``fmu_dir``; if False a missing FMU is an error.
+    report : callable(str), optional
+        Receives progress messages ("building Gearbox.fmu ...").
+
+    Returns
+    -------
+    dict of str -> pathlib.Path
+        Absolute FMU file per component.
+
+    Raises
+    ------
+    ScenarioError
+        ``components.<name>.fmu`` for a missing FMU that cannot be built.
+    """
+    fmu_dir = default_fmu_dir() if fmu_dir is None else Path(fmu_dir)
+    if build:
+        ensure_compiled_kernels(report)  # the kernels the FMUs and the master step, once per machine
+        wanted: dict[str, tuple[DrivetrainSpec, list[str]]] = {}
+        for comp in scenario.components:
+            if comp.drivetrain is not None:
+                spec, names = wanted.get(comp.drivetrain.sha256, (comp.drivetrain, []))
+                wanted[spec.sha256] = (spec, names + [comp.fmu.stem])
+        for spec, names in wanted.values():  # in their content's folder, built when missing or stale
+            ensure_drivetrain_fmus(spec, fmu_dir, names, report)
+        for comp in scenario.components:
+            if comp.series is not None:
+                ensure_series_fmu(comp.series, fmu_dir, report)
+        names = sorted({_preset_fmu(scenario, comp) for comp in missing_fmus(scenario, fmu_dir)} - {None})
+        if names:
+            if report:
+                report(f"building {', '.join(n + '.fmu' for n in names)} into {fmu_dir} ...")
+            build_all(fmu_dir, names=names)
+    return resolve_fmu_paths(scenario, fmu_dir)
+
+
+def _preset_fmu(scenario: Scenario, name: str) -> str | None:
+    """The model name of the project FMU built from a preset that component ``name`` asks for (None: not one)."""
+    comp = scenario.component(name)
+    kind = of_file(comp.fmu)
+    if kind is None or PRESET not in kind.built_from or comp.drivetrain is not None or comp.series is not None:
+        return None
+    return kind.name

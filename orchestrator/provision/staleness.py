@@ -1,0 +1,48 @@
+"""Project FMUs built from other code than the installed dtcosim.
+
+A project FMU carries the hash of its code and of the model it was built from in its
+pythonfmu entry module name (``resources/slavemodule.txt``) and that model in its FMU
+record (``resources/dtcosim.json``); it is stale when the installed sources, built from
+the same model, would give another hash (:func:`fmus.build.code_hash`).
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import zipfile
+from pathlib import Path
+from typing import Mapping
+
+from fmus.build import code_hash
+from fmus.registry import KINDS
+from fmus.slaves.record import RECORD_FILE
+
+_BUILD_ID = re.compile(r"^_dtcosim_[a-z]+_([0-9a-f]{12})_slave$")
+
+
+def stale_project_fmus(paths: Mapping[str, Path]) -> list[str]:
+    """Warnings for project FMUs built from other code than the installed ``components``/``fmus``.
+
+    Parameters
+    ----------
+    paths : mapping of str -> Path
+        FMU file per component; FMUs that are not the project's are not checked.
+    """
+    out = []
+    for comp, path in paths.items():
+        try:
+            with zipfile.ZipFile(path) as zf:
+                module = zf.read("resources/slavemodule.txt").decode().strip()
+                record = json.loads(zf.read(f"resources/{RECORD_FILE}"))
+            model = record["model"]
+        except (KeyError, OSError, ValueError, TypeError, zipfile.BadZipFile):
+            continue
+        m = _BUILD_ID.match(module)
+        name = record.get("fmu")
+        if not m or name not in KINDS:
+            continue
+        if m.group(1) != code_hash(name, model):
+            out.append(f"{path} ({comp}) was built from other code than the installed dtcosim (build {m.group(1)}); "
+                       f"rebuild it with `dtcosim build --out {path.parent}`")
+    return out
