@@ -3,7 +3,7 @@
 Every import statement counts, function-local ones too (:mod:`fmus.source_closure` reads them
 from the syntax tree). The layers, bottom up::
 
-    components.model <- components.reference <- components.analysis        the physics
+    components.compile <- components.model <- components.reference <- components.analysis   the physics
     fmus.slaves <- fmus (build, registry, documentation, checks)            the FMUs
     orchestrator.inputs <- cosim <- interop <- run <- study <- commands     reading and running FMUs
                            cosim <- provision <- study, commands            finding and building them
@@ -30,9 +30,10 @@ _ORCHESTRATOR_READS = {"orchestrator.inputs", "orchestrator.cosim", "orchestrato
 #: layer -> the layers of its own top-level package it may import; everything imports the base modules
 #: (``orchestrator.errors``, ...). ``fmus`` is the package's own modules (build, registry, documentation).
 ALLOWED = {
-    "components.model": {"components.model"},
-    "components.reference": {"components.model", "components.reference"},
-    "components.analysis": {"components.model", "components.reference", "components.analysis"},
+    "components.compile": {"components.compile"},
+    "components.model": {"components.compile", "components.model"},
+    "components.reference": {"components.compile", "components.model", "components.reference"},
+    "components.analysis": {"components.compile", "components.model", "components.reference", "components.analysis"},
     "fmus.slaves": {"fmus.slaves"},
     "fmus": {"fmus.slaves", "fmus"},
     "orchestrator.inputs": {"orchestrator.inputs"},
@@ -60,8 +61,6 @@ FMUS_ALLOWED = {
 
 #: circles being removed on another branch: the no-circle test of their package is expected to fail until then
 PENDING_CIRCLES = {
-    "components": ({"components.model.gearbox_kernel", "components.model.gearbox_model"},
-                   "gearbox_kernel <-> gearbox_model: removed by the kernel rewrite"),
     "orchestrator": ({"orchestrator.cosim.parameter_checks", "orchestrator.cosim.physics_view",
                       "orchestrator.cosim.system"},
                      "cosim parameter_checks -> physics_view -> system: removed by the master rewrite"),

@@ -1,7 +1,7 @@
 """Where built FMUs live: the FMU folder and its content-keyed subfolders (a light module: the CLI imports it at start-up).
 
 The FMU folder is ``$DTCOSIM_FMU_DIR`` if set, else ``fmus/`` in dtcosim's per-user
-cache (:func:`components.model.numba_cache.user_cache_root`: ``$DTCOSIM_CACHE_DIR``, else
+cache (:func:`components.compile.user_cache.user_cache_root`: ``$DTCOSIM_CACHE_DIR``, else
 ``$XDG_CACHE_HOME/dtcosim`` or ``~/.cache/dtcosim``), or the folder a command is given
 (``--fmu-dir``, ``dtcosim build --out``). Nothing is ever written into the installed
 package or a source checkout. Inside it:
@@ -20,7 +20,7 @@ import os
 from pathlib import Path
 from typing import Protocol
 
-from components.model.numba_cache import user_cache_root
+from components.compile.user_cache import user_cache_root
 
 #: environment variable naming the FMU folder
 FMU_DIR_VARIABLE = "DTCOSIM_FMU_DIR"

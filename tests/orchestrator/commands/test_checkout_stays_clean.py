@@ -48,7 +48,7 @@ def checkout(tmp_path_factory) -> Path:
 
 def _user_cache(tmp_path: Path) -> Path:
     """A per-user cache of its own, sharing this one's compiled kernels (compiling them anew takes minutes)."""
-    from components.model.numba_cache import user_cache_root
+    from components.compile.user_cache import user_cache_root
 
     cache = tmp_path / "user-cache"
     cache.mkdir()
