@@ -67,7 +67,7 @@ def test_a_file_size_limit_keeps_the_parquet_stream_to_its_last_block_and_says_s
     out = tmp_path / "limited"
     out.mkdir()
     proc = stops.start(fmu_dir, out, "--stop", "10", "--results", "parquet",
-                       preexec_fn=stops._file_size_limit(1_000_000))  # above the FMUs' largest file (0.9 MB)
+                       preexec_fn=stops._file_size_limit(1_500_000))  # above the FMUs' largest file (1.1 MB)
     _, stderr = proc.communicate(timeout=300)
     assert proc.returncode == 1, stderr
     summary = stops.summary_of(out)
