@@ -34,8 +34,9 @@ def _subpackage(name: str) -> str | None:
 
 
 def _modules_of(subpackage: str) -> list[str]:
-    folder = ROOT.joinpath(*subpackage.split("."))
-    return [f"{subpackage}.{p.stem}" for p in sorted(folder.glob("*.py")) if p.stem != "__init__"]
+    folder = ROOT.joinpath(*subpackage.split("."))  # its modules and those of its own subpackages
+    return [".".join((subpackage, *p.relative_to(folder).with_suffix("").parts))
+            for p in sorted(folder.rglob("*.py")) if p.stem != "__init__"]
 
 
 @pytest.mark.parametrize("subpackage", sorted(ALLOWED))

@@ -16,7 +16,7 @@ from components.model.aot import AotKernel, aot_directory, build_in_subprocess, 
 from components.model.kernel import aot_kernel
 from components.model.wind import aot_wind_kernel
 
-from .compiled_loop import aot_loop_kernel
+from .stepping.compiled_loop import aot_loop_kernel
 
 
 def aot_kernels() -> tuple[AotKernel, ...]:
