@@ -85,6 +85,7 @@ class FinishedRows:
         return None
 
     def time_s(self) -> np.ndarray:
+        """Times of the kept rows [s] (the last one off the grid if an FMU ended the run there)."""
         n = self.count if self.kept is not None else 0
         times = self.start_s + self.interval_s * np.arange(n, dtype=float)
         if n and self.last_time_s is not None:
@@ -92,6 +93,7 @@ class FinishedRows:
         return times
 
     def values(self) -> np.ndarray:
+        """The kept rows, columns in ``system.recorded`` order (none without keeping)."""
         if self.kept is None:
             return np.empty((0, len(self.order)))
         return self.kept[:self.count]

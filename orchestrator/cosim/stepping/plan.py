@@ -108,6 +108,8 @@ class FmuStep:
     input_vrs, output_vrs : ctypes arrays of fmi2ValueReference
     ports : TypedPorts or None
         Integer, Enumeration, Boolean and String inputs and outputs (None: Real only).
+    n_inputs, n_outputs : int
+        ``len(inputs)``, ``len(outputs)``.
     input_address, input_vr_address, output_vr_address, output_offset : int
         The addresses the raw FMI calls take (``output_offset``: byte offset of
         ``column`` in a row).
@@ -125,11 +127,14 @@ class FmuStep:
     output_vrs: ctypes.Array
     ports: TypedPorts | None = None
     input_address: int = 0
+    n_inputs: int = field(init=False)
+    n_outputs: int = field(init=False)
     input_vr_address: int = field(init=False)
     output_vr_address: int = field(init=False)
     output_offset: int = field(init=False)
 
     def __post_init__(self) -> None:
+        self.n_inputs, self.n_outputs = len(self.inputs), len(self.outputs)
         self.input_vr_address = ctypes.addressof(self.input_vrs)
         self.output_vr_address = ctypes.addressof(self.output_vrs)
         self.output_offset = self.column * VALUE_BYTES
@@ -138,14 +143,6 @@ class FmuStep:
     def name(self) -> str:
         """The component's name."""
         return self.instance.name
-
-    @property
-    def n_inputs(self) -> int:
-        return len(self.inputs)
-
-    @property
-    def n_outputs(self) -> int:
-        return len(self.outputs)
 
 
 @dataclass(eq=False)

@@ -52,27 +52,29 @@ class PythonLoop:
         self.plan = plan
         self.buffers = buffers
         self.loop_solver = loop_solver
+        #: per FMU: its fmi2SetReal, fmi2DoStep and fmi2GetReal (:data:`TIMED_FUNCTIONS` order)
+        self.calls = [(f.instance.set_real, f.instance.do_step, f.instance.get_real) for f in plan.fmus]
+        #: per FMU: set its typed inputs ``(k, c)``, read its typed outputs ``(k, c)`` (None: it has none)
+        self.typed = []
         gauss_seidel = plan.algorithm == "gauss-seidel"
-        self._typed = []  # per FMU: (set typed inputs or None, read typed outputs or None)
         for fmu in plan.fmus:
             if fmu.ports is None:
-                self._typed.append((None, None))
+                self.typed.append((None, None))
                 continue
             before, after = fmu.ports.bind(buffers.ring, text, plan.stride, gauss_seidel, buffers.direct, StepFailed)
-            self._typed.append((before if fmu.ports.inputs else None, after if fmu.ports.outputs else None))
+            self.typed.append((before if fmu.ports.inputs else None, after if fmu.ports.outputs else None))
 
     # ------------------------------------------------------------------ the loop
     def advance(self, k_start: int, k_end: int, t0: float, H: float) -> int:
         """Steps ``k_start <= k < k_end``; returns ``k_end`` (raises StepFailed on a failing status)."""
-        buffers, stride = self.buffers, self.plan.stride
-        steps = list(zip(self.plan.fmus, self._typed))
+        buffers, stride, fmus = self.buffers, self.plan.stride, self.plan.fmus
         for k in range(k_start, k_end):
             t = t0 + k * H
             rows = buffers.offsets(k, k_start)
             sampling = (k + 1) % stride == 0
-            for fmu, typed in steps:
-                self._step(fmu, typed[0], k, t, H, rows)
-                self._read(fmu, typed[1], k, fmu.n_outputs if sampling else fmu.n_coupling, rows)
+            for fmu in fmus:
+                self._step(fmu, k, t, H, rows)
+                self._read(fmu, k, fmu.n_outputs if sampling else fmu.n_coupling, rows)
             if self.loop_solver is not None:
                 self._solve_loops(k, t + H, rows[0])
             if sampling and not buffers.direct:
@@ -89,25 +91,32 @@ class PythonLoop:
         """
         t = t0 + k * H
         rows = self.buffers.offsets(k, k_start)
-        for fmu, (before, after) in list(zip(self.plan.fmus, self._typed))[first:]:
+        for fmu in self.plan.fmus[first:]:
             if fmu.slot > first:
-                self._step(fmu, before, k, t, H, rows)
-            self._read(fmu, after, k, fmu.n_outputs, rows)
+                self._step(fmu, k, t, H, rows)
+            self._read(fmu, k, fmu.n_outputs, rows)
         if self.loop_solver is not None:
             self._solve_loops(k, t + H, rows[0])
         return k + 1
 
     # ------------------------------------------------------------------ one FMU
-    def _step(self, fmu: FmuStep, set_typed, k: int, t: float, H: float, rows: tuple[int, int, int, int]) -> None:
+    def _step(self, fmu: FmuStep, k: int, t: float, H: float, rows: tuple[int, int, int, int]) -> None:
         """Set the FMU's inputs (Real, then typed) and step it from ``t_k``."""
         new, now, before, c = rows
         if fmu.feeds:
             self._set_inputs(fmu, new, now, before)
+        set_typed = self.typed[fmu.slot][0]
         if set_typed is not None:
             set_typed(k, c)
+        set_real, do_step, _ = self.calls[fmu.slot]
+        component = fmu.instance.component
         if fmu.n_inputs:
-            self._set_real(fmu, k)
-        self._do_step(fmu, k, t, H)
+            status = set_real(component, fmu.input_vr_address, fmu.n_inputs, fmu.input_address)
+            if status > 1:
+                raise StepFailed(fmu.slot, "fmi2SetReal", status, k)
+        status = do_step(component, t, H, 1)
+        if status > 1:
+            raise StepFailed(fmu.slot, "fmi2DoStep", status, k)
 
     def _set_inputs(self, fmu: FmuStep, new: int, now: int, before: int) -> None:
         """Each coupled Real input from its feed (see the module docstring), into the plan's input buffer."""
@@ -127,35 +136,21 @@ class PythonLoop:
                 value = feed.factor * value + feed.offset
             inputs[feed.input] = value
 
-    def _read(self, fmu: FmuStep, read_typed, k: int, n: int, rows: tuple[int, int, int, int]) -> None:
-        """The first ``n`` Real outputs of the FMU at ``t_{k+1}`` (and its typed outputs)."""
+    def _read(self, fmu: FmuStep, k: int, n: int, rows: tuple[int, int, int, int]) -> None:
+        """The first ``n`` Real outputs of the FMU into the row of ``t_{k+1}`` (and its typed outputs)."""
         if n:
-            self._get_real(fmu, k, n, self.buffers.address + rows[0] * VALUE_BYTES)
+            get_real = self.calls[fmu.slot][2]
+            row_address = self.buffers.address + rows[0] * VALUE_BYTES
+            status = get_real(fmu.instance.component, fmu.output_vr_address, n, row_address + fmu.output_offset)
+            if status > 1:
+                raise StepFailed(fmu.slot, "fmi2GetReal", status, k)
+        read_typed = self.typed[fmu.slot][1]
         if read_typed is not None:
             read_typed(k, rows[3])
 
     def _solve_loops(self, k: int, t: float, new: int) -> None:
         n = self.buffers.n_columns
         self.loop_solver.solve(self.buffers.flat[new:new + n], k, t)
-
-    # ------------------------------------------------------------------ the FMI calls
-    def _set_real(self, fmu: FmuStep, k: int) -> None:
-        inst = fmu.instance
-        status = inst.set_real(inst.component, fmu.input_vr_address, fmu.n_inputs, fmu.input_address)
-        if status > 1:
-            raise StepFailed(fmu.slot, "fmi2SetReal", status, k)
-
-    def _do_step(self, fmu: FmuStep, k: int, t: float, H: float) -> None:
-        inst = fmu.instance
-        status = inst.do_step(inst.component, t, H, 1)
-        if status > 1:
-            raise StepFailed(fmu.slot, "fmi2DoStep", status, k)
-
-    def _get_real(self, fmu: FmuStep, k: int, n: int, row_address: int) -> None:
-        inst = fmu.instance
-        status = inst.get_real(inst.component, fmu.output_vr_address, n, row_address + fmu.output_offset)
-        if status > 1:
-            raise StepFailed(fmu.slot, "fmi2GetReal", status, k)
 
 
 class ProfiledLoop(PythonLoop):
@@ -172,24 +167,19 @@ class ProfiledLoop(PythonLoop):
                  loop_solver: LoopSolver | None = None) -> None:
         super().__init__(plan, buffers, text, loop_solver)
         self.timers = timers
+        self.calls = [tuple(_timed(function, timers[slot], column) for column, function in enumerate(calls))
+                      for slot, calls in enumerate(self.calls)]
 
-    def _set_real(self, fmu: FmuStep, k: int) -> None:
-        started = time.perf_counter()
-        try:
-            super()._set_real(fmu, k)
-        finally:
-            self.timers[fmu.slot, 0] += time.perf_counter() - started
 
-    def _do_step(self, fmu: FmuStep, k: int, t: float, H: float) -> None:
-        started = time.perf_counter()
-        try:
-            super()._do_step(fmu, k, t, H)
-        finally:
-            self.timers[fmu.slot, 1] += time.perf_counter() - started
+def _timed(function, timer: np.ndarray, column: int):
+    """``function`` that adds its wall time to ``timer[column]``."""
+    clock = time.perf_counter
 
-    def _get_real(self, fmu: FmuStep, k: int, n: int, row_address: int) -> None:
-        started = time.perf_counter()
+    def timed(*args):
+        started = clock()
         try:
-            super()._get_real(fmu, k, n, row_address)
+            return function(*args)
         finally:
-            self.timers[fmu.slot, 2] += time.perf_counter() - started
+            timer[column] += clock() - started
+
+    return timed
