@@ -242,7 +242,7 @@ def main() -> None:
     print(f"three trivial pythonfmu FMUs, {args.steps} steps, median of {args.repeat} interleaved runs")
     for label in labels:
         dt = median[label]
-        print(f"  {label:<42} {dt * 1e6:7.1f} us/step   ({(dt - floor) * 1e6:+6.1f} us vs floor)")
+        print(f"  {label:<48} {dt * 1e6:7.1f} us/step   ({(dt - floor) * 1e6:+6.1f} us vs floor)")
     for i, (alg, ex) in enumerate(variants):
         line = f"master overhead {alg}/{ex}: Python loop {(median[python[i]] - floor) * 1e6:.1f} us"
         if compiled:
