@@ -30,7 +30,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from bench_sweep import free_cores  # noqa: E402
 
-from orchestrator.inputs.load_cases import load_cases_from_dict  # noqa: E402
+from orchestrator.inputs.load_case_file import load_cases_from_dict  # noqa: E402
 from orchestrator.study.lifetime_outputs import write_lifetime_outputs  # noqa: E402
 from orchestrator.study.lifetime_results import store_run_data  # noqa: E402
 from orchestrator.study.load_cases import prepare_load_cases  # noqa: E402
@@ -40,7 +40,8 @@ from orchestrator.study.sweep import run_sweep  # noqa: E402
 def reduced_set(length_s: float, transient_s: float, step_s: float | None) -> dict:
     """The paper-turbine set with 4 bins (5-21 m/s, 4 m/s wide) and 2 seeds."""
     from orchestrator.inputs.files import read_toml
-    from orchestrator.inputs.load_cases import LoadCaseError, find_load_cases
+    from orchestrator.inputs.load_case_file import find_load_cases
+    from orchestrator.inputs.load_cases import LoadCaseError
 
     doc = read_toml(find_load_cases("paper-turbine"), LoadCaseError)
     doc["name"] = "bench-loads"

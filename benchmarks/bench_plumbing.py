@@ -8,12 +8,13 @@ through fmpy + pythonfmu and the master's own work. Compared:
    with Python lists, 8 calls per step) - DESIGN.md's reference loop;
 2. a hand-written loop calling the raw FMI functions with pre-built arrays (the floor), with the
    GIL held over each call (as the master calls PythonFMUs) and released (ctypes' default);
-3. the dtcosim master (Gauss-Seidel/Jacobi, hold/linear), recording every step, with its
-   generated step loop, with the plain-Python reference loop (what the code generation saves)
-   and, where numba imports, with the compiled loop (``orchestrator.cosim.compiled_loop``: no
-   Python and no ctypes conversion per call, so it can go below the "floor" of item 2).
+3. the dtcosim master (Gauss-Seidel/Jacobi, hold/linear), recording every step, with each
+   executor of its stepping plan: the Python loop (``orchestrator.cosim.stepping.python_loop``:
+   what a C FMU, a typed port or a profile runs) and, where numba imports, the compiled loop
+   (``orchestrator.cosim.stepping.compiled_loop``, the default for these FMUs: no Python and no
+   ctypes conversion per call, so it can go below the "floor" of item 2).
 
-Run: ``python benchmarks/bench_plumbing.py [--steps N]``. Prints microseconds per
+Run: ``python benchmarks/bench_plumbing.py [--steps N] [--repeat N]``. Prints microseconds per
 communication step and the master's overhead above the floor.
 """
 
@@ -191,7 +192,7 @@ def raw_loop(paths, steps: int, h: float = 1e-3, hold_gil: bool = True) -> float
     return dt
 
 
-def master_loop(folder: Path, steps: int, algorithm: str, extrapolation: str, step_loop: str = "generated") -> float:
+def master_loop(folder: Path, steps: int, algorithm: str, extrapolation: str, step_loop: str = "python") -> float:
     """The dtcosim master on the same FMUs (records every step); seconds per step of the loop."""
     from orchestrator.cosim.master import CoSimulation
     from orchestrator.cosim.system import resolve_system
@@ -215,9 +216,8 @@ def main() -> None:
     labels = ["fmpy high-level loop (8 calls/step)", "raw FMI calls, plain addresses (floor)",
               "  same, releasing the GIL per call"]
     variants = [(alg, ex) for alg in ("gauss-seidel", "jacobi") for ex in ("hold", "linear")]
-    labels += [f"dtcosim master {alg}/{ex}" for alg, ex in variants]
-    interpreted = [f"  same, interpreted loop {alg}/{ex}" for alg, ex in variants]
-    labels += interpreted
+    python = [f"dtcosim master, Python loop {alg}/{ex}" for alg, ex in variants]
+    labels += python
     try:
         import numba  # noqa: F401 - optional: the compiled step loop
     except ImportError:
@@ -233,23 +233,21 @@ def main() -> None:
             times[labels[0]].append(high_level_loop(paths, args.steps))
             times[labels[1]].append(raw_loop(paths, args.steps))
             times[labels[2]].append(raw_loop(paths, args.steps, hold_gil=False))
-            for label, (alg, ex) in zip(labels[3:], variants):
-                times[label].append(master_loop(folder, args.steps, alg, ex))
-            for label, (alg, ex) in zip(interpreted, variants):
-                times[label].append(master_loop(folder, args.steps, alg, ex, "interpreted"))
+            for label, (alg, ex) in zip(python, variants):
+                times[label].append(master_loop(folder, args.steps, alg, ex, "python"))
             for label, (alg, ex) in zip(compiled, variants):
-                times[label].append(master_loop(folder, args.steps, alg, ex, "numba"))
+                times[label].append(master_loop(folder, args.steps, alg, ex, "compiled"))
     median = {label: statistics.median(v) for label, v in times.items()}
     floor = median[labels[1]]
     print(f"three trivial pythonfmu FMUs, {args.steps} steps, median of {args.repeat} interleaved runs")
     for label in labels:
         dt = median[label]
-        print(f"  {label:<42} {dt * 1e6:7.1f} us/step   ({(dt - floor) * 1e6:+6.1f} us vs floor)")
-    for (alg, ex), label in zip(variants, interpreted):
-        gen = median[f"dtcosim master {alg}/{ex}"] - floor
-        interp = median[label] - floor
-        print(f"master overhead {alg}/{ex}: generated {gen * 1e6:.1f} us, interpreted {interp * 1e6:.1f} us "
-              f"per step ({interp / gen if gen > 0 else float('inf'):.1f} x)")
+        print(f"  {label:<48} {dt * 1e6:7.1f} us/step   ({(dt - floor) * 1e6:+6.1f} us vs floor)")
+    for i, (alg, ex) in enumerate(variants):
+        line = f"master overhead {alg}/{ex}: Python loop {(median[python[i]] - floor) * 1e6:.1f} us"
+        if compiled:
+            line += f", compiled loop {(median[compiled[i]] - floor) * 1e6:.1f} us"
+        print(line + " per step")
 
 
 if __name__ == "__main__":

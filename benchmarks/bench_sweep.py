@@ -23,7 +23,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from orchestrator.inputs.study import find_study, load_study
+from orchestrator.inputs.study_file import find_study, load_study
 from orchestrator.study.prepare import prepare_study
 from orchestrator.study.sweep import run_sweep
 

@@ -29,7 +29,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..validation import finite_series, integer_at_least
-from .fatigue import sample_durations
+from .load_duration import sample_durations
 
 #: a run's range spans at least this many (and fewer than twice as many) lattice cells
 LATTICE_LEVELS = 1024

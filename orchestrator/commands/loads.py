@@ -98,7 +98,8 @@ def run(args: argparse.Namespace) -> int:
     """Validate the set, run its pending cases, write the lifetime results."""
     import uuid
 
-    from ..inputs.load_cases import LoadCaseError, find_load_cases, load_load_cases
+    from ..inputs.load_case_file import find_load_cases, load_load_cases
+    from ..inputs.load_cases import LoadCaseError
     from ..study.journal import JOURNAL_FILE, read_journal
     from ..study.lifetime_outputs import write_lifetime_outputs
     from ..study.lifetime_results import check_curves, mark_missing_run_files, store_run_data

@@ -71,7 +71,8 @@ def _progress_bar(total: int, initial_desc: str):
 
 def run(args: argparse.Namespace) -> int:
     """Validate the study, run its pending points, write the results."""
-    from ..inputs.study import StudyError, find_study, load_study
+    from ..inputs.study import StudyError
+    from ..inputs.study_file import find_study, load_study
     from ..study.journal import JOURNAL_FILE, read_journal
     from ..study.prepare import prepare_study
     from ..study.report import point_records, status_counts, write_outputs

@@ -27,9 +27,11 @@ FMI 2 defines without a step.
 from __future__ import annotations
 
 import math
-from typing import Any, Sequence
+from typing import Sequence
 
 import numpy as np
+
+from .stepping.plan import StepPlan
 
 
 class LoopNotConverged(Exception):
@@ -40,29 +42,15 @@ class LoopNotConverged(Exception):
         self.k = k
 
 
-class _Member:
-    """One FMU of a loop: its Real input buffer, the feeds of those inputs and where its outputs go in a row."""
-
-    __slots__ = ("slot", "inst", "buf", "buf_addr", "vr_in", "n_in", "vr_out", "n_out", "out_offset_bytes", "feeds")
-
-    def __init__(self, slot: int, inst: Any, buf, buf_addr: int, vr_in: int, n_in: int, vr_out: int, n_out: int,
-                 out_offset_bytes: int, feeds: list[tuple[int, int, float, float]]) -> None:
-        self.slot, self.inst, self.buf, self.buf_addr, self.vr_in, self.n_in = slot, inst, buf, buf_addr, vr_in, n_in
-        self.vr_out, self.n_out, self.out_offset_bytes, self.feeds = vr_out, n_out, out_offset_bytes, feeds
-
-
 class LoopSolver:
     """Fixed-point sweeps over the members of each algebraic loop (see the module docstring).
 
     Parameters
     ----------
-    groups : sequence of sequence of tuple
-        Per loop, its members in stepping order, each as ``(slot, inst, in_buf, in_buf_addr,
-        in_vr_addr, n_in, out_vr_addr, n_out, out_offset_bytes, feeds)`` with ``feeds``
-        ``[(input index, source column, factor, offset), ...]`` (the raw FMI layout of
-        :mod:`orchestrator.cosim.master`).
-    names : sequence of sequence of str
-        The component names of each loop (for messages).
+    plan : StepPlan
+        The run's stepping plan: each member's Real inputs, their feeds and its output columns.
+    loops : sequence of sequence of str
+        The component names of each loop.
     tolerance : float
         Largest move of an input in the last sweep, relative to ``max(1, |u|)``.
     max_iterations : int
@@ -71,10 +59,11 @@ class LoopSolver:
         Exception raised as ``stop(slot, function, status, k)`` on a failing FMI status.
     """
 
-    def __init__(self, groups: Sequence[Sequence[tuple]], names: Sequence[Sequence[str]], tolerance: float,
-                 max_iterations: int, stop: type) -> None:
-        self.groups = [[_Member(*m) for m in group] for group in groups]
-        self.names = [", ".join(n) for n in names]
+    def __init__(self, plan: StepPlan, loops: Sequence[Sequence[str]], tolerance: float, max_iterations: int,
+                 stop: type) -> None:
+        self.inputs = plan.input_values
+        self.groups = [plan.fmus_of(loop) for loop in loops]
+        self.names = [", ".join(n) for n in loops]
         self.tolerance = float(tolerance)
         self.max_iterations = int(max_iterations)
         self.stop = stop
@@ -89,26 +78,27 @@ class LoopSolver:
             end point did not converge).
         """
         address = row.ctypes.data
-        tol, stop = self.tolerance, self.stop
+        tol, stop, buf = self.tolerance, self.stop, self.inputs
         for g, group in enumerate(self.groups):
             moved = 0.0
             for _ in range(self.max_iterations):
                 moved = 0.0
                 for m in group:
-                    buf = m.buf
-                    for j, col, factor, offset in m.feeds:
-                        u = factor * row[col] + offset
+                    for feed in m.feeds:
+                        j = feed.input
+                        u = feed.factor * row[feed.column] + feed.offset
                         change = abs(u - buf[j]) / max(1.0, abs(u))
                         if not change <= moved:  # also a NaN, which never converges
                             moved = change if change == change else math.inf
                         buf[j] = u
-                    inst = m.inst
-                    if m.n_in:
-                        st = inst.set_real(inst.component, m.vr_in, m.n_in, m.buf_addr)
+                    inst = m.instance
+                    if m.n_inputs:
+                        st = inst.set_real(inst.component, m.input_vr_address, m.n_inputs, m.input_address)
                         if st > 1:
                             raise stop(m.slot, "fmi2SetReal", st, k)
-                    if m.n_out:
-                        st = inst.get_real(inst.component, m.vr_out, m.n_out, address + m.out_offset_bytes)
+                    if m.n_outputs:
+                        st = inst.get_real(inst.component, m.output_vr_address, m.n_outputs,
+                                           address + m.output_offset)
                         if st > 1:
                             raise stop(m.slot, "fmi2GetReal", st, k)
                 if moved <= tol:
@@ -118,26 +108,3 @@ class LoopSolver:
                                           f"{t:.6g} s: an input still moved by {moved:.3g} (relative) after "
                                           f"{self.max_iterations} sweeps (simulation.loop_max_iterations; the loop's "
                                           f"gain must be below 1 in magnitude for the iteration to converge)")
-
-
-def loop_groups(plan: Sequence[tuple], loops: Sequence[Sequence[str]], slot_names: Sequence[str]) -> list[list[tuple]]:
-    """The solver's member tuples of each loop from the interpreted step loop's plan entries.
-
-    ``plan`` entries are ``(i, inst, buf, buf_addr, vr_in, n_in, vr_out, n_out, n_couple,
-    out_offset_bytes, feeds, lin_feeds, ...)`` in stepping order; ``feeds`` ``(j, upstream,
-    col)`` and ``lin_feeds`` ``(j, upstream, col, factor, offset)``.
-    """
-    out = []
-    for loop in loops:
-        members = set(loop)
-        group = []
-        for entry in plan:
-            i, inst, buf, buf_addr, vr_in, n_in, vr_out, n_out, _, offset, feeds, lin_feeds = entry[:12]
-            if slot_names[i] not in members:
-                continue
-            all_feeds = sorted([(j, col, 1.0, 0.0) for j, _, col in feeds]
-                               + [(j, col, factor, shift) for j, _, col, factor, shift in lin_feeds])
-            group.append((i, inst, buf, buf_addr, vr_in, n_in, vr_out, n_out, offset, all_feeds))
-        out.append(group)
-    return out
-

@@ -15,7 +15,7 @@ from typing import Callable
 from components.compile.aot import AotKernel, aot_directory, build_in_subprocess, enabled, failed_before, missing
 from components.model.kernel import AHEAD_OF_TIME
 
-from .compiled_loop import aot_loop_kernel
+from .stepping.compiled_loop import aot_loop_kernel
 
 
 def aot_kernels() -> tuple[AotKernel, ...]:

@@ -31,7 +31,7 @@ from components.model.wind import WindParameters
 
 from ..frozen_map import FrozenMap
 from .roles import GEARBOX, GENERATOR, ROTOR, TORQUE_CONTROLLER, WIND_SOURCE, ComponentRole
-from .system import ResolvedSystem
+from .resolved import ResolvedSystem
 
 
 class PhysicsUnavailable(DtcosimError, ValueError):

@@ -15,13 +15,12 @@ every value within what the FMU accepts (FMI Integer range, declared bounds, a
 dtcosim model's own validation: :mod:`orchestrator.cosim.parameter_checks`); the
 results within the size limits (:func:`check_sizes`). The first problem raises
 :class:`~orchestrator.errors.ScenarioError` naming the scenario key. The result,
-a :class:`ResolvedSystem`, is what the master runs.
+a :class:`~orchestrator.cosim.resolved.ResolvedSystem`, is what the master runs.
 """
 
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Mapping, Sequence
 
@@ -31,105 +30,18 @@ from ..errors import AlgebraicLoopError, ScenarioError, suggestion
 from ..frozen_map import FrozenMap
 from ..inputs.limits import MAX_RESULT_VALUES
 from ..inputs.scenario import Component, Scenario, VariableRef
-from .event_slots import AssignedEvent, assign_events
+from .event_slots import assign_events
 from .fmu_interface import FmuInterface, FmuVariable, read_fmu_interface
 from .graph import algebraic_loop_groups, find_algebraic_loop, initialization_order, stepping_order
 from .parameter_checks import model_problem, value_problem
-from .roles import ComponentRole, declared_roles
+from .resolved import RecordedVariable, ResolvedSystem
+from .roles import declared_roles
 from .values import transformation_problem, type_mismatch
 
 #: causalities a scenario may give a value to
 SETTABLE_CAUSALITIES = ("parameter", "input")
 #: causalities a connection or initial binding may read from
 READABLE_CAUSALITIES = ("output", "calculatedParameter")
-
-
-@dataclass(frozen=True)
-class RecordedVariable:
-    """A variable sampled into the results.
-
-    Attributes
-    ----------
-    component, variable : str
-    value_reference : int
-    unit : str
-        Unit declared by the FMU ("" if none).
-    type : str
-        FMI type: ``Real``, ``Integer``, ``Boolean``, ``String`` or ``Enumeration``.
-    """
-
-    component: str
-    variable: str
-    value_reference: int
-    unit: str
-    type: str = "Real"
-
-    @property
-    def column(self) -> str:
-        """Result column name ``component.variable``."""
-        return f"{self.component}.{self.variable}"
-
-
-@dataclass(frozen=True)
-class ResolvedSystem:
-    """A scenario whose names have all been checked against the FMUs.
-
-    Attributes
-    ----------
-    scenario : Scenario
-        The checked scenario; its load events (``[[events]]``) are already written into
-        the event-slot parameters of their component (see :mod:`orchestrator.inputs.load_events`).
-    fmu_paths : mapping of str -> pathlib.Path
-        Absolute FMU file of each component.
-    interfaces : mapping of str -> FmuInterface
-        Model description of each component's FMU.
-    order : tuple of str
-        Stepping order (Gauss-Seidel sweep order; Jacobi ignores it).
-    init_order : tuple of str
-        Order of the initialisation sweeps (connections and initial bindings).
-    recorded : tuple of RecordedVariable
-        Recorded variables in the order of the record patterns.
-    events : tuple of AssignedEvent
-        The scenario's load events with the component and slot that apply them.
-    roles : mapping of str -> ComponentRole
-        Declared role of each component that has one (its FMU's record or the scenario).
-    algebraic_loops : tuple of tuple of str
-        With ``simulation.algebraic_loops = "iterate"``: the components of each algebraic
-        loop, which the master solves by iteration (:mod:`orchestrator.cosim.algebraic_loops`).
-    """
-
-    scenario: Scenario
-    fmu_paths: Mapping[str, Path]
-    interfaces: Mapping[str, FmuInterface]
-    order: tuple[str, ...]
-    init_order: tuple[str, ...]
-    recorded: tuple[RecordedVariable, ...]
-    events: tuple[AssignedEvent, ...] = ()
-    roles: Mapping[str, ComponentRole] = field(default_factory=dict)
-    algebraic_loops: tuple[tuple[str, ...], ...] = ()
-
-    def with_role(self, role: str) -> list[ComponentRole]:
-        """The components declared with ``role``, in scenario order."""
-        return [r for r in self.roles.values() if r.role == role]
-
-    def loop_transformation(self, con):
-        """What the step loop applies on connection ``con`` (:func:`orchestrator.cosim.values.numeric_transformation`)."""
-        from .values import numeric_transformation
-
-        return numeric_transformation(con.transformation, self.variable(con.source), self.variable(con.target),
-                                      self.interfaces[con.source.component].enumerations,
-                                      self.interfaces[con.target.component].enumerations)
-
-    def variable(self, ref: VariableRef) -> FmuVariable:
-        """Model-description entry of a ``component.variable`` reference."""
-        return self.interfaces[ref.component].variables[ref.variable]
-
-    def parameter_values(self, component: str) -> dict[str, object]:
-        """Effective parameter values of a component: FMU start values overridden by the scenario."""
-        iface = self.interfaces[component]
-        values = {n: v.start for n, v in iface.variables.items() if v.causality == "parameter"}
-        values.update(self.scenario.component(component).parameters)
-        return values
 
 
 def find_fmu(scenario: Scenario, component: Component, candidates: Sequence[Path]) -> Path:

@@ -1,7 +1,7 @@
 """Integer, Enumeration, Boolean and String values in the stepping loop (everything but Real).
 
-Real variables are exchanged by the master's own statements (one ``fmi2SetReal`` /
-``fmi2GetReal`` per FMU and step, :mod:`orchestrator.cosim.master`); a system with
+Real variables are exchanged by the stepping loop itself (one ``fmi2SetReal`` /
+``fmi2GetReal`` per FMU and step, :mod:`orchestrator.cosim.stepping`); a system with
 only Real variables never touches this module. The other FMI 2.0 types go through
 one :class:`TypedPorts` per FMU that has such connections or recorded variables:
 
@@ -116,7 +116,7 @@ class TypedPorts:
         """The loop's two calls for this FMU: ``before(k, c)`` (set inputs) and ``after(k, c)`` (read outputs).
 
         ``c`` is the row offset of the block buffer when every step is sampled (row
-        ``k + c`` holds ``t_k``, :mod:`orchestrator.cosim.master`); unused with the ring.
+        ``k + c`` holds ``t_k``, :class:`orchestrator.cosim.stepping.plan.RowBuffers`); unused with the ring.
 
         Parameters
         ----------

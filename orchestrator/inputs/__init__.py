@@ -4,7 +4,10 @@ Modules
 -------
 files               reading TOML, the packaged files, finding a file by path or packaged name
 scenario            a co-simulation scenario and its TOML format
-study               a parameter study and its TOML format
+study               a parameter study: its points
+study_file          the study file (TOML): schema and loader
+load_cases          a set of load cases (wind bins, operating rows, fatigue options)
+load_case_file      the load-case file (TOML): schema and loader
 load_events         generator load events of a scenario (``[[events]]``)
 analysis_settings   settings of the result analyses (``[analysis]``)
 measures            what a study measures per run (names, units, parsing)

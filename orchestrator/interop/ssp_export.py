@@ -51,7 +51,7 @@ from typing import Any, Mapping
 
 from fmus.start_values import StartValueError, write_with_start_values
 
-from ..cosim.system import ResolvedSystem
+from ..cosim.resolved import ResolvedSystem
 from ..errors import SspError
 from ..inputs.analysis_settings import AnalysisSettings
 from ..inputs.scenario import VariableRef

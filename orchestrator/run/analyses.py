@@ -47,10 +47,10 @@ from components.analysis.spectrum import amplitude_spectrum
 from components.errors import DtcosimError
 
 from ..atomic_files import atomic_path
-from ..cosim.master import RunOutcome
+from ..cosim.outcome import RunOutcome
 from ..cosim.physics_view import PhysicsUnavailable, gearbox_drivetrain, wind_parameters
 from ..cosim.roles import GEARBOX, GENERATOR, WIND_SOURCE
-from ..cosim.system import ResolvedSystem
+from ..cosim.resolved import ResolvedSystem
 from .text_tables import fit_table, number
 
 

@@ -16,7 +16,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from components.analysis.fatigue import LoadDurationDistribution  # noqa: E402
+from components.analysis.load_duration import LoadDurationDistribution  # noqa: E402
 from components.analysis.spectrum import amplitude_spectrum  # noqa: E402
 
 from ..plotting import close_figure, envelope, shade_inside_backlash  # noqa: E402

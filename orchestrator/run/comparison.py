@@ -17,10 +17,10 @@ import numpy as np
 
 from components.reference.results import SimulationResult, window_statistics
 
-from ..cosim.master import RunOutcome
+from ..cosim.outcome import RunOutcome
 from ..cosim.physics_view import PhysicsView, physics_view
 from ..cosim.roles import GEARBOX, GENERATOR, WIND_SOURCE
-from ..cosim.system import ResolvedSystem
+from ..cosim.resolved import ResolvedSystem
 
 STATISTICS = ("mean", "std", "min", "max")
 

@@ -15,10 +15,10 @@ import numpy as np
 
 from components.reference.results import window_statistics
 
-from ..cosim.master import RunOutcome
+from ..cosim.outcome import RunOutcome
 from ..cosim.physics_view import PhysicsUnavailable, gearbox_drivetrain
 from ..cosim.roles import GEARBOX, GENERATOR, WIND_SOURCE, ComponentRole
-from ..cosim.system import ResolvedSystem
+from ..cosim.resolved import ResolvedSystem
 
 
 class Skipped(Exception):

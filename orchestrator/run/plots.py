@@ -17,9 +17,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..cosim.master import RunOutcome
+from ..cosim.outcome import RunOutcome
 from ..cosim.roles import GEARBOX, GENERATOR, WIND_SOURCE, ComponentRole
-from ..cosim.system import ResolvedSystem
+from ..cosim.resolved import ResolvedSystem
 from ..plotting import RPM_PER_RAD_S, envelope, new_figure, new_grid, plot_envelope, save_figure
 from .derived import Skipped, generator_vs_ideal, single_role
 from .memory import release_between_phases

@@ -13,9 +13,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..cosim.master import RunOutcome
+from ..cosim.outcome import RunOutcome
 from ..cosim.roles import ROLES
-from ..cosim.system import ResolvedSystem
+from ..cosim.resolved import ResolvedSystem
 
 TIME_SERIES = "time_series"
 #: recorded quantities that have a simulated counterpart (the same signal kind in another role)

@@ -39,8 +39,8 @@ from typing import Any, Mapping
 
 from components.reference.results import window_statistics
 
-from ..cosim.master import RunOutcome
-from ..cosim.system import ResolvedSystem
+from ..cosim.outcome import RunOutcome
+from ..cosim.resolved import ResolvedSystem
 from ..inputs.results_format import RESULTS_FILES, concrete_format
 from ..result_files import jsonable, versions
 from .writers import Column, CsvWriter, ResultWriter

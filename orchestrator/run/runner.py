@@ -14,10 +14,11 @@ from pathlib import Path
 from typing import Any, Callable
 
 from ..atomic_files import describe_os_error
-from ..cosim.master import CoSimulation, RunOutcome
+from ..cosim.master import CoSimulation
+from ..cosim.outcome import RunOutcome
 from ..cosim.physics_view import PhysicsUnavailable, physics_view
 from ..cosim.stop_requests import StopRequests, exit_status
-from ..cosim.system import ResolvedSystem
+from ..cosim.resolved import ResolvedSystem
 from ..errors import FmuStepError, InitializationError, RunInterrupted, signal_name
 from ..inputs.scenario import Scenario, load_scenario
 from .analyses import analyse_run

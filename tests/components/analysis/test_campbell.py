@@ -14,7 +14,7 @@ from components.analysis.campbell import (
     excitation_frequencies,
 )
 from components.analysis.equilibrium import OperatingPoint, static_equilibrium
-from components.analysis.fatigue import load_duration_distribution
+from components.analysis.load_duration import load_duration_distribution
 from components.analysis.modes import drivetrain_modes
 from components.errors import ParameterError
 from components.model.presets import table6_gearbox

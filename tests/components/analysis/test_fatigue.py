@@ -12,13 +12,12 @@ from components.analysis.fatigue import (
     damage_equivalent_load,
     fatigue_loads,
     fatigue_report,
-    load_duration_distribution,
     rainflow,
     reversals,
-    sample_durations,
     write_del_csv,
     write_ldd_csv,
 )
+from components.analysis.load_duration import load_duration_distribution, sample_durations
 from components.errors import ParameterError
 from components.model.presets import table6_gearbox
 from components.model.wind import RotorSpeedProcess, WindParameters

@@ -66,7 +66,7 @@ def test_the_iterated_loop_gives_the_hand_computed_fixed_point_at_every_sample(t
 
 def test_the_sweeps_stop_at_the_tolerance_and_count_like_the_contraction(tmp_path):
     system = resolve_system(loop_scenario(tmp_path, 0.5, 1.0, algebraic_loops="iterate", loop_tolerance=1e-6))
-    sim = CoSimulation(system, step_loop="interpreted")
+    sim = CoSimulation(system, step_loop="python")
     outcome = sim.run(handle_sigint=False)
     assert outcome.complete, outcome.error
     values = outcome.column("a.Float64_continuous_output")

@@ -3,6 +3,8 @@ initialisation, sampling, failures, convergence with the step size."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from scipy.linalg import expm
@@ -10,6 +12,7 @@ from scipy.linalg import expm
 from orchestrator.cosim.master import CoSimulation
 from orchestrator.cosim.system import resolve_system
 from orchestrator.inputs.scenario import load_scenario
+from orchestrator.inputs.transformations import LinearTransformation
 
 CHAIN = """
 name = "chain"
@@ -228,42 +231,60 @@ def test_wall_time_limit_stops_between_blocks_and_keeps_the_samples(toy_scenario
     assert CoSimulation(system).run(handle_sigint=False, wall_time_limit_s=0).complete
 
 
-@pytest.mark.parametrize("algorithm", ["gauss-seidel", "jacobi"])
-@pytest.mark.parametrize("extrapolation", ["hold", "linear"])
-@pytest.mark.parametrize("interval", [0.001, 0.003])
-def test_the_generated_step_loop_equals_its_plain_python_reference(toy_scenario, algorithm, extrapolation, interval):
-    text = MASSES.format(step=1e-3, algorithm=algorithm).replace(
-        "output_interval = 0.02", f'output_interval = {interval}\nextrapolation = "{extrapolation}"')
-    system = resolve_system(load_scenario(toy_scenario(text)))
-    generated = CoSimulation(system).run(handle_sigint=False)
-    reference = CoSimulation(system, step_loop="interpreted").run(handle_sigint=False)
-    assert generated.complete and reference.complete and generated.steps == reference.steps
-    np.testing.assert_array_equal(generated.values, reference.values)  # the same FMI calls with the same values
+def both_executors(system):
+    """The run of ``system`` by the compiled loop and by the Python loop (the same stepping plan)."""
+    compiled = CoSimulation(system, step_loop="compiled").run(handle_sigint=False)
+    python = CoSimulation(system, step_loop="python").run(handle_sigint=False)
+    return compiled, python
 
 
 @pytest.mark.parametrize("algorithm", ["gauss-seidel", "jacobi"])
 @pytest.mark.parametrize("extrapolation", ["hold", "linear"])
 @pytest.mark.parametrize("interval", [0.001, 0.003])
-def test_the_compiled_step_loop_equals_the_generated_one(toy_scenario, algorithm, extrapolation, interval):
+@pytest.mark.parametrize("transformed", [False, True])
+def test_the_compiled_and_the_python_loop_record_the_same_values(toy_scenario, algorithm, extrapolation, interval,
+                                                                  transformed):
     pytest.importorskip("numba")
     text = MASSES.format(step=1e-3, algorithm=algorithm).replace(
         "output_interval = 0.02", f'output_interval = {interval}\nextrapolation = "{extrapolation}"')
-    system = resolve_system(load_scenario(toy_scenario(text)))
-    compiled = CoSimulation(system, step_loop="numba").run(handle_sigint=False)
-    generated = CoSimulation(system, step_loop="generated").run(handle_sigint=False)
-    assert compiled.complete and generated.complete and compiled.steps == generated.steps
-    np.testing.assert_array_equal(compiled.values, generated.values)  # the same FMI calls with the same values
+    scenario = load_scenario(toy_scenario(text))
+    if transformed:  # a linear transformation (SSP) on one of the coupled inputs
+        scenario = replace(scenario, connections=tuple(
+            replace(c, transformation=LinearTransformation(0.9, 1e-3)) if c.target.variable == "xa" else c
+            for c in scenario.connections))
+    compiled, python = both_executors(resolve_system(scenario))
+    assert compiled.complete and python.complete and compiled.steps == python.steps
+    np.testing.assert_array_equal(compiled.values, python.values)  # the same FMI calls with the same values
+    np.testing.assert_array_equal(compiled.time_s, python.time_s)
+
+
+@pytest.mark.parametrize("interval", [0.01, 0.03])
+def test_the_compiled_and_the_python_loop_stop_alike_on_a_failing_fmu(toy_scenario, interval):
+    pytest.importorskip("numba")
+    text = FAIL.replace("step = 0.01", f"step = 0.01\noutput_interval = {interval}")
+    compiled, python = both_executors(resolve_system(load_scenario(toy_scenario(text))))
+    assert not compiled.complete and compiled.steps == python.steps == 50
+    assert compiled.error == python.error and "fmi2DoStep" in compiled.error
+    np.testing.assert_array_equal(compiled.values, python.values)
+    np.testing.assert_array_equal(compiled.time_s, python.time_s)
 
 
 def test_the_compiled_step_loop_refuses_what_it_cannot_run(toy_scenario):
     pytest.importorskip("numba")
     system = resolve_system(load_scenario(toy_scenario(MASSES.format(step=1e-3, algorithm="jacobi"))))
-    with pytest.raises(ValueError, match="step_loop 'numba' cannot run this system: profiling timers"):
-        CoSimulation(system, profile=True, step_loop="numba").run(handle_sigint=False)
-    profiled = CoSimulation(system, profile=True).run(handle_sigint=False)  # auto: the generated loop times the calls
-    assert profiled.complete and profiled.profile is not None
+    with pytest.raises(ValueError, match="step_loop 'compiled' cannot run this system: profiling timers"):
+        CoSimulation(system, profile=True, step_loop="compiled").run(handle_sigint=False)
+    profiled = CoSimulation(system, profile=True).run(handle_sigint=False)  # auto: the Python loop times the calls
+    assert profiled.complete and set(profiled.profile) == {"a", "b"}
+    assert all(times["fmi2DoStep"] > 0 for times in profiled.profile.values())
+    np.testing.assert_array_equal(profiled.values, CoSimulation(system).run(handle_sigint=False).values)
 
 
-def test_an_unknown_step_loop_is_refused(toy_scenario):
-    with pytest.raises(ValueError, match="step_loop 'compiled'"):
-        CoSimulation(resolve_system(load_scenario(toy_scenario())), step_loop="compiled")
+def test_an_unknown_step_loop_is_refused_and_the_earlier_names_are_accepted(toy_scenario):
+    system = resolve_system(load_scenario(toy_scenario()))
+    with pytest.raises(ValueError, match="step_loop 'turbo': expected one of auto, compiled, python"):
+        CoSimulation(system, step_loop="turbo")
+    assert [CoSimulation(system, step_loop=name).step_loop for name in ("numba", "generated", "interpreted")] == \
+        ["compiled", "python", "python"]
+
+

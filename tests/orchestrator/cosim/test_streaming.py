@@ -37,10 +37,11 @@ def masses(toy_scenario, algorithm, extrapolation, interval, stop=2.0):
 
 
 @pytest.mark.parametrize("algorithm, extrapolation, interval, step_loop", [
-    ("gauss-seidel", "linear", 0.001, "generated"),  # every step sampled: the block buffer itself
-    ("jacobi", "hold", 0.003, "generated"),  # a ring buffer and sample rows that straddle blocks
-    ("gauss-seidel", "linear", 0.003, "interpreted"),
-    ("jacobi", "linear", 0.4, "interpreted"),  # fewer samples than blocks
+    ("gauss-seidel", "linear", 0.001, "auto"),  # every step sampled: the block buffer itself
+    ("jacobi", "hold", 0.003, "auto"),  # a ring buffer and sample rows that straddle blocks
+    ("gauss-seidel", "linear", 0.001, "python"),
+    ("gauss-seidel", "linear", 0.003, "python"),
+    ("jacobi", "linear", 0.4, "python"),  # fewer samples than blocks
 ])
 def test_block_boundaries_do_not_change_the_results(toy_scenario, monkeypatch, algorithm, extrapolation, interval,
                                                     step_loop):

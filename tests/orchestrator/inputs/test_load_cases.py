@@ -6,13 +6,13 @@ import numpy as np
 import pytest
 
 from components import units
-from orchestrator.inputs.load_cases import (
-    LoadCaseError,
+from orchestrator.inputs.load_case_file import (
     find_load_cases,
     load_cases_from_dict,
     load_load_cases,
     packaged_load_cases,
 )
+from orchestrator.inputs.load_cases import LoadCaseError
 
 
 def _doc(**changes):

@@ -8,12 +8,8 @@ import numpy as np
 import pytest
 
 from components.errors import DtcosimError
-from orchestrator.inputs.study import (
-    StudyError,
-    find_study,
-    load_study,
-    study_from_dict,
-)
+from orchestrator.inputs.study import StudyError
+from orchestrator.inputs.study_file import find_study, load_study, study_from_dict
 from orchestrator.study.prepare import prepare_study
 from tests.helpers.studies import SMALL_STUDY, run_cli
 
@@ -171,7 +167,7 @@ def test_cli_timeout_overrides_the_study_and_is_checked(write_study, tmp_path):
 
 @pytest.mark.parametrize("name", ["paper-sensitivity", "shaft3-seeds"])
 def test_every_packaged_study_is_valid_against_its_base(name, fmu_dir):
-    from orchestrator.inputs.study import packaged_studies
+    from orchestrator.inputs.study_file import packaged_studies
 
     assert set(packaged_studies()) == {"paper-sensitivity", "shaft3-seeds"}
     prepared = prepare_study(load_study(find_study(name)), fmu_dir=fmu_dir, build=False)

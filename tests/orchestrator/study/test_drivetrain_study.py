@@ -10,7 +10,8 @@ from components.model.wind import RotorSpeedProcess, WindParameters
 from components.reference.solver import simulate_monolithic
 from orchestrator.inputs.drivetrain_entries import with_entries
 from orchestrator.inputs.drivetrain_file import find_drivetrain, load_drivetrain_file
-from orchestrator.inputs.study import StudyError, load_study
+from orchestrator.inputs.study import StudyError
+from orchestrator.inputs.study_file import load_study
 from orchestrator.provision.folders import drivetrain_fmu_dir
 from orchestrator.study.engine import PointTask, run_point
 from orchestrator.study.prepare import prepare_study

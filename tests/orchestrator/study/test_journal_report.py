@@ -6,7 +6,7 @@ import json
 
 import pytest
 
-from orchestrator.inputs.study import load_study
+from orchestrator.inputs.study_file import load_study
 from orchestrator.study.engine import PointTask, run_point
 from orchestrator.study.journal import (
     Journal,

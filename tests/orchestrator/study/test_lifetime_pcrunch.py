@@ -26,7 +26,7 @@ LIFE = DesignLife(20.0, 0.97)
 @pytest.fixture(scope="module")
 def split_run(paper_run, fmu_dir, tmp_path_factory):
     """(channels, [(t, {channel: y}), (t, {channel: y})]) of the paper run's two halves after 5 s."""
-    from orchestrator.inputs.load_cases import load_cases_from_dict
+    from orchestrator.inputs.load_case_file import load_cases_from_dict
     from orchestrator.study.load_cases import prepare_load_cases
 
     out, _, _ = paper_run

@@ -5,7 +5,8 @@ from __future__ import annotations
 import pytest
 
 from components import units
-from orchestrator.inputs.load_cases import LoadCaseError, load_cases_from_dict
+from orchestrator.inputs.load_case_file import load_cases_from_dict
+from orchestrator.inputs.load_cases import LoadCaseError
 from orchestrator.study.load_cases import SEED_STRIDE, prepare_load_cases
 
 

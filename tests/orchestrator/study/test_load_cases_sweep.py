@@ -121,7 +121,7 @@ def _run_stats(out: Path) -> dict[int, dict]:
 
 
 def test_load_revolutions_equal_the_integral_of_the_speed_and_bin_times_sum_to_the_runs(killed_and_resumed):
-    from orchestrator.inputs.load_cases import load_load_cases
+    from orchestrator.inputs.load_case_file import load_load_cases
     from orchestrator.study.lifetime_results import read_run_file
 
     out, _, _ = killed_and_resumed
@@ -162,7 +162,7 @@ def test_report_recomputes_after_a_changed_design_life_without_running(killed_an
 def test_workers_publish_the_progress_of_each_running_case(tmp_path, fmu_dir):
     from dataclasses import replace
 
-    from orchestrator.inputs.load_cases import load_cases_from_dict
+    from orchestrator.inputs.load_case_file import load_cases_from_dict
     from orchestrator.study.lifetime_results import store_run_data
     from orchestrator.study.load_cases import prepare_load_cases
     from orchestrator.study.sweep import run_sweep

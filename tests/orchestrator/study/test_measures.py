@@ -49,7 +49,7 @@ def test_del_over_a_window_is_what_the_run_analysis_computes():
 
 def test_cells_combine_dels_by_damage_and_other_measures_arithmetically(fmu_dir):
     """Six seeds per cell of shaft3-seeds: a DEL cell is (mean DEL^m)^(1/m), a std cell the plain mean."""
-    from orchestrator.inputs.study import find_study, load_study
+    from orchestrator.inputs.study_file import find_study, load_study
     from orchestrator.study.plots import grid
     from orchestrator.study.prepare import prepare_study
 

@@ -10,7 +10,8 @@ import pytest
 
 from orchestrator.commands.cli import main
 from orchestrator.errors import SspError
-from orchestrator.inputs.study import StudyError, load_study
+from orchestrator.inputs.study import StudyError
+from orchestrator.inputs.study_file import load_study
 from tests.helpers.studies import SMALL_HEAD, SMALL_STUDY, SMALL_TABLES
 
 COSIM_SEEDS = """

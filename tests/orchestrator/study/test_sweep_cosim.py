@@ -7,7 +7,7 @@ import shutil
 import numpy as np
 import pytest
 
-from orchestrator.inputs.study import load_study
+from orchestrator.inputs.study_file import load_study
 from orchestrator.study.prepare import prepare_study
 from orchestrator.study.report import read_table
 from orchestrator.study.sweep import run_sweep

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from orchestrator.inputs.study import load_study
+from orchestrator.inputs.study_file import load_study
 from orchestrator.study.journal import read_journal
 from orchestrator.study.prepare import prepare_study
 from orchestrator.study.report import read_table

@@ -1,20 +1,22 @@
-"""numba part of :mod:`orchestrator.cosim.compiled_loop` (imported only where numba is installed).
+"""numba part of :mod:`orchestrator.cosim.stepping.compiled_loop` (imported only where numba is installed).
 
 :func:`run_block` steps a block of communication steps of a system described by
-the plan arrays of :func:`orchestrator.cosim.compiled_loop.loop_plan`, calling
-the FMI functions through their addresses.
+the plan arrays of :func:`orchestrator.cosim.stepping.compiled_loop.plan_arrays`,
+calling the FMI functions through their addresses. It is
+:meth:`orchestrator.cosim.stepping.python_loop.PythonLoop.advance` for Real-only
+systems, statement for statement.
 """
 
 from __future__ import annotations
 
 import numpy as np
 from llvmlite import ir  # optional requirement (comes with numba)
-from numba import njit, types  # optional requirement: without numba the generated loop runs
+from numba import njit, types  # optional requirement: without numba the Python loop runs
 from numba.extending import intrinsic
 
 from components.compile.numba_cache import enable_stable_cache
 
-from .compiled_loop_layout import (
+from .compiled_layout import (
     F_COLUMN,
     F_INPUT,
     F_TRANSFORMED,
@@ -65,10 +67,11 @@ def _call_values(typingctx, fn, component, vr, n, values):
 @njit(cache=False)
 def run_block(k_start, k_end, t0, h, plan, feeds, coefficients, in_bufs, ring, data, base, stride, linear,
                direct, status):
-    """Steps ``k_start <= k < k_end`` (see ``compile_step_loop``); returns the steps done.
+    """Steps ``k_start <= k < k_end`` (see :class:`~orchestrator.cosim.stepping.plan.RowBuffers`); returns the
+    steps done.
 
     On a failing status (> fmi2Warning) ``status`` gets (slot, function code, status, k) and the
-    step it happened in is returned as done-so-far (the caller raises the master's _Stop).
+    step it happened in is returned as done-so-far (the caller raises StepFailed).
     """
     n_cols = ring.shape[1]
     flat = ring.reshape(-1)
