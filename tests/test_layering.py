@@ -59,11 +59,6 @@ FMUS_ALLOWED = {
     "orchestrator.reports": set(),
 }
 
-#: circles being removed on another branch: the no-circle test of their package is expected to fail until then
-PENDING_CIRCLES = {
-}
-
-
 def _layer(name: str) -> str | None:
     """The layer of module ``name`` (None: a package itself, or a base module of ``components`` or ``orchestrator``)."""
     parts = name.split(".")
@@ -170,20 +165,15 @@ def test_import_circles_are_found(tmp_path):
     assert circles_of({**graph, "made_up.c": set()}) == []
 
 
-@pytest.mark.parametrize("top", [
-    pytest.param(top, marks=pytest.mark.xfail(strict=True, reason=PENDING_CIRCLES[top][1]))
-    if top in PENDING_CIRCLES else top
-    for top in PACKAGES
-])
+@pytest.mark.parametrize("top", sorted(PACKAGES))
 def test_no_import_circle(top):
     assert import_circles(top) == []
 
 
-@pytest.mark.parametrize("top", sorted(PACKAGES))
-def test_no_import_circle_but_the_pending_ones(top):
-    """While a package's circle is being removed elsewhere, no other circle may appear in it."""
-    pending = PENDING_CIRCLES.get(top, (set(), ""))[0]
-    assert [c for c in import_circles(top) if c != pending] == []
+def test_a_circle_is_found():
+    """The circle finder itself: a graph with a circle of three and a self-contained pair."""
+    graph = {"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}, "e": set()}
+    assert circles_of(graph) == [{"a", "b", "c"}]
 
 
 def test_the_fmu_model_imports_no_integrator_of_scipy_and_no_matplotlib():

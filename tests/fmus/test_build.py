@@ -266,8 +266,8 @@ def test_the_record_declares_role_model_and_signals(built_fmus, name, role, sign
         xml = archive.read("modelDescription.xml").decode()
     assert record["role"] == role and record["fmu"] == name and record["source"] == "preset table6"
     assert '<Tool name="dtcosim">' in xml and f'role="{role}"' in xml and 'record="resources/dtcosim.json"' in xml
-    for variable, kind in signals.items():
-        assert record["signals"][variable]["signal"] == kind
+    for variable, signal in signals.items():
+        assert record["signals"][variable]["signal"] == signal
     assert record["model"] == _model(name, "table6")
     if name == "Gearbox":
         assert record["signals"]["stage1.F_sp[2]"] == {"signal": "contact_force", "stage": "stage1",
