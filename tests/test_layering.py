@@ -170,12 +170,6 @@ def test_no_import_circle(top):
     assert import_circles(top) == []
 
 
-def test_a_circle_is_found():
-    """The circle finder itself: a graph with a circle of three and a self-contained pair."""
-    graph = {"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}, "e": set()}
-    assert circles_of(graph) == [{"a", "b", "c"}]
-
-
 def test_the_fmu_model_imports_no_integrator_of_scipy_and_no_matplotlib():
     code = ("import importlib, pkgutil, sys, components.model as m\n"
             "for i in pkgutil.iter_modules(m.__path__): importlib.import_module('components.model.' + i.name)\n"
