@@ -48,7 +48,7 @@ def invert(g, out):
         if pivot != col:
             g[[col, pivot]] = g[[pivot, col]]
             out[[col, pivot]] = out[[pivot, col]]
-        inv_p = 1.0 / g[col, col]
+        inv_p = 1.0 / float(g[col, col])  # a zero pivot raises ZeroDivisionError, as in the compiled form
         g[col] *= inv_p
         out[col] *= inv_p
         f = g[:, col].copy()

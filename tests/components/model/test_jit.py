@@ -27,9 +27,8 @@ def _copy(root, package: str, factor: int, kernel: str = KERNEL) -> KernelSource
 @pytest.fixture
 def packages(tmp_path, monkeypatch):
     monkeypatch.setenv("DTCOSIM_CACHE_DIR", str(tmp_path / "cache"))
-    before = set(sys.modules)
     yield tmp_path
-    for name in set(sys.modules) - before:  # the test's compiled modules
+    for name in [name for name in sys.modules if name.startswith("_dtcosim_kernel_test_")]:  # the test's modules
         del sys.modules[name]
 
 
