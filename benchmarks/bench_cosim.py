@@ -49,7 +49,7 @@ def main() -> None:
     from orchestrator.cosim.master import CoSimulation
     from orchestrator.cosim.physics_view import physics_view
     from orchestrator.cosim.system import resolve_system
-    from orchestrator.inputs.scenario import find_scenario, load_scenario
+    from orchestrator.inputs.scenario_file import find_scenario, load_scenario
     from orchestrator.interop.libcosim import run_ssp_in_libcosim
     from orchestrator.interop.ssp import export_ssp
     from orchestrator.run.comparison import compare, run_reference

@@ -96,7 +96,7 @@ class Phases:
 
 
 def _long_scenario(args):
-    from orchestrator.inputs.scenario import find_scenario, load_scenario
+    from orchestrator.inputs.scenario_file import find_scenario, load_scenario
 
     scenario = load_scenario(find_scenario("paper-60s")).with_simulation(stop_s=args.stop, window_s=(5.0, args.stop))
     if args.step is not None:

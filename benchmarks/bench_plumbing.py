@@ -196,7 +196,7 @@ def master_loop(folder: Path, steps: int, algorithm: str, extrapolation: str, st
     """The dtcosim master on the same FMUs (records every step); seconds per step of the loop."""
     from orchestrator.cosim.master import CoSimulation
     from orchestrator.cosim.system import resolve_system
-    from orchestrator.inputs.scenario import load_scenario
+    from orchestrator.inputs.scenario_file import load_scenario
 
     path = folder / f"plumbing-{algorithm}-{extrapolation}.toml"
     path.write_text(SCENARIO.format(stop=steps * 1e-3, algorithm=algorithm, extrapolation=extrapolation))

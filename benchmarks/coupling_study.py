@@ -53,7 +53,7 @@ def _setup(stop: float, fmu_dir, output_interval: float | None):
     from current_fmus import current_fmu_paths
     from orchestrator.cosim.physics_view import physics_view
     from orchestrator.cosim.system import resolve_system
-    from orchestrator.inputs.scenario import find_scenario, load_scenario
+    from orchestrator.inputs.scenario_file import find_scenario, load_scenario
     from orchestrator.run.comparison import run_reference
 
     base = load_scenario(find_scenario("paper-60s"))

@@ -54,7 +54,7 @@ def run(args: argparse.Namespace) -> int:
     ensure_compiled_kernels(report=print, retry=True)
     fmu_dir = args.out if args.out is not None else default_fmu_dir()
     if args.scenario is not None:
-        from ..inputs.scenario import find_scenario, load_scenario
+        from ..inputs.scenario_file import find_scenario, load_scenario
         from ..provision.project_fmus import ensure_fmus
 
         scenario = load_scenario(find_scenario(args.scenario))

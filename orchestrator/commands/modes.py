@@ -82,7 +82,7 @@ def scenario_drivetrain(spec: str, fmu_dir: Path | None = None):
     from ..cosim.physics_view import PhysicsUnavailable, physics_view
     from ..cosim.system import resolve_system
     from ..errors import ScenarioError
-    from ..inputs.scenario import find_scenario
+    from ..inputs.scenario_file import find_scenario
     from ..provision.project_fmus import ensure_fmus
     from ..run.runner import load_any
 

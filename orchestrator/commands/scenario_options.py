@@ -32,7 +32,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def load(spec, args: argparse.Namespace, command: str):
     """The scenario ``spec`` names (TOML, SSP or packaged name), read with ``--step``/``--stop`` for an SSP that lacks them."""
-    from ..inputs.scenario import find_scenario
+    from ..inputs.scenario_file import find_scenario
     from ..run.runner import load_any
 
     def note(message: str) -> None:

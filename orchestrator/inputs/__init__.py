@@ -3,7 +3,8 @@
 Modules
 -------
 files               reading TOML, the packaged files, finding a file by path or packaged name
-scenario            a co-simulation scenario and its TOML format
+scenario            a co-simulation scenario: components, connections, settings
+scenario_file       the scenario file (TOML): schema, loader, finding a packaged one
 study               a parameter study: its points
 study_file          the study file (TOML): schema and loader
 load_cases          a set of load cases (wind bins, operating rows, fatigue options)

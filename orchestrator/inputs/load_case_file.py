@@ -240,7 +240,7 @@ def _curve(tab: _CurveTable, i: int, src: str | None) -> CurveRule:
 
 def _scenario_path(spec: str, base_dir: Path | None, source: str | None) -> Path:
     from ..errors import ScenarioError
-    from .scenario import find_scenario
+    from .scenario_file import find_scenario
 
     p = Path(spec)
     if base_dir is not None and not p.is_absolute() and (base_dir / p).is_file():

@@ -259,7 +259,7 @@ def study_from_dict(data: Mapping[str, Any], name: str | None = None, base_dir: 
 def _scenario_path(spec: str, base_dir: Path | None, source: str | None) -> Path:
     """The base scenario file: relative to the study file, else a path or a packaged scenario name."""
     from ..errors import ScenarioError
-    from .scenario import find_scenario
+    from .scenario_file import find_scenario
 
     p = Path(spec)
     if base_dir is not None and not p.is_absolute() and (base_dir / p).is_file():

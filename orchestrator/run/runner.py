@@ -20,7 +20,8 @@ from ..cosim.physics_view import PhysicsUnavailable, physics_view
 from ..cosim.stop_requests import StopRequests, exit_status
 from ..cosim.resolved import ResolvedSystem
 from ..errors import FmuStepError, InitializationError, RunInterrupted, signal_name
-from ..inputs.scenario import Scenario, load_scenario
+from ..inputs.scenario import Scenario
+from ..inputs.scenario_file import load_scenario
 from .analyses import analyse_run
 from .comparison import compare, format_comparison, run_reference
 from .derived import Skipped, generator_vs_ideal

@@ -139,7 +139,7 @@ variables = ["sine.y", "a1.y", "a2.y"]
 
 @pytest.mark.parametrize("g1, g2", [(0.5, 0.5), (-1.5, 0.4)])
 def test_a_driven_loop_follows_its_hand_computed_solution_at_every_communication_point(toy_scenario, g1, g2):
-    from orchestrator.inputs.scenario import load_scenario
+    from orchestrator.inputs.scenario_file import load_scenario
 
     system = resolve_system(load_scenario(toy_scenario(ADDER_LOOP.format(g1=g1, g2=g2, max_iterations=200))))
     assert system.algebraic_loops == (("a1", "a2"),)
@@ -152,7 +152,7 @@ def test_a_driven_loop_follows_its_hand_computed_solution_at_every_communication
 
 
 def test_a_loop_without_a_solution_stops_the_run_where_it_diverges_keeping_what_was_computed(toy_scenario):
-    from orchestrator.inputs.scenario import load_scenario
+    from orchestrator.inputs.scenario_file import load_scenario
 
     # g1 g2 = 1: y1 = y1 + sin has no solution once sin != 0 (at t = 0 it is 0, and everything converges)
     system = resolve_system(load_scenario(toy_scenario(ADDER_LOOP.format(g1=1.0, g2=1.0, max_iterations=25))))

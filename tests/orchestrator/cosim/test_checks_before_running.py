@@ -16,11 +16,8 @@ from orchestrator.commands.cli import main
 from orchestrator.cosim.system import resolve_system
 from orchestrator.errors import ScenarioError
 from orchestrator.inputs.overrides import apply_parameters
-from orchestrator.inputs.scenario import (
-    SimulationSettings,
-    find_scenario,
-    load_scenario,
-)
+from orchestrator.inputs.scenario import SimulationSettings
+from orchestrator.inputs.scenario_file import find_scenario, load_scenario
 
 
 @pytest.fixture(scope="module")

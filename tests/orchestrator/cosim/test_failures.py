@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from orchestrator.inputs.scenario import find_scenario, load_scenario
+from orchestrator.inputs.scenario_file import find_scenario, load_scenario
 from orchestrator.result_files import find_timeseries, read_timeseries
 from tests.helpers.scenarios import TOY_SCENARIO, dtcosim, write_scenario
 

@@ -11,7 +11,7 @@ from scipy.linalg import expm
 
 from orchestrator.cosim.master import CoSimulation
 from orchestrator.cosim.system import resolve_system
-from orchestrator.inputs.scenario import load_scenario
+from orchestrator.inputs.scenario_file import load_scenario
 from orchestrator.inputs.transformations import LinearTransformation
 
 CHAIN = """

@@ -9,7 +9,7 @@ from orchestrator.cosim import master
 from orchestrator.cosim.master import CoSimulation
 from orchestrator.cosim.stop_requests import StopRequests
 from orchestrator.cosim.system import resolve_system
-from orchestrator.inputs.scenario import load_scenario
+from orchestrator.inputs.scenario_file import load_scenario
 from tests.orchestrator.cosim.test_master import MASSES
 
 

@@ -10,7 +10,7 @@ import pytest
 from orchestrator.cosim.master import CoSimulation
 from orchestrator.cosim.system import resolve_system
 from orchestrator.errors import AlgebraicLoopError, ScenarioError
-from orchestrator.inputs.scenario import load_scenario
+from orchestrator.inputs.scenario_file import load_scenario
 from orchestrator.run.results import write_timeseries
 from tests.helpers.reference_fmus import read_typed_timeseries, reference_fmu
 from tests.helpers.scenarios import write_scenario

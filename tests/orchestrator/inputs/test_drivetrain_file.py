@@ -244,7 +244,7 @@ def test_a_bad_file_is_one_named_error(change, pattern, tmp_path):
 
 
 def test_a_scenario_naming_a_bad_drivetrain_file_fails_before_any_build(tmp_path):
-    from orchestrator.inputs.scenario import load_scenario
+    from orchestrator.inputs.scenario_file import load_scenario
 
     doc = base()
     doc["stages"][0]["planets"] = 0

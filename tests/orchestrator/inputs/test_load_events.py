@@ -16,12 +16,7 @@ from orchestrator.cosim.system import resolve_system
 from orchestrator.errors import ScenarioError
 from orchestrator.inputs.analysis_settings import AnalysisSettings
 from orchestrator.inputs.load_events import ScenarioEvent
-from orchestrator.inputs.scenario import (
-    find_scenario,
-    load_scenario,
-    packaged_scenarios,
-    scenario_from_dict,
-)
+from orchestrator.inputs.scenario_file import find_scenario, load_scenario, packaged_scenarios, scenario_from_dict
 
 EVENT_SCENARIOS = ("grid-fault", "emergency-stop", "torque-step")
 

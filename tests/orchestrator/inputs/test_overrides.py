@@ -9,7 +9,7 @@ import pytest
 from orchestrator.commands import scenario_options
 from orchestrator.errors import ScenarioError
 from orchestrator.inputs.overrides import SimulationOverrides
-from orchestrator.inputs.scenario import find_scenario, load_scenario
+from orchestrator.inputs.scenario_file import find_scenario, load_scenario
 
 
 @pytest.fixture(scope="module")

@@ -15,7 +15,7 @@ from orchestrator.cosim.graph import (
 )
 from orchestrator.cosim.system import resolve_system
 from orchestrator.errors import AlgebraicLoopError, ScenarioError
-from orchestrator.inputs.scenario import load_scenario
+from orchestrator.inputs.scenario_file import load_scenario
 from tests.helpers.scenarios import TOY_SCENARIO
 
 
@@ -175,7 +175,7 @@ def test_scenario_pickles_with_plain_pickle():
     """A Scenario crosses process boundaries (multiprocessing, Dask) with the standard pickle."""
     import pickle
 
-    from orchestrator.inputs.scenario import packaged_scenarios
+    from orchestrator.inputs.scenario_file import packaged_scenarios
 
     scenario = load_scenario(packaged_scenarios()["grid-fault"])
     clone = pickle.loads(pickle.dumps(scenario))

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from orchestrator.errors import ScenarioError
-from orchestrator.inputs.scenario import load_scenario
+from orchestrator.inputs.scenario_file import load_scenario
 from orchestrator.inputs.series_file import LoadRecordError, read_load_record, si_conversion
 from tests.helpers.openfast_data import openfast_file
 

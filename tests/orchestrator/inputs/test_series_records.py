@@ -12,7 +12,7 @@ import pytest
 
 from orchestrator.provision.series_fmus import ensure_series_fmu
 from orchestrator.errors import ScenarioError
-from orchestrator.inputs.scenario import load_scenario
+from orchestrator.inputs.scenario_file import load_scenario
 from orchestrator.inputs.series_file import LoadRecordError
 
 SCENARIO = """

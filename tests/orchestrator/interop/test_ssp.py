@@ -11,7 +11,7 @@ import pytest
 
 from orchestrator.cosim.master import CoSimulation
 from orchestrator.cosim.system import resolve_system
-from orchestrator.inputs.scenario import find_scenario, load_scenario
+from orchestrator.inputs.scenario_file import find_scenario, load_scenario
 from orchestrator.interop.ssp import NS, PARAMETER_SET, export_ssp, import_ssp
 from orchestrator.provision.locate import resolve_fmu_paths
 from orchestrator.run.runner import load_any

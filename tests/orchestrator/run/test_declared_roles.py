@@ -11,7 +11,7 @@ import pytest
 from orchestrator.cosim.physics_view import PhysicsUnavailable, physics_view
 from orchestrator.cosim.system import resolve_system
 from orchestrator.errors import ScenarioError
-from orchestrator.inputs.scenario import load_scenario
+from orchestrator.inputs.scenario_file import load_scenario
 from orchestrator.result_files import read_timeseries
 from tests.helpers.scenarios import dtcosim, write_scenario
 

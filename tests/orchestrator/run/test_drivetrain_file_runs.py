@@ -11,7 +11,7 @@ import pytest
 
 from components.model.kernel import choose_kernel
 from orchestrator.inputs.drivetrain_file import find_drivetrain, load_drivetrain_file
-from orchestrator.inputs.scenario import find_scenario
+from orchestrator.inputs.scenario_file import find_scenario
 from orchestrator.provision.folders import drivetrain_fmu_dir
 from tests.helpers.scenarios import dtcosim
 

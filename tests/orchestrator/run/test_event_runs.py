@@ -15,7 +15,7 @@ from components.analysis.contact_loss import contact_loss_summary
 from components.analysis.spectrum import amplitude_spectrum
 from orchestrator.commands.cli import main
 from orchestrator.cosim.system import resolve_system
-from orchestrator.inputs.scenario import find_scenario, load_scenario
+from orchestrator.inputs.scenario_file import find_scenario, load_scenario
 from orchestrator.provision.locate import resolve_fmu_paths
 from orchestrator.result_files import read_timeseries
 from orchestrator.run.comparison import run_reference

@@ -21,7 +21,7 @@ from orchestrator.provision.series_fmus import ensure_series_fmu
 from orchestrator.cosim.system import resolve_system
 from orchestrator.errors import ScenarioError
 from orchestrator.inputs.overrides import apply_parameters
-from orchestrator.inputs.scenario import find_scenario, load_scenario
+from orchestrator.inputs.scenario_file import find_scenario, load_scenario
 from orchestrator.run.runner import run_scenario
 from tests.helpers.openfast_data import openfast_file
 

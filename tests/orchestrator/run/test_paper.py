@@ -13,7 +13,7 @@ from components.reference.cases import TABLE7_PAPER
 from orchestrator.cosim.master import CoSimulation
 from orchestrator.cosim.physics_view import physics_view
 from orchestrator.cosim.system import resolve_system
-from orchestrator.inputs.scenario import find_scenario, load_scenario
+from orchestrator.inputs.scenario_file import find_scenario, load_scenario
 from orchestrator.provision.locate import resolve_fmu_paths
 from orchestrator.result_files import read_timeseries
 from orchestrator.run.comparison import compare, run_reference

@@ -8,7 +8,7 @@ import pytest
 from orchestrator.columnar_files import ARROW_END_OF_STREAM, read_columnar
 from orchestrator.errors import ScenarioError
 from orchestrator.inputs.results_format import AUTO_PARQUET_VALUES, concrete_format
-from orchestrator.inputs.scenario import find_scenario, load_scenario, scenario_from_dict
+from orchestrator.inputs.scenario_file import find_scenario, load_scenario, scenario_from_dict
 from orchestrator.result_files import find_timeseries, read_timeseries
 from orchestrator.run.parquet_writer import ParquetWriter
 from orchestrator.run.results import results_writer

@@ -25,7 +25,7 @@ def test_compare_reference_reads_a_table5_gearbox_from_its_record(table5_fmu_dir
     # the paper scenario records stage2 and stage3 forces that a single planetary stage does not have:
     # record the gearbox's outputs by pattern instead
     scenario = tmp_path / "table5.toml"
-    from orchestrator.inputs.scenario import find_scenario
+    from orchestrator.inputs.scenario_file import find_scenario
 
     text = find_scenario("paper-60s").read_text()
     start = text.index("[record]")

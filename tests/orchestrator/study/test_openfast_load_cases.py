@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from orchestrator.inputs.load_case_file import find_load_cases, load_load_cases
-from orchestrator.inputs.scenario import find_scenario, load_scenario
+from orchestrator.inputs.scenario_file import find_scenario, load_scenario
 from orchestrator.inputs.series_file import read_load_record
 from tests.helpers.openfast_data import openfast_file
 

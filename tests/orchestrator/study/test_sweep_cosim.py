@@ -36,7 +36,7 @@ values = [2000.0, 5729.6]
 
 
 def test_cosim_sweep_runs_from_shipped_fmu_bytes(write_study, fmu_dir, tmp_path):
-    from orchestrator.inputs.scenario import find_scenario
+    from orchestrator.inputs.scenario_file import find_scenario
 
     # the base scenario and its FMUs in a directory of their own, deleted before the sweep runs:
     # the workers can only use the bytes that travel with the tasks
@@ -89,7 +89,7 @@ def test_cosim_peak_acceleration_matches_the_monolithic_engine(write_study, fmu_
     Before the Gearbox FMU had ``alpha_out_max`` the co-simulation differenced
     ``omega_out`` on the 2 ms grid and found ~680 rad/s^2 here, 22 x too low.
     """
-    from orchestrator.inputs.scenario import find_scenario
+    from orchestrator.inputs.scenario_file import find_scenario
     from orchestrator.study.engine import PointTask, run_point
 
     shutil.copy(find_scenario("paper-60s"), tmp_path / "paper.toml")
