@@ -17,8 +17,8 @@ the mean CPU time per step (``time.process_time``: the FMUs run in this
 process); the runners take turns block by block, so load changes on a shared
 machine hit them alike.
 
-Targets (issue 14): compiled <= 20 us per step; numpy fallback no slower than
-before the issue (82 us on the machine of that day). Both are figures of that
+Targets (issue 14): compiled <= 20 us per step (the numpy fallback of that issue,
+82 us then, is now the compiled kernel's own source interpreted: issue 28). Figures of that
 machine (the shared VM's speed varies 2x from day to day); ``--baseline REV``
 measures them on this one, as ratios: it builds the Gearbox FMU of git revision ``REV``
 (default :data:`PRE_ISSUE_REVISION`, the last commit before issue 14's work) in a
@@ -291,14 +291,10 @@ def main(argv: list[str] | None = None) -> int:
                   f"{blockwise('baseline', 'gearbox')}); "
                   f"target >= {needed:.2f} ({BEFORE_ISSUE_US:g} -> {TARGET_COMPILED_US:g} us/step on that day's "
                   f"machine) -> {'met' if speedup >= needed else 'NOT met'}")
-    if args.baseline:
-        ratio = med["gearbox_numpy"] / med["baseline"]
-        print(f"  Gearbox FMU numpy / the FMU of {args.baseline}: {ratio:.2f} "
-              f"(blockwise: {blockwise('gearbox_numpy', 'baseline')})")
-        print(f"  target numpy fallback no slower than before issue 14 -> {'met' if ratio <= 1.0 else 'NOT met'}")
-    else:
-        print(f"  target numpy fallback <= {BEFORE_ISSUE_US:g} us/step (before issue 14, that day's machine) -> "
-              f"{'met' if med['gearbox_numpy'] <= BEFORE_ISSUE_US else 'NOT met'}; --baseline measures it here")
+    # the interpreted kernel is the compiled one's source run by Python (issue 28: the physics written once); it is
+    # no longer held to issue 14's target for the separate numpy implementation it replaced (82 us that day)
+    print(f"  kernel interpreted: {med['gearbox_numpy'] / med['gearbox']:.1f} x the compiled Gearbox FMU "
+          "(what runs where neither numba nor the FMU's ahead-of-time module is there)")
     return 0
 
 

@@ -11,7 +11,7 @@ inertias, the mesh moment arms ``-r_b = -r cos(alpha)`` (eq. 5-7), the shafts, t
 from __future__ import annotations
 
 from .contact import contact_force, stiffness_sensitivity
-from .linalg import axpy, copy, vecmat
+from .linalg import axpy, vecmat, vecmat_sum
 from .stiffness import stiffness_factors
 
 
@@ -23,22 +23,33 @@ def deflections(y, n, a_t, a_port, port, port_rate, out):
     axpy(port_rate, a_port, out[1])
 
 
+def _deflections_loop(y, n, a_t, a_port, port, port_rate, out):
+    """:func:`deflections` in one pass over ``a_t`` (the same sums in the same order)."""
+    for i in range(a_t.shape[1]):
+        d = 0.0
+        r = 0.0
+        for j in range(n):
+            d += y[j] * a_t[j, i]
+            r += y[n + j] * a_t[j, i]
+        out[0, i] = d + port * a_port[i]
+        out[1, i] = r + port_rate * a_port[i]
+
+
 def acceleration(y, port, port_rate, alpha, factor, a_t, a_port, fast, contact, z, defl, acc):
     """Deviation accelerations ``q_ddot`` [rad/s^2] into ``acc``.
 
-    Writes the deflections into ``defl`` and the forces [N] into ``z[:n_mesh]``; ``z`` starts with
-    ``[F, q, v, u, u_dot, alpha_in]`` afterwards.
+    Writes the deflections into ``defl``, the forces [N] into ``z[:n_mesh]`` and ``u, u_dot, alpha_in``
+    after ``n_mesh + 2 n`` entries of ``z``.
     """
     m = defl.shape[1]
     n2 = y.shape[0]
     deflections(y, n2 // 2, a_t, a_port, port, port_rate, defl)
     for i in range(m):
         z[i] = contact_force(defl[0, i], defl[1, i], factor[i], contact[i])[0]
-    copy(y, z[m:m + n2])
     z[m + n2] = port
     z[m + n2 + 1] = port_rate
     z[m + n2 + 2] = alpha
-    vecmat(z[:m + n2 + 3], fast, acc)
+    vecmat_sum(z[:m], fast[:m], y, fast[m:m + n2], z[m + n2:m + n2 + 3], fast[m + n2:], acc)
 
 
 def jacobian(y, port, port_rate, factor, a_t, a_port, contact, defl, nz_index, nz_value, cos_alpha, stks, stcs,
@@ -55,10 +66,12 @@ def jacobian(y, port, port_rate, factor, a_t, a_port, contact, defl, nz_index, n
     deflections(y, n, a_t, a_port, port, port_rate, defl)
     for i in range(m):
         _, fd[i], fv[i], _ = contact_force(defl[0, i], defl[1, i], factor[i], contact[i])
-    dq[:, :] = stks
-    dv[:, :] = stcs
-    port_jac[0, :] = stks_port
-    port_jac[1, :] = stcs_port
+    for j in range(n):
+        for col in range(n):
+            dq[j, col] = stks[j, col]
+            dv[j, col] = stcs[j, col]
+        port_jac[0, j] = stks_port[j]
+        port_jac[1, j] = stcs_port[j]
     for i in range(m):
         cq = cos_alpha[i] * fd[i]
         cv = cos_alpha[i] * fv[i]
@@ -78,8 +91,9 @@ def jacobian(y, port, port_rate, factor, a_t, a_port, contact, defl, nz_index, n
             port_jac[1, jp] += bv * a_port[i]
     for j in range(n):
         s = -inv_m[j]
-        dq[j, :] *= s
-        dv[j, :] *= s
+        for col in range(n):
+            dq[j, col] *= s
+            dv[j, col] *= s
         port_jac[0, j] *= s
         port_jac[1, j] *= s
 
@@ -100,4 +114,6 @@ def stiffness_rate(y, n, angle, speed, port, port_rate, a_t, a_port, contact, ph
         out[j] += s
 
 
+#: the one-pass loop numba compiles in place of the numpy form (see :mod:`components.compile.jit`)
+COMPILED = {"deflections": _deflections_loop}
 INLINE = ("deflections", "acceleration")

@@ -72,6 +72,28 @@ def factor(hd, dq, dv, winv):
         winv[i, i] += 1.0
 
 
+def _factor_loop(hd, dq, dv, winv):
+    """:func:`factor` as loops (the same operations; numba compiles it without temporaries)."""
+    n = dq.shape[0]
+    g = np.empty((n, n))
+    for i in range(n):
+        for j in range(n):
+            g[i, j] = -hd * dv[i, j] - (hd * hd) * dq[i, j]
+        g[i, i] += 1.0
+    ginv = np.empty((n, n))
+    invert(g, ginv)
+    for i in range(n):
+        for j in range(n):
+            s = 0.0
+            for k in range(n):
+                s += ginv[i, k] * dq[k, j]
+            winv[i, j] = (hd * hd) * s
+            winv[i, n + j] = hd * ginv[i, j]
+            winv[n + i, j] = hd * s
+            winv[n + i, n + j] = ginv[i, j]
+        winv[i, i] += 1.0
+
+
 def use_factorisation(hd, dq, dv, winvs, istate):
     """Make ``W^-1`` for ``hd`` the active one of the two kept (``winvs``, shape (2, 2n, 2n)); returns its slot.
 
@@ -127,7 +149,8 @@ def time_derivative_term(k, y, t, h, hd, angle0, driver, port, winv, w_basis):
             matvec(winv[:, n:], k.port_jac[0], w_basis[0])
             matvec(winv[:, n:], k.port_jac[1], w_basis[1])
             matvec(winv[:, n:], k.kappa, w_basis[2])
-            w_basis[2] *= -1.0
+            for i in range(n2):
+                w_basis[2, i] = -w_basis[2, i]
             ist[BASIS_VALID] = 1.0
         c0 = hd * rate(port, t)
         c1 = hd * accel(port, t)
@@ -314,4 +337,6 @@ def advance(k, y, t_end, alpha_shift, driver, port, angle0, twist_q, twist_port)
     return OK, t, h, 0.0, twist_integral
 
 
-INLINE = ("twist_and_rate", "evaluate")
+#: the loops numba compiles in place of the numpy forms (see :mod:`components.compile.jit`)
+COMPILED = {"factor": _factor_loop}
+INLINE = ("twist_and_rate", "evaluate", "time_derivative_term", "refresh_jacobian", "advance")

@@ -32,6 +32,12 @@ def matmul(a, b, out):
     out[:] = np.cumsum(a[:, :, None] * b[None, :, :], axis=1)[:, -1, :]
 
 
+def vecmat_sum(a, wa, b, wb, tail, wt, out):
+    """``out = a @ wa + b @ wb + tail @ wt``: the product of ``[a, b, tail] @ [wa; wb; wt]`` without joining them,
+    summed from the first term of ``a`` to the last of ``tail``."""
+    out[:] = np.cumsum(np.concatenate((a[:, None] * wa, b[:, None] * wb, tail[:, None] * wt)), axis=0)[-1]
+
+
 def axpy(alpha, x, y):
     """``y += alpha x``."""
     y += alpha * x
@@ -92,6 +98,18 @@ def _matmul_loop(a, b, out):
             out[i, j] = s
 
 
+def _vecmat_sum_loop(a, wa, b, wb, tail, wt, out):
+    for j in range(out.shape[0]):
+        s = 0.0
+        for i in range(a.shape[0]):
+            s += a[i] * wa[i, j]
+        for i in range(b.shape[0]):
+            s += b[i] * wb[i, j]
+        for i in range(tail.shape[0]):
+            s += tail[i] * wt[i, j]
+        out[j] = s
+
+
 def _axpy_loop(alpha, x, y):
     for i in range(x.shape[0]):
         y[i] += alpha * x[i]
@@ -133,6 +151,6 @@ def _invert_loop(g, out):
 
 #: the loops numba compiles in place of the numpy forms (see :mod:`components.compile.jit`)
 COMPILED = {"copy": _copy_loop, "matvec": _matvec_loop, "vecmat": _vecmat_loop, "axpy": _axpy_loop,
-            "matmul": _matmul_loop, "invert": _invert_loop}
+            "vecmat_sum": _vecmat_sum_loop, "matmul": _matmul_loop, "invert": _invert_loop}
 #: inlined into their callers by numba (no call boundary on the hot path)
-INLINE = ("copy", "matvec", "vecmat", "axpy")
+INLINE = ("copy", "matvec", "vecmat", "vecmat_sum", "axpy")

@@ -246,7 +246,7 @@ def gearbox_step(buf, lay, dims, t, h, omega_rotor, phi_rotor, omega_gen, phi_ge
     return OK, tau, h, 0.0
 
 
-INLINE = ("vector", "matrix")
+INLINE = ("vector", "matrix", "views")
 #: entry points of the ahead-of-time compiled module (:mod:`components.compile.aot`) and their signatures
 AOT_EXPORTS = {
     "gearbox_step": "Tuple((i8, f8, f8, f8))(f8[::1], i8[::1], i8[::1], f8, f8, f8, f8, f8, f8, f8, f8, f8)",
