@@ -50,7 +50,11 @@ def _imbalance(y, n, port, factor, a_t, a_port, fast, contact, z, defl, acc, inv
     for j in range(n):
         worst = max(worst, abs(acc[j]) / inv_m[j])
         s = 0.0
-        for i in range(m + 2 * n + 3):
+        for i in range(m):  # the forces, then [q, v], then the port input, its rate and the driver acceleration
+            s += abs(z[i] * fast[i, j])
+        for i in range(2 * n):
+            s += abs(y[i] * fast[m + i, j])
+        for i in range(m + 2 * n, m + 2 * n + 3):
             s += abs(z[i] * fast[i, j])
         scale = max(scale, s / inv_m[j])
     return worst, scale
