@@ -11,7 +11,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.linalg as sla
@@ -186,7 +186,12 @@ class Mode:
     index : int
         1-based, in order of undamped natural frequency.
     undamped_frequency_hz : float
-        From ``K u = omega^2 M u`` [Hz].
+        The undamped natural frequency of the matched eigenvalue, ``|lambda| / (2 pi)`` [Hz], so that a
+        row's undamped and damped frequency belong to one eigenvalue (``Im lambda <= |lambda|``: the
+        damped frequency never exceeds it); for an overdamped mode, from ``K u = omega^2 M u``.
+    system_frequency_hz : float
+        From ``K u = omega^2 M u``: the frequency of the undamped system's mode whose shape this row shows
+        [Hz] (equal to the above for proportional damping).
     overdamped : bool
         True if the damped system has no oscillatory (complex) eigenvalue pair for
         this mode: a disturbance decays without oscillating (two real roots).
@@ -224,6 +229,7 @@ class Mode:
     energy_fraction: np.ndarray
     kind: str = "mode"
     eigen_index: int | None = None
+    system_frequency_hz: float = float("nan")
 
 
 def normalise_shape(u: np.ndarray) -> np.ndarray:
@@ -234,9 +240,13 @@ def normalise_shape(u: np.ndarray) -> np.ndarray:
 def modal_analysis(mass: np.ndarray, damping: np.ndarray, stiffness: np.ndarray) -> tuple[list[Mode], StateSpaceModes, UndampedModes]:
     """Undamped and damped modes of ``M q'' + C q' + K q = 0``, matched mode by mode.
 
-    Every complex eigenvalue pair (``Im lambda > 0``) is assigned to the undamped mode
-    whose shape it resembles most (mass-weighted MAC, optimal one-to-one assignment);
-    undamped modes without a pair are overdamped. Real eigenvalues (the overdamped
+    Every complex eigenvalue pair (``Im lambda > 0``) is assigned one-to-one to an undamped
+    mode, minimising the sum over pairs of ``|ln(|lambda| / omega)| - MAC`` (mass-weighted
+    MAC of the shapes): close in frequency first - the modes of a planetary stage come in
+    groups of equal or nearly equal frequency whose shapes alone do not tell them apart -
+    then alike in shape. Each row reports its eigenvalue's ``|lambda|`` as the undamped and
+    ``Im lambda`` as the damped frequency (never above it); undamped modes without a pair are
+    overdamped. Rows are ordered by undamped frequency. Real eigenvalues (the overdamped
     roots) stay in the returned :class:`StateSpaceModes`.
 
     Parameters
@@ -260,7 +270,11 @@ def modal_analysis(mass: np.ndarray, damping: np.ndarray, stiffness: np.ndarray)
     assigned: dict[int, tuple[int, float]] = {}
     if osc.size:
         mac = modal_assurance(und.shapes, ss.right[:n, osc], m)
-        rows, cols = linear_sum_assignment(-mac)
+        magnitude = np.abs(ss.eigenvalues[osc])
+        with np.errstate(divide="ignore"):
+            distance = np.abs(np.log(magnitude[None, :] / und.omega_rad_s[:, None]))
+        distance[~np.isfinite(distance)] = 1e6  # a rigid-body mode takes no oscillating eigenvalue
+        rows, cols = linear_sum_assignment(distance - mac)
         assigned = {int(r): (int(osc[cidx]), float(mac[r, cidx])) for r, cidx in zip(rows, cols)}
     modes = []
     for i in range(n):
@@ -273,9 +287,12 @@ def modal_analysis(mass: np.ndarray, damping: np.ndarray, stiffness: np.ndarray)
             j, mac_val = assigned[i]
             lam = complex(ss.eigenvalues[j])
             zeta = -lam.real / abs(lam)
-            modes.append(Mode(i + 1, w / (2 * math.pi), False, zeta, lam.imag / (2 * math.pi), modal_zeta, lam, mac_val,
-                              normalise_shape(u), energy, eigen_index=j))
+            modes.append(Mode(i + 1, abs(lam) / (2 * math.pi), False, zeta, lam.imag / (2 * math.pi), modal_zeta, lam,
+                              mac_val, normalise_shape(u), energy, eigen_index=j, system_frequency_hz=w / (2 * math.pi)))
         else:
             modes.append(Mode(i + 1, w / (2 * math.pi), True, modal_zeta, float("nan"), modal_zeta, None, float("nan"),
-                              normalise_shape(u), energy, "rigid" if w == 0.0 else "mode"))
+                              normalise_shape(u), energy, "rigid" if w == 0.0 else "mode",
+                              system_frequency_hz=w / (2 * math.pi)))
+    modes.sort(key=lambda mode: mode.undamped_frequency_hz)
+    modes = [replace(mode, index=k + 1) for k, mode in enumerate(modes)]
     return modes, ss, und

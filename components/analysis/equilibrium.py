@@ -21,12 +21,11 @@ mesh cycle; the linearisation uses that mean (factor 1) unless given another fac
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import DtcosimError, ParameterError
+from ..errors import DtcosimError, ParameterError, SolverError
 from ..model.assembly import Assembly
 from ..model.drivetrain import Drivetrain
 from ..units import rad_per_s_to_rpm, rpm
@@ -154,10 +153,10 @@ def static_equilibrium(
     """Deviation angles at which meshes and shafts carry a constant output torque.
 
     Solves ``Q(q, v=0) - T e_out = 0`` (``Q`` from :meth:`Assembly.generalised_forces`,
-    ``e_out`` the output body) by Newton's method with the analytic stiffness
-    ``-M dA/dq`` and a backtracking line search. The starting point comes from two
-    linear solves with the meshes as linear springs offset by half the backlash on the
-    loaded flank (secant stiffness of the Hertzian law at the first solve's forces).
+    ``e_out`` the output body) with the kernel's static solver
+    (:meth:`Assembly.static_deflection`: Newton with the analytic stiffness and a backtracking
+    line search, started from two linear solves with the meshes as linear springs offset by
+    half the backlash on the loaded flank) - the same one that starts every run.
 
     Parameters
     ----------
@@ -168,8 +167,8 @@ def static_equilibrium(
     stiffness_factor : float or ndarray, shape (n_mesh,)
         Mesh stiffness multiplier (time-varying stiffness frozen at one phase); 1 = mean.
     rtol : float
-        Convergence: largest generalised-force imbalance below ``rtol`` x the
-        quasi-static rotor torque.
+        Convergence: largest generalised-force imbalance below ``rtol`` x the largest sum
+        of generalised-force magnitudes on one body.
     max_iterations : int
         Newton iterations before :class:`EquilibriumError`.
 
@@ -181,54 +180,14 @@ def static_equilibrium(
     torque = finite("output_torque_nm", output_torque_nm)
     if torque == 0.0:
         raise ParameterError("output_torque_nm", torque, "non-zero (unloaded teeth float in the backlash)")
-    n = a.n_dof
-    load = _output_load(a, torque)
-    zeros = np.zeros(n)
-    scale = abs(torque) * max(1.0, abs(float(a.kinematic_ratio_all[a.free[a.output_dof]])))
-    flank = math.copysign(1.0, torque)  # normal power flow loads every mesh on the positive flank
-    half_jt = np.array([0.5 * m.contact.backlash_circumferential_m for m in a.meshes])
-    k0 = np.array([m.contact.stiffness for m in a.meshes]) * stiffness_factor
-    expo = np.array([m.contact.exponent for m in a.meshes])
-
-    def linear_guess(k_lin: np.ndarray) -> np.ndarray:
-        # meshes as linear springs F = k (d - flank j_t/2):  K q = -T e_out + B^T k flank j_t/2
-        kk = a.A.T @ ((a.cos_alpha * k_lin)[:, None] * a.A) + a.STkS
-        rhs = -load + a.A.T @ (a.cos_alpha * k_lin * flank * half_jt)
-        return np.linalg.solve(kk, rhs)
-
-    q = linear_guess(k0 * 1e-2 ** (expo - 1.0))  # stiffness at 1 cm penetration: soft, safe start
-    force = (a.A @ q - flank * half_jt) * k0 * 1e-2 ** (expo - 1.0)
-    pen = (np.abs(force) / k0) ** (1.0 / expo)
-    q = linear_guess(k0 * np.maximum(pen, 1e-9) ** (expo - 1.0))  # secant stiffness at those forces
-
-    def residual(qq: np.ndarray):
-        loads = a.loads(qq, zeros, stiffness_factor=stiffness_factor)
-        return a.generalised_forces(loads) - load, loads
-
-    r, loads = residual(q)
-    norm = np.abs(r).max()
-    it = 0
-    while norm > rtol * scale:
-        if it >= max_iterations:
-            raise EquilibriumError(
-                f"static equilibrium not found after {it} Newton iterations (residual {norm:.3g} N m)"
-            )
-        it += 1
-        dq, _, _, _ = a.acceleration_jacobian(q, zeros, stiffness_factor=stiffness_factor)
-        stiffness = -(a.inertia_kgm2[:, None] * dq)
-        try:
-            step = np.linalg.solve(stiffness, r)
-        except np.linalg.LinAlgError:
-            raise EquilibriumError("singular stiffness at the equilibrium iterate (a mesh out of contact?)") from None
-        alpha = 1.0
-        while True:
-            q_new = q + alpha * step
-            r_new, loads_new = residual(q_new)
-            norm_new = np.abs(r_new).max()
-            if norm_new < norm or alpha < 1e-6:
-                break
-            alpha *= 0.5
-        q, r, loads, norm = q_new, r_new, loads_new, norm_new
+    zeros = np.zeros(a.n_dof)
+    try:
+        q, iterations, _ = a.static_deflection(torque, stiffness_factor, rtol=rtol,
+                                               max_iterations=max_iterations)
+    except SolverError as exc:
+        raise EquilibriumError(str(exc).rsplit(" (at t =", 1)[0]) from None
+    loads = a.loads(q, zeros, stiffness_factor=stiffness_factor)
+    residual = a.generalised_forces(loads) - _output_load(a, torque)
     return StaticEquilibrium(
         q_rad=q,
         contact_force_n=loads.contact_force_n.copy(),
@@ -237,8 +196,8 @@ def static_equilibrium(
         mesh_damping_ns_per_m=loads.d_force_d_rate.copy(),
         shaft_torque_nm=loads.shaft_torque_nm.copy(),
         rotor_torque_nm=float(a.driver_torque(loads, 0.0)),
-        iterations=it,
-        residual_nm=float(norm),
+        iterations=iterations,
+        residual_nm=float(np.abs(residual).max()),
     )
 
 

@@ -41,7 +41,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import ParameterError, SolverError
 from . import kernel as model_kernel
 from .contact import ContactLaw, MeshContact
 from .drivetrain import Drivetrain
@@ -504,6 +504,60 @@ class Assembly:
         if not self.ports.size:
             return dq, dv, np.zeros((n, 0)), np.zeros((n, 0))
         return dq, dv, port_jac[0][:, None], port_jac[1][:, None]
+
+    def static_deflection(self, load_nm: float, stiffness_factor: np.ndarray | float = 1.0,
+                          kernel: str | None = None, rtol: float = 1e-11,
+                          max_iterations: int = 60) -> tuple[np.ndarray, int, float]:
+        """Deviation angles at which meshes and shafts carry the counter torque ``load_nm`` at constant speed.
+
+        :func:`components.model.kernel.statics.static_deflection` (Newton from two linear-spring guesses)
+        for an uncut assembly, whose output body carries the load.
+
+        Parameters
+        ----------
+        load_nm : float
+            Counter torque on the output body [N m], non-zero (unloaded teeth float in the backlash).
+        stiffness_factor : float or ndarray, shape (n_mesh,)
+            Mesh stiffness multiplier (time-varying stiffness frozen at one phase); 1 = mean.
+        kernel : {"auto", "numpy", "compiled"}, optional
+            Form of the kernel.
+        rtol : float
+            Converged when the largest generalised-force imbalance is below ``rtol`` times the largest sum of
+            generalised-force magnitudes on one body.
+        max_iterations : int
+            Newton iterations.
+
+        Returns
+        -------
+        q : ndarray, shape (n_dof,)
+            Deviation angles [rad].
+        iterations : int
+        imbalance : float
+            The remaining relative imbalance.
+
+        Raises
+        ------
+        SolverError
+            Not found (no convergence, singular stiffness).
+        """
+        if self.ports.size or self.output_dof is None:
+            raise ParameterError("assembly", "cut at the generator", "an uncut assembly (the output a degree of freedom)")
+        if not math.isfinite(load_nm) or load_nm == 0.0:
+            raise ParameterError("load_nm", load_nm, "a finite non-zero torque (unloaded teeth float in the backlash)")
+        n, m = self.n_dof, self.n_mesh
+        y = np.zeros(2 * n)
+        factor = np.ascontiguousarray(np.broadcast_to(np.asarray(stiffness_factor, dtype=float), (m,)))
+        status, iterations, imbalance = model_kernel.monolithic(kernel)[0].static_deflection(
+            y, n, float(load_nm), factor, math.copysign(1.0, load_nm), self.A_T, self.port_deflection,
+            self.fast_matrix, self.law.table, self.nz_index, self.nz_value, self.cos_alpha, self.STkS, self.STcS,
+            np.zeros(n), np.zeros(n), self.inv_inertia, np.zeros(m + 2 * n + 4), np.zeros((2, m)), np.zeros(n),
+            np.zeros(m), np.zeros(m), np.zeros((n, n)), np.zeros((n, n)), np.zeros((2, n)), np.zeros((n, n)),
+            np.zeros((n, n)), np.zeros(n), np.zeros(n), np.zeros(m), np.zeros(2 * n), rtol, max_iterations)
+        if status != 0:
+            what = "a singular stiffness" if status == 2 else f"{iterations} Newton iterations"
+            raise SolverError(f"the static deflection at {load_nm:g} N m was not found ({what}, relative imbalance "
+                              f"{imbalance:.3g})", 0.0)
+        return y[:n].copy(), int(iterations), float(imbalance)
 
     # -------------------------------------------------------------- energy
     def kinetic_energy(self, speeds_rad_s: np.ndarray, driver_speed_rad_s: np.ndarray | float) -> np.ndarray:

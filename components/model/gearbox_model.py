@@ -39,6 +39,10 @@ from .kernel import layout as L
 SHAFT_TORQUE_MODES = ("average", "end")
 #: how the generator end of shaft 3 moves within a communication step (see :class:`GearboxModel`)
 GENERATOR_INTERFACES = ("motion", "inertia")
+#: where a run starts: at the static deflection of its initial load, or undeflected (today's start before issue 29)
+STARTS = ("operating_point", "rest")
+#: the static deflection's convergence (relative generalised-force imbalance) and Newton iterations
+STATIC_RTOL, STATIC_MAX_ITERATIONS = 1e-11, 60
 
 
 #: the inputs of :meth:`GearboxModel.step`, in order
@@ -136,6 +140,14 @@ class GearboxModel:
     kernel : {"auto", "numpy", "compiled"}, optional
         Form of the kernel that steps it (:mod:`components.compile.choice`; default:
         ``$DTCOSIM_KERNEL``, else ``auto``): the same equations compiled or interpreted.
+    start : {"operating_point", "rest"}
+        ``operating_point``: :meth:`initialize` puts the gearbox at the static deflection of its
+        initial load (the counter torque input at constant speed; :mod:`components.model.kernel.statics`),
+        so constant inputs give constant outputs from the start. With the ``motion`` interface the
+        generator-angle input is then read relative to the static twist of shaft 3 (a constant port
+        offset: the generator's angle origin is arbitrary). Without a load (counter torque 0) the teeth
+        float in the backlash and the start is undeflected. ``rest``: undeflected at full load, the
+        load applied as a step at the start (the paper's convention).
 
     Attributes
     ----------
@@ -157,8 +169,10 @@ class GearboxModel:
         kernel: str | None = None,
         generator_interface: str = "motion",
         rotor_derivatives: bool = False,
+        start: str = "operating_point",
     ) -> None:
         self.generator_interface = one_of("generator_interface", generator_interface, GENERATOR_INTERFACES)
+        self.start = one_of("start", start, STARTS)
         inertia = self.generator_interface == "inertia"
         if inertia and drivetrain.generator is None:
             raise ParameterError("generator_interface", "inertia", "a drivetrain with a generator")
@@ -180,6 +194,8 @@ class GearboxModel:
         self._step = entry_point(self._module.gearbox_step,
                                  ("float64[::1]", "int64[::1]", "int64[::1]") + ("float64",) * 9)
         self.initialized = False
+        #: Newton iterations of the static deflection at the last initialisation (0: started undeflected)
+        self.static_iterations = 0
 
     # ------------------------------------------------------------ the kernel's buffer
     def _slot_shapes(self) -> dict[str, tuple[int, ...]]:
@@ -422,7 +438,8 @@ class GearboxModel:
     # ------------------------------------------------------------ stepping
     def initialize(self, t0: float, omega_rotor: float, phi_rotor: float, omega_gen: float, phi_gen: float,
                    counter_torque_nm: float = 0.0) -> None:
-        """Kinematically consistent start with zero deflection at time ``t0`` [s].
+        """Kinematically consistent start at time ``t0`` [s], at the static deflection of the counter torque
+        (``start = "operating_point"``) or undeflected.
 
         Parameters
         ----------
@@ -431,7 +448,13 @@ class GearboxModel:
         omega_gen, phi_gen : float
             Generator speed [rad/s] and angle [rad] at ``t0``.
         counter_torque_nm : float
-            Counter torque on the generator rotor [N m] (used by the ``inertia`` interface only).
+            Counter torque on the generator rotor [N m]: the load of the static deflection, and the port
+            input of the ``inertia`` interface.
+
+        Raises
+        ------
+        SolverError
+            The static deflection was not found.
         """
         finite("start_time", t0)
         for name, val in (("omega_rotor", omega_rotor), ("phi_rotor", phi_rotor), ("omega_gen", omega_gen),
@@ -457,7 +480,11 @@ class GearboxModel:
             sc[L.S_PORT_ANGLE], sc[L.S_PORT_SPEED] = counter_torque_nm, 0.0
         sc[L.S_LAST_OMEGA_ROTOR] = omega_rotor
         sc[L.S_LAST_OMEGA_GEN] = omega_gen
+        sc[L.S_PORT_OFFSET] = 0.0
         buf, lay, dims = self._buffer, self._offsets, self._dims
+        self.static_iterations = 0
+        if self.start == "operating_point" and counter_torque_nm != 0.0:
+            self._settle(t0, omega_rotor, phi_rotor, omega_gen, phi_gen, counter_torque_nm)
         self._module.current_loads(buf, lay, dims)  # loads at the initial state
         alpha = self.output_acceleration_rad_s2
         sc[L.S_ALPHA_OUT_AVG] = alpha
@@ -466,6 +493,37 @@ class GearboxModel:
         sc[L.S_SHAFT_TORQUE_AVG] = self.shaft_torque_end_nm
         self._module.outputs(buf, lay, dims)
         self.initialized = True
+
+    def _settle(self, t0: float, omega_rotor: float, phi_rotor: float, omega_gen: float, phi_gen: float,
+                counter_torque_nm: float) -> None:
+        """The static deflection at the counter torque (inertia interface: this model's own generator; motion
+        interface: a copy with the generator as a degree of freedom, whose static twist of shaft 3 becomes the
+        port offset)."""
+        flank = math.copysign(1.0, counter_torque_nm)
+        if self.generator_dof is not None:
+            status, iterations, imbalance = self._module.settle(self._buffer, self._offsets, self._dims, flank,
+                                                                STATIC_RTOL, STATIC_MAX_ITERATIONS)
+            self._static_result(status, iterations, imbalance, t0)
+            return
+        free = GearboxModel(self.assembly.drivetrain, self.control, kernel=self.kernel, generator_interface="inertia",
+                            start="operating_point")
+        free.initialize(t0, omega_rotor, phi_rotor, omega_gen, phi_gen, counter_torque_nm)
+        n = self.assembly.n_dof
+        names = free.assembly.dof_names
+        self.y[:n] = [free.y[names.index(body)] for body in self.assembly.dof_names]
+        static_port = float(free.y[free.generator_dof])
+        sc = self._scalars
+        sc[L.S_PORT_OFFSET] = static_port - sc[L.S_PORT_ANGLE]
+        sc[L.S_PORT_ANGLE] = static_port
+        self.static_iterations = free.static_iterations
+
+    def _static_result(self, status: int, iterations: int, imbalance: float, t0: float) -> None:
+        """Raise the SolverError of a static deflection that was not found; else note its iterations."""
+        if status != 0:
+            what = "a singular stiffness" if status == 2 else f"{iterations} Newton iterations"
+            raise SolverError(f"the static deflection at the initial load was not found ({what}, relative imbalance "
+                              f"{imbalance:.3g}); start at rest instead (start = 'rest', FMU: start_at_rest)", t0)
+        self.static_iterations = iterations
 
     def step(self, t: float, h: float, omega_rotor: float, phi_rotor: float, omega_gen: float, phi_gen: float,
              counter_torque_nm: float = 0.0, alpha_rotor: float = 0.0, jerk_rotor: float = 0.0) -> None:

@@ -143,7 +143,7 @@ def run_reference_case(case: ReferenceCase, **overrides) -> tuple[SimulationResu
         raise ParameterError("overrides", sorted(overrides), "only t_end_s and output_interval_s")
     from .solver import simulate_monolithic  # scipy.integrate: only when a case runs
 
-    result = simulate_monolithic(drivetrain, driver, t_end, output_interval_s=dt)
+    result = simulate_monolithic(drivetrain, driver, t_end, output_interval_s=dt, start="rest")  # the paper's load step
     window = (min(case.window_s[0], t_end), min(case.window_s[1], t_end))
     return result, case_statistics(result, drivetrain, window)
 

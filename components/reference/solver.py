@@ -22,10 +22,11 @@ import numpy as np
 from scipy.integrate import odeint
 
 from ..errors import ParameterError, SolverError, WallTimeLimitError
+from ..model import kernel as model_kernel
 from ..model.assembly import Assembly
 from ..model.drivetrain import Drivetrain
-from ..model import kernel as model_kernel
-from ..validation import finite, non_negative, positive
+from ..model.gearbox_model import STARTS
+from ..validation import finite, non_negative, one_of, positive
 from .results import EnergyAudit, SimulationResult
 
 
@@ -189,13 +190,16 @@ def simulate_monolithic(
     raise_on_failure: bool = False,
     initial_state: np.ndarray | None = None,
     kernel: str | None = None,
+    start: str = "operating_point",
 ) -> SimulationResult:
     """Integrate the monolithic drivetrain model.
 
-    Initial state: by default kinematically consistent speeds at the initial driver
-    speed and zero deflection (teeth centred in the backlash); loads act as steps at
-    t = 0. ``initial_state`` starts from another state instead, e.g. the static
-    equilibrium of :func:`components.analysis.modes.static_equilibrium` (no load step).
+    Initial state: kinematically consistent speeds at the initial driver speed, and by
+    default (``start="operating_point"``) the static deflection of the load at the start
+    time (:meth:`Assembly.static_deflection`; undeflected without a load), so a constant
+    input gives a constant output from the start - as the co-simulation's Gearbox starts.
+    ``start="rest"``: zero deflection (teeth centred in the backlash), the load a step at
+    the start (the paper's convention). ``initial_state`` starts from any other state.
 
     Parameters
     ----------
@@ -216,9 +220,11 @@ def simulate_monolithic(
     initial_state : ndarray, shape (2 n_dof,), optional
         ``[q, v]`` at ``t_start_s``: deviation angles [rad] and deviation speeds
         [rad/s] of the free bodies (order of ``Assembly.dof_names``), relative to
-        the kinematic motion ``kappa * theta_in``. Default: zeros.
+        the kinematic motion ``kappa * theta_in``. Default: per ``start``.
     kernel : {"auto", "numpy", "compiled"}, optional
         Implementation of the right-hand side and Jacobian (see :class:`MonolithicSystem`).
+    start : {"operating_point", "rest"}
+        Where the default initial state is (above).
 
     Returns
     -------
@@ -250,11 +256,15 @@ def simulate_monolithic(
         [np.full(n, settings.atol_angle_rad), np.full(n, settings.atol_speed_rad_s), np.full(3, 1e-3)]
     )
     y = np.zeros(2 * n + 3)
+    one_of("start", start, STARTS)
     if initial_state is not None:
         y0 = np.asarray(initial_state, dtype=float)
         if y0.shape != (2 * n,) or not np.all(np.isfinite(y0)):
             raise ParameterError("initial_state", y0.shape, f"finite [q, v] of shape ({2 * n},)")
         y[: 2 * n] = y0
+    elif start == "operating_point" and float(system.schedule(t0)) != 0.0:
+        y[:n] = system.assembly.static_deflection(float(system.schedule(t0)), system._stiffness_factor(t0),
+                                                  kernel=kernel)[0]
     Y = np.full((t_out.size, y.size), np.nan)
     Y[0] = y
     hmax = settings.max_step_s

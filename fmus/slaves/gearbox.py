@@ -14,8 +14,9 @@ solver step).
 The structure (stages, planets, shafts) is the drivetrain of the FMU's record
 (``resources/dtcosim.json``, fixed at build time); every number is a parameter (see :mod:`fmus.slaves.gearbox_parameters`).
 Before the first step (initialisation mode) the outputs describe the
-kinematically consistent, undeflected initial state at the current inputs,
-e.g. ``omega_out = ratio * omega_rotor``.
+kinematically consistent initial state at the current inputs, e.g.
+``omega_out = ratio * omega_rotor``: the static deflection of the ``counter_torque``
+input (unless ``start_at_rest``), so constant inputs give constant outputs from the start.
 """
 
 from __future__ import annotations
@@ -102,12 +103,17 @@ class Gearbox(DtcosimSlave):
             boolean_parameter("rotor_derivatives", False,
                               "extrapolate the rotor motion over a step from the inputs alpha_rotor and jerk_rotor "
                               "(third-order Taylor) instead of the slope of the last two speed inputs"),
+            boolean_parameter("start_at_rest", False,
+                              "start undeflected at full load, the load a step at the start time (false: at the "
+                              "static deflection of the counter_torque input at the initial speeds, so constant "
+                              "inputs give constant outputs from the start)"),
             real_input("omega_rotor", omega0, "rad/s", "rotor speed driving the stage-1 carrier"),
             real_input("phi_rotor", 0.0, "rad", "rotor angle"),
             real_input("omega_gen", ratio * omega0, "rad/s", "generator speed (far end of shaft 3)"),
             real_input("phi_gen", 0.0, "rad", "generator angle (far end of shaft 3; not used by the inertia interface)"),
             real_input("counter_torque", template.generator.counter_torque_nm, "N.m",
-                       "counter torque on the generator rotor, held over a step (inertia interface only)"),
+                       "counter torque on the generator rotor: the load of the static deflection at the start, and "
+                       "held over a step with the inertia interface"),
             real_input("alpha_rotor", 0.0, "rad/s2", "rotor acceleration (with rotor_derivatives only)"),
             real_input("jerk_rotor", 0.0, "rad/s3", "rotor jerk (with rotor_derivatives only)"),
             real_output("shaft_torque", "N.m",
@@ -181,7 +187,8 @@ class Gearbox(DtcosimSlave):
         control = control_from_values(self.value)
         self.model = GearboxModel(drivetrain, control, SHAFT_TORQUE_MODES[mode], bool(self.value("extrapolate_inputs")),
                                   generator_interface=GENERATOR_INTERFACES[interface],
-                                  rotor_derivatives=bool(self.value("rotor_derivatives")))
+                                  rotor_derivatives=bool(self.value("rotor_derivatives")),
+                                  start="rest" if self.value("start_at_rest") else "operating_point")
         if self.model.kernel_note and not self._kernel_reported:  # once per instance: the host sees why it is slower
             self._report(f"Gearbox: {self.model.kernel_note}", Fmi2Status.warning)
             self._kernel_reported = True

@@ -89,6 +89,44 @@ def record_coverage(system, component: str) -> None:
             f"[{t0:g}, {t1:g}] s (record time = simulation time + time_offset; or out_of_record = 0, hold)"))
 
 
+def record_speed_ratio(system) -> tuple[str, Any, str] | None:
+    """A load record whose generator/rotor speed ratio is not its drivetrain's, as ``(key, value, expectation)``.
+
+    A record that carries both speeds (OpenFAST's RotSpeed and GenSpeed or HSShftV) measured a drivetrain
+    of that ratio; played through another (a record of another turbine), its speeds and loads run
+    through the wrong gearbox without a word. The ratio is in the TimeSeriesSource's record
+    (``model["series"]["speed_ratio"]``, unless the series says ``check_speed_ratio = false``); the
+    drivetrain's is the scenario's dtcosim Gearbox's.
+    """
+    from components.model.assembly import Assembly
+
+    from .physics_view import PhysicsUnavailable, dtcosim_component, gearbox_drivetrain
+    from .roles import GEARBOX, TIME_SERIES
+
+    sources = [(name, role.record["model"]["series"]["speed_ratio"]) for name, role in system.roles.items()
+               if role.role == TIME_SERIES and role.record is not None
+               and "speed_ratio" in role.record.get("model", {}).get("series", {})]
+    if not sources:
+        return None
+    try:
+        gear = dtcosim_component(system, GEARBOX).component
+        drivetrain = gearbox_drivetrain(system, gear)
+    except PhysicsUnavailable:
+        return None
+    ratio = abs(float(Assembly(drivetrain, cut_at_generator=True).port_ratio[0]))
+    from ..inputs.series_spec import SPEED_RATIO_TOLERANCE
+
+    for name, recorded in sources:
+        for record, value in zip(recorded.get("records", []), recorded.get("ratios", [recorded["ratio"]])):
+            if not abs(abs(value) / ratio - 1.0) <= SPEED_RATIO_TOLERANCE:
+                return (f"components.{name}.series", f"{record}: {recorded['generator']} / {recorded['rotor']} = "
+                        f"{abs(value):.4g}",
+                        f"the generator/rotor speed ratio of the drivetrain of {gear}, {ratio:.4g}, within "
+                        f"{SPEED_RATIO_TOLERANCE:.0%} (a record of another drivetrain runs through the wrong gearbox; "
+                        "check_speed_ratio = false in the series table runs it anyway)")
+    return None
+
+
 def model_problem(system) -> tuple[str, Any, str] | None:
     """``(scenario key, value, expectation)`` of the first dtcosim model that rejects the values, else None.
 
@@ -122,4 +160,4 @@ def model_problem(system) -> tuple[str, Any, str] | None:
             if cause.name in variables:
                 key += f".{cause.name}"
             return key, cause.value, cause.expected
-    return None
+    return record_speed_ratio(system)

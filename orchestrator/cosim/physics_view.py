@@ -55,6 +55,8 @@ class PhysicsView:
         Role -> what that FMU was built from (``"preset table6"``, a drivetrain file).
     notes : tuple of str
         Differences between the co-simulation set-up and this monolithic description.
+    start : {"operating_point", "rest"}
+        Where the Gearbox starts (its parameter ``start_at_rest``): the monolithic reference starts there too.
     """
 
     drivetrain: Drivetrain
@@ -62,6 +64,7 @@ class PhysicsView:
     components: Mapping[str, str]
     sources: Mapping[str, str]
     notes: tuple[str, ...] = ()
+    start: str = "operating_point"
 
 
 def dtcosim_component(system: ResolvedSystem, role: str) -> ComponentRole:
@@ -161,5 +164,6 @@ def physics_view(system: ResolvedSystem) -> PhysicsView:
                      "kinematically consistent")
     components = {WIND_SOURCE: wind_c.component, GEARBOX: gear_c.component, GENERATOR: gen_c.component}
     sources = {role: str(system.roles[name].record.get("source", "")) for role, name in components.items()}
+    start = "rest" if _values(system, gear_c.component).get("start_at_rest") else "operating_point"
     return PhysicsView(drivetrain, wind_parameters(system, wind_c.component), FrozenMap(components),
-                       FrozenMap(sources), tuple(notes))
+                       FrozenMap(sources), tuple(notes), start)

@@ -8,6 +8,7 @@
     record = "openfast-data/DLC1.1_0_NREL5MW_OC3_spar_0.outb"   # see "Where a record is found"
     time_offset = 0.0            # s: record time = simulation time + time_offset
     out_of_record = "error"      # or "hold" (first/last sample)
+    check_speed_ratio = true     # a record with rotor and generator speeds must have the drivetrain's ratio (2 %)
     [[components.loads.series.channels]]
     channel = "RotSpeed"         # as in the record
     output = "rotor_speed"       # FMU output (default: the channel name)
@@ -47,12 +48,20 @@ from .series_file import LoadRecordError, read_load_record, si_conversion
 
 #: environment variable with data roots
 DATA_ENV = "DTCOSIM_DATA"
-#: what an OpenFAST channel records (the signal kind of the simulated counterpart)
+#: what an OpenFAST channel records (the signal kind of the simulated counterpart); several channels may record
+#: one quantity (ElastoDyn's RotSpeed and LSSTipVxa, GenSpeed and HSShftV, RotTorq and LSShftTq, ...)
 OPENFAST_QUANTITIES = {
-    "RotSpeed": "rotor_speed", "GenSpeed": "generator_speed", "GenTq": "generator_torque", "Azimuth": "rotor_angle",
-    "RtFldMxh": "aerodynamic_torque", "RotTorq": "low_speed_shaft_torque", "HSSBrTq": "brake_torque",
-    "BldPitch1": "blade_pitch", "GenPwr": "generator_power", "Wind1VelX": "wind_speed",
+    "RotSpeed": "rotor_speed", "LSSTipVxa": "rotor_speed", "LSSGagVxa": "rotor_speed",
+    "GenSpeed": "generator_speed", "HSShftV": "generator_speed",
+    "GenTq": "generator_torque", "Azimuth": "rotor_angle", "LSSTipPxa": "rotor_angle",
+    "RtFldMxh": "aerodynamic_torque", "RtAeroMxh": "aerodynamic_torque",
+    "RotTorq": "low_speed_shaft_torque", "LSShftTq": "low_speed_shaft_torque", "LSShftMxa": "low_speed_shaft_torque",
+    "HSShftTq": "high_speed_shaft_torque", "HSSBrTq": "brake_torque",
+    "BldPitch1": "blade_pitch", "GenPwr": "generator_power", "HSShftPwr": "generator_power",
+    "Wind1VelX": "wind_speed",
 }
+#: a record's generator/rotor speed ratio may differ from its drivetrain's by this much before a run is refused
+SPEED_RATIO_TOLERANCE = 0.02
 _ANGLE_QUANTITIES = {"rotor_speed": "rotor_angle", "generator_speed": "generator_angle"}
 
 
@@ -70,6 +79,8 @@ class SeriesTable(Table):
     records: list[str] | None = Field(None, min_length=1, description="a list of record files (.outb, .out, .csv)")
     time_offset: float = Field(0.0, description="record time minus simulation time [s]")
     out_of_record: Literal["hold", "error"] = "error"
+    check_speed_ratio: bool = Field(True, description="true or false: refuse a record whose generator/rotor speed "
+                                                      "ratio is not the drivetrain's")
     channels: list[ChannelTable] = Field(min_length=1, description="an array of tables [[...channels]]")
 
 
@@ -105,6 +116,9 @@ class RecordedSamples:
     record: Path
     time_s: np.ndarray
     samples: np.ndarray
+    #: ``{"ratio", "generator", "rotor"}``: the record's generator/rotor speed ratio and the channels it comes
+    #: from (:func:`speed_ratio`), or None where the record does not carry both speeds
+    speed_ratio: dict | None = None
 
     @property
     def data_sha256(self) -> str:
@@ -119,8 +133,11 @@ class RecordedSamples:
         return float(self.time_s[-1])
 
     def summary(self) -> dict[str, Any]:
-        return {"source": self.record.name, "start_s": self.start_s, "end_s": self.end_s,
-                "samples": int(self.time_s.size), "data_sha256": self.data_sha256}
+        out = {"source": self.record.name, "start_s": self.start_s, "end_s": self.end_s,
+               "samples": int(self.time_s.size), "data_sha256": self.data_sha256}
+        if self.speed_ratio is not None:
+            out["speed_ratio"] = self.speed_ratio
+        return out
 
 
 @dataclass(frozen=True, eq=False)
@@ -138,6 +155,9 @@ class SeriesSpec:
     out_of_record : str
     selectable : bool
         True for ``records = [...]``: the FMU packs them all and its ``record`` parameter selects one.
+    check_speed_ratio : bool
+        Refuse a run whose drivetrain's speed ratio is not the records' (the check needs the drivetrain:
+        :func:`orchestrator.cosim.parameter_checks.record_speed_ratio`).
     """
 
     records: tuple
@@ -145,6 +165,7 @@ class SeriesSpec:
     time_offset_s: float
     out_of_record: str
     selectable: bool = False
+    check_speed_ratio: bool = True
 
     @property
     def record(self) -> Path:
@@ -186,6 +207,11 @@ class SeriesSpec:
                   "out_of_record": self.out_of_record, "outputs": [dict(o) for o in self.outputs],
                   "start_s": self.start_s, "end_s": self.end_s,
                   "samples": int(self.time_s.size), "data_sha256": self.data_sha256}
+        ratios = [r.speed_ratio for r in self.records if r.speed_ratio is not None]
+        if ratios and self.check_speed_ratio:
+            series["speed_ratio"] = dict(ratios[0], records=[r.record.name for r in self.records
+                                                             if r.speed_ratio is not None],
+                                         ratios=[x["ratio"] for x in ratios])
         if self.selectable:
             series["records"] = [r.summary() for r in self.records]
         return {"series": series}
@@ -227,13 +253,51 @@ class SeriesSpec:
                 f"set time_offset, or out_of_record = \"hold\")"), source)
 
 
+def speed_ratio(record) -> dict | None:
+    """The generator/rotor speed ratio of a record that carries both speeds, or None.
+
+    The median of ``generator / rotor`` over the samples where the rotor turns at more than a tenth
+    of its largest speed (in one unit: both speeds are converted to SI first), with the channels used
+    (the first of :data:`OPENFAST_QUANTITIES` for each quantity present in the record).
+    """
+    def first(quantity: str) -> str | None:
+        return next((c for c, q in OPENFAST_QUANTITIES.items() if q == quantity and c in record.channels), None)
+
+    rotor, generator = first("rotor_speed"), first("generator_speed")
+    if rotor is None or generator is None:
+        return None
+    speeds = []
+    for name in (rotor, generator):
+        unit, values = record.channel(name)
+        try:
+            speeds.append(np.asarray(values, dtype=float) * si_conversion(unit, name, record.source)[1])
+        except LoadRecordError:
+            return None
+    w_r, w_g = speeds
+    turning = np.isfinite(w_r) & np.isfinite(w_g) & (np.abs(w_r) > 0.1 * np.nanmax(np.abs(w_r)))
+    if not np.any(turning):
+        return None
+    return {"ratio": float(np.median(w_g[turning] / w_r[turning])), "generator": generator, "rotor": rotor}
+
+
+def _channel(record, name: str) -> tuple[str, np.ndarray]:
+    """:meth:`Record.channel`; a missing channel also names the record's channels of the same quantity."""
+    if name not in record.channels and name in OPENFAST_QUANTITIES:
+        quantity = OPENFAST_QUANTITIES[name]
+        same = [c for c, q in OPENFAST_QUANTITIES.items() if q == quantity and c in record.channels]
+        if same:
+            raise LoadRecordError("channel", name, f"a channel of the record; it records the {quantity.replace('_', ' ')} "
+                                  f"as {', '.join(same)} (did you mean {same[0]}?)", record.source)
+    return record.channel(name)
+
+
 def _selected(table: SeriesTable, path: Path, key: str, source: str | None) -> tuple[list[dict], RecordedSamples]:
     """The outputs and the converted samples of ``table.channels`` in the record ``path``."""
     record = read_load_record(path)
     outputs, columns, seen = [], [], {}
     for i, ch in enumerate(table.channels):
         ckey = f"{key}.channels[{i}]"
-        unit, values = record.channel(ch.channel)
+        unit, values = _channel(record, ch.channel)
         si_unit, factor = si_conversion(unit, ch.channel, record.source)
         bad = np.flatnonzero(~np.isfinite(values))
         if bad.size:
@@ -256,7 +320,7 @@ def _selected(table: SeriesTable, path: Path, key: str, source: str | None) -> t
                             "unit": "rad" if integral else si_unit, "column": column,
                             "interpolation": ch.interpolation, "integral_of": integral,
                             "initial": float(ch.angle_initial) if integral else 0.0, "quantity": q})
-    return outputs, RecordedSamples(path, record.time_s.copy(), np.column_stack(columns))
+    return outputs, RecordedSamples(path, record.time_s.copy(), np.column_stack(columns), speed_ratio(record))
 
 
 def series_from_table(table: SeriesTable, key: str, base_dir: Path | None, source: str | None) -> SeriesSpec:
@@ -288,4 +352,4 @@ def series_from_table(table: SeriesTable, key: str, base_dir: Path | None, sourc
             outputs = these
         recorded.append(samples)
     return SeriesSpec(tuple(recorded), tuple(outputs), float(table.time_offset), table.out_of_record,
-                      selectable=table.records is not None)
+                      selectable=table.records is not None, check_speed_ratio=table.check_speed_ratio)

@@ -60,7 +60,7 @@ def reference_name(column: str, system: ResolvedSystem, view: PhysicsView,
 
 
 def run_reference(system: ResolvedSystem, view: PhysicsView | None = None) -> SimulationResult:
-    """The monolithic solution on the scenario's time grid (start, stop, output interval).
+    """The monolithic solution on the scenario's time grid (start, stop, output interval), started where the Gearbox is.
 
     Raises
     ------
@@ -74,7 +74,7 @@ def run_reference(system: ResolvedSystem, view: PhysicsView | None = None) -> Si
     sim = system.scenario.simulation
     return simulate_monolithic(
         setup.drivetrain, RotorSpeedProcess(setup.wind), sim.stop_s,
-        output_interval_s=sim.output_interval_s, t_start_s=sim.start_s,
+        output_interval_s=sim.output_interval_s, t_start_s=sim.start_s, start=setup.start,
     )
 
 

@@ -213,6 +213,7 @@ def _monolithic(payload: StudyPayload, task: PointTask) -> tuple[dict[str, float
         values = {**payload.model_parameters, **task.parameters}
         drivetrain, driver = MODELS[payload.model].build(values)
         start, stop, interval = payload.time_grid
+        initial = MODELS[payload.model].start
     else:
         from components.model.wind import RotorSpeedProcess
 
@@ -223,8 +224,9 @@ def _monolithic(payload: StudyPayload, task: PointTask) -> tuple[dict[str, float
         drivetrain, driver = view.drivetrain, RotorSpeedProcess(view.wind)
         sim = system.scenario.simulation
         start, stop, interval = sim.start_s, sim.stop_s, sim.output_interval_s
+        initial = view.start
     result = simulate_monolithic(drivetrain, driver, stop, output_interval_s=interval, settings=settings,
-                                 t_start_s=start, raise_on_failure=True)
+                                 t_start_s=start, raise_on_failure=True, start=initial)
     out: dict[str, float] = {}
     for m in payload.measures:
         if m.name == "cpu_time":

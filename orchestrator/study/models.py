@@ -48,12 +48,15 @@ class BuiltinModel:
     build : callable(mapping) -> (Drivetrain, SpeedDriver)
         The model for given parameter values (defaults for the missing ones);
         raises :class:`~components.errors.ParameterError` for a bad value.
+    start : {"operating_point", "rest"}
+        Where its runs start (:func:`components.reference.solver.simulate_monolithic`).
     """
 
     name: str
     description: str
     defaults: Callable[[], dict[str, float]]
     build: Callable[[Mapping[str, Any]], tuple[Any, Any]]
+    start: str = "operating_point"
 
 
 _R1 = "gearbox.R1"
@@ -95,5 +98,6 @@ MODELS: dict[str, BuiltinModel] = {
                     "counter torque on the output gear, constant input speed, no generator",
         defaults=_variant_defaults,
         build=_variant_build,
+        start="rest",  # Sec. 4.1: the counter torque a step at t = 0 (eq. 11 measures the start-up impact)
     ),
 }

@@ -38,10 +38,11 @@ def reference_loop(t_end: float) -> dict[str, np.ndarray]:
     gearbox = GearboxModel(drivetrain)
     wind = PhasorStepper(RotorSpeedProcess(WindParameters()))  # as the WindSource FMU steps it
     w0, p0 = wind.speed_and_angle()
-    gearbox.initialize(0.0, w0, p0, gearbox.ratio * w0, gearbox.ratio * p0)  # initialisation-mode outputs
+    torque0 = drivetrain.generator.counter_torque_nm  # the Gearbox FMU's counter_torque input: its default
+    gearbox.initialize(0.0, w0, p0, gearbox.ratio * w0, gearbox.ratio * p0, torque0)  # initialisation-mode outputs
     w_out = gearbox.output_speed_rad_s
     ratio = w_out / w0
-    gearbox.initialize(0.0, w0, p0, w_out, ratio * p0)
+    gearbox.initialize(0.0, w0, p0, w_out, ratio * p0, torque0)
     generator = GeneratorRotor(drivetrain.generator, w_out, ratio * p0)
     speed, torque = [generator.speed_rad_s], [gearbox.shaft_torque_nm]
     for n in range(int(round(t_end / H))):

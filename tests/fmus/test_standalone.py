@@ -89,7 +89,7 @@ def test_gearbox_matches_gearbox_model(fmu_path, start_values, configure, mode):
                           input=table, start_values=start_values, output=outputs)
     t = result["time"]
     np.testing.assert_array_equal(t, grid(t_end))
-    model.initialize(0.0, *rows[0])
+    model.initialize(0.0, *rows[0], drivetrain.generator.counter_torque_nm)  # the FMU's counter_torque default
     expected = {name: [] for name in outputs}
 
     def record():

@@ -6,8 +6,9 @@ LSODA: the same equations (:mod:`.dynamics`) as the co-simulation gearbox, with 
 degree of freedom braked by the counter torque, plus three quadratures for the energy balance
 (rotor power, output power, dissipated power). :func:`contact_forces_many` and
 :func:`stiffness_factors_many` evaluate the contact law and the mesh stiffness over many states
-(recorded trajectories, quadrature points). This entry module is run compiled by numba (just in
-time) or interpreted.
+(recorded trajectories, quadrature points), and :func:`.statics.static_deflection` the static
+equilibrium of the reference and the analyses. This entry module is run compiled by numba (just
+in time) or interpreted.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ from __future__ import annotations
 from .contact import contact_force, mesh_forces, regularised
 from .dynamics import deflections, jacobian
 from .linalg import copy, vecmat
+from .statics import static_deflection  # noqa: F401 - an entry of this module (Assembly.static_deflection)
 from .stiffness import stiffness_factors
 
 

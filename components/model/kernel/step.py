@@ -18,6 +18,8 @@ from __future__ import annotations
 import math
 from collections import namedtuple
 
+import numpy as np
+
 from .dynamics import acceleration
 from .integrator import advance
 from .layout import (
@@ -26,12 +28,13 @@ from .layout import (
     INV_M, ISTATE, K1, K2, K3, KAPPA, LAST_ACC, LAST_DEFL, LAST_FORCE, NON_FINITE_INPUT, NZ_INDEX, NZ_VALUE, OK,
     OUT_KINEMATIC, OUT_RATE_INDEX, OUTPUT_MATRIX, OUTPUTS, PHASING, PORT, PORT_JAC, RHS, S_ALPHA_OUT_AVG,
     S_DRIVER_ACCEL, S_DRIVER_ANGLE, S_DRIVER_SPEED, S_KX, S_LAST_ALPHA, S_LAST_OMEGA_GEN, S_LAST_OMEGA_ROTOR,
-    S_LAST_STEP, S_OUTPUT_TWIST, S_PORT_ANGLE, S_PORT_SPEED, S_SHAFT_C, S_SHAFT_K, S_SHAFT_TORQUE_AVG, S_TIME,
+    S_LAST_STEP, S_OUTPUT_TWIST, S_PORT_ANGLE, S_PORT_OFFSET, S_PORT_SPEED, S_SHAFT_C, S_SHAFT_K, S_SHAFT_TORQUE_AVG, S_TIME,
     S_TWIST_PORT, SCALARS, SENS, SLOPE, STATE_FIRST, STATE_LAST, STCS, STCS_PORT, STKS, STKS_PORT, TWIST_Q, W_BASES,
     W_HDT, WINVS, Y, Y1, YN, Z, ALPHA_OUT_MAX,
 )
 from .linalg import copy, vecmat
 from .motion import accel, fit, linear_target, taylor_target
+from .statics import static_deflection
 from .stiffness import stiffness_factors
 
 #: everything :func:`~.integrator.advance` reads and writes: views of the buffer
@@ -131,6 +134,30 @@ def current_loads(buf, lay, dims):
     outputs(buf, lay, dims)
 
 
+def settle(buf, lay, dims, flank, rtol, max_iterations):
+    """Replace the deviation angles by the static deflection at the current port input (speeds kept), then
+    evaluate the loads there (:func:`current_loads`).
+
+    Returns ``(status, iterations, imbalance)`` of :func:`.statics.static_deflection`.
+    """
+    k = views(buf, lay, dims)
+    sc = vector(buf, lay, SCALARS)
+    n = dims[D_N]
+    m = dims[D_M]
+    if k.tvs:
+        stiffness_factors(sc[S_DRIVER_ANGLE], k.phasing, k.factor, k.slope)
+    else:
+        k.factor[:] = 1.0
+    y = vector(buf, lay, Y)
+    status, iterations, imbalance = static_deflection(
+        y, n, sc[S_PORT_ANGLE], k.factor, flank, k.a_t, k.a_port, k.fast, k.contact, k.nz_index, k.nz_value,
+        k.cos_alpha, k.stks, k.stcs, k.stks_port, k.stcs_port, k.inv_m, k.z, k.defl, k.acc, k.fd, k.fv, k.dq, k.dv,
+        k.port_jac, np.empty((n, n)), np.empty((n, n)), np.empty(n), np.empty(n), np.empty(m), np.empty(2 * n), rtol,
+        max_iterations)
+    current_loads(buf, lay, dims)
+    return status, iterations, imbalance
+
+
 def gearbox_step(buf, lay, dims, t, h, omega_rotor, phi_rotor, omega_gen, phi_gen, counter_torque, alpha_rotor,
                  jerk_rotor):
     """Advance the state in ``buf`` from ``t`` to ``t + h`` [s] with the inputs received at ``t``; outputs into the buffer.
@@ -163,11 +190,12 @@ def gearbox_step(buf, lay, dims, t, h, omega_rotor, phi_rotor, omega_gen, phi_ge
         dv = omega_gen - kx * sc[S_DRIVER_SPEED] - y[n + gdof]
         if not math.isfinite(dv + port0):
             return NON_FINITE_INPUT, 0.0, h, 0.0
-    else:  # motion interface: the port is the generator end's deviation from the kinematic motion
+    else:  # motion interface: the port is the generator end's deviation from the kinematic motion (its angle
+        # input read relative to the static twist it had at initialisation: the port offset)
         port0 = sc[S_PORT_ANGLE]
         port_speed0 = sc[S_PORT_SPEED]
         gen_angle1, gen_speed1 = linear_target(h, phi_gen, omega_gen, alpha_gen)
-        port1 = gen_angle1 - kx * angle1
+        port1 = gen_angle1 - kx * angle1 + sc[S_PORT_OFFSET]
         port_speed1 = gen_speed1 - kx * speed1
     if not math.isfinite(angle1 + speed1 + port1 + port_speed1):
         return NON_FINITE_INPUT, 0.0, h, 0.0
@@ -224,4 +252,5 @@ AOT_EXPORTS = {
     "gearbox_step": "Tuple((i8, f8, f8, f8))(f8[::1], i8[::1], i8[::1], f8, f8, f8, f8, f8, f8, f8, f8, f8)",
     "outputs": "void(f8[::1], i8[::1], i8[::1])",
     "current_loads": "void(f8[::1], i8[::1], i8[::1])",
+    "settle": "Tuple((i8, i8, f8))(f8[::1], i8[::1], i8[::1], f8, f8, i8)",
 }

@@ -156,12 +156,18 @@ def test_parallel_stage_with_generator_matches_two_degree_of_freedom_closed_form
     b = jd * k3 + jg * (k_m + k3)
     w2 = np.sort(np.roots([jd * jg, -b, k_m * k3]).real)
     an = drivetrain_modes(dt, OperatingPoint.from_rpm(5.0, torque_nm))
-    f = [m.mode.undamped_frequency_hz for m in an.modes]
+    f = [m.mode.system_frequency_hz for m in an.modes]  # the undamped system's
     assert f == pytest.approx(np.sqrt(w2) / (2 * math.pi), rel=1e-8)
     quartic = np.polysub(np.polymul([jd, c_m + c3, k_m + k3], [jg, c3, k3]), np.polymul([c3, k3], [c3, k3]))
     lam = np.roots(quartic)
     got = an.state_space.eigenvalues
     assert np.sort_complex(got) == pytest.approx(np.sort_complex(lam), rel=1e-6)
+    # each row: the undamped (|lambda|) and damped (Im lambda) frequency of one eigenvalue of the quartic
+    oscillating = np.sort_complex(lam[lam.imag > 0])
+    rows = [m.mode for m in an.modes if not m.mode.overdamped]
+    assert [r.undamped_frequency_hz for r in rows] == pytest.approx(np.sort(np.abs(oscillating)) / (2 * math.pi),
+                                                                    rel=1e-6)
+    assert all(r.damped_frequency_hz <= r.undamped_frequency_hz for r in rows)
 
 
 # ------------------------------------------------------------------ Lin and Parker
@@ -264,7 +270,7 @@ def test_table6_generator_mode_matches_the_series_stiffness_closed_form(table6_m
     ]
     k_eff = 1.0 / sum(1.0 / (k * (ratio / 100.0) ** 2) for k, ratio in chain)
     expected = math.sqrt(k_eff / dt.generator.inertia_kgm2) / (2 * math.pi)
-    assert table6_modes.modes[0].mode.undamped_frequency_hz == pytest.approx(expected, rel=1e-5)
+    assert table6_modes.modes[0].mode.system_frequency_hz == pytest.approx(expected, rel=1e-5)
     # the gearbox compliance lowers it 2.8 % below the rigid-gearbox value sqrt(k3 / J_gen)
     rigid = math.sqrt(sh3.stiffness_nm_per_rad / dt.generator.inertia_kgm2) / (2 * math.pi)
     assert expected / rigid == pytest.approx(0.9718, abs=1e-3)

@@ -29,7 +29,7 @@ def _integrate(h, max_age, t_end=0.2):
     """
     dt = _linear_stage()
     control = StepControl(rtol=1e3, atol_q=1e3, atol_v=1e3, jacobian_max_age=max_age)
-    model = GearboxModel(dt, control=control, generator_interface="inertia")
+    model = GearboxModel(dt, control=control, generator_interface="inertia", start="rest")  # a load step to resolve
     w = 0.5
     model.initialize(0.0, w, 0.0, model.ratio * w, 0.0, 500.0)
     n = int(round(t_end / h))
@@ -69,6 +69,8 @@ def _paper_setup():
 
 
 def _cosim(dt, wind, t_end, h, model=None, gen=None, start=0):
+    """The Gearbox and GeneratorRotor coupled by hand, started as the paper does (undeflected, the load a step: no
+    counter torque at initialisation); the monolithic comparisons start at rest too."""
     model = model or GearboxModel(dt)
     gen = gen or GeneratorRotor(dt.generator, initial_speed_rad_s=dt.ratio * wind.speed(0.0))
     if start == 0:
@@ -87,7 +89,7 @@ def test_cosimulated_gearbox_tracks_the_monolithic_reference():
     dt, wind = _paper_setup()
     h = 1e-3
     out, model, gen = _cosim(dt, wind, 3.5, h)
-    ref = simulate_monolithic(dt, wind, 3.5, output_interval_s=h)
+    ref = simulate_monolithic(dt, wind, 3.5, output_interval_s=h, start="rest")
     sel = slice(1000, None)  # after the first second
     for col, name in ((0, "stage1.F_sp[1]"), (1, "stage3.F_mesh"), (2, "omega_gen")):
         err = np.abs(out[sel, col] - ref[name][1:][sel]).max()
@@ -128,7 +130,7 @@ def test_averaged_torque_conserves_the_exchanged_impulse():
     dt, wind = _paper_setup()
     h = 2e-3
     out, _, _ = _cosim(dt, wind, 1.0, h)
-    ref = simulate_monolithic(dt, wind, 1.0, output_interval_s=1e-4)
+    ref = simulate_monolithic(dt, wind, 1.0, output_interval_s=1e-4, start="rest")
     t = ref.time_s
     torque = ref["shaft3.torque"]
     impulse_ref = np.trapezoid(torque, t)
@@ -158,7 +160,7 @@ def test_output_acceleration_and_its_running_peak():
     # alpha_out is the step average: the speed increment of each step over h
     np.testing.assert_allclose(alpha[1:], np.diff(speed) / h, rtol=1e-9, atol=1e-9)
     # ... and follows the monolithic model's step-averaged acceleration (trapezoid of its samples)
-    mono = simulate_monolithic(dt, wind, 0.5, output_interval_s=h)["alpha_out"]
+    mono = simulate_monolithic(dt, wind, 0.5, output_interval_s=h, start="rest")["alpha_out"]
     late = slice(300, None)
     diff = alpha[late] - 0.5 * (mono[:-1] + mono[1:])[late]
     scale = np.abs(mono[300:]).max()
@@ -181,12 +183,12 @@ def test_monolithic_wall_time_limit():
 
     dt, wind = _paper_setup()
     tiny = SolverSettings(wall_time_limit_s=1e-9)
-    result = simulate_monolithic(dt, wind, 1.0, settings=tiny)
+    result = simulate_monolithic(dt, wind, 1.0, settings=tiny, start="rest")
     assert not result.complete
     assert result.message.startswith("wall-time limit of 1e-09 s reached (at t = ")
     assert result.time_s.size == 1  # one load segment: only the initial sample survives
     with pytest.raises(WallTimeLimitError, match=r"wall-time limit of 1e-09 s reached \(at t = "):
-        simulate_monolithic(dt, wind, 1.0, settings=tiny, raise_on_failure=True)
+        simulate_monolithic(dt, wind, 1.0, settings=tiny, raise_on_failure=True, start="rest")
     with pytest.raises(WallTimeLimitError, match="wall-time limit"):
         peak_output_acceleration(dt, wind, 1.0, settings=tiny)
     with pytest.raises(ParameterError, match=r"wall_time_limit_s = -1\.0: expected >= 0"):

@@ -40,7 +40,8 @@ def test_successful_runs_exit_0_and_failed_ones_1_every_time(fmu_dir, tmp_path):
         done["ok"] += 1
         if i % FAIL_EVERY == FAIL_EVERY - 1 or i == SOAK_RUNS - 1:
             bad = dtcosim("run", "--fmu-dir", str(fmu_dir), "--stop", "0.1", "-q", "--no-plots",
-                          "--set", "gearbox.shaft1.stiffness=1e30", "--out", str(tmp_path / "bad"), cwd=tmp_path)
+                          "--set", "gearbox.shaft1.stiffness=1e30", "--set", "gearbox.start_at_rest=true",
+                          "--out", str(tmp_path / "bad"), cwd=tmp_path)
             if bad.returncode != 1:
                 wrong.append((f"failing run after {i}", bad.returncode, bad.stderr[-400:]))
             done["failed"] += 1

@@ -106,7 +106,8 @@ def test_readme_recipe_runs_the_exported_ssp_in_ecos(fmu_dir, tmp_path):
         # dtcosim counts, move the Gearbox's step control in the start-up transient by up to 2e-4 of a value)
         np.testing.assert_allclose(ecos[ecos_name], reference, rtol=0, atol=6e-7 + 1e-8 * np.ptp(reference),
                                    err_msg=name)
-    assert np.ptp(series["gearbox.shaft_torque"][:n]) > 1.0e4
+    # not a constant: from the static operating point the torque follows the wind speed, ~317 N.m over 1 s
+    assert np.ptp(series["gearbox.shaft_torque"][:n]) > 100.0
 
 
 @pytest.mark.slow

@@ -19,10 +19,10 @@ pytestmark = pytest.mark.slow
 
 DATA = Path(__file__).resolve().parents[2] / "data" / "drivetrains"
 #: the Table 7 run (preset table6, default scenario: H = 20 ms, the Gearbox's inertia interface with the rotor's
-#: derivative inputs, tolerances 0.3 x its defaults): gearbox.stage1.F_sp[1] over [5, 60] s (900822.8985906718 /
-#: 8170.510280449017 with the motion interface at H = 5 ms; the coupling study: all within 1e-4 of the monolithic
-#: reference)
-TABLE7_STAGE1_F_SP1 = (900822.8804545203, 8169.500932949844)
+#: derivative inputs, tolerances 0.3 x its defaults), started at the static operating point:
+#: gearbox.stage1.F_sp[1] over [5, 60] s (started from rest, as before issue 29: 900822.8804545203 /
+#: 8169.500932949844; the start-up transient has decayed by 5 s to 3e-5 of the std)
+TABLE7_STAGE1_F_SP1 = (900823.0001204831, 8169.749744794173)
 
 
 @pytest.fixture(scope="module")

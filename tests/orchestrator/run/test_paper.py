@@ -133,15 +133,21 @@ def test_coupling_error_shrinks_with_the_communication_step(fmu_dir):
         assert e[0] / e[3] > 10.0, (name, e)  # faster than first order over a factor 10 in H
 
 
-def test_the_interface_model_at_10_ms_is_closer_than_the_motion_interface_at_2_ms(fmu_dir):
-    """paper-60s's Gearbox interface (inertia, rotor derivatives) against the motion interface, [1, 3] s."""
+def test_the_interface_model_at_10_ms_is_closer_than_the_motion_interface_at_5_ms(fmu_dir):
+    """paper-60s's Gearbox interface (inertia, rotor derivatives) against the motion interface, [1, 3] s.
+
+    Both start at the static deflection (issue 29): without the start-up transient the interface model at
+    10 ms is 4.8 x (generator speed) and 8.7 x (stage-1 force) closer than the motion interface at 10 ms,
+    closer than it at 5 ms, and about as close as it at 2-3 ms (measured 2026-12-03). With the start-up
+    transient of the undeflected start it was closer than the motion interface at 2 ms.
+    """
     interface_model = _coupling_errors(fmu_dir, (10e-3,))[0]
-    motion = _coupling_errors(fmu_dir, (10e-3, 2e-3), **MOTION_INTERFACE)
-    print("RMS difference to monolithic: interface model at 10 ms", interface_model, "motion interface at 10, 2 ms",
+    motion = _coupling_errors(fmu_dir, (10e-3, 5e-3), **MOTION_INTERFACE)
+    print("RMS difference to monolithic: interface model at 10 ms", interface_model, "motion interface at 10, 5 ms",
           motion)
     for name in interface_model:
         assert interface_model[name] < motion[1][name] < motion[0][name], (name, interface_model, motion)
-        assert interface_model[name] < 0.05 * motion[0][name], (name, interface_model, motion)
+        assert interface_model[name] < 0.25 * motion[0][name], (name, interface_model, motion)
 
 
 def test_step_averaged_shaft_torque_beats_end_of_step(fmu_dir):
