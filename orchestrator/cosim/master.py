@@ -262,17 +262,23 @@ class CoSimulation:
             ended_by=None if self._ended is None else self._ended[0],
         )
 
-    def initial_values(self) -> dict[str, float]:
+    def initial_values(self, transferred: bool = False) -> dict[str, float]:
         """Instantiate and initialise the FMUs, return what the initial bindings set, free the FMUs.
+
+        Parameters
+        ----------
+        transferred : bool
+            Also the values the connected inputs get in initialisation.
 
         Returns
         -------
         dict of str -> float
-            ``{"component.parameter": value}`` for every ``[[initial]]`` binding.
+            ``{"component.parameter": value}`` for every ``[[initial]]`` binding (with
+            ``transferred``: also ``{"component.input": value}`` for every connected input).
         """
         try:
             self._instantiate()
-            return initialise(self.system, self.instances)
+            return initialise(self.system, self.instances, transferred)
         finally:
             self._close()
 
