@@ -23,6 +23,7 @@ import numpy as np
 
 from components.analysis.equilibrium import OperatingPoint
 from components.analysis.load_law import LOAD_LAWS, LoadLaw
+from components.analysis.settling import settling_time
 from components.errors import ParameterError
 from components.model.presets import PRESETS, preset
 from components.units import rpm
@@ -87,18 +88,8 @@ def scenario_drivetrain(spec: str, fmu_dir: Path | None = None):
         Where speed and torque came from.
     name : str
     """
-    from dataclasses import replace
-
-    from components.model.generator import GeneratorParameters
-
-    from ..cosim.master import CoSimulation
-    from ..cosim.physics_view import (
-        PhysicsUnavailable,
-        drivetrain_with_generator,
-        physics_view,
-        rotor_driven_view,
-    )
-    from ..cosim.roles import ROTOR, WIND_SOURCE
+    from ..cosim.operating_point import drivetrain_at_start
+    from ..cosim.physics_view import PhysicsUnavailable
     from ..cosim.system import resolve_system
     from ..errors import ScenarioError
     from ..inputs.scenario_file import find_scenario
@@ -108,29 +99,10 @@ def scenario_drivetrain(spec: str, fmu_dir: Path | None = None):
     scenario = load_any(find_scenario(spec))
     system = resolve_system(scenario, fmu_paths=ensure_fmus(scenario, fmu_dir, build=True))
     try:
-        dt, gear_c, _ = drivetrain_with_generator(system)
-        rotor = rotor_driven_view(system).rotor if any(
-            r.record is not None for r in system.with_role(ROTOR)) else None
-        wind = physics_view(system).wind if rotor is None and any(
-            r.record is not None for r in system.with_role(WIND_SOURCE)) else None
+        start = drivetrain_at_start(system)
     except PhysicsUnavailable as exc:
         raise ScenarioError("(scenario)", scenario.name, f"a scenario with a dtcosim drivetrain ({exc})") from None
-    initial = CoSimulation(system).initial_values(transferred=True)
-    speed_key, torque_key = f"{gear_c.component}.omega_rotor", f"{gear_c.component}.counter_torque"
-    if wind is not None:
-        omega0, speed_source = wind.mean_speed_rad_s, "the wind's mean speed"
-    elif speed_key in initial:
-        omega0, speed_source = float(initial[speed_key]), f"{speed_key} at the start"
-    else:
-        raise ScenarioError("(scenario)", scenario.name, f"a scenario that connects {speed_key}")
-    if dt.generator.events:
-        dt = replace(dt, generator=GeneratorParameters(dt.generator.inertia_kgm2, dt.generator.counter_torque_nm))
-    torque, torque_source = dt.generator.counter_torque_nm, "the generator's counter_torque"
-    if torque_key in initial and float(initial[torque_key]) != 0.0:
-        torque, torque_source = float(initial[torque_key]), f"{torque_key} at the start"
-    from components.analysis.equilibrium import OperatingPoint
-
-    return dt, rotor, OperatingPoint(omega0, torque), f"{speed_source}; {torque_source}", scenario.name
+    return start.drivetrain, start.rotor, start.operating_point, start.source, scenario.name
 
 
 def run(args: argparse.Namespace) -> int:
@@ -198,6 +170,11 @@ def run(args: argparse.Namespace) -> int:
     n_under = len(an.underdamped)
     print(f"{n_under} underdamped mode(s), {len(an.modes) - n_under} overdamped; "
           f"real eigenvalues (overdamped roots): {len(an.overdamped_roots_per_s)}")
+    try:
+        print(f"settling time (where an analysis window should start after the run's start): "
+              f"{settling_time(an).describe()}")
+    except ValueError as exc:
+        print(f"settling time: none ({exc})")
     crossings = [c for c in report["campbell"].crossings() if not c["overdamped"]]
     if crossings:
         print("Campbell crossings of underdamped modes (" + report["campbell"].load_law.describe() + "):")
