@@ -40,6 +40,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..model.assembly import Assembly
 from ..model.drivetrain import Drivetrain
+from ..model.rotor import RotorParameters
 from ..model.stages import PlanetaryStage
 from ..units import rad_per_s_to_rpm
 from .equilibrium import OperatingPoint
@@ -208,6 +209,7 @@ def campbell_diagram(
     load_law: LoadLaw | None = None,
     rotor_orders: Sequence[int] = (1, 3),
     mesh_harmonics: Sequence[int] = (1,),
+    rotor: RotorParameters | None = None,
 ) -> CampbellDiagram:
     """Linearise at every rotor speed under a load law and collect the modes.
 
@@ -220,6 +222,8 @@ def campbell_diagram(
         Default: quadratic to the paper's rated point (16 rpm, 25.4 kN m).
     rotor_orders, mesh_harmonics : sequence of int
         Excitation lines (see :func:`excitation_frequencies`).
+    rotor : RotorParameters, optional
+        A torque-driven rotor (free drivetrain); default: the rotor held.
 
     Returns
     -------
@@ -234,7 +238,7 @@ def campbell_diagram(
     kinds: list[str] = []
     labels: list[str] = []
     for i, (speed, torque) in enumerate(zip(w, torques)):
-        an = drivetrain_modes(drivetrain, OperatingPoint(float(speed), float(torque)))
+        an = drivetrain_modes(drivetrain, OperatingPoint(float(speed), float(torque)), rotor=rotor)
         und.append([m.mode.undamped_frequency_hz for m in an.modes])
         dmp.append([m.mode.damped_frequency_hz for m in an.modes])
         zeta.append([m.mode.damping_ratio for m in an.modes])

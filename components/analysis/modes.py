@@ -21,8 +21,13 @@ import numpy as np
 
 from ..model.assembly import Assembly
 from ..model.drivetrain import Drivetrain
+from ..model.rotor import RotorParameters
 from .eigen import Mode, StateSpaceModes, modal_analysis, normalise_shape
 from .equilibrium import LinearModel, OperatingPoint, linearise
+from .rotor_coupling import ROTOR_BODY, coupled
+
+#: name of the main shaft's strain-energy group (torque-driven rotor with a flexible main shaft)
+MAIN_SHAFT = "main_shaft"
 
 #: Shape components below this fraction of the largest count as "not moving" (mode kinds).
 STILL_TOLERANCE = 1e-6
@@ -123,17 +128,29 @@ class DrivetrainModalAnalysis:
     model : LinearModel
         The linearisation (matrices, equilibrium, assembly).
     state_space : StateSpaceModes
-        All ``2 n`` eigenvalues with right and left eigenvectors.
+        All ``2 n`` eigenvalues with right and left eigenvectors (of the reduced coordinates
+        with a torque-driven rotor).
+    bodies : list of str, optional
+        Names of the shapes' components (default: the model's degrees of freedom).
+    rotor : RotorParameters or None
+        The torque-driven rotor; None: the rotor speed is held.
     """
 
     modes: list[DrivetrainMode]
     model: LinearModel
     state_space: StateSpaceModes
+    bodies: list[str] | None = None
+    rotor: RotorParameters | None = None
 
     @property
     def dof_names(self) -> list[str]:
-        """Body names in state order."""
-        return self.model.dof_names
+        """Names of the bodies of the mode shapes (with a torque-driven rotor: the rotor first)."""
+        return list(self.model.dof_names) if self.bodies is None else self.bodies
+
+    @property
+    def rotor_held(self) -> bool:
+        """True if the rotor speed was held (prescribed); False with a torque-driven rotor."""
+        return self.rotor is None
 
     @property
     def underdamped(self) -> list[DrivetrainMode]:
@@ -174,6 +191,11 @@ class DrivetrainModalAnalysis:
         eq = self.model.equilibrium
         return {
             "operating_point": self.model.operating_point.as_dict(),
+            "rotor": "held (prescribed speed)" if self.rotor is None else {
+                "driven_by": "torque", "inertia_kgm2": self.rotor.inertia_kgm2,
+                "shaft_stiffness_nm_rad": self.rotor.shaft_stiffness_nm_rad,
+                "shaft_damping_nms_rad": self.rotor.shaft_damping_nms_rad,
+                "carrier_inertia_kgm2": self.rotor.carrier_inertia_kgm2},
             "dof_names": list(self.dof_names),
             "equilibrium": {
                 "contact_force_n": dict(zip(a.mesh_names, map(float, eq.contact_force_n))),
@@ -189,7 +211,8 @@ class DrivetrainModalAnalysis:
         }
 
 
-def drivetrain_modes(drivetrain: Drivetrain, operating_point: OperatingPoint, stiffness_factor: np.ndarray | float = 1.0) -> DrivetrainModalAnalysis:
+def drivetrain_modes(drivetrain: Drivetrain, operating_point: OperatingPoint, stiffness_factor: np.ndarray | float = 1.0,
+                     rotor: RotorParameters | None = None) -> DrivetrainModalAnalysis:
     """Linearise a drivetrain at an operating point and analyse its modes.
 
     Parameters
@@ -201,6 +224,10 @@ def drivetrain_modes(drivetrain: Drivetrain, operating_point: OperatingPoint, st
         or ``OperatingPoint.of_drivetrain(dt, omega)``).
     stiffness_factor : float or ndarray
         Mesh stiffness multiplier (1: mean stiffness).
+    rotor : RotorParameters, optional
+        A torque-driven rotor (and main shaft) on the stage-1 carrier: the drivetrain is free
+        at both ends (:func:`components.analysis.rotor_coupling.free_rotor`). None: the rotor
+        speed is held (a wind source prescribes it).
 
     Returns
     -------
@@ -208,11 +235,12 @@ def drivetrain_modes(drivetrain: Drivetrain, operating_point: OperatingPoint, st
     """
     model = linearise(drivetrain, operating_point, stiffness_factor)
     a = model.assembly
-    modes, ss, und = modal_analysis(model.mass, model.damping, model.stiffness)
-    names = model.dof_names
-    roles = [a.bodies[j].role for j in a.free]
-    stages = [a.bodies[j].stage for j in a.free]
-    kappa = a.kinematic_ratio
+    cm = coupled(model, rotor)
+    modes, ss, und = modal_analysis(cm.mass, cm.damping, cm.stiffness)
+    names = cm.body_names
+    lead = len(names) - a.n_dof
+    roles = ["rotor", "carrier"][:lead] + [a.bodies[j].role for j in a.free]
+    stages = [ROTOR_BODY, a.bodies[a.driver].stage][:lead] + [a.bodies[j].stage for j in a.free]
     group_names, membership = _element_groups(a)
     body_groups = [f"{stages[i]}.planets" if roles[i] == "planet" else names[i] for i in range(len(names))]
     body_group_names = list(dict.fromkeys(body_groups))
@@ -220,8 +248,13 @@ def drivetrain_modes(drivetrain: Drivetrain, operating_point: OperatingPoint, st
     k_mesh = a.cos_alpha * model.equilibrium.mesh_stiffness_n_per_m
     k_elem = np.concatenate([k_mesh, a.shaft_k])
     rows = np.vstack([a.A, a.S])
+    if cm.main_shaft is not None:
+        group_names = group_names + [MAIN_SHAFT]
+        membership = np.pad(membership, ((0, 1), (0, 1)))
+        membership[-1, -1] = 1.0
     out = []
-    for m, u in zip(modes, und.shapes.T):
+    for m, u_y in zip(modes, und.shapes.T):
+        u = cm.basis @ u_y  # body deviations
         big = np.abs(u).max()
         moving = np.abs(u) > STILL_TOLERANCE * big
         planet_stages = {stages[i] for i in np.flatnonzero(moving)}
@@ -231,22 +264,27 @@ def drivetrain_modes(drivetrain: Drivetrain, operating_point: OperatingPoint, st
             kind, stage = "rigid", None
         else:
             kind, stage = "rotational", None
-        referred = normalise_shape(u / kappa)
-        strain = k_elem * (rows @ u) ** 2
+        referred = normalise_shape(u / cm.kinematic_ratio)
+        strain = k_elem * (rows @ (cm.to_gearbox @ u)) ** 2
+        if cm.main_shaft is not None:
+            twist, k_shaft = cm.main_shaft
+            strain = np.append(strain, k_shaft * (twist @ u) ** 2)
         strain_share = membership @ strain / strain.sum() if strain.sum() > 0 else membership @ strain
-        mode = replace(m, kind=kind)
+        kinetic = cm.body_inertia_kgm2 * u * u
+        energy = kinetic / kinetic.sum() if kinetic.sum() > 0 else kinetic
+        mode = replace(m, kind=kind, shape=normalise_shape(u), energy_fraction=energy)
         out.append(
             DrivetrainMode(
                 mode=mode,
                 kind=kind,
                 stage=stage,
                 shape_referred=referred,
-                dominant_bodies=_share_text(body_group_names, body_membership @ m.energy_fraction),
+                dominant_bodies=_share_text(body_group_names, body_membership @ energy),
                 strain_energy_fraction=dict(zip(group_names, map(float, strain_share))),
                 dominant_elements=_share_text(group_names, strain_share),
             )
         )
-    return DrivetrainModalAnalysis(out, model, ss)
+    return DrivetrainModalAnalysis(out, model, ss, list(names), rotor)
 
 
 def two_inertia_frequency_hz(stiffness_nm_per_rad: float, inertia1_kgm2: float, inertia2_kgm2: float) -> float:

@@ -167,6 +167,7 @@ class Gearbox(DtcosimSlave):
         self._output_order = itemgetter(*order) if n > 1 and order != list(range(n)) else None
         self.model: GearboxModel | None = None
         self._kernel_reported = False
+        self._start_inputs = None
 
     def output_group(self, name: str) -> Hashable:
         return _OUTPUTS
@@ -195,10 +196,42 @@ class Gearbox(DtcosimSlave):
 
     def _initialize(self, start_time: float) -> None:
         values = self._values
-        self.model.initialize(start_time, *(values[i] for i in self._vr_inputs[:5]))
+        inputs = [values[i] for i in self._vr_inputs[:5]]
+        self.model.initialize(start_time, *inputs)
+        self._start_inputs: tuple[float, list[float]] | None = (start_time, inputs)
 
     def _step(self, time: float, step_size: float) -> None:
+        if self._start_inputs is not None:
+            self._check_input_timing(time, step_size)
         self.model.step(time, step_size, *self._inputs(self._values))
+
+    def _check_input_timing(self, time: float, step_size: float) -> None:
+        """Warn once if the first step's angles are not the initial ones: a source stepped before the Gearbox.
+
+        The Gearbox takes its inputs as the values at the communication point ``t_n`` (FMI 2.0) and
+        extrapolates them over the step. A source stepped first (Gauss-Seidel) hands over its values at
+        ``t_n + h``: its angle leads by one step, ``omega h`` at the carrier, times the gear ratio at the
+        generator - a shaft twist that rings through the drivetrain at the start.
+        """
+        t0, initial = self._start_inputs
+        self._start_inputs = None
+        if time != t0:
+            return
+        values = self._values
+        checked = [("phi_rotor", 1, 0)]
+        if self.model.generator_interface == "motion":
+            checked.append(("phi_gen", 3, 2))
+        for name, k, speed_k in checked:
+            moved = values[self._vr_inputs[k]] - initial[k]
+            per_step = abs(initial[speed_k]) * step_size
+            if per_step > 0.0 and abs(moved) > 0.5 * per_step:
+                self._report(
+                    f"Gearbox: {name} moved by {moved:.4g} rad between initialisation and the first step at "
+                    f"t = {time:g} s ({moved / per_step:.2g} steps of its speed): its source was stepped before the "
+                    f"Gearbox. The Gearbox takes inputs as values at the communication point (FMI 2.0), so the "
+                    f"motion it is given leads by one step ({per_step:.3g} rad; x the gear ratio at the generator): "
+                    f"the extra twist rings through the drivetrain. Step the Gearbox before the components that "
+                    f"drive it (simulation.order with the gearbox first)", Fmi2Status.warning)
 
     def _refresh(self, group: Hashable) -> None:
         out = self.model.output_list()  # the compiled model: its kernel wrote them during the step

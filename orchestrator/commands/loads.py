@@ -35,10 +35,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_cluster_arguments(p)
     p.add_argument("--out", type=Path, default=None, help="output directory (default: results/<set name>)")
     add_fmu_arguments(p, "the base scenario's")
-    p.add_argument("--length", type=float, default=None, metavar="SECONDS",
-                   help="override the analysed length of each run (runs.length; changes the run keys)")
-    p.add_argument("--transient", type=float, default=None, metavar="SECONDS",
-                   help="override the discarded transient of each run (runs.transient; changes the run keys)")
+    p.add_argument("--length", type=_seconds_or("to_stop"), default=None, metavar="SECONDS",
+                   help='override the analysed length of each run, or "to_stop" (runs.length; changes the run keys)')
+    p.add_argument("--transient", type=_seconds_or("settled"), default=None, metavar="SECONDS",
+                   help='override the discarded transient of each run, or "settled": the drivetrain\'s settling '
+                        "time (runs.transient; changes the run keys)")
     p.add_argument("--seeds", type=int, default=None, metavar="N",
                    help="override the seeds with 1..N (runs.seeds)")
     p.add_argument("--retry-failed", action="store_true", help="run cases whose journal record says 'failed' again")
@@ -94,6 +95,19 @@ class _Progress:
         self.total.close()
 
 
+def _seconds_or(word: str):
+    """An argparse type: a number of seconds, or ``word`` (given back as the string)."""
+    def parse(text: str):
+        if text == word:
+            return word
+        try:
+            return float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected seconds or {word!r}, got {text!r}") from None
+    parse.__name__ = f"seconds or {word!r}"
+    return parse
+
+
 def run(args: argparse.Namespace) -> int:
     """Validate the set, run its pending cases, write the lifetime results."""
     import uuid
@@ -113,8 +127,9 @@ def run(args: argparse.Namespace) -> int:
     lcs = load_load_cases(find_load_cases(args.set))
     changes = {}
     for option, attr in (("length", "length_s"), ("transient", "transient_s"), ("timeout", "timeout_s")):
-        if getattr(args, option) is not None:
-            changes[attr] = getattr(args, option)
+        value = getattr(args, option)
+        if value is not None:
+            changes[attr] = None if value in ("to_stop", "settled") else value
     if args.seeds is not None:
         if args.seeds < 1:
             raise LoadCaseError("--seeds", args.seeds, "an integer >= 1")
@@ -131,7 +146,7 @@ def run(args: argparse.Namespace) -> int:
     if args.check:
         todo = pending_points(prepared, read_journal(out_dir / JOURNAL_FILE), args.retry_failed)
         print(f"{lcs.name}: valid; base scenario {lcs.base_scenario}; {len(plc.bins)} bins x {len(lcs.seeds)} seeds = "
-              f"{len(plc.cases)} runs of {lcs.transient_s:g} + {lcs.length_s:g} s, {len(todo)} to run into {out_dir}; "
+              f"{len(plc.cases)} runs of {plc.load_cases.transient_s:g} + {plc.load_cases.length_s:g} s, {len(todo)} to run into {out_dir}; "
               f"{len(plc.channels)} channels; wind {lcs.wind.describe()}")
         return 0
     if args.report:

@@ -6,7 +6,10 @@ counter torque, rebuilt as for the monolithic reference
 (:func:`orchestrator.cosim.physics_view.physics_view`: the FMUs' records with the scenario's values) - and the operating point is the
 scenario's: the WindSource's mean rotor speed ``omega0`` and the generator's
 base counter torque (load events and the wind's fluctuation are not part of a
-linearisation). ``--rotor-speed-rpm`` and ``--torque-nm`` override either.
+linearisation). A scenario whose Gearbox a torque-driven Rotor FMU drives is analysed
+with that rotor (and main shaft) free: the drivetrain's free-free torsion
+(:mod:`components.analysis.rotor_coupling`), at the Rotor's initial speed.
+``--rotor-speed-rpm`` and ``--torque-nm`` override speed and torque.
 Without a scenario: ``--drivetrain FILE`` at the file's operating point and load, or
 ``--preset`` (default table6) at 16 rpm and the preset's load.
 """
@@ -20,6 +23,7 @@ import numpy as np
 
 from components.analysis.equilibrium import OperatingPoint
 from components.analysis.load_law import LOAD_LAWS, LoadLaw
+from components.analysis.settling import settling_time
 from components.errors import ParameterError
 from components.model.presets import PRESETS, preset
 from components.units import rpm
@@ -65,21 +69,27 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def scenario_drivetrain(spec: str, fmu_dir: Path | None = None):
-    """Drivetrain, mean rotor speed [rad/s] and scenario name of a scenario (its FMUs are built if missing).
+    """Drivetrain, rotor, operating point and where it came from, and the scenario name of a scenario.
+
+    Its FMUs are built if missing. The rotor is held where the Gearbox's rotor speed is
+    prescribed (a WindSource: at the wind's mean speed; a recorded speed: at the speed its
+    initialisation gives the Gearbox) and free where a torque-driven Rotor FMU drives it (at
+    the speed the initialisation gives). The output torque is the Gearbox's initial
+    ``counter_torque`` where a generator or controller sets it, else the generator's counter torque.
 
     Returns
     -------
     drivetrain : components.model.drivetrain.Drivetrain
         With the generator's inertia and base counter torque (no load events).
-    omega0_rad_s : float
-        The WindSource's mean rotor speed.
+    rotor : components.model.rotor.RotorParameters or None
+        The torque-driven rotor; None: held.
+    operating_point : components.analysis.equilibrium.OperatingPoint
+    source : str
+        Where speed and torque came from.
     name : str
     """
-    from dataclasses import replace
-
-    from components.model.generator import GeneratorParameters
-
-    from ..cosim.physics_view import PhysicsUnavailable, physics_view
+    from ..cosim.operating_point import drivetrain_at_start
+    from ..cosim.physics_view import PhysicsUnavailable
     from ..cosim.system import resolve_system
     from ..errors import ScenarioError
     from ..inputs.scenario_file import find_scenario
@@ -89,13 +99,10 @@ def scenario_drivetrain(spec: str, fmu_dir: Path | None = None):
     scenario = load_any(find_scenario(spec))
     system = resolve_system(scenario, fmu_paths=ensure_fmus(scenario, fmu_dir, build=True))
     try:
-        setup = physics_view(system)
+        start = drivetrain_at_start(system)
     except PhysicsUnavailable as exc:
         raise ScenarioError("(scenario)", scenario.name, f"a scenario with a dtcosim drivetrain ({exc})") from None
-    dt = setup.drivetrain
-    if dt.generator is not None and dt.generator.events:
-        dt = replace(dt, generator=GeneratorParameters(dt.generator.inertia_kgm2, dt.generator.counter_torque_nm))
-    return dt, setup.wind.mean_speed_rad_s, scenario.name
+    return start.drivetrain, start.rotor, start.operating_point, start.source, scenario.name
 
 
 def run(args: argparse.Namespace) -> int:
@@ -103,22 +110,30 @@ def run(args: argparse.Namespace) -> int:
     if sum(x is not None for x in (args.scenario, args.preset, args.drivetrain)) > 1:
         raise ParameterError("--preset/--drivetrain", args.preset or args.drivetrain,
                              "one of SCENARIO, --preset and --drivetrain")
+    rotor = None
     if args.drivetrain is not None:
         from ..inputs.drivetrain_file import find_drivetrain, load_drivetrain_file
 
         spec = load_drivetrain_file(find_drivetrain(args.drivetrain))
-        drivetrain, omega0, origin = spec.drivetrain, spec.rotor_speed_rad_s, spec.origin
+        drivetrain, origin = spec.drivetrain, spec.origin
+        op = OperatingPoint.of_drivetrain(drivetrain, spec.rotor_speed_rad_s)
+        source = "the file's operating point and counter torque"
         out_dir = args.out if args.out is not None else Path("results") / spec.name / "modes"
     elif args.scenario is not None:
-        drivetrain, omega0, source = scenario_drivetrain(args.scenario, args.fmu_dir)
-        origin = f"scenario {source}"
-        out_dir = args.out if args.out is not None else Path("results") / source / "modes"
+        drivetrain, rotor, op, source, name = scenario_drivetrain(args.scenario, args.fmu_dir)
+        origin = f"scenario {name}"
+        out_dir = args.out if args.out is not None else Path("results") / name / "modes"
     else:
         name = args.preset or "table6"
-        drivetrain, omega0, origin = preset(name), rpm(16.0), f"preset {name}"
+        drivetrain, origin = preset(name), f"preset {name}"
+        op = OperatingPoint.of_drivetrain(drivetrain, rpm(16.0))
+        source = "the paper's rated speed and the preset's load"
         out_dir = args.out if args.out is not None else Path("results") / "modes"
-    speed = rpm(args.rotor_speed_rpm) if args.rotor_speed_rpm is not None else omega0
-    op = OperatingPoint(speed, args.torque_nm) if args.torque_nm is not None else OperatingPoint.of_drivetrain(drivetrain, speed)
+    if args.rotor_speed_rpm is not None or args.torque_nm is not None:
+        op = OperatingPoint(rpm(args.rotor_speed_rpm) if args.rotor_speed_rpm is not None else op.rotor_speed_rad_s,
+                            args.torque_nm if args.torque_nm is not None else op.output_torque_nm)
+        source += " (overridden on the command line)"
+    speed = op.rotor_speed_rad_s
     lo, hi = args.speed_range
     if not 0.0 < lo < hi:
         raise ParameterError("speed_range", (lo, hi), "0 < LOW < HIGH [rpm]")
@@ -131,18 +146,35 @@ def run(args: argparse.Namespace) -> int:
         modal_report,
     )
 
+    if args.verify and rotor is not None:
+        raise ParameterError("--verify", True, "a scenario with a held rotor (a prescribed speed): the free-response "
+                             "check simulates the drivetrain at a prescribed rotor speed")
     report = modal_report(
-        drivetrain, op, out_dir, law, rpm(np.linspace(lo, hi, args.speed_points)), args.shapes, args.verify
+        drivetrain, op, out_dir, law, rpm(np.linspace(lo, hi, args.speed_points)), args.shapes, args.verify, rotor
     )
     an = report["analysis"]
     eq = an.model.equilibrium
-    print(f"dtcosim modes: {origin} at {op.rotor_speed_rpm:.6g} rpm, output torque {op.output_torque_nm:.6g} N m")
+    print(f"dtcosim modes: {origin} at {op.rotor_speed_rpm:.6g} rpm, output torque {op.output_torque_nm:.6g} N m "
+          f"({source})")
+    if rotor is None:
+        print("rotor held at the operating speed (a prescribed speed): the modes of the drivetrain between a held "
+              "rotor and the generator")
+    else:
+        shaft = (f", main shaft {rotor.shaft_stiffness_nm_rad:.6g} N m/rad" if rotor.has_shaft else
+                 ", rigid main shaft")
+        print(f"torque-driven rotor {rotor.inertia_kgm2:.6g} kg m^2{shaft}: the drivetrain is free at both ends "
+              "(rigid-body rotation removed; generator torque held constant)")
     print(f"static equilibrium: residual {eq.residual_nm:.2g} N m after {eq.iterations} Newton iteration(s) "
           f"from the secant-stiffness start; rotor torque {eq.rotor_torque_nm:.6g} N m")
     print(format_mode_table(an))
     n_under = len(an.underdamped)
     print(f"{n_under} underdamped mode(s), {len(an.modes) - n_under} overdamped; "
           f"real eigenvalues (overdamped roots): {len(an.overdamped_roots_per_s)}")
+    try:
+        print(f"settling time (where an analysis window should start after the run's start): "
+              f"{settling_time(an).describe()}")
+    except ValueError as exc:
+        print(f"settling time: none ({exc})")
     crossings = [c for c in report["campbell"].crossings() if not c["overdamped"]]
     if crossings:
         print("Campbell crossings of underdamped modes (" + report["campbell"].load_law.describe() + "):")

@@ -114,6 +114,12 @@ def run(args: argparse.Namespace) -> int:
             bar.close()
     outcome = report.outcome
     s = report.summary
+    for component, messages in s.get("fmu_messages", {}).items():  # what the FMUs warned about, once each
+        for message in dict.fromkeys(m for m in messages if m.startswith("[warning]")):
+            text = message.removeprefix("[warning]").strip().removeprefix("logStatusWarning:").strip()
+            print(f"dtcosim run: warning: FMU {component}: {text}", file=sys.stderr)
+    if "window_warning" in s:
+        print(f"dtcosim run: warning: {s['window_warning']}", file=sys.stderr)
     if not outcome.time_s.size:  # stopped before the first sample: nothing to show
         print(f"dtcosim run: {outcome.error}; nothing was simulated ({out_dir / 'summary.json'} says so)",
               file=sys.stderr)

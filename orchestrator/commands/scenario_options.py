@@ -38,7 +38,13 @@ def load(spec, args: argparse.Namespace, command: str):
     def note(message: str) -> None:
         print(f"dtcosim {command}: note: {message}", file=sys.stderr)
 
-    return load_any(find_scenario(spec), step_s=args.step, stop_s=args.stop, report=note)
+    scenario = load_any(find_scenario(spec), step_s=args.step, stop_s=args.stop, report=note)
+    for comp in scenario.components:
+        if comp.series is not None:
+            used = {c.source.variable for c in scenario.connections if c.source.component == comp.name}
+            for warning in comp.series.warnings(used):
+                print(f"dtcosim {command}: warning: {warning}", file=sys.stderr)
+    return scenario
 
 
 def apply(scenario, args: argparse.Namespace, command: str):

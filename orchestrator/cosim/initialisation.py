@@ -24,13 +24,20 @@ from .resolved import ResolvedSystem
 EXTRA_INIT_SWEEPS = 2
 
 
-def initialise(system: ResolvedSystem, instances: Mapping[str, FmuInstance]) -> dict[str, float]:
+def initialise(system: ResolvedSystem, instances: Mapping[str, FmuInstance],
+               transferred: bool = False) -> dict[str, float]:
     """Sweep until the transferred values are a fixed point, then exit initialisation mode.
+
+    Parameters
+    ----------
+    transferred : bool
+        Return every transferred value (connected inputs too), not only the bindings.
 
     Returns
     -------
     dict of str -> float
-        ``{"component.parameter": value}`` for every ``[[initial]]`` binding.
+        ``{"component.parameter": value}`` for every ``[[initial]]`` binding (with
+        ``transferred``: also ``{"component.input": value}`` for every connected input).
 
     Raises
     ------
@@ -86,5 +93,7 @@ def initialise(system: ResolvedSystem, instances: Mapping[str, FmuInstance]) -> 
         )
     for name in system.init_order:
         instances[name].exit_initialization(t0)
+    if transferred:
+        return dict(last)
     bound = {str(b.target) for b in sc.initial}
     return {k: v for k, v in last.items() if k in bound}

@@ -214,7 +214,9 @@ class CoSimulation:
         loop_time = loop_cpu = 0.0
         try:
             self._instantiate(stop)
-            initial_values = initialise(self.system, self.instances)
+            start_values = initialise(self.system, self.instances, transferred=True)
+            bound = {str(b.target) for b in self.system.scenario.initial}
+            initial_values = {k: v for k, v in start_values.items() if k in bound}
             stop.raise_if_requested("initialisation", sim.start_s)
             plan = build_plan(self.system, self.instances)
             buffers = RowBuffers.allocate(plan.n_columns, plan.stride, BLOCK_STEPS)
@@ -251,6 +253,7 @@ class CoSimulation:
             cpu_time_s=time.process_time() - cpu0,
             loop_cpu_time_s=loop_cpu,
             initial_values=initial_values,
+            start_values=start_values,
             fmu_log={name: list(inst.log) for name, inst in self.instances.items()},
             profile=None if timers is None else {
                 fmu.name: dict(zip(TIMED_FUNCTIONS, map(float, row))) for fmu, row in zip(plan.fmus, timers)
@@ -262,17 +265,23 @@ class CoSimulation:
             ended_by=None if self._ended is None else self._ended[0],
         )
 
-    def initial_values(self) -> dict[str, float]:
+    def initial_values(self, transferred: bool = False) -> dict[str, float]:
         """Instantiate and initialise the FMUs, return what the initial bindings set, free the FMUs.
+
+        Parameters
+        ----------
+        transferred : bool
+            Also the values the connected inputs get in initialisation.
 
         Returns
         -------
         dict of str -> float
-            ``{"component.parameter": value}`` for every ``[[initial]]`` binding.
+            ``{"component.parameter": value}`` for every ``[[initial]]`` binding (with
+            ``transferred``: also ``{"component.input": value}`` for every connected input).
         """
         try:
             self._instantiate()
-            return initialise(self.system, self.instances)
+            return initialise(self.system, self.instances, transferred)
         finally:
             self._close()
 

@@ -48,6 +48,9 @@ class RunOutcome:
         this process, so it includes their work; use it for benchmarks on a shared machine).
     initial_values : dict of str -> float
         Values transferred by the initialisation sweeps (``"generator.omega0"`` ...).
+    start_values : dict of str -> float
+        Every value transferred in initialisation: the bindings and the connected inputs
+        (``"gearbox.omega_rotor"`` ...): the operating point the run starts at.
     fmu_log : dict of str -> list of str
         Last log messages of each FMU.
     profile : dict of str -> dict of str -> float, optional
@@ -75,6 +78,7 @@ class RunOutcome:
     cpu_time_s: float = 0.0
     loop_cpu_time_s: float = 0.0
     initial_values: dict[str, float] = field(default_factory=dict)
+    start_values: dict[str, float] = field(default_factory=dict)
     fmu_log: dict[str, list[str]] = field(default_factory=dict)
     profile: dict[str, dict[str, float]] | None = None
     stop_signal: str | None = None

@@ -141,6 +141,22 @@ def controller_parameters(system: ResolvedSystem, component: str) -> TorqueLawPa
                         controller_from_values)
 
 
+def drivetrain_with_generator(system: ResolvedSystem) -> tuple[Drivetrain, ComponentRole, ComponentRole]:
+    """The Gearbox FMU's drivetrain with the GeneratorRotor FMU's generator, and the two components.
+
+    Raises
+    ------
+    PhysicsUnavailable
+        Either role missing or doubled, a foreign FMU in it, a gearbox without a generator shaft.
+    """
+    gear_c = dtcosim_component(system, GEARBOX)
+    gen_c = dtcosim_component(system, GENERATOR)
+    drivetrain = gearbox_drivetrain(system, gear_c.component)
+    if drivetrain.generator is None:
+        raise PhysicsUnavailable(f"{gear_c.component}: its record has no generator shaft (not a co-simulation gearbox)")
+    return replace(drivetrain, generator=generator_parameters(system, gen_c.component)), gear_c, gen_c
+
+
 def physics_view(system: ResolvedSystem) -> PhysicsView:
     """The monolithic description of a scenario of one dtcosim WindSource, Gearbox and GeneratorRotor.
 
@@ -151,12 +167,7 @@ def physics_view(system: ResolvedSystem) -> PhysicsView:
         model rejects.
     """
     wind_c = dtcosim_component(system, WIND_SOURCE)
-    gear_c = dtcosim_component(system, GEARBOX)
-    gen_c = dtcosim_component(system, GENERATOR)
-    drivetrain = gearbox_drivetrain(system, gear_c.component)
-    if drivetrain.generator is None:
-        raise PhysicsUnavailable(f"{gear_c.component}: its record has no generator shaft (not a co-simulation gearbox)")
-    drivetrain = replace(drivetrain, generator=generator_parameters(system, gen_c.component))
+    drivetrain, gear_c, gen_c = drivetrain_with_generator(system)
     notes = []
     bound = {str(b.target) for b in system.scenario.initial}
     if f"{gen_c.component}.initial_speed" not in bound:
@@ -167,3 +178,41 @@ def physics_view(system: ResolvedSystem) -> PhysicsView:
     start = "rest" if _values(system, gear_c.component).get("start_at_rest") else "operating_point"
     return PhysicsView(drivetrain, wind_parameters(system, wind_c.component), FrozenMap(components),
                        FrozenMap(sources), tuple(notes), start)
+
+
+@dataclass(frozen=True)
+class RotorDrivenView:
+    """The drivetrain of a scenario whose Gearbox a torque-driven Rotor FMU drives.
+
+    Attributes
+    ----------
+    drivetrain : Drivetrain
+        The Gearbox FMU's drivetrain with the GeneratorRotor's generator.
+    rotor : RotorParameters
+        The Rotor FMU's rotor (and main shaft) with the scenario's values.
+    initial_speed_rad_s : float
+        The Rotor's ``initial_speed`` parameter (a scenario may bind it at run time from a record).
+    components : mapping of str -> str
+        Role -> component name.
+    """
+
+    drivetrain: Drivetrain
+    rotor: RotorParameters
+    initial_speed_rad_s: float
+    components: Mapping[str, str]
+
+
+def rotor_driven_view(system: ResolvedSystem) -> RotorDrivenView:
+    """The drivetrain, rotor and initial rotor speed of a scenario of one dtcosim Rotor, Gearbox and GeneratorRotor.
+
+    Raises
+    ------
+    PhysicsUnavailable
+        A role missing or doubled, a foreign FMU in one of the roles, or values the model rejects.
+    """
+    rotor_c = dtcosim_component(system, ROTOR)
+    drivetrain, gear_c, gen_c = drivetrain_with_generator(system)
+    rotor = rotor_parameters(system, rotor_c.component)
+    components = {ROTOR: rotor_c.component, GEARBOX: gear_c.component, GENERATOR: gen_c.component}
+    return RotorDrivenView(drivetrain, rotor, float(_values(system, rotor_c.component)["initial_speed"]),
+                           FrozenMap(components))

@@ -28,8 +28,9 @@ from .load_cases import (
     DEFAULT_EXPONENTS,
     DEFAULT_LENGTH_S,
     DEFAULT_LEVELS,
-    DEFAULT_TRANSIENT_S,
     FOLDER,
+    SETTLED,
+    TO_STOP,
     CurveRule,
     FatigueOptions,
     LoadCaseError,
@@ -55,8 +56,10 @@ class _SimulationTable(Table):
 
 
 class _RunsTable(Table):
-    length: float = Field(DEFAULT_LENGTH_S, gt=0, description="the analysed length of each run > 0 [s]")
-    transient: float = Field(DEFAULT_TRANSIENT_S, ge=0, description="the discarded start of each run >= 0 [s]")
+    length: Annotated[float, Field(gt=0)] | Literal["to_stop"] = Field(
+        DEFAULT_LENGTH_S, description='the analysed length of each run > 0 [s], or "to_stop" (to the base scenario\'s stop)')
+    transient: Annotated[float, Field(ge=0)] | Literal["settled"] = Field(
+        "settled", description='the discarded start of each run >= 0 [s], or "settled" (the drivetrain\'s settling time)')
     seeds: Annotated[int, Field(ge=1)] | list[Annotated[int, Field(ge=0)]] = Field(
         1, description="a number of seeds >= 1 (seeds 1..n) or a list of distinct integers >= 0")
     seed_parameter: str | None = Field(None, description='a parameter name "component.parameter" ("" for none)')
@@ -282,7 +285,8 @@ def load_cases_from_dict(data: Mapping[str, Any], name: str | None = None, base_
                               algorithm=doc.simulation.algorithm, extrapolation=doc.simulation.extrapolation)
     return LoadCaseSet(
         name=doc.name if doc.name is not None else (name or "load-cases"), base_scenario=doc.base.scenario, base_path=path,
-        base_parameters=params, simulation=sim, length_s=runs.length, transient_s=runs.transient, seeds=seeds,
+        base_parameters=params, simulation=sim, length_s=None if runs.length == TO_STOP else runs.length,
+        transient_s=None if runs.transient == SETTLED else runs.transient, seeds=seeds,
         seed_parameter=runs.seed_parameter, wind=_wind(doc.wind, source), edges_m_s=_edges(doc.bins, source),
         law=_law(doc.operating_law, source), rows=tuple(_row(r, i, source) for i, r in enumerate(doc.operating_points)),
         life=life, fatigue=fatigue, curves=tuple(_curve(c, i, source) for i, c in enumerate(doc.sn_curves)),

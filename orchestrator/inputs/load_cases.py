@@ -14,8 +14,8 @@ runs). A load-case file (:func:`orchestrator.inputs.load_case_file.load_load_cas
     [base]
     scenario = "paper-60s"                 # packaged scenario name or TOML path (relative to this file)
     [runs]
-    length = 600.0                         # s analysed per run (default 600)
-    transient = 10.0                       # s simulated first and discarded (default 10)
+    length = 600.0                         # s analysed per run (default 600; "to_stop": to the base scenario's stop)
+    transient = "settled"                  # s simulated first and discarded (default "settled", see below)
     seeds = 3                              # seeds 1, 2, 3 (or a list)
     [wind]
     distribution = "rayleigh"              # or "weibull" with k and A
@@ -44,7 +44,7 @@ runs). A load-case file (:func:`orchestrator.inputs.load_case_file.load_load_cas
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Mapping
 
@@ -64,6 +64,12 @@ from .schema import NAME_PATTERN, ParameterValue
 FOLDER = "load_cases"
 DEFAULT_LENGTH_S = 600.0
 DEFAULT_TRANSIENT_S = 10.0
+#: ``runs.transient = "settled"`` (the default): the drivetrain's settling time, rounded up to 0.1 s
+#: (:func:`orchestrator.cosim.operating_point.settling_of`: five time constants of its slowest mode at
+#: the base scenario's start)
+SETTLED = "settled"
+#: ``runs.length = "to_stop"``: each run analyses up to the base scenario's stop (a record's end)
+TO_STOP = "to_stop"
 DEFAULT_EXPONENTS = (3.0, 5.0, 8.0, 10.0)
 DEFAULT_EQUIVALENT_CYCLES = 1.0e7
 DEFAULT_LEVELS = 64
@@ -201,8 +207,9 @@ class LoadCaseSet:
     simulation : SimulationOverrides
         Master options (step, output interval, algorithm, extrapolation); the time grid
         comes from :attr:`length_s` and :attr:`transient_s`.
-    length_s, transient_s : float
-        Analysed length and discarded transient of each run [s].
+    length_s, transient_s : float or None
+        Analysed length and discarded transient of each run [s]; None before :meth:`settled`
+        (``runs.length = "to_stop"``, ``runs.transient = "settled"``).
     seeds : tuple of int
     seed_parameter : str or None
         ``component.parameter`` each seed sets; None: the wind source's ``seed``
@@ -226,8 +233,8 @@ class LoadCaseSet:
     base_path: Path
     base_parameters: Mapping[str, ParameterValue]
     simulation: SimulationOverrides
-    length_s: float
-    transient_s: float
+    length_s: float | None
+    transient_s: float | None
     seeds: tuple[int, ...]
     seed_parameter: str | None
     wind: WindDistribution
@@ -246,9 +253,9 @@ class LoadCaseSet:
         object.__setattr__(self, "base_parameters", FrozenMap(dict(self.base_parameters)))
         if not isinstance(self.name, str) or not NAME_PATTERN.match(self.name):
             raise LoadCaseError("name", self.name, "a name of letters, digits, '_' or '-'", src)
-        if not (math.isfinite(self.length_s) and self.length_s > 0):
+        if self.length_s is not None and not (math.isfinite(self.length_s) and self.length_s > 0):
             raise LoadCaseError("runs.length", self.length_s, "a run length > 0 s", src)
-        if not (math.isfinite(self.transient_s) and self.transient_s >= 0):
+        if self.transient_s is not None and not (math.isfinite(self.transient_s) and self.transient_s >= 0):
             raise LoadCaseError("runs.transient", self.transient_s, "a transient >= 0 s", src)
         if not self.seeds:
             raise LoadCaseError("runs.seeds", list(self.seeds), "at least one seed", src)
@@ -314,8 +321,41 @@ class LoadCaseSet:
         """Bins x seeds."""
         return (len(self.edges_m_s) - 1) * len(self.seeds)
 
+    def settled(self, settling_s: float | None, settling_text: str, base_stop_s: float) -> tuple["LoadCaseSet", list[str]]:
+        """The set with its transient and length in seconds, and warnings about its window.
+
+        ``settling_s``: the base drivetrain's settling time (None: no dtcosim drivetrain, no settling
+        time known); ``settling_text`` says where it comes from; ``base_stop_s``: the base scenario's
+        stop (for ``length = "to_stop"``).
+
+        Raises
+        ------
+        LoadCaseError
+            ``transient = "settled"`` without a settling time; ``length = "to_stop"`` with nothing left.
+        """
+        src, notes = self.source, []
+        transient = self.transient_s
+        if transient is None:
+            if settling_s is None:
+                raise LoadCaseError("runs.transient", SETTLED, "a transient in seconds (the base scenario has no "
+                                    "dtcosim drivetrain whose settling time could be derived)", src)
+            transient = math.ceil(settling_s * 10.0 - 1e-9) / 10.0
+        elif settling_s is not None and transient + 1e-9 < settling_s:
+            notes.append(f"runs.transient = {transient:g} s is shorter than the drivetrain's settling time "
+                         f"{settling_text}: every run's analysed window includes what is left of its start-up; "
+                         f'runs.transient = "settled" derives it')
+        length = self.length_s
+        if length is None:
+            length = base_stop_s - transient
+            if not length > 0:
+                raise LoadCaseError("runs.length", TO_STOP, f"a base scenario that runs past the transient "
+                                    f"{transient:g} s (it stops at {base_stop_s:g} s)", src)
+        return replace(self, transient_s=float(transient), length_s=float(length)), notes
+
     def time_grid(self) -> SimulationOverrides:
         """The runs' ``[simulation]``: start 0, stop ``transient + length``, window after the transient."""
+        if self.transient_s is None or self.length_s is None:
+            raise LoadCaseError("runs", "settled", "a set whose transient and length are known (settled())", self.source)
         stop = self.transient_s + self.length_s
         s = self.simulation
         return SimulationOverrides(start_s=0.0, stop_s=stop, step_s=s.step_s, output_interval_s=s.output_interval_s,

@@ -109,11 +109,22 @@ _GENERIC = {
 }
 
 
+def _without_union_tag(root: type[BaseModel], loc: tuple) -> tuple:
+    """``loc`` without the union member pydantic appends (``runs.length.constrained-float`` -> ``runs.length``)."""
+    if len(loc) > 1 and isinstance(loc[-1], str):
+        parent, table = _walk(root, loc[:-1])
+        annotation = getattr(parent, "annotation", None)
+        if table is None and typing.get_origin(annotation) in (Union, types.UnionType) \
+                and typing.get_origin(_strip(annotation)) not in (list, dict):
+            return loc[:-1]  # a leaf of union type: the last part names the member, not a key
+    return loc
+
+
 def entry_error(exc: ValidationError, root: type[BaseModel], error: type[EntryError],
                 source: str | None) -> EntryError:
     """The first problem of a pydantic validation as one ``error`` naming key, value and expectation."""
     first = exc.errors(include_url=False)[0]
-    loc = tuple(first["loc"])
+    loc = _without_union_tag(root, tuple(first["loc"]))
     kind = first["type"]
     key = key_path(loc) or "(document)"
     value = first.get("input")

@@ -15,6 +15,18 @@
     interpolation = "pchip"      # C1 (default) or "linear" (C0)
     angle = "rotor_angle"        # optional: also the integral of this channel (a speed), from angle_initial
     quantity = "rotor_speed"     # optional: what it records (default from the OpenFAST channel name)
+    lowpass_hz = 1.0             # optional: a zero-phase low-pass of the channel at this cut-off [Hz]
+
+Each channel's resolution (the quantisation step of its numbers: 3 significant digits, 2 decimals,
+the 16-bit steps of a compressed ``.outb``) and sampling are checked when the record is read
+(:mod:`components.analysis.record_resolution`). A channel that prescribes a motion (a rotor or
+generator speed or angle) whose steps are larger than half of its own sample-to-sample motion
+(:data:`STEP_RATIO_WARNING`) plays a staircase that excites the drivetrain's modes: a warning
+names the channel, its step and the remedy (``lowpass_hz``, or the torque-driven Rotor). The
+low-pass runs forward and backward (no delay; :func:`~components.analysis.record_resolution.lowpass_zero_phase`)
+on the SI samples before the FMU is built; an ``angle`` is the integral of the filtered speed.
+The resolution, the step ratio and the cut-off of each channel are in the FMU's record model and in
+``summary.json`` (``fmus.<name>.records``).
 
 Several records of the same channels (e.g. the seeds of one load case) in one FMU: ``records = [...]``
 instead of ``record``; the FMU then has an Integer parameter ``record`` (1-based, default 1, bounds
@@ -42,6 +54,14 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import Field
 
+from components.analysis.record_resolution import (
+    estimate_resolution,
+    lowpass_zero_phase,
+    sampling_of,
+    step_ratio,
+)
+from components.errors import ParameterError
+
 from ..errors import ScenarioError
 from .schema import Table
 from .series_file import LoadRecordError, read_load_record, si_conversion
@@ -63,6 +83,10 @@ OPENFAST_QUANTITIES = {
 #: a record's generator/rotor speed ratio may differ from its drivetrain's by this much before a run is refused
 SPEED_RATIO_TOLERANCE = 0.02
 _ANGLE_QUANTITIES = {"rotor_speed": "rotor_angle", "generator_speed": "generator_angle"}
+#: quantities a record prescribes as a motion of the drivetrain (kinematic inputs)
+KINEMATIC_QUANTITIES = ("rotor_speed", "generator_speed", "rotor_angle", "generator_angle")
+#: a kinematic channel whose steps sum to more than this fraction of its own motion gets a warning
+STEP_RATIO_WARNING = 0.5
 
 
 class ChannelTable(Table):
@@ -72,6 +96,7 @@ class ChannelTable(Table):
     angle: str | None = Field(None, description="an output name for the integral of this channel")
     angle_initial: float = Field(0.0, description="the angle at the record's first time [rad]")
     quantity: str | None = Field(None, description="what the channel records, e.g. generator_speed")
+    lowpass_hz: float | None = Field(None, gt=0.0, description="a zero-phase low-pass cut-off [Hz] (none by default)")
 
 
 class SeriesTable(Table):
@@ -119,6 +144,12 @@ class RecordedSamples:
     #: ``{"ratio", "generator", "rotor"}``: the record's generator/rotor speed ratio and the channels it comes
     #: from (:func:`speed_ratio`), or None where the record does not carry both speeds
     speed_ratio: dict | None = None
+    #: what the record's check found (:func:`_resolution_warning`): ``(outputs, message)`` per quantised kinematic
+    #: channel, ``outputs`` the FMU outputs it feeds (its value and its angle)
+    warnings: tuple = ()
+    #: per selected channel: ``channel``, ``resolution`` (:meth:`Resolution.as_dict`), ``step_ratio``, ``sampling``,
+    #: ``lowpass_hz``
+    checks: tuple = ()
 
     @property
     def data_sha256(self) -> str:
@@ -137,6 +168,7 @@ class RecordedSamples:
                "samples": int(self.time_s.size), "data_sha256": self.data_sha256}
         if self.speed_ratio is not None:
             out["speed_ratio"] = self.speed_ratio
+        out["channels"] = [dict(c) for c in self.checks]
         return out
 
 
@@ -166,6 +198,15 @@ class SeriesSpec:
     out_of_record: str
     selectable: bool = False
     check_speed_ratio: bool = True
+
+    def warnings(self, used_outputs=None) -> list[str]:
+        """The records' warnings (quantised kinematic channels), each once.
+
+        ``used_outputs``: the FMU outputs that drive another component (None: all); a channel whose
+        outputs (its value and its angle) drive nothing is only recorded, and not warned about.
+        """
+        return list(dict.fromkeys(message for r in self.records for outputs, message in r.warnings
+                                  if used_outputs is None or set(outputs) & set(used_outputs)))
 
     @property
     def record(self) -> Path:
@@ -214,6 +255,8 @@ class SeriesSpec:
                                          ratios=[x["ratio"] for x in ratios])
         if self.selectable:
             series["records"] = [r.summary() for r in self.records]
+        else:
+            series["channels"] = [dict(c) for c in self.records[0].checks]
         return {"series": series}
 
     @property
@@ -291,10 +334,23 @@ def _channel(record, name: str) -> tuple[str, np.ndarray]:
     return record.channel(name)
 
 
+def _resolution_warning(path: Path, ckey: str, ch: ChannelTable, unit: str, quantity: str, check: dict) -> str | None:
+    """The warning for a kinematic channel whose quantisation steps dominate its motion (None: no warning)."""
+    if quantity not in KINEMATIC_QUANTITIES or ch.lowpass_hz is not None or check["step_ratio"] <= STEP_RATIO_WARNING:
+        return None
+    return (f"{path.name}: {ckey} = {ch.channel} is recorded with {check['resolution']['description']}, sampled "
+            f"every {check['sampling']['interval_s']:.3g} s; its steps add up to {check['step_ratio']:.2g}x its own "
+            f"sample-to-sample motion (more than {STEP_RATIO_WARNING:g}), so played as a prescribed "
+            f"{quantity.replace('_', ' ')} the staircase excites the drivetrain's modes and the torques show the "
+            f"quantisation. Remedy: {ckey}.lowpass_hz = 1.0 (a zero-phase low-pass below the drivetrain's first mode), "
+            f"or drive the rotor by its torque (Rotor FMU)")
+
+
 def _selected(table: SeriesTable, path: Path, key: str, source: str | None) -> tuple[list[dict], RecordedSamples]:
-    """The outputs and the converted samples of ``table.channels`` in the record ``path``."""
+    """The outputs and the converted (and, where asked, low-passed) samples of ``table.channels`` in the record ``path``."""
     record = read_load_record(path)
-    outputs, columns, seen = [], [], {}
+    outputs, columns, seen, warnings, checks = [], [], {}, [], []
+    sampling = sampling_of(record.time_s)
     for i, ch in enumerate(table.channels):
         ckey = f"{key}.channels[{i}]"
         unit, values = _channel(record, ch.channel)
@@ -304,8 +360,26 @@ def _selected(table: SeriesTable, path: Path, key: str, source: str | None) -> t
             raise LoadRecordError(ch.channel, f"NaN at t = {record.time_s[bad[0]]:g} s (row {int(bad[0])})",
                               f"finite samples ({bad.size} of {values.size} are not)", record.source)
         quantity = ch.quantity or OPENFAST_QUANTITIES.get(ch.channel, "")
+        raw = np.asarray(values, dtype=float)
+        resolution = estimate_resolution(raw)  # on the numbers as written, before the unit conversion
+        check = {"resolution": resolution.as_dict(unit, factor), "step_ratio": step_ratio(raw, resolution.steps),
+                 "sampling": sampling.as_dict(), "lowpass_hz": ch.lowpass_hz}
+        warning = _resolution_warning(path, ckey, ch, unit, quantity, check)
+        if warning is not None:
+            warnings.append(((ch.output or ch.channel,) + ((ch.angle,) if ch.angle else ()), warning))
+        si_values = raw * factor
+        if ch.lowpass_hz is not None:
+            if not sampling.uniform:
+                raise ScenarioError(f"{ckey}.lowpass_hz", ch.lowpass_hz, f"a record sampled evenly to filter "
+                                    f"({path.name}: time steps {sampling.smallest_s:g} to {sampling.largest_s:g} s)",
+                                    source)
+            try:
+                si_values = lowpass_zero_phase(si_values, sampling.interval_s, ch.lowpass_hz)
+            except ParameterError as exc:
+                raise ScenarioError(f"{ckey}.lowpass_hz", ch.lowpass_hz, f"{exc.expected} ({path.name})",
+                                    source) from None
         column = len(columns)
-        columns.append(values * factor)
+        columns.append(si_values)
         names = [(ch.output or ch.channel, False, quantity)]
         if ch.angle:
             if si_unit != "rad/s":
@@ -319,8 +393,11 @@ def _selected(table: SeriesTable, path: Path, key: str, source: str | None) -> t
             outputs.append({"output": name, "channel": ch.channel, "record_unit": unit,
                             "unit": "rad" if integral else si_unit, "column": column,
                             "interpolation": ch.interpolation, "integral_of": integral,
-                            "initial": float(ch.angle_initial) if integral else 0.0, "quantity": q})
-    return outputs, RecordedSamples(path, record.time_s.copy(), np.column_stack(columns), speed_ratio(record))
+                            "initial": float(ch.angle_initial) if integral else 0.0, "quantity": q,
+                            "lowpass_hz": ch.lowpass_hz})
+        checks.append({"channel": ch.channel, **check})
+    return outputs, RecordedSamples(path, record.time_s.copy(), np.column_stack(columns), speed_ratio(record),
+                                    tuple(warnings), tuple(checks))
 
 
 def series_from_table(table: SeriesTable, key: str, base_dir: Path | None, source: str | None) -> SeriesSpec:

@@ -31,7 +31,9 @@ from components.analysis.modal_verification import (
     free_response_check,
 )
 from components.analysis.modes import DrivetrainModalAnalysis, drivetrain_modes
+from components.errors import ParameterError
 from components.model.drivetrain import Drivetrain
+from components.model.rotor import RotorParameters
 
 from ..atomic_files import write_text_atomic
 from .modal_plots import plot_campbell, plot_mode_shapes
@@ -70,6 +72,7 @@ def modal_report(
     campbell_speeds_rad_s: np.ndarray | None = None,
     n_shapes: int = 8,
     verify: bool = False,
+    rotor: RotorParameters | None = None,
 ) -> dict:
     """Modal analysis, Campbell diagram (and optionally the free-response check) with files.
 
@@ -87,7 +90,9 @@ def modal_report(
     n_shapes : int
         Modes shown in ``modes.png``.
     verify : bool
-        Also run :func:`components.analysis.modal_verification.free_response_check`.
+        Also run :func:`components.analysis.modal_verification.free_response_check` (held rotor only).
+    rotor : RotorParameters, optional
+        A torque-driven rotor: the drivetrain free at both ends (default: the rotor held).
 
     Returns
     -------
@@ -95,11 +100,13 @@ def modal_report(
         ``{"analysis", "campbell", "verification", "files"}``: the result objects and the
         written paths (a plain-JSON summary is in ``modes.json``).
     """
-    analysis = drivetrain_modes(drivetrain, operating_point)
+    if verify and rotor is not None:
+        raise ParameterError("verify", True, "a held rotor (the free-response check prescribes the rotor speed)")
+    analysis = drivetrain_modes(drivetrain, operating_point, rotor=rotor)
     law = load_law or LoadLaw("quadratic", abs(operating_point.rotor_speed_rad_s), operating_point.output_torque_nm)
     if campbell_speeds_rad_s is None:
         campbell_speeds_rad_s = np.linspace(4.0, 20.0, 33) * np.pi / 30.0
-    campbell: CampbellDiagram = campbell_diagram(drivetrain, campbell_speeds_rad_s, law)
+    campbell: CampbellDiagram = campbell_diagram(drivetrain, campbell_speeds_rad_s, law, rotor=rotor)
     checks = free_response_check(drivetrain, operating_point, analysis) if verify else None
     files: dict[str, Path] = {}
     if out_dir is not None:

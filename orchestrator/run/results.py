@@ -117,6 +117,14 @@ def run_status(outcome: RunOutcome, problems: list[str] | None = None) -> str:
     return "complete" if outcome.complete and not problems else "failed"
 
 
+def _record_checks(component) -> dict[str, Any]:
+    """``{"records": [...]}``: per record its channels' resolution, step ratio and low-pass cut-off ({} without a record)."""
+    series = getattr(component, "series", None)
+    if series is None:
+        return {}
+    return {"records": [{"source": r.record.name, "channels": [dict(c) for c in r.checks]} for r in series.records]}
+
+
 def build_summary(system: ResolvedSystem, outcome: RunOutcome, *, wall_time_s: float,
                   derived: Mapping[str, Any] | None = None, comparison: Mapping[str, Any] | None = None,
                   files: Mapping[str, str] | None = None, listing: Mapping[str, Any] | None = None,
@@ -176,6 +184,7 @@ def build_summary(system: ResolvedSystem, outcome: RunOutcome, *, wall_time_s: f
             "guid": iface.guid,
             "generation_tool": iface.generation_tool,
             "parameters": dict(sc.component(name).parameters),
+            **_record_checks(sc.component(name)),
         }
         for name, iface in system.interfaces.items()
     }

@@ -190,6 +190,8 @@ def run_scenario(system: ResolvedSystem, out_dir: str | Path, *, compare_referen
         if post.stopped:
             derived["post_processing"] = {"stopped": post.stopped, "not_done": post.not_done}
         derived["analyses_skipped"] = skipped
+        if outcome.start_values:
+            derived.update(_settling(system, outcome))
         summary = build_summary(system, outcome, wall_time_s=time.perf_counter() - wall0, derived=derived,
                                 comparison=comparison, listing=folder.listing(), header=folder.header,
                                 problems=problems)
@@ -207,6 +209,23 @@ def run_scenario(system: ResolvedSystem, out_dir: str | Path, *, compare_referen
         else:
             status = 1
     return RunReport(outcome, summary, files, comparison_text, problems, list(folder.replaced), status)
+
+
+def _settling(system: ResolvedSystem, outcome: RunOutcome) -> dict[str, Any]:
+    """``settling`` (the drivetrain's settling time at the run's start) and a ``window_warning`` when the window
+    starts before it ({} without a dtcosim drivetrain)."""
+    from ..cosim.operating_point import settling_of, window_note
+
+    settling = settling_of(system, outcome.start_values)
+    if settling is None:
+        return {}
+    sim = system.scenario.simulation
+    out: dict[str, Any] = {"settling": settling.as_dict()}
+    note = window_note(settling, sim.window_s[0], sim.start_s, f"the analysis window [{sim.window_s[0]:g}, "
+                                                                f"{sim.window_s[1]:g}] s")
+    if note is not None:
+        out["window_warning"] = note
+    return out
 
 
 def _finish_timeseries(writer: ResultWriter, outcome: RunOutcome, folder: RunFolder, problems: list[str]) -> None:

@@ -130,6 +130,7 @@ def report_text(res: LifetimeResults) -> str:
     f = lcs.fatigue
     lines = [f"load-case set {lcs.name}: {len(plc.bins)} wind-speed bins x {len(lcs.seeds)} seeds = {len(plc.cases)} runs "
              f"of {lcs.length_s:g} s (after a {lcs.transient_s:g} s transient)",
+             *([f"settling time of the drivetrain: {plc.settling['description']}"] if plc.settling else []),
              f"wind: {lcs.wind.describe()}; bins {lcs.edges_m_s[0]:g}-{lcs.edges_m_s[-1]:g} m/s hold "
              f"{100 * lcs.operating_share:.2f} % of the time",
              f"life: {lcs.life.years:g} years, availability {lcs.life.availability:g}; lifetime DELs at "
@@ -165,6 +166,7 @@ def summary(res: LifetimeResults) -> dict[str, Any]:
     lcs = plc.load_cases
     return {
         "load_case_set": lcs.name, "source": lcs.source, "complete": res.complete, "missing_runs": res.missing,
+        "transient_s": lcs.transient_s, "length_s": lcs.length_s, "settling": plc.settling,
         "runs": len(plc.cases), "finished_runs": len(res.runs), "wind": lcs.wind.as_dict(),
         "operating_share": lcs.operating_share, "life": {"years": lcs.life.years, "availability": lcs.life.availability,
                                                          "seconds": lcs.life.seconds},

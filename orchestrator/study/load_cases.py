@@ -101,6 +101,8 @@ class PreparedLoadCases:
     meshes : mapping of str -> tuple of str
         ``"<stage> <mesh>"`` -> contact-force columns of that stage's mesh kind (one per planet).
     notes : tuple of str
+    settling : mapping or None
+        The base drivetrain's settling time at the base scenario's start, with the mode it comes from.
     """
 
     load_cases: LoadCaseSet
@@ -111,11 +113,34 @@ class PreparedLoadCases:
     high_speed_shaft: str | None
     meshes: Mapping[str, tuple[str, ...]]
     notes: tuple[str, ...] = ()
+    #: the base drivetrain's settling time (:meth:`components.analysis.settling.Settling.as_dict`), None without one
+    settling: Mapping[str, Any] | None = None
 
     @property
     def keys(self) -> tuple[str, ...]:
         """Point key of each case."""
         return self.prepared.keys
+
+
+def _settled(lcs: LoadCaseSet, fmu_dir, build: bool) -> tuple[LoadCaseSet, dict | None, list[str]]:
+    """The set with transient and length in seconds (``"settled"``, ``"to_stop"`` resolved), the base drivetrain's
+    settling time and the warnings about the window (the FMUs of the base scenario are instantiated once)."""
+    from ..cosim.operating_point import settling_of
+    from ..cosim.system import resolve_system
+    from ..inputs.overrides import apply_parameters
+    from ..provision.project_fmus import ensure_fmus
+    from ..run.runner import load_any
+
+    try:
+        scenario = apply_parameters(load_any(lcs.base_path), lcs.base_parameters)
+        system = resolve_system(scenario, fmu_paths=ensure_fmus(scenario, fmu_dir, build=build))
+    except ScenarioError as exc:
+        raise LoadCaseError("base.scenario", lcs.base_scenario, f"a valid scenario with its FMUs ({exc})",
+                            lcs.source) from None
+    settling = settling_of(system)
+    resolved, notes = lcs.settled(None if settling is None else settling.time_s,
+                                  "" if settling is None else settling.describe(), scenario.simulation.stop_s)
+    return resolved, None if settling is None else settling.as_dict(), notes
 
 
 def _base_system(lcs: LoadCaseSet, fmu_dir, build: bool):
@@ -277,6 +302,7 @@ def prepare_load_cases(lcs: LoadCaseSet, fmu_dir: str | Path | None = None, buil
     """
     src = lcs.source
     bins = lcs.bins
+    lcs, settling, window_notes = _settled(lcs, fmu_dir, build)
     system = _base_system(lcs, fmu_dir, build)
     channels, hss, meshes = _channels(system, lcs)
     targets = _targets(system, lcs, bins)
@@ -300,4 +326,5 @@ def prepare_load_cases(lcs: LoadCaseSet, fmu_dir: str | Path | None = None, buil
                  for c, p in zip(cases, prepared.points))
     payload = replace(prepared.payload, run_data=spec)
     prepared = replace(prepared, payload=payload, identity=identity, keys=keys)
-    return PreparedLoadCases(lcs, bins, cases, channels, prepared, hss, meshes, tuple(prepared.notes))
+    return PreparedLoadCases(lcs, bins, cases, channels, prepared, hss, meshes,
+                             tuple(window_notes) + tuple(prepared.notes), settling)

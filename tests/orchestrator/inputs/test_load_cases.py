@@ -47,7 +47,9 @@ def test_the_packaged_paper_turbine_set_has_bins_from_cut_in_to_cut_out_with_thr
     rated = lcs.bins[-1].point
     assert rated.region == "3" and rated.generator_torque_nm == 25.4e3
     assert rated.rotor_speed_rad_s == pytest.approx(units.rpm(16.0))
-    assert lcs.time_grid().window_s == (10.0, 610.0) and lcs.time_grid().stop_s == 610.0
+    assert lcs.transient_s is None  # "settled": derived from the base drivetrain when the set is prepared
+    settled, notes = lcs.settled(2.8163, "2.82 s = ...", 60.0)
+    assert settled.time_grid().window_s == (2.9, 602.9) and settled.time_grid().stop_s == 602.9 and notes == []
 
 
 def test_bins_take_the_law_and_a_row_overrides_it_for_its_bin():

@@ -5,6 +5,7 @@ each run playing its own record, and the lifetime report ranking the bins."""
 from __future__ import annotations
 
 import csv
+import json
 import os
 import subprocess
 import sys
@@ -37,7 +38,9 @@ def test_each_bin_plays_the_record_whose_mean_wind_speed_it_holds():
         assert b.low_m_s <= wind.mean() < b.high_m_s
         assert b.centre_m_s == pytest.approx(wind.mean(), abs=0.01)  # bins centred on the records' means
     assert sorted(b.parameters["loads.record"] for b in lcs.bins) == [1, 2, 3, 4]
-    assert lcs.time_grid().stop_s <= min(float(r.time_s[-1]) for r in records)  # runs inside the 10 s records
+    assert lcs.transient_s is None and lcs.length_s is None  # "settled", "to_stop"
+    settled, _ = lcs.settled(2.753, "", 10.0)
+    assert settled.time_grid().window_s == (2.8, 10.0)  # runs inside the 10 s records, to their end
 
 
 def _dtcosim(*args, cwd):
@@ -66,7 +69,8 @@ def ran(tmp_path_factory):
 def test_the_set_validates_and_counts_its_runs(ran):
     check = ran[0]
     assert check.returncode == 0, check.stderr
-    assert "valid" in check.stdout and "4 bins x 1 seeds = 4 runs of 1 + 9 s" in check.stdout
+    assert "valid" in check.stdout and "4 bins x 1 seeds = 4 runs of 2.8 + 7.2 s" in check.stdout
+    assert "warning" not in check.stderr, check.stderr
 
 
 @pytest.mark.slow
@@ -90,7 +94,12 @@ def test_four_runs_play_four_records_and_the_report_ranks_the_bins(ran):
     records = _records()
     rows = _rows(out / "runs.csv")
     lcs = load_load_cases(find_load_cases("openfast-dlc11"))
-    w0, w1 = lcs.time_grid().window_s
+    summary = json.loads((out / "lifetime.json").read_text())
+    assert summary["transient_s"] == 2.8 and summary["length_s"] == pytest.approx(7.2)
+    assert summary["settling"]["frequency_hz"] == pytest.approx(6.88, abs=0.01)
+    assert "settling time of the drivetrain: 2.75 s = 5 time constants of the 6.88 Hz mode" in \
+        (out / "lifetime_report.txt").read_text()
+    w0, w1 = 2.8, 10.0
     speeds = []
     for b in lcs.bins:
         rec = records[b.parameters["loads.record"] - 1]
