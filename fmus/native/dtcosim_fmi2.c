@@ -17,8 +17,10 @@
  *    start is a NULL from fmi2Instantiate with a message naming what was looked for, never an abort
  *    of the host. It never finalises Python (the host process ends it);
  *  - holds the GIL for every call, so instances may live in several host threads;
- *  - forwards the slave's log queue to the host's logger: warnings and errors always, the rest with
- *    logging on (fmi2Instantiate's loggingOn or fmi2SetDebugLogging);
+ *  - forwards the slave's log queue to the host's logger with logging on (fmi2Instantiate's loggingOn
+ *    or fmi2SetDebugLogging) and never without: fmpy keeps one process-wide logger callback whose
+ *    target may be gone once logging is off (a call then crashes the host). Errors also go to
+ *    stderr (the slaves echo theirs; this file those it finds itself);
  *  - maps the Python calls onto FMI statuses as pythonfmu does (an exception: its text logged, then
  *    fmi2Error; do_step returning False: fmi2Discard) and answers fmi2Terminated = false after a
  *    discarded step (the slave keeps its state at the step's start: fmi2LastSuccessfulTime).
@@ -135,14 +137,14 @@ static void log_text(const fmi2CallbackFunctions *cb, fmi2String name, fmi2Statu
 }
 
 /* ----------------------------------------------------------------- small helpers */
-static void say(const fmi2CallbackFunctions *cb, fmi2String name, fmi2Status status, fmi2String category,
-                const char *fmt, ...) {
+static void say(const fmi2CallbackFunctions *cb, int logging_on, fmi2String name, fmi2Status status,
+                fmi2String category, const char *fmt, ...) {
     char text[8192];
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(text, sizeof text, fmt, ap);
     va_end(ap);
-    if (cb != NULL && cb->logger != NULL)
+    if (logging_on && cb != NULL && cb->logger != NULL)
         log_text(cb, name, status, category, text);
     if (status >= fmi2Error)  /* hosts often leave logging off: an error must be seen somewhere */
         fprintf(stderr, "%s: %s\n", name ? name : "dtcosim FMU", text);
@@ -389,7 +391,7 @@ static void flush_log(Instance *c) {
         const char *text = msg ? py.UnicodeAsUTF8(msg) : "";
         if (py.ErrOccurred())
             py.ErrClear();
-        if ((c->logging_on || status >= fmi2Warning) && c->cb.logger != NULL)
+        if (c->logging_on && c->cb.logger != NULL)
             log_text(&c->cb, c->name, (fmi2Status)status, category ? category : "logAll", text ? text : "");
         if (st) py.DecRef(st);
         if (cat) py.DecRef(cat);
@@ -417,8 +419,10 @@ static void report_exception(Instance *c, const char *what) {
     if (tname == NULL || strcmp(tname, "FmuError") != 0) {
         char text[8192];
         snprintf(text, sizeof text, "%s: %s: %s", what, tname ? tname : "exception", vtext ? vtext : "");
-        if (c->cb.logger != NULL)
+        if (c->logging_on && c->cb.logger != NULL)
             log_text(&c->cb, c->name, fmi2Error, "logStatusError", text);
+        else
+            fprintf(stderr, "%s: %s\n", c->name, text);
     }
     if (tn) py.DecRef(tn);
     if (vs) py.DecRef(vs);
@@ -514,17 +518,17 @@ EXPORT fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, 
                                      fmi2Boolean visible, fmi2Boolean loggingOn) {
     (void)fmuGUID;
     if (fmuType != fmi2CoSimulation) {
-        say(functions, instanceName, fmi2Error, "logStatusError", "this FMU supports Co-Simulation only");
+        say(functions, loggingOn, instanceName, fmi2Error, "logStatusError", "this FMU supports Co-Simulation only");
         return NULL;
     }
     if (fmuResourceLocation == NULL) {
-        say(functions, instanceName, fmi2Error, "logStatusError", "no fmuResourceLocation given");
+        say(functions, loggingOn, instanceName, fmi2Error, "logStatusError", "no fmuResourceLocation given");
         return NULL;
     }
     char resources[2048];
     uri_to_path(fmuResourceLocation, resources, sizeof resources);
     if (!start_python(resources)) {
-        say(functions, instanceName, fmi2Error, "logStatusError", "cannot start Python: %s", start_problem);
+        say(functions, loggingOn, instanceName, fmi2Error, "logStatusError", "cannot start Python: %s", start_problem);
         return NULL;
     }
     char file[2300], module[512], class_name[256];
@@ -533,7 +537,7 @@ EXPORT fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, 
     snprintf(file, sizeof file, "%s/slaveclass.txt", resources);
     read_line(file, class_name, sizeof class_name);
     if (module[0] == '\0' || class_name[0] == '\0') {
-        say(functions, instanceName, fmi2Error, "logStatusError",
+        say(functions, loggingOn, instanceName, fmi2Error, "logStatusError",
             "%s has no slavemodule.txt or slaveclass.txt: not a dtcosim FMU's resources", resources);
         return NULL;
     }
@@ -684,7 +688,7 @@ static fmi2Status get_values(fmi2Component comp, const char *method, const fmi2V
     PyObject *list = r ? py.SequenceList(r) : NULL;
     if (r != NULL && (list == NULL || py.ListSize(list) != (Py_ssize_t)nvr)) {
         if (py.ErrOccurred()) py.ErrClear();
-        say(&c->cb, c->name, fmi2Error, "logStatusError", "%s returned %s values for %zu references", method,
+        say(&c->cb, c->logging_on, c->name, fmi2Error, "logStatusError", "%s returned %s values for %zu references", method,
             list ? "another number of" : "no list of", nvr);
         s = fmi2Error;
     } else if (r == NULL)
@@ -727,7 +731,7 @@ EXPORT fmi2Status fmi2GetString(fmi2Component comp, const fmi2ValueReference vr[
     if (nvr == 0)
         return fmi2OK;
     if (nvr > 256) {
-        say(&c->cb, c->name, fmi2Error, "logStatusError", "fmi2GetString: at most 256 references per call");
+        say(&c->cb, c->logging_on, c->name, fmi2Error, "logStatusError", "fmi2GetString: at most 256 references per call");
         return fmi2Error;
     }
     int g = py.GILState_Ensure();
@@ -882,7 +886,7 @@ EXPORT fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueR
                                                fmi2Real dvU[]) {
     (void)vUnknown; (void)nU; (void)vKnown; (void)nK; (void)dvK; (void)dvU;
     Instance *i = (Instance *)c;
-    say(&i->cb, i->name, fmi2Error, "logStatusError", "fmi2GetDirectionalDerivative is not provided");
+    say(&i->cb, i->logging_on, i->name, fmi2Error, "logStatusError", "fmi2GetDirectionalDerivative is not provided");
     return fmi2Error;
 }
 
@@ -891,7 +895,7 @@ EXPORT fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueRe
                                               const fmi2Integer order[], const fmi2Real value[]) {
     (void)vr; (void)nvr; (void)order; (void)value;
     Instance *i = (Instance *)c;
-    say(&i->cb, i->name, fmi2Error, "logStatusError", "fmi2SetRealInputDerivatives: canInterpolateInputs is false");
+    say(&i->cb, i->logging_on, i->name, fmi2Error, "logStatusError", "fmi2SetRealInputDerivatives: canInterpolateInputs is false");
     return fmi2Error;
 }
 
@@ -899,7 +903,7 @@ EXPORT fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueR
                                                const fmi2Integer order[], fmi2Real value[]) {
     (void)vr; (void)nvr; (void)order; (void)value;
     Instance *i = (Instance *)c;
-    say(&i->cb, i->name, fmi2Error, "logStatusError", "fmi2GetRealOutputDerivatives: maxOutputDerivativeOrder is 0");
+    say(&i->cb, i->logging_on, i->name, fmi2Error, "logStatusError", "fmi2GetRealOutputDerivatives: maxOutputDerivativeOrder is 0");
     return fmi2Error;
 }
 

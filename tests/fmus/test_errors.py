@@ -1,9 +1,9 @@
 """Errors reach the host with a status and a message naming the cause; the host never crashes.
 
 dtcosim's FMU binary (fmus/native/dtcosim_fmi2.c) maps a Python exception to fmi2Error (that
-instance cannot go on; pythonfmu 0.7's wrapper said fmi2Fatal) and forwards warnings and errors
-to the logger whether logging is on or not; the slaves log the message first and echo errors
-to stderr (see fmus/slaves/base.py).
+instance cannot go on; pythonfmu 0.7's wrapper said fmi2Fatal) and forwards log messages only
+with ``loggingOn``; the slaves log the message first and echo errors to stderr (see
+fmus/slaves/base.py).
 """
 
 from __future__ import annotations

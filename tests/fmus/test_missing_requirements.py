@@ -41,8 +41,7 @@ def test_hidden_numpy_gives_null_and_a_logged_message_naming_it(fmu_path, this_p
 def test_without_logging_the_message_is_still_on_stderr(fmu_path, this_python):
     report, stderr = instantiate(this_python, fmu_path("Gearbox"), attempts=1, logging_on=False,
                                  env={"PYTHONPATH": str(HIDE_NUMPY)})
-    assert report["attempts"][0]["ok"] is False
-    assert [s for s, _ in report["messages"]] == [ERROR]  # errors reach the logger with logging off too
+    assert report["attempts"][0]["ok"] is False and report["messages"] == []  # no logger call with logging off
     assert "Python module 'numpy' cannot be imported" in stderr
 
 
