@@ -1,14 +1,14 @@
-"""The linux64 binary of the dtcosim FMUs: ``fmus/native/dtcosim_fmi2.c``, compiled here, and the Python it finds.
+"""The linux64 binary of the dtcosim FMUs: ``fmus/native/*.c``, compiled here, and the Python it finds.
 
 pythonfmu's own binary (its C++ wrapper) does not link libpython, so a C host must preload it
 (``LD_PRELOAD``) and set ``PYTHONPATH``, and it corrupts the heap the host finds at exit (issue 32).
-``dtcosim_fmi2.c`` replaces it on linux64: FMI 2.0 Co-Simulation in C that runs the same Python
+``fmus/native/`` replaces it on linux64: FMI 2.0 Co-Simulation in C that runs the same Python
 slave through the CPython C API, finding and starting Python itself (its module comment says
 how). The build (:func:`fmus.build.build_fmu`) puts three things into each FMU:
 
 * ``binaries/linux64/<model>.so``: this file compiled (:func:`compiled_binary`; cached in the
-  user cache by the source's hash; ``cc -shared -fPIC -O2``, the compiler the compiled kernels
-  need). Without a C compiler the FMU keeps pythonfmu's binary and the build says so;
+  user cache by the sources' hash; ``cc -shared -fPIC -O2 -fvisibility=hidden``, the compiler the
+  compiled kernels need). Without a C compiler the FMU keeps pythonfmu's binary and the build says so;
 * ``resources/python.txt`` (:func:`python_record`): the building Python's ``libpython``, home
   (``sys.base_prefix``), version and site-packages, where the binary looks first;
 * ``resources/slaveclass.txt``: the slave's class name in the entry module
@@ -30,8 +30,10 @@ from pathlib import Path
 
 from components.compile.user_cache import user_cache_root
 
-#: the C source of the binary
-SOURCE = Path(__file__).with_name("native") / "dtcosim_fmi2.c"
+#: the C sources of the binary (the FMI functions, an instance, the Python runtime) and their header
+NATIVE_DIR = Path(__file__).with_name("native")
+SOURCES = ("dtcosim_fmi2.c", "instance.c", "python_runtime.c")
+HEADER = "dtcosim_fmu.h"
 #: resource files the binary reads
 PYTHON_FILE = "python.txt"
 CLASS_FILE = "slaveclass.txt"
@@ -79,7 +81,11 @@ def compiler() -> str | None:
 
 def source_digest() -> str:
     """16 hex digits of the binary's source: part of every FMU's build id (a changed binary rebuilds the FMUs)."""
-    return hashlib.sha256(SOURCE.read_bytes()).hexdigest()[:16]
+    return hashlib.sha256(_source_bytes()).hexdigest()[:16]
+
+
+def _source_bytes() -> bytes:
+    return b"\0".join((NATIVE_DIR / name).read_bytes() for name in (*SOURCES, HEADER))
 
 
 def compiled_binary() -> Path:
@@ -92,7 +98,7 @@ def compiled_binary() -> Path:
     """
     if not sys.platform.startswith("linux"):
         raise NativeBuildError(f"the dtcosim FMU binary is built for linux64 only (this is {sys.platform})")
-    source = SOURCE.read_bytes()
+    source = _source_bytes()
     cc = compiler()
     if cc is None:
         raise NativeBuildError("no C compiler (cc, gcc or clang) to build the FMU binary: install one "
@@ -104,10 +110,12 @@ def compiled_binary() -> Path:
     target.parent.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(dir=target.parent) as tmp:
         out = Path(tmp) / target.name
-        proc = subprocess.run([cc, "-shared", "-fPIC", "-O2", "-o", str(out), str(SOURCE), "-ldl", "-lpthread"],
+        # hidden visibility: only the fmi2 functions are exported, so no host symbol can interpose the helpers
+        proc = subprocess.run([cc, "-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-o", str(out),
+                               *(str(NATIVE_DIR / name) for name in SOURCES), "-ldl", "-lpthread"],
                               capture_output=True, text=True)
         if proc.returncode != 0 or not out.is_file():
-            raise NativeBuildError(f"{cc} could not compile {SOURCE.name}: {proc.stderr.strip()[-2000:]}")
+            raise NativeBuildError(f"{cc} could not compile {', '.join(SOURCES)}: {proc.stderr.strip()[-2000:]}")
         os.replace(out, target)  # atomic: a concurrent build finds either nothing or the whole file
     return target
 

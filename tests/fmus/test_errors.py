@@ -17,7 +17,6 @@ from fmpy.fmi1 import FMICallException
 from components.model.presets import cosim_preset
 from tests.helpers.fmu_hosts import (
     FMI_ERROR,
-    FMI_FATAL,
     Instance,
     gearbox_motion,
     run_python,
