@@ -38,6 +38,7 @@ import re
 import shutil
 import sys
 import tempfile
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Sequence
@@ -50,7 +51,7 @@ from components.errors import DtcosimError
 from components.model.drivetrain import Drivetrain
 from components.model.wind import WindParameters
 
-from . import model_description, registry, runtime_files
+from . import binary, model_description, registry, runtime_files
 from .parameter_ranges import parameter_bounds
 from .records import full_record
 from .slaves import base as slave_base
@@ -173,7 +174,7 @@ def _embedded_files(name: str, source: SourceTree) -> list[tuple[str, Path]]:
 def build_config(name: str, model: dict) -> dict:
     """Configuration that, together with the code, determines an FMU: its name and record ``model``."""
     return {"format": BUILD_FORMAT, "fmu": name, "model": model, "pythonfmu": pythonfmu.__version__,
-            "dtcosim": components.__version__}
+            "dtcosim": components.__version__, "binary": binary.source_digest()}
 
 
 def code_hash(name: str, model: dict, source: SourceTree | None = None) -> str:
@@ -380,8 +381,13 @@ def build_fmu(name: str, out_dir: Path | str, preset: str = "table6", source: So
         role=kind.role, record_file=f"resources/{RECORD_FILE}", bounds=bounds,
     )
     xml = runtime_files.describe(xml, runtime.requirements)
-    model_description.rewrite_archive(fmu_path, {model_description.MODEL_DESCRIPTION: xml,
-                                                 f"resources/{RECORD_FILE}": json.dumps(record, indent=1).encode()})
+    members = {model_description.MODEL_DESCRIPTION: xml,
+               f"resources/{RECORD_FILE}": json.dumps(record, indent=1).encode()}
+    try:
+        members.update(binary.native_members(name, name))
+    except binary.NativeBuildError as exc:  # the FMU keeps pythonfmu's binary: C hosts must preload libpython
+        warnings.warn(f"{name}.fmu keeps pythonfmu's linux64 binary: {exc}", stacklevel=2)
+    model_description.rewrite_archive(fmu_path, members)
     if validate:
         from .validation import check_fmu
 

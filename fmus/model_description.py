@@ -149,13 +149,19 @@ def read_member(fmu_path: Path, name: str = MODEL_DESCRIPTION) -> bytes:
 
 
 def rewrite_archive(fmu_path: Path, replacements: dict[str, bytes]) -> None:
-    """Rewrite an FMU archive (deflate-compressed) with some members replaced."""
+    """Rewrite an FMU archive (deflate-compressed) with some members replaced; new names are added."""
     fmu_path = Path(fmu_path)
     with zipfile.ZipFile(fmu_path) as archive:
         members = [(info, archive.read(info)) for info in archive.infolist()]
     tmp = fmu_path.with_suffix(".fmu.tmp")
+    present = {info.filename for info, _ in members}
     with zipfile.ZipFile(tmp, "w") as archive:
         for info, data in members:
             info.compress_type = zipfile.ZIP_DEFLATED
             archive.writestr(info, replacements.get(info.filename, data))
+        for name in sorted(set(replacements) - present):
+            info = zipfile.ZipInfo(name, date_time=(1980, 1, 1, 0, 0, 0))
+            info.compress_type = zipfile.ZIP_DEFLATED
+            info.external_attr = (0o755 if name.endswith(".so") else 0o644) << 16
+            archive.writestr(info, replacements[name])
     tmp.replace(fmu_path)

@@ -26,8 +26,8 @@ from .runtime_guard import REQUIREMENTS_FILE, RuntimeRequirements, format_requir
 GUARD_SOURCE = Path(__file__).with_name("runtime_guard.py")
 GUARD_FILE = "runtime_guard.py"
 
-_HEADER = ("The host process must also provide CPython's symbols (a libpython loaded with global\n"
-           "symbols, e.g. LD_PRELOAD for C/C++ hosts): see documentation/index.html.\n"
+_HEADER = ("The FMU's linux64 binary finds this Python itself (resources/python.txt, or DTCOSIM_FMU_LIBPYTHON,\n"
+           "DTCOSIM_FMU_PYTHONHOME, DTCOSIM_FMU_PYTHONPATH): see documentation/index.html.\n"
            "Ranges: from the tested minor release of each package to its next major release;\n"
            "Python: the minor version the FMU was built and tested with.")
 

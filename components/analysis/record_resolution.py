@@ -44,7 +44,6 @@ change (``sum |dx| / T``). A staircase that moves one step every ``n`` samples h
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -277,16 +276,6 @@ def step_ratio(values, steps) -> float:
     if moved == 0.0:
         return 0.0
     return float(np.sum(np.maximum(q[:-1], q[1:])) / moved)
-
-
-def round_down(x: float, digits: int = 2) -> float:
-    """``x > 0`` rounded down to ``digits`` significant digits (0.6734 -> 0.67)."""
-    if not (x > 0.0 and math.isfinite(x)):
-        return x
-    e = math.floor(math.log10(x)) - digits + 1
-    if e < 0:
-        return math.floor(x * 10.0 ** -e * (1 + 1e-12)) / 10.0 ** -e
-    return math.floor(x / 10.0 ** e * (1 + 1e-12)) * 10.0 ** e
 
 
 def lowpass_zero_phase(values, interval_s: float, cutoff_hz: float, order: int = 2) -> np.ndarray:

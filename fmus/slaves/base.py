@@ -26,15 +26,15 @@ How errors reach the host (pythonfmu 0.7 C wrapper)
   bad inputs and a communication point or step that is not a finite number
   (a step must also be > 0); the component state is left at the last
   communication point.
-* There is no way to return ``fmi2Error`` from Python: a Python exception
-  becomes ``fmi2Fatal`` and its text is lost ("unknown error"), so the message
-  is always logged first (:meth:`_fail`). The wrapper also releases its
+* A Python exception becomes ``fmi2Error`` in dtcosim's binary
+  (``fmus/native/dtcosim_fmi2.c``), and ``fmi2Fatal`` with its text lost ("unknown
+  error") in pythonfmu 0.7's C++ wrapper (still the win64 binary), so the message
+  is always logged first (:meth:`_fail`). pythonfmu's wrapper also releases its
   references to the instance, the class and the log queue when the exception
   reaches it and again in ``fmi2FreeInstance``; that double release crashed
   the host after a few failed instances. :func:`_balance_wrapper_release` adds
-  the one reference the wrapper takes back, so a host can free a failed
-  instance safely (with a wrapper that does not over-release, one instance
-  leaks per failure).
+  the one reference that wrapper takes back, only under that wrapper (it passes a
+  ``logger`` keyword, dtcosim's binary does not).
 """
 
 from __future__ import annotations
@@ -167,7 +167,11 @@ class DtcosimSlave(Fmi2Slave):
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__(**kwargs)
-        register_state_release(self.resources)  # pythonfmu's exit-time use-after-free, see .shutdown
+        #: created by pythonfmu's C++ wrapper (the win64 binary, or a build without a C compiler), which passes
+        #: its logger; dtcosim's own binary (fmus/native/dtcosim_fmi2.c) passes none and needs no work-arounds
+        self._pythonfmu_wrapper = "logger" in kwargs
+        if self._pythonfmu_wrapper:
+            register_state_release(self.resources)  # pythonfmu's exit-time use-after-free, see .shutdown
         #: the parameter set of this FMU's record (structure and defaults)
         record = read_fmu_record(self.resources)
         self.model: dict[str, Any] = record["model"]
@@ -294,10 +298,12 @@ class DtcosimSlave(Fmi2Slave):
             print(f"[{type(self).__name__} {self.instance_name!r}] {message}", file=sys.stderr, flush=True)
 
     def _fail(self, context: str, exc: BaseException) -> None:
-        """Log ``exc`` (:func:`plain_reason`) and raise it to the wrapper (the host gets ``fmi2Fatal``)."""
+        """Log ``exc`` (:func:`plain_reason`) and raise it to the binary (the host gets ``fmi2Error``;
+        ``fmi2Fatal`` from pythonfmu's wrapper)."""
         message = f"{context}: {plain_reason(exc)}"
         self._report(message, Fmi2Status.error)
-        _balance_wrapper_release(self)
+        if self._pythonfmu_wrapper:
+            _balance_wrapper_release(self)
         raise FmuError(message) from None
 
     # ---------------------------------------------------------------- life cycle

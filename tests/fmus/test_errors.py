@@ -1,8 +1,9 @@
 """Errors reach the host with a status and a message naming the cause; the host never crashes.
 
-pythonfmu 0.7 maps a Python exception to fmi2Fatal (there is no way to return
-fmi2Error from Python) and forwards log messages only with ``loggingOn``; the
-slaves log the message first and echo errors to stderr (see fmus/slaves/base.py).
+dtcosim's FMU binary (fmus/native/dtcosim_fmi2.c) maps a Python exception to fmi2Error (that
+instance cannot go on; pythonfmu 0.7's wrapper said fmi2Fatal) and forwards log messages only
+with ``loggingOn``; the slaves log the message first and echo errors to stderr (see
+fmus/slaves/base.py).
 """
 
 from __future__ import annotations
@@ -16,7 +17,6 @@ from fmpy.fmi1 import FMICallException
 from components.model.presets import cosim_preset
 from tests.helpers.fmu_hosts import (
     FMI_ERROR,
-    FMI_FATAL,
     Instance,
     gearbox_motion,
     run_python,
@@ -146,7 +146,7 @@ def test_host_misuse_is_reported(fmu_path):
     assert any(s == 1 and "inertia is fixed after initialisation" in m for s, m in inst.messages)
     with pytest.raises(FMICallException) as failure:
         inst.set(omega=1.0)
-    assert failure.value.status == FMI_FATAL
+    assert failure.value.status == FMI_ERROR
     assert any("setReal: TypeError: omega is an output and cannot be set" in m for m in inst.error_messages())
     inst.free()
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import importlib.util
 import math
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -136,3 +137,37 @@ def run_python(python: Path | str, *args: str, env: dict | None = None, timeout:
     full_env.update(env or {})
     return subprocess.run([str(python), *args], capture_output=True, text=True, env=full_env, timeout=timeout,
                           cwd="/")
+
+
+#: the environment of a C host started from a desktop: no Python anywhere, the system's PATH only
+SYSTEM_ENV = {"PATH": "/usr/bin:/bin"}
+
+
+def c_host(tmp_path: Path) -> Path:
+    """``drivers/c_host.c`` compiled into ``tmp_path`` (skips the test without a C compiler)."""
+    import pytest
+
+    compiler = shutil.which("cc") or shutil.which("gcc")
+    if compiler is None:
+        pytest.skip("no C compiler")
+    host = tmp_path / "c_host"
+    if not host.exists():
+        subprocess.run([compiler, "-O1", "-o", str(host), str(DRIVERS / "c_host.c"), "-ldl"], check=True,
+                       capture_output=True)
+    return host
+
+
+def c_host_args(host: Path, fmu: Path, folder: Path, steps: int, output: str, inputs: tuple[str, ...] = ()) -> list[str]:
+    """The command line of ``c_host`` for an FMU unpacked into ``folder``: its binary, resources, GUID, VRs."""
+    import zipfile
+
+    from fmpy import read_model_description
+
+    if not folder.exists():
+        with zipfile.ZipFile(fmu) as archive:
+            archive.extractall(folder)
+    md = read_model_description(str(fmu))
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    model = md.coSimulation.modelIdentifier
+    return [str(host), str(folder / "binaries" / "linux64" / f"{model}.so"), (folder / "resources").as_uri(), md.guid,
+            str(steps), str(vr[output])] + [str(vr[n]) for n in inputs]

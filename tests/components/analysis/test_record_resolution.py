@@ -8,7 +8,6 @@ import pytest
 from components.analysis.record_resolution import (
     estimate_resolution,
     lowpass_zero_phase,
-    round_down,
     sampling_of,
     significant_digits,
     step_ratio,
@@ -86,6 +85,3 @@ def test_a_cut_off_at_or_above_nyquist_is_refused(cutoff, match):
     with pytest.raises(ParameterError, match=match):
         lowpass_zero_phase(np.zeros(100), 0.05, cutoff)
 
-
-def test_round_down():
-    assert round_down(0.6734) == 0.67 and round_down(1234.0) == 1200.0

@@ -1,0 +1,134 @@
+"""The linux64 binary of the dtcosim FMUs: ``fmus/native/*.c``, compiled here, and the Python it finds.
+
+pythonfmu's own binary (its C++ wrapper) does not link libpython, so a C host must preload it
+(``LD_PRELOAD``) and set ``PYTHONPATH``, and it corrupts the heap the host finds at exit (issue 32).
+``fmus/native/`` replaces it on linux64: FMI 2.0 Co-Simulation in C that runs the same Python
+slave through the CPython C API, finding and starting Python itself (its module comment says
+how). The build (:func:`fmus.build.build_fmu`) puts three things into each FMU:
+
+* ``binaries/linux64/<model>.so``: this file compiled (:func:`compiled_binary`; cached in the
+  user cache by the sources' hash; ``cc -shared -fPIC -O2 -fvisibility=hidden``, the compiler the
+  compiled kernels need). Without a C compiler the FMU keeps pythonfmu's binary and the build says so;
+* ``resources/python.txt`` (:func:`python_record`): the building Python's ``libpython``, home
+  (``sys.base_prefix``), version and site-packages, where the binary looks first;
+* ``resources/slaveclass.txt``: the slave's class name in the entry module
+  (``resources/slavemodule.txt``, written by pythonfmu).
+
+The other platforms' binaries (``win64``) stay pythonfmu's.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import shutil
+import subprocess
+import sys
+import sysconfig
+import tempfile
+from pathlib import Path
+
+from components.compile.user_cache import user_cache_root
+
+#: the C sources of the binary (the FMI functions, an instance, the Python runtime) and their header
+NATIVE_DIR = Path(__file__).with_name("native")
+SOURCES = ("dtcosim_fmi2.c", "instance.c", "python_runtime.c")
+HEADER = "dtcosim_fmu.h"
+#: resource files the binary reads
+PYTHON_FILE = "python.txt"
+CLASS_FILE = "slaveclass.txt"
+#: the FMU member the binary replaces
+BINARY_FOLDER = "binaries/linux64"
+
+
+class NativeBuildError(RuntimeError):
+    """The binary could not be compiled (the message says why and what to install)."""
+
+
+def libpython() -> Path | None:
+    """The shared libpython of this interpreter, or None (a statically linked Python has none)."""
+    name = sysconfig.get_config_var("LDLIBRARY") or ""
+    libdir = sysconfig.get_config_var("LIBDIR") or ""
+    if not name.endswith(".so") and ".so." not in name:
+        return None
+    path = Path(libdir) / name
+    return path if path.is_file() else None
+
+
+def site_folders() -> list[str]:
+    """The site-packages of this environment (purelib, platlib), where numpy and scipy are."""
+    paths = sysconfig.get_paths()
+    return list(dict.fromkeys(str(Path(paths[k]).resolve()) for k in ("purelib", "platlib") if paths.get(k)))
+
+
+def python_record() -> str:
+    """``resources/python.txt``: ``key=value`` lines the binary reads (libpython, home, version, path...)."""
+    lib = libpython()
+    lines = [f"libpython={'' if lib is None else lib}", f"home={sys.base_prefix}",
+             f"version={sys.version_info.major}.{sys.version_info.minor}"]
+    lines += [f"path={p}" for p in site_folders()]
+    return "\n".join(lines) + "\n"
+
+
+def compiler() -> str | None:
+    """A C compiler: ``$CC``, then Python's own (sysconfig ``CC``), then cc, gcc, clang."""
+    for candidate in (os.environ.get("CC"), (sysconfig.get_config_var("CC") or "").split(" ")[0], "cc", "gcc",
+                      "clang"):
+        if candidate and shutil.which(candidate):
+            return shutil.which(candidate)
+    return None
+
+
+def source_digest() -> str:
+    """16 hex digits of the binary's source: part of every FMU's build id (a changed binary rebuilds the FMUs)."""
+    return hashlib.sha256(_source_bytes()).hexdigest()[:16]
+
+
+def _source_bytes() -> bytes:
+    return b"\0".join((NATIVE_DIR / name).read_bytes() for name in (*SOURCES, HEADER))
+
+
+def compiled_binary() -> Path:
+    """The compiled binary (built once per source version into the user cache).
+
+    Raises
+    ------
+    NativeBuildError
+        No C compiler, or the compiler failed (its output in the message).
+    """
+    if not sys.platform.startswith("linux"):
+        raise NativeBuildError(f"the dtcosim FMU binary is built for linux64 only (this is {sys.platform})")
+    source = _source_bytes()
+    cc = compiler()
+    if cc is None:
+        raise NativeBuildError("no C compiler (cc, gcc or clang) to build the FMU binary: install one "
+                               "(Debian: apt install gcc), or the FMU keeps pythonfmu's binary")
+    key = hashlib.sha256(source + cc.encode()).hexdigest()[:16]
+    target = user_cache_root() / "native" / key / "dtcosim_fmi2.so"
+    if target.is_file():
+        return target
+    target.parent.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(dir=target.parent) as tmp:
+        out = Path(tmp) / target.name
+        # hidden visibility: only the fmi2 functions are exported, so no host symbol can interpose the helpers
+        proc = subprocess.run([cc, "-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-o", str(out),
+                               *(str(NATIVE_DIR / name) for name in SOURCES), "-ldl", "-lpthread"],
+                              capture_output=True, text=True)
+        if proc.returncode != 0 or not out.is_file():
+            raise NativeBuildError(f"{cc} could not compile {', '.join(SOURCES)}: {proc.stderr.strip()[-2000:]}")
+        os.replace(out, target)  # atomic: a concurrent build finds either nothing or the whole file
+    return target
+
+
+def native_members(model_identifier: str, class_name: str) -> dict[str, bytes]:
+    """The FMU members this module adds or replaces (see the module docstring).
+
+    Raises
+    ------
+    NativeBuildError
+        As :func:`compiled_binary`.
+    """
+    binary = compiled_binary().read_bytes()
+    return {f"{BINARY_FOLDER}/{model_identifier}.so": binary,
+            f"resources/{PYTHON_FILE}": python_record().encode(),
+            f"resources/{CLASS_FILE}": (class_name + "\n").encode()}

@@ -1,0 +1,78 @@
+"""The FMUs' own linux64 binary (fmus/binary.py, fmus/native/): what it exports, what it records, how it builds."""
+
+from __future__ import annotations
+
+import ctypes
+import sys
+import sysconfig
+import zipfile
+
+import pytest
+
+from fmus import binary
+
+#: the FMI 2.0 functions of a co-simulation FMU (the standard's fmi2Functions.h: common and co-simulation)
+FMI2_CS_FUNCTIONS = (
+    "fmi2GetTypesPlatform", "fmi2GetVersion", "fmi2SetDebugLogging", "fmi2Instantiate", "fmi2FreeInstance",
+    "fmi2SetupExperiment", "fmi2EnterInitializationMode", "fmi2ExitInitializationMode", "fmi2Terminate", "fmi2Reset",
+    "fmi2GetReal", "fmi2GetInteger", "fmi2GetBoolean", "fmi2GetString", "fmi2SetReal", "fmi2SetInteger",
+    "fmi2SetBoolean", "fmi2SetString", "fmi2GetFMUstate", "fmi2SetFMUstate", "fmi2FreeFMUstate",
+    "fmi2SerializedFMUstateSize", "fmi2SerializeFMUstate", "fmi2DeSerializeFMUstate", "fmi2GetDirectionalDerivative",
+    "fmi2SetRealInputDerivatives", "fmi2GetRealOutputDerivatives", "fmi2DoStep", "fmi2CancelStep", "fmi2GetStatus",
+    "fmi2GetRealStatus", "fmi2GetIntegerStatus", "fmi2GetBooleanStatus", "fmi2GetStringStatus",
+)
+
+pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the binary is built for linux64")
+
+
+@pytest.fixture(scope="module")
+def library():
+    try:
+        path = binary.compiled_binary()
+    except binary.NativeBuildError as exc:
+        pytest.skip(str(exc))
+    return ctypes.CDLL(str(path))
+
+
+def test_it_exports_every_fmi2_co_simulation_function_and_no_helper(library):
+    missing = [name for name in FMI2_CS_FUNCTIONS if not hasattr(library, name)]
+    assert missing == []
+    for helper in ("start_python", "call", "say", "log_text", "flush_log", "py"):  # hidden: no host can interpose them
+        assert not hasattr(library, helper), helper
+    library.fmi2GetVersion.restype = ctypes.c_char_p
+    library.fmi2GetTypesPlatform.restype = ctypes.c_char_p
+    assert library.fmi2GetVersion() == b"2.0" and library.fmi2GetTypesPlatform() == b"default"
+
+
+def test_python_record_names_this_interpreter():
+    lines = binary.python_record().splitlines()
+    record = {}
+    for line in lines:
+        key, _, value = line.partition("=")
+        record.setdefault(key, []).append(value)
+    assert record["home"] == [sys.base_prefix]
+    assert record["version"] == [f"{sys.version_info.major}.{sys.version_info.minor}"]
+    assert sysconfig.get_paths()["purelib"] in record["path"] or any(p.endswith("site-packages") for p in record["path"])
+    lib = binary.libpython()
+    assert record["libpython"] == ["" if lib is None else str(lib)]
+
+
+def test_the_build_id_follows_the_binary_s_sources(monkeypatch, tmp_path):
+    before = binary.source_digest()
+    copy = tmp_path / "native"
+    copy.mkdir()
+    for name in (*binary.SOURCES, binary.HEADER):
+        (copy / name).write_bytes((binary.NATIVE_DIR / name).read_bytes())
+    (copy / binary.SOURCES[0]).write_bytes((copy / binary.SOURCES[0]).read_bytes() + b"\n/* changed */\n")
+    monkeypatch.setattr(binary, "NATIVE_DIR", copy)
+    assert binary.source_digest() != before
+
+
+def test_every_built_fmu_carries_the_binary_and_its_records(fmu_path):
+    for name in ("Gearbox", "WindSource", "GeneratorRotor"):
+        with zipfile.ZipFile(fmu_path(name)) as archive:
+            names = set(archive.namelist())
+            assert f"binaries/linux64/{name}.so" in names and "binaries/win64/" + name + ".dll" in names
+            assert archive.read(f"binaries/linux64/{name}.so") == binary.compiled_binary().read_bytes()
+            assert archive.read("resources/slaveclass.txt").decode().strip() == name
+            assert archive.read("resources/python.txt").decode() == binary.python_record()
