@@ -1,8 +1,9 @@
 """``dtcosim loads``: run a load-case set on Dask workers and write lifetime DELs, damage, LDD and LRD.
 
 Exit status: 0 every run finished (``ok`` or ``failed``); 1 invalid set, or runs
-that hit an infrastructure error (re-tried by the next call); 130 interrupted
-(finished runs are kept; the same command continues).
+that hit an infrastructure error (re-tried by the next call); 128 + the signal when
+interrupted: 130 Ctrl-C, 143 SIGTERM, 129 SIGHUP (finished runs are kept; the same command
+continues).
 """
 
 from __future__ import annotations
@@ -206,5 +207,5 @@ def run(args: argparse.Namespace) -> int:
     if report.interrupted:
         print(f"dtcosim loads: interrupted; finished runs kept in {out_dir / JOURNAL_FILE}; run the same command "
               "again to continue", file=sys.stderr)
-        return 130
+        return 128 + (report.signal or 2)
     return 1 if counts["error"] or counts["pending"] else 0
