@@ -114,7 +114,7 @@ def run(args: argparse.Namespace) -> int:
     import uuid
 
     from ..inputs.load_case_file import find_load_cases, load_load_cases
-    from ..inputs.load_cases import LoadCaseError
+    from ..inputs.load_cases import MAX_SEEDS, LoadCaseError
     from ..study.journal import JOURNAL_FILE, read_journal
     from ..study.lifetime_outputs import write_lifetime_outputs
     from ..study.lifetime_results import check_curves, mark_missing_run_files, store_run_data
@@ -132,8 +132,8 @@ def run(args: argparse.Namespace) -> int:
         if value is not None:
             changes[attr] = None if value in ("to_stop", "settled") else value
     if args.seeds is not None:
-        if args.seeds < 1:
-            raise LoadCaseError("--seeds", args.seeds, "an integer >= 1")
+        if not 1 <= args.seeds <= MAX_SEEDS:  # before a tuple of that many exists
+            raise LoadCaseError("--seeds", args.seeds, f"an integer from 1 to {MAX_SEEDS}")
         changes["seeds"] = tuple(range(1, args.seeds + 1))
     if changes:
         lcs = replace(lcs, **changes)
