@@ -12,6 +12,8 @@ import zipfile
 
 import pytest
 
+from fmus.model_description import rewrite_archive
+
 from orchestrator.commands.cli import main
 from orchestrator.cosim.system import resolve_system
 from orchestrator.errors import ScenarioError
@@ -150,6 +152,9 @@ def _copy_without(src, dst, prefix):
                            "it has binaries for: win64"),
     ("not a zip", "a readable FMU"),
     ("truncated", "a readable FMU"),
+    # a module that does not exist crashed `dtcosim run` with exit 139 and passed validate (issue 35.1)
+    ("missing module", "resources/slavemodule.txt names the slave module 'no_such_module', which is not in "
+                       "resources/"),
 ])
 def test_a_broken_fmu_file_is_a_named_error_not_a_crash(fmu_dir, tmp_path, capsys, damage, expected):
     folder = tmp_path / "fmus"
@@ -159,6 +164,8 @@ def test_a_broken_fmu_file_is_a_named_error_not_a_crash(fmu_dir, tmp_path, capsy
         gearbox.write_text("not an archive")
     elif damage == "truncated":
         gearbox.write_bytes(gearbox.read_bytes()[:2000])
+    elif damage == "missing module":
+        rewrite_archive(gearbox, {"resources/slavemodule.txt": b"no_such_module\n"})
     else:
         _copy_without(fmu_dir / "Gearbox.fmu", gearbox, damage)
     assert main(["run", "--fmu-dir", str(folder), "--no-build", "--stop", "0.1", "--out", str(tmp_path / "o")]) == 1
