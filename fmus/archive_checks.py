@@ -24,6 +24,15 @@ RECORD_MEMBER = "resources/dtcosim.json"
 PLATFORM_EXTENSIONS = {"linux64": ".so", "linux32": ".so", "win64": ".dll", "win32": ".dll", "darwin64": ".dylib"}
 
 
+def _slave_module(path: Path | str) -> str | None:
+    """The module ``resources/slavemodule.txt`` names (None: unreadable)."""
+    try:
+        with zipfile.ZipFile(path) as archive:
+            return archive.read(PYTHONFMU_MODULE_FILE).decode("utf-8").strip() or None
+    except (zipfile.BadZipFile, OSError, KeyError, UnicodeDecodeError):
+        return None
+
+
 def platform_binary(model_identifier: str) -> str:
     """The archive member of the binary this host loads: ``binaries/linux64/<id>.so`` here."""
     from fmpy import platform, sharedLibraryExtension
@@ -78,6 +87,11 @@ def archive_problems(path: str | Path, model_identifier: str | None, generation_
     if "pythonfmu" in tool and PYTHONFMU_MODULE_FILE not in names:
         problems.append(f"no {PYTHONFMU_MODULE_FILE}: a PythonFMU binary cannot find its slave without its "
                         "resources folder")
+    elif "pythonfmu" in tool:
+        module = _slave_module(path)
+        if module is not None and not ({f"resources/{module}.py", f"resources/{module}/__init__.py"} & names):
+            problems.append(f"{PYTHONFMU_MODULE_FILE} names the slave module {module!r}, which is not in "
+                            f"resources/ (no resources/{module}.py): the FMU cannot create its slave")
     if tool.startswith("dtcosim") and RECORD_MEMBER not in names:
         problems.append(f"no {RECORD_MEMBER}: a dtcosim FMU reads its model from its record")
     return problems

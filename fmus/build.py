@@ -31,9 +31,11 @@ checked with ``fmpy.validation``.
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import importlib
 import json
+import os
 import re
 import shutil
 import sys
@@ -357,6 +359,17 @@ def build_fmu(name: str, out_dir: Path | str, preset: str = "table6", source: So
         model = kind.model(drivetrain, wind)
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
+    # written, completed and checked under a temporary name in the same folder, then renamed: an interrupted
+    # build leaves no FMU under the final name, and two builds into one folder each rename a whole archive
+    with tempfile.TemporaryDirectory(prefix=f".{name}-building-", dir=out_dir) as part:
+        built = _build_archive(name, kind, model, origin, source, Path(part), resources, validate)
+        final = out_dir / f"{name}.fmu"
+        os.replace(built.path, final)
+    return dataclasses.replace(built, path=final)
+
+
+def _build_archive(name, kind, model, origin, source, part_dir: Path, resources, validate) -> BuiltFmu:
+    """The whole FMU ``<part_dir>/<name>.fmu`` (see :func:`build_fmu`)."""
     with tempfile.TemporaryDirectory(prefix="dtcosim_fmu_") as tmp:
         script, package_dir, build_id = stage(name, model, origin, Path(tmp), source)
         package = package_dir.name
@@ -364,7 +377,7 @@ def build_fmu(name: str, out_dir: Path | str, preset: str = "table6", source: So
                                       [path for _, path in _embedded_files(name, source)])
         importlib.invalidate_caches()
         try:
-            fmu_path = Path(FmuBuilder.build_FMU(script, dest=out_dir / f"{name}.fmu",
+            fmu_path = Path(FmuBuilder.build_FMU(script, dest=part_dir / f"{name}.fmu",
                                                  project_files=[package_dir, Path(tmp) / RECORD_FILE,
                                                                 runtime.requirements_file,
                                                                 *_staged_resources(Path(tmp), resources)],

@@ -1,8 +1,9 @@
 """``dtcosim loads``: run a load-case set on Dask workers and write lifetime DELs, damage, LDD and LRD.
 
 Exit status: 0 every run finished (``ok`` or ``failed``); 1 invalid set, or runs
-that hit an infrastructure error (re-tried by the next call); 130 interrupted
-(finished runs are kept; the same command continues).
+that hit an infrastructure error (re-tried by the next call); 128 + the signal when
+interrupted: 130 Ctrl-C, 143 SIGTERM, 129 SIGHUP (finished runs are kept; the same command
+continues).
 """
 
 from __future__ import annotations
@@ -113,7 +114,7 @@ def run(args: argparse.Namespace) -> int:
     import uuid
 
     from ..inputs.load_case_file import find_load_cases, load_load_cases
-    from ..inputs.load_cases import LoadCaseError
+    from ..inputs.load_cases import MAX_SEEDS, LoadCaseError
     from ..study.journal import JOURNAL_FILE, read_journal
     from ..study.lifetime_outputs import write_lifetime_outputs
     from ..study.lifetime_results import check_curves, mark_missing_run_files, store_run_data
@@ -131,8 +132,8 @@ def run(args: argparse.Namespace) -> int:
         if value is not None:
             changes[attr] = None if value in ("to_stop", "settled") else value
     if args.seeds is not None:
-        if args.seeds < 1:
-            raise LoadCaseError("--seeds", args.seeds, "an integer >= 1")
+        if not 1 <= args.seeds <= MAX_SEEDS:  # before a tuple of that many exists
+            raise LoadCaseError("--seeds", args.seeds, f"an integer from 1 to {MAX_SEEDS}")
         changes["seeds"] = tuple(range(1, args.seeds + 1))
     if changes:
         lcs = replace(lcs, **changes)
@@ -206,5 +207,5 @@ def run(args: argparse.Namespace) -> int:
     if report.interrupted:
         print(f"dtcosim loads: interrupted; finished runs kept in {out_dir / JOURNAL_FILE}; run the same command "
               "again to continue", file=sys.stderr)
-        return 130
+        return 128 + (report.signal or 2)
     return 1 if counts["error"] or counts["pending"] else 0

@@ -8,6 +8,9 @@ subclass, raised before anything runs.
 
 from __future__ import annotations
 
+import os
+import stat
+import sys
 import tomllib
 from importlib import resources
 from pathlib import Path
@@ -19,16 +22,33 @@ from ..errors import EntryError
 DATA_PACKAGE = "orchestrator"
 
 
+#: the largest input file read [bytes]: the packaged ones are below 20 kB
+MAX_INPUT_BYTES = 16 * 2**20
+
+
 def read_toml(path: str | Path, error: type[EntryError]) -> dict[str, Any]:
     """The parsed TOML file at ``path``.
+
+    Only a regular file of at most :data:`MAX_INPUT_BYTES` is read (a FIFO or ``/dev/zero`` would
+    block or never end); nesting too deep for the parser and integers of more digits than Python
+    converts are refused as invalid TOML.
 
     Raises
     ------
     EntryError
-        ``error`` with key ``(file)`` if the file cannot be read or is not UTF-8 text,
-        ``(syntax)`` if it is not valid TOML.
+        ``error`` with key ``(file)`` if the file cannot be read, is no regular file, is too large
+        or is not UTF-8 text, ``(syntax)`` if it is not valid TOML.
     """
     path = Path(path)
+    try:
+        info = os.stat(path)
+    except OSError as exc:
+        raise error("(file)", str(path), f"a readable {error.kind} file ({exc.strerror})") from None
+    if not stat.S_ISREG(info.st_mode):
+        raise error("(file)", str(path), f"a regular {error.kind} file (this is a device, pipe or folder)") from None
+    if info.st_size > MAX_INPUT_BYTES:
+        raise error("(file)", str(path), f"a {error.kind} file of at most {MAX_INPUT_BYTES // 2**20} MiB "
+                    f"({info.st_size} bytes)") from None
     try:
         text = path.read_text(encoding="utf-8")
     except OSError as exc:
@@ -41,6 +61,12 @@ def read_toml(path: str | Path, error: type[EntryError]) -> dict[str, Any]:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise error("(syntax)", str(path), f"valid TOML ({exc})") from None
+    except RecursionError:
+        raise error("(syntax)", str(path), "valid TOML nested less deeply (arrays or inline tables nested "
+                    "beyond what the parser follows)") from None
+    except ValueError:  # an integer beyond Python's int-from-string limit
+        raise error("(syntax)", str(path), f"valid TOML with integers of at most {sys.get_int_max_str_digits()} "
+                    "digits") from None
 
 
 def packaged_files(folder: str) -> dict[str, Path]:

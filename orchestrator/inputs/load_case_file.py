@@ -29,6 +29,7 @@ from .load_cases import (
     DEFAULT_LENGTH_S,
     DEFAULT_LEVELS,
     FOLDER,
+    MAX_SEEDS,
     SETTLED,
     TO_STOP,
     CurveRule,
@@ -269,6 +270,10 @@ def load_cases_from_dict(data: Mapping[str, Any], name: str | None = None, base_
     path = _scenario_path(doc.base.scenario, base_dir, source)
     params = flatten_parameters(doc.base.parameters, "base.parameters", LoadCaseError, source)
     runs = doc.runs
+    count = runs.seeds if isinstance(runs.seeds, int) else len(runs.seeds)
+    if count > MAX_SEEDS:  # before a tuple of that many exists
+        raise LoadCaseError("runs.seeds", runs.seeds if isinstance(runs.seeds, int) else count,
+                            f"at most {MAX_SEEDS} seeds per bin", source)
     seeds = tuple(range(1, runs.seeds + 1)) if isinstance(runs.seeds, int) else tuple(runs.seeds)
     if runs.seed_parameter:
         comp, _, param = runs.seed_parameter.partition(".")

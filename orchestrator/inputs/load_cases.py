@@ -68,6 +68,10 @@ DEFAULT_TRANSIENT_S = 10.0
 #: (:func:`orchestrator.cosim.operating_point.settling_of`: five time constants of its slowest mode at
 #: the base scenario's start)
 SETTLED = "settled"
+#: the most seeds per bin and runs per set: far above any design load case set (IEC 61400-1 asks for six
+#: seeds per bin), low enough that a mistyped count is refused before anything is allocated
+MAX_SEEDS = 1000
+MAX_RUNS = 100_000
 #: ``runs.length = "to_stop"``: each run analyses up to the base scenario's stop (a record's end)
 TO_STOP = "to_stop"
 DEFAULT_EXPONENTS = (3.0, 5.0, 8.0, 10.0)
@@ -259,6 +263,8 @@ class LoadCaseSet:
             raise LoadCaseError("runs.transient", self.transient_s, "a transient >= 0 s", src)
         if not self.seeds:
             raise LoadCaseError("runs.seeds", list(self.seeds), "at least one seed", src)
+        if len(self.seeds) > MAX_SEEDS:
+            raise LoadCaseError("runs.seeds", len(self.seeds), f"at most {MAX_SEEDS} seeds per bin", src)
         if len(set(self.seeds)) != len(self.seeds):
             raise LoadCaseError("runs.seeds", list(self.seeds), "distinct seeds", src)
         edges = np.asarray(self.edges_m_s, dtype=float)
@@ -268,6 +274,9 @@ class LoadCaseSet:
             if not self.edges_m_s[0] <= row.wind_speed_m_s < self.edges_m_s[-1]:
                 raise LoadCaseError(f"operating_points[{i}].wind_speed", row.wind_speed_m_s,
                                     f"a wind speed inside the bins [{self.edges_m_s[0]:g}, {self.edges_m_s[-1]:g}) m/s", src)
+        if self.n_runs > MAX_RUNS:
+            raise LoadCaseError("runs.seeds", len(self.seeds), f"at most {MAX_RUNS} runs in a set ({len(edges) - 1} "
+                                f"bins x {len(self.seeds)} seeds = {self.n_runs})", src)
         taken: dict[int, int] = {}
         for i, row in enumerate(self.rows):
             b = self.bin_of(row.wind_speed_m_s)

@@ -19,6 +19,8 @@ and parameter values) change a scenario the same way:
 
 from __future__ import annotations
 
+import math
+
 from dataclasses import dataclass, fields
 from typing import Any, Mapping
 
@@ -77,7 +79,9 @@ class SimulationOverrides:
         """The :class:`~orchestrator.inputs.scenario.SimulationSettings` changes and notes for ``sim``."""
         changes = {f.name: getattr(self, f.name) for f in fields(self) if getattr(self, f.name) is not None}
         notes: list[str] = []
-        if self.step_s is not None and self.output_interval_s is None:
+        # a step that is no finite number > 0 is left to the settings' validation (an error naming the key)
+        if self.step_s is not None and self.output_interval_s is None and math.isfinite(self.step_s) \
+                and self.step_s > 0.0:
             ratio = sim.output_interval_s / self.step_s
             if ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-9 * ratio:
                 changes["output_interval_s"] = self.step_s

@@ -18,7 +18,7 @@ from fmus.registry import DRIVETRAIN_FILE, names_built_from
 
 from ..inputs.drivetrain_file import DrivetrainSpec
 from .folders import drivetrain_fmu_dir
-from .staleness import stale_project_fmus
+from .staleness import broken_fmu, stale_project_fmus
 
 #: the FMUs a drivetrain file is built into
 DRIVETRAIN_FMU_NAMES = names_built_from(DRIVETRAIN_FILE)
@@ -57,7 +57,7 @@ def ensure_drivetrain_fmus(spec: DrivetrainSpec, fmu_dir: Path, names: Iterable[
     paths = {n: folder / f"{n}.fmu" for n in names}
     todo = [n for n, p in paths.items() if not p.is_file()]
     present = {n: p for n, p in paths.items() if p.is_file()}
-    todo += [n for n in present if stale_project_fmus({n: present[n]})]
+    todo += [n for n in present if broken_fmu(present[n]) or stale_project_fmus({n: present[n]})]
     if todo:
         build_drivetrain_fmus(spec, folder, sorted(set(todo)), report)
     return folder

@@ -26,6 +26,7 @@ from ..inputs.scenario import Scenario
 from .drivetrain_fmus import ensure_drivetrain_fmus
 from .folders import default_fmu_dir
 from .locate import missing_fmus, resolve_fmu_paths
+from .staleness import broken_fmu
 from .series_fmus import ensure_series_fmu
 
 
@@ -66,7 +67,10 @@ def ensure_fmus(scenario: Scenario, fmu_dir: str | Path | None = None, build: bo
         for comp in scenario.components:
             if comp.series is not None:
                 ensure_series_fmu(comp.series, fmu_dir, report)
-        names = sorted({_preset_fmu(scenario, comp) for comp in missing_fmus(scenario, fmu_dir)} - {None})
+        # missing, or broken in the folder dtcosim builds into (an interrupted build of an older version)
+        broken = [comp.name for comp in scenario.components if (fmu_dir / comp.fmu.name).is_file()
+                  and _preset_fmu(scenario, comp.name) is not None and broken_fmu(fmu_dir / comp.fmu.name)]
+        names = sorted({_preset_fmu(scenario, comp) for comp in [*missing_fmus(scenario, fmu_dir), *broken]} - {None})
         if names:
             if report:
                 report(f"building {', '.join(n + '.fmu' for n in names)} into {fmu_dir} ...")

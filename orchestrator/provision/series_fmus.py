@@ -19,7 +19,7 @@ from fmus.slaves.time_series_source import DATA_FILE
 
 from ..inputs.series_spec import SeriesSpec
 from .folders import series_fmu_dir
-from .staleness import stale_project_fmus
+from .staleness import broken_fmu, stale_project_fmus
 
 #: the FMU a load record is built into
 (SERIES_FMU,) = built_from(LOAD_RECORD)
@@ -40,6 +40,6 @@ def build_series_fmu(spec: SeriesSpec, out_dir: Path, report: Callable[[str], No
 def ensure_series_fmu(spec: SeriesSpec, fmu_dir: Path, report: Callable[[str], None] | None = None) -> Path:
     """The TimeSeriesSource FMU of ``spec`` in ``fmu_dir``, built when missing or stale."""
     path = series_fmu_dir(fmu_dir, spec) / SERIES_FMU.file_name
-    if not path.is_file() or stale_project_fmus({"series": path}):
+    if not path.is_file() or broken_fmu(path) or stale_project_fmus({"series": path}):
         build_series_fmu(spec, path.parent, report)
     return path

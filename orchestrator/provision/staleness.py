@@ -21,6 +21,25 @@ from fmus.slaves.record import RECORD_FILE
 _BUILD_ID = re.compile(r"^_dtcosim_[a-z]+_([0-9a-f]{12})_slave$")
 
 
+def broken_fmu(path: Path) -> str | None:
+    """Why the FMU file at ``path`` cannot be a whole project FMU (None: it reads as one).
+
+    An interrupted or concurrent build of an older dtcosim could leave a truncated archive, or one without
+    its slave module or record; in the folders dtcosim builds into such a file is rebuilt, not used.
+    """
+    try:
+        with zipfile.ZipFile(path) as zf:
+            names = set(zf.namelist())
+            bad = zf.testzip()
+    except (OSError, zipfile.BadZipFile) as exc:
+        return f"not a readable zip archive ({exc})"
+    if bad is not None:
+        return f"the archive member {bad} is corrupt"
+    missing = [m for m in ("resources/slavemodule.txt", f"resources/{RECORD_FILE}", "modelDescription.xml")
+               if m not in names]
+    return f"it lacks {', '.join(missing)}" if missing else None
+
+
 def stale_project_fmus(paths: Mapping[str, Path]) -> list[str]:
     """Warnings for project FMUs built from other code than the installed ``components``/``fmus``.
 

@@ -9,6 +9,11 @@ Then it writes a first ``summary.json`` that says the run is in progress
 adds each file to that summary as soon as it is whole, so at every moment the
 summary tells what the folder holds, also after the process was killed.
 
+One run at a time: :meth:`RunFolder.prepare` takes an exclusive lock (``flock``) on the
+folder itself and keeps it until :meth:`RunFolder.release` (or the process ends); a second
+run into a folder in use is refused before it touches anything, naming the folder and the
+holder's pid from its running summary (two runs into one folder corrupted each other's files).
+
 Every file goes in by temporary file and rename (:mod:`orchestrator.atomic_files`);
 the results file is streamed into ``<name>.partial`` and renamed when whole
 (:mod:`orchestrator.run.writers`).
@@ -104,10 +109,38 @@ class RunFolder:
             What the summary says from the start (``scenario``, ``scenario_file``, ...).
         """
         folder = cls(cls.check(path, key))
+        folder._lock(key)
         folder.header = {**dict(header), "started_at": _now(), "pid": os.getpid()}
         folder._clear_previous()
         folder.save()
         return folder
+
+    def _lock(self, key: str) -> None:
+        """Take the folder's run lock (see the module docstring); OutputFolderError when another run holds it."""
+        import fcntl
+
+        fd = os.open(self.path, os.O_RDONLY | os.O_DIRECTORY)  # the folder itself: no file of its own
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            os.close(fd)
+            try:
+                holder = json.loads(self.summary_path.read_text(encoding="utf-8")).get("pid", "unknown")
+            except (OSError, ValueError, AttributeError):
+                holder = "unknown"
+            raise OutputFolderError(key, str(self.path), f"a folder no other run is writing into (the run with pid "
+                                    f"{holder} holds it: wait for it or choose another {key})") from None
+        self._lock_fd = fd
+
+    def release(self) -> None:
+        """Release the folder's run lock."""
+        fd = getattr(self, "_lock_fd", None)
+        if fd is not None:
+            self._lock_fd = None
+            os.close(fd)
+
+    def __del__(self) -> None:
+        self.release()
 
     def _clear_previous(self) -> None:
         names: set[str] = set()

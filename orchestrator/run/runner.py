@@ -208,6 +208,7 @@ def run_scenario(system: ResolvedSystem, out_dir: str | Path, *, compare_referen
             status = 0
         else:
             status = 1
+    folder.release()
     return RunReport(outcome, summary, files, comparison_text, problems, list(folder.replaced), status)
 
 

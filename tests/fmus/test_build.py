@@ -273,3 +273,25 @@ def test_the_record_declares_role_model_and_signals(built_fmus, name, role, sign
         assert record["signals"]["stage1.F_sp[2]"] == {"signal": "contact_force", "stage": "stage1",
                                                        "mesh": "sun_planet", "planet": "2"}
         assert build(record["model"]["drivetrain"]) == drivetrain_of_preset("table6")
+
+
+def test_an_interrupted_build_leaves_the_previous_fmu_whole_and_nothing_half_written(fmu_path, tmp_path, monkeypatch):
+    """pythonfmu wrote straight to <name>.fmu: an interrupted build left a broken archive under the final name
+    that later runs never rebuilt (issue 35.3). The build now renames a finished archive into place."""
+    out = tmp_path / "fmus"
+    out.mkdir()
+    shutil.copy(fmu_path("WindSource"), out / "WindSource.fmu")
+    before = (out / "WindSource.fmu").read_bytes()
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt  # Ctrl-C while the archive is being completed
+
+    monkeypatch.setattr(fmu_build.model_description, "rewrite_archive", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        fmu_build.build_fmu("WindSource", out)
+    assert (out / "WindSource.fmu").read_bytes() == before  # the previous FMU, untouched
+    assert sorted(p.name for p in out.iterdir()) == ["WindSource.fmu"]  # no partial file or folder left
+    monkeypatch.undo()
+    built = fmu_build.build_fmu("WindSource", out)
+    assert built.path == out / "WindSource.fmu" and check_fmu(built.path) == []
+    assert sorted(p.name for p in out.iterdir()) == ["WindSource.fmu"]

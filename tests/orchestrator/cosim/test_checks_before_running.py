@@ -12,6 +12,8 @@ import zipfile
 
 import pytest
 
+from fmus.model_description import rewrite_archive
+
 from orchestrator.commands.cli import main
 from orchestrator.cosim.system import resolve_system
 from orchestrator.errors import ScenarioError
@@ -150,6 +152,9 @@ def _copy_without(src, dst, prefix):
                            "it has binaries for: win64"),
     ("not a zip", "a readable FMU"),
     ("truncated", "a readable FMU"),
+    # a module that does not exist crashed `dtcosim run` with exit 139 and passed validate (issue 35.1)
+    ("missing module", "resources/slavemodule.txt names the slave module 'no_such_module', which is not in "
+                       "resources/"),
 ])
 def test_a_broken_fmu_file_is_a_named_error_not_a_crash(fmu_dir, tmp_path, capsys, damage, expected):
     folder = tmp_path / "fmus"
@@ -159,6 +164,8 @@ def test_a_broken_fmu_file_is_a_named_error_not_a_crash(fmu_dir, tmp_path, capsy
         gearbox.write_text("not an archive")
     elif damage == "truncated":
         gearbox.write_bytes(gearbox.read_bytes()[:2000])
+    elif damage == "missing module":
+        rewrite_archive(gearbox, {"resources/slavemodule.txt": b"no_such_module\n"})
     else:
         _copy_without(fmu_dir / "Gearbox.fmu", gearbox, damage)
     assert main(["run", "--fmu-dir", str(folder), "--no-build", "--stop", "0.1", "--out", str(tmp_path / "o")]) == 1
@@ -205,3 +212,24 @@ def test_the_limits_are_stated_in_the_docs():
     for text in ("100 000 000", "100 000 harmonics", "1e-9", "100 000 bins", "1 GiB"):
         assert text in docs, text
     assert limits.MAX_RESULT_VALUES == 100_000_000 and math.isclose(limits.MIN_RELATIVE_STEP, 1e-9)
+
+
+@pytest.mark.parametrize("damage", ["truncated", "no record"])
+def test_a_broken_fmu_in_the_folder_dtcosim_builds_into_is_rebuilt(fmu_dir, tmp_path, damage):
+    """An interrupted build of an older version left a broken archive that later runs never rebuilt ("expected a
+    readable FMU" until the user deleted it; issue 35.3): in the folder dtcosim builds into it is built again."""
+    from orchestrator.provision.project_fmus import ensure_fmus
+    from orchestrator.provision.staleness import broken_fmu
+
+    folder = tmp_path / "fmus"
+    shutil.copytree(fmu_dir, folder)
+    gearbox = folder / "Gearbox.fmu"
+    if damage == "truncated":
+        gearbox.write_bytes(gearbox.read_bytes()[:3000])
+    else:
+        _copy_without(fmu_dir / "Gearbox.fmu", gearbox, "resources/dtcosim.json")
+    assert broken_fmu(gearbox)
+    paths = ensure_fmus(load_scenario(find_scenario("paper-60s")), folder)
+    assert paths["gearbox"] == gearbox and broken_fmu(gearbox) is None
+    with zipfile.ZipFile(gearbox) as archive:
+        assert archive.testzip() is None

@@ -13,6 +13,7 @@ from orchestrator.inputs.load_case_file import (
     packaged_load_cases,
 )
 from orchestrator.inputs.load_cases import LoadCaseError
+from tests.helpers.scenarios import dtcosim
 
 
 def _doc(**changes):
@@ -101,3 +102,18 @@ def test_seed_placeholders_are_kept_for_the_study_and_seed_counts_expand():
     lcs = load_cases_from_dict(_doc(operating_points=rows, runs={"seeds": [4, 7]}))
     assert lcs.seeds == (4, 7)
     assert lcs.bins[0].parameters["wind.file"] == "records/5ms-{seed}.outb"
+
+
+@pytest.mark.parametrize("seeds, match", [
+    (3_000_000, r"runs\.seeds = 3000000: expected at most 1000 seeds per bin"),
+    (list(range(1001)), r"runs\.seeds = 1001: expected at most 1000 seeds per bin"),
+])
+def test_a_seed_count_beyond_the_bound_is_refused_before_it_is_allocated(seeds, match):
+    # --seeds 3000000 hung and 2147483648 raised MemoryError (issue 35.7): the count is checked first
+    with pytest.raises(LoadCaseError, match=match):
+        load_cases_from_dict(_doc(runs={"length": 20.0, "transient": 5.0, "seeds": seeds}))
+
+
+def test_the_command_refuses_a_huge_seed_count_at_once(tmp_path):
+    res = dtcosim("loads", "paper-turbine", "--seeds", "2147483648", "--check", cwd=tmp_path, timeout=60)
+    assert res.returncode == 1 and "--seeds = 2147483648: expected an integer from 1 to 1000" in res.stderr

@@ -56,3 +56,13 @@ def test_the_window_option_sets_the_window_and_names_itself_in_the_overrides(pap
 def test_a_window_outside_the_run_is_named_before_anything_runs(paper):
     with pytest.raises(ScenarioError, match=r"simulation.window = \[0.5, 2.0\]: expected .* within \[0, 1\] s"):
         scenario_options.apply(paper, _args(stop=1.0, window=[0.5, 2.0]), "run")
+
+
+@pytest.mark.parametrize("step, match", [(0.0, r"simulation\.step = 0\.0: expected > 0 s"),
+                                         (-1e-3, r"simulation\.step = -0\.001: expected > 0 s"),
+                                         (float("nan"), r"simulation\.step = nan: expected a finite number"),
+                                         (float("inf"), r"simulation\.step = inf: expected a finite number")])
+def test_a_step_that_is_no_positive_number_is_a_named_error_not_a_traceback(paper, step, match):
+    # --step 0 raised ZeroDivisionError and --step nan ValueError from the output-interval check (issue 35.9)
+    with pytest.raises(ScenarioError, match=match):
+        SimulationOverrides(step_s=step).apply(paper)

@@ -85,6 +85,28 @@ def killed_and_resumed(tmp_path_factory, fmu_dir):
     return out, before, second
 
 
+@pytest.mark.slow
+def test_sigterm_stops_the_set_with_128_plus_the_signal_and_keeps_what_finished(tmp_path, fmu_dir):
+    """``dtcosim loads`` exited 130 whatever the signal (issue 35.8): SIGTERM gives 143, as ``sweep``."""
+    (tmp_path / "set.toml").write_text(SET)
+    out = tmp_path / "out"
+    cmd = [str(Path(sys.executable).parent / "dtcosim"), "loads", "set.toml", "--workers", "1", "--out", str(out),
+           "--fmu-dir", str(fmu_dir), "-q"]
+    proc = subprocess.Popen(cmd, cwd=tmp_path, start_new_session=True, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 600
+    while not any(r["status"] == "ok" for r in _journal(out)) and proc.poll() is None:
+        assert time.monotonic() < deadline, "no run finished in 600 s"
+        time.sleep(0.05)
+    if proc.poll() is not None:
+        pytest.skip("the set finished before it could be stopped")
+    os.killpg(proc.pid, signal.SIGTERM)
+    _, stderr = proc.communicate(timeout=300)
+    assert proc.returncode == 143, stderr
+    assert "interrupted" in stderr and "Traceback" not in stderr
+    assert any(r["status"] == "ok" for r in _journal(out))
+
+
 def test_killing_and_starting_again_repeats_no_finished_run(killed_and_resumed):
     out, before, second = killed_and_resumed
     done_before = {r["key"] for r in before if r["status"] == "ok"}
