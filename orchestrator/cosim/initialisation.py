@@ -93,7 +93,10 @@ def initialise(system: ResolvedSystem, instances: Mapping[str, FmuInstance],
         )
     for name in system.init_order:
         instances[name].exit_initialization(t0)
-    if transferred:
-        return dict(last)
-    bound = {str(b.target) for b in sc.initial}
-    return {k: v for k, v in last.items() if k in bound}
+    return dict(last) if transferred else bound_values(system, last)
+
+
+def bound_values(system: ResolvedSystem, values: Mapping[str, float]) -> dict[str, float]:
+    """The ``[[initial]]`` bindings' values among ``values`` (``{"component.parameter": value}``)."""
+    bound = {str(b.target) for b in system.scenario.initial}
+    return {k: v for k, v in values.items() if k in bound}

@@ -107,7 +107,7 @@ import numpy as np
 from ..errors import FmuStepError, InitializationError
 from .algebraic_loops import LoopNotConverged, LoopSolver
 from .fmi_runtime import FmuInstance
-from .initialisation import initialise
+from .initialisation import bound_values, initialise
 from .outcome import RunOutcome
 from .resolved import ResolvedSystem
 from .rows import FinishedRows, RowSink
@@ -215,8 +215,7 @@ class CoSimulation:
         try:
             self._instantiate(stop)
             start_values = initialise(self.system, self.instances, transferred=True)
-            bound = {str(b.target) for b in self.system.scenario.initial}
-            initial_values = {k: v for k, v in start_values.items() if k in bound}
+            initial_values = bound_values(self.system, start_values)
             stop.raise_if_requested("initialisation", sim.start_s)
             plan = build_plan(self.system, self.instances)
             buffers = RowBuffers.allocate(plan.n_columns, plan.stride, BLOCK_STEPS)
