@@ -407,8 +407,9 @@ def _build_archive(name, kind, model, origin, source, part_dir: Path, resources,
         problems = check_fmu(fmu_path)
         if problems:
             raise BuildError(f"{fmu_path} is not valid:\n  " + "\n  ".join(problems))
-    if kind.cross_check is not None:
-        _add_cross_check(name, fmu_path, kind.cross_check)
+    case = kind.cross_check_case(model)
+    if case is not None:
+        _add_cross_check(name, fmu_path, case)
     return BuiltFmu(name, fmu_path, build_id, package, script.stem)
 
 

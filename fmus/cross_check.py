@@ -59,10 +59,10 @@ def reference_members(fmu_path: Path, case: CrossCheckCase) -> dict[str, bytes]:
     step = _step_of(md)
     inputs = stated_inputs(case, md, step)
     outputs = [v.name for v in md.modelVariables if v.causality == "output"]
-    result = simulate_fmu(str(fmu_path), start_time=0.0, stop_time=case.stop_time, step_size=step,
+    result = simulate_fmu(str(fmu_path), start_time=case.start_time, stop_time=case.stop_time, step_size=step,
                           output_interval=step, input=inputs if len(inputs.dtype.names) > 1 else None,
                           output=outputs, validate=False)
-    opt = f"StartTime,0\nStopTime,{case.stop_time:g}\nStepSize,{step:g}\nRelTol,{REL_TOL:g}\n"
+    opt = f"StartTime,{case.start_time!r}\nStopTime,{case.stop_time!r}\nStepSize,{step!r}\nRelTol,{REL_TOL:g}\n"
     return {f"{MEMBER_DIR}/{model}_in.csv": _csv_text(inputs).encode(),
             f"{MEMBER_DIR}/{model}_ref.opt": opt.encode(),
             f"{MEMBER_DIR}/{model}_ref.csv": _csv_text(result[["time", *outputs]]).encode()}

@@ -35,16 +35,19 @@ class CrossCheckCase:
     Attributes
     ----------
     stop_time : float
-        [s], from a start at 0.
+        [s].
     ramps : tuple of Ramp
         Inputs that move; the others stay at their start values.
     integrals : tuple of (str, str)
         ``(angle input, speed input)``: the angle is the speed's exact integral from its start value.
+    start_time : float
+        [s] (a load record's FMU starts where its record does).
     """
 
     stop_time: float
     ramps: tuple[Ramp, ...] = ()
     integrals: tuple[tuple[str, str], ...] = ()
+    start_time: float = 0.0
 
 
 def _inputs_of(md) -> list:
@@ -61,8 +64,8 @@ def _start(v) -> float:
 
 def stated_inputs(case: CrossCheckCase, md, step: float) -> np.ndarray:
     """The stated inputs as a structured array (``time`` and one field per input of ``md``)."""
-    n = int(round(case.stop_time / step))
-    t = np.arange(n + 1) * step
+    n = int(round((case.stop_time - case.start_time) / step))
+    t = case.start_time + np.arange(n + 1) * step
     values = {v.name: np.full(t.size, _start(v)) for v in _inputs_of(md)}
     for ramp in case.ramps:
         if ramp.name not in values:

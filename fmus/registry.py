@@ -76,6 +76,14 @@ def _controller_model(drivetrain: Drivetrain, wind: WindParameters) -> dict[str,
     return {"controller": describe(TorqueLawParameters()), "initial_speed_rad_s": drivetrain.ratio * wind.mean_speed_rad_s}
 
 
+def _series_cross_check(model: dict[str, Any]) -> CrossCheckCase:
+    """A load record's FMU: its first second of record (or the whole record if shorter), from the record's start."""
+    series = model["series"]
+    start = float(series["start_s"]) - float(series["time_offset_s"])
+    stop = min(start + 1.0, float(series["end_s"]) - float(series["time_offset_s"]))
+    return CrossCheckCase(stop, start_time=start)
+
+
 @dataclass(frozen=True)
 class FmuKind:
     """One FMU this project builds.
@@ -95,8 +103,9 @@ class FmuKind:
         (None: its model comes with what it is built from, a load record's samples).
     init_note : str
         Its part of the initialisation order (documentation).
-    cross_check : CrossCheckCase or None
-        The stand-alone run whose inputs and outputs the FMU carries (:mod:`fmus.cross_check`).
+    cross_check : CrossCheckCase or callable
+        The stand-alone run whose inputs and outputs the FMU carries (:mod:`fmus.cross_check`), or
+        ``model -> CrossCheckCase`` where it depends on what the FMU is built from (a load record).
     """
 
     name: str
@@ -105,7 +114,11 @@ class FmuKind:
     built_from: tuple[str, ...]
     model_of: ModelOf | None
     init_note: str
-    cross_check: CrossCheckCase | None = None
+    cross_check: CrossCheckCase | Callable[[dict[str, Any]], CrossCheckCase] | None = None
+
+    def cross_check_case(self, model: dict[str, Any]) -> CrossCheckCase | None:
+        """The cross-check run of this FMU built from ``model``."""
+        return self.cross_check(model) if callable(self.cross_check) else self.cross_check
 
     @property
     def file_name(self) -> str:
@@ -177,7 +190,8 @@ KINDS: dict[str, FmuKind] = {k.name: k for k in (
             CrossCheckCase(1.0, ramps=(Ramp("generator_speed", (0.1, 0.3), (1.0, 1.05)),))),
     FmuKind("TimeSeriesSource", "time_series_source", TIME_SERIES, (LOAD_RECORD,), None,
             "it has no inputs and comes first; set time_offset so that the run lies inside the "
-            "record (out_of_record = error refuses a start outside it in fmi2ExitInitializationMode)."),
+            "record (out_of_record = error refuses a start outside it in fmi2ExitInitializationMode).",
+            _series_cross_check),
 )}
 #: every model name, in declaration order
 FMU_NAMES = tuple(KINDS)

@@ -21,6 +21,7 @@ from tests.helpers.reference_fmus import reference_fmu
 from tests.helpers.scenarios import dtcosim
 
 CHECKED = [k.name for k in registry.KINDS.values() if k.cross_check is not None]
+BUILT = [name for name in CHECKED if registry.PRESET in registry.kind(name).built_from]
 
 
 class _Var:
@@ -57,8 +58,17 @@ def test_a_ramp_of_an_input_the_fmu_lacks_is_refused():
         stated_inputs(CrossCheckCase(1.0, ramps=(Ramp("u", (0.0, 1.0), (1.0, 2.0)),)), _Md(_Var("w", "1")), 0.1)
 
 
-def test_every_fmu_built_from_a_drivetrain_declares_a_cross_check():
-    assert set(CHECKED) == set(registry.names_built_from(registry.PRESET))
+def test_every_fmu_declares_a_cross_check():
+    assert set(CHECKED) == set(registry.FMU_NAMES)
+
+
+def test_a_load_record_fmu_checks_its_first_second_of_record_in_simulation_time():
+    model = {"series": {"start_s": 30.0, "end_s": 90.0, "time_offset_s": 30.0}}
+    case = registry.kind("TimeSeriesSource").cross_check_case(model)
+    assert (case.start_time, case.stop_time) == (0.0, 1.0)
+    model = {"series": {"start_s": 30.0, "end_s": 30.5, "time_offset_s": 0.0}}
+    case = registry.kind("TimeSeriesSource").cross_check_case(model)
+    assert (case.start_time, case.stop_time) == (30.0, 30.5)
 
 
 def _host_run(fmu: Path, tmp: Path) -> Path:
@@ -82,7 +92,7 @@ def _host_run(fmu: Path, tmp: Path) -> Path:
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name", CHECKED)
+@pytest.mark.parametrize("name", BUILT)
 def test_the_fmu_carries_its_cross_check_and_another_host_meets_it(name, fmu_path, tmp_path):
     from fmpy import read_model_description
     from fmpy.util import read_csv, read_ref_opt_file
