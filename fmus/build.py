@@ -407,7 +407,21 @@ def _build_archive(name, kind, model, origin, source, part_dir: Path, resources,
         problems = check_fmu(fmu_path)
         if problems:
             raise BuildError(f"{fmu_path} is not valid:\n  " + "\n  ".join(problems))
+    case = kind.cross_check_case(model)
+    if case is not None:
+        _add_cross_check(name, fmu_path, case)
     return BuiltFmu(name, fmu_path, build_id, package, script.stem)
+
+
+def _add_cross_check(name: str, fmu_path: Path, case) -> None:
+    """Run the finished FMU stand-alone and pack its cross-check files (:mod:`fmus.cross_check`) into it."""
+    from .cross_check import reference_members
+
+    try:
+        members = reference_members(fmu_path, case)
+    except Exception as exc:  # the FMU's own run failed: the build must not ship it
+        raise BuildError(f"{name}.fmu: its stand-alone cross-check run failed: {type(exc).__name__}: {exc}") from None
+    model_description.rewrite_archive(fmu_path, members)
 
 
 def _staged_resources(tmp: Path, resources: dict[str, Path] | None) -> list[Path]:

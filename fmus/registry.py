@@ -32,6 +32,7 @@ from components.model.rotor import RotorParameters
 from components.model.torque_controller import TorqueLawParameters
 from components.model.wind import WindParameters
 
+from .cross_check_case import CrossCheckCase, Ramp
 from .slaves.record import GEARBOX, GENERATOR, ROTOR, TIME_SERIES, TORQUE_CONTROLLER, WIND_SOURCE
 
 #: what an FMU is built from: a drivetrain preset, a drivetrain file (``drivetrain = "..."`` in a scenario),
@@ -75,6 +76,14 @@ def _controller_model(drivetrain: Drivetrain, wind: WindParameters) -> dict[str,
     return {"controller": describe(TorqueLawParameters()), "initial_speed_rad_s": drivetrain.ratio * wind.mean_speed_rad_s}
 
 
+def _series_cross_check(model: dict[str, Any]) -> CrossCheckCase:
+    """A load record's FMU: its first second of record (or the whole record if shorter), from the record's start."""
+    series = model["series"]
+    start = float(series["start_s"]) - float(series["time_offset_s"])
+    stop = min(start + 1.0, float(series["end_s"]) - float(series["time_offset_s"]))
+    return CrossCheckCase(stop, start_time=start)
+
+
 @dataclass(frozen=True)
 class FmuKind:
     """One FMU this project builds.
@@ -94,6 +103,9 @@ class FmuKind:
         (None: its model comes with what it is built from, a load record's samples).
     init_note : str
         Its part of the initialisation order (documentation).
+    cross_check : CrossCheckCase or callable
+        The stand-alone run whose inputs and outputs the FMU carries (:mod:`fmus.cross_check`), or
+        ``model -> CrossCheckCase`` where it depends on what the FMU is built from (a load record).
     """
 
     name: str
@@ -102,6 +114,11 @@ class FmuKind:
     built_from: tuple[str, ...]
     model_of: ModelOf | None
     init_note: str
+    cross_check: CrossCheckCase | Callable[[dict[str, Any]], CrossCheckCase] | None = None
+
+    def cross_check_case(self, model: dict[str, Any]) -> CrossCheckCase | None:
+        """The cross-check run of this FMU built from ``model``."""
+        return self.cross_check(model) if callable(self.cross_check) else self.cross_check
 
     @property
     def file_name(self) -> str:
@@ -144,24 +161,37 @@ class FmuKind:
 KINDS: dict[str, FmuKind] = {k.name: k for k in (
     FmuKind("WindSource", "wind_source", WIND_SOURCE, (PRESET,), _wind_model,
             "it has no inputs and comes first; its outputs at the start time depend on its parameters only, "
-            "and after each step they are the values at t + h computed in the FMU."),
+            "and after each step they are the values at t + h computed in the FMU.",
+            CrossCheckCase(2.0)),
     FmuKind("Gearbox", "gearbox", GEARBOX, (PRESET, DRIVETRAIN_FILE), _gearbox_model,
             "set omega_rotor and phi_rotor before reading omega_out; omega_gen and phi_gen come from the "
             "GeneratorRotor (or, standalone, must advance consistently with each other: angles held while speeds "
-            "are not zero twist the shafts)."),
+            "are not zero twist the shafts).",
+            # a 1 % generator-speed pulse of 20 ms (the angles integrate the speeds): the drivetrain rings
+            CrossCheckCase(0.5, ramps=(Ramp("omega_gen", (0.1, 0.11, 0.12), (1.0, 1.01, 1.0)),),
+                           integrals=(("phi_rotor", "omega_rotor"), ("phi_gen", "omega_gen")))),
     FmuKind("GeneratorRotor", "generator_rotor", GENERATOR, (PRESET, DRIVETRAIN_FILE), _generator_model,
             "set initial_speed (the Gearbox's omega_out) and initial_angle before "
-            "fmi2ExitInitializationMode; its input shaft_torque is used from the first fmi2DoStep on."),
+            "fmi2ExitInitializationMode; its input shaft_torque is used from the first fmi2DoStep on.",
+            # balanced at the default counter torque, then a 10 % shaft-torque pulse
+            CrossCheckCase(0.5, ramps=(Ramp("shaft_torque", (0.0, 0.1, 0.15, 0.2), values=(25400.0, 25400.0, 27940.0,
+                                                                                         25400.0)),))),
     FmuKind("Rotor", "rotor", ROTOR, (PRESET,), _rotor_model,
             "set initial_speed (and aero_torque, which sets a main shaft's initial twist) before "
             "fmi2ExitInitializationMode; its outputs omega and phi drive the Gearbox's omega_rotor and phi_rotor, "
-            "the Gearbox's torque_rotor comes back as gearbox_torque from the first fmi2DoStep on."),
+            "the Gearbox's torque_rotor comes back as gearbox_torque from the first fmi2DoStep on.",
+            # balanced at the paper's rated rotor torque, then a 10 % aerodynamic-torque pulse
+            CrossCheckCase(0.5, ramps=(Ramp("gearbox_torque", (0.0,), values=(2.54e6,)),
+                                       Ramp("aero_torque", (0.0, 0.1, 0.15, 0.2), values=(2.54e6, 2.54e6, 2.794e6,
+                                                                                        2.54e6))))),
     FmuKind("TorqueController", "torque_controller", TORQUE_CONTROLLER, (PRESET,), _controller_model,
             "set generator_speed (the generator's initial speed) and pitch before "
-            "fmi2ExitInitializationMode: they set the filter state and the initial torque."),
+            "fmi2ExitInitializationMode: they set the filter state and the initial torque.",
+            CrossCheckCase(1.0, ramps=(Ramp("generator_speed", (0.1, 0.3), (1.0, 1.05)),))),
     FmuKind("TimeSeriesSource", "time_series_source", TIME_SERIES, (LOAD_RECORD,), None,
             "it has no inputs and comes first; set time_offset so that the run lies inside the "
-            "record (out_of_record = error refuses a start outside it in fmi2ExitInitializationMode)."),
+            "record (out_of_record = error refuses a start outside it in fmi2ExitInitializationMode).",
+            _series_cross_check),
 )}
 #: every model name, in declaration order
 FMU_NAMES = tuple(KINDS)

@@ -47,8 +47,10 @@ ALLOWED = {
                                                     "orchestrator.reports", "orchestrator.commands"},
 }
 
-#: what of ``fmus`` a layer that only reads FMUs may reach: the FMU's record, the registry, the archive checks
-FMUS_READ = {"fmus", "fmus.slaves", "fmus.registry", "fmus.slaves.record", "fmus.archive_checks"}
+#: what of ``fmus`` a layer that only reads FMUs may reach: the FMU's record, the registry (with the cross-check
+#: case each FMU declares), the archive checks
+FMUS_READ = {"fmus", "fmus.slaves", "fmus.registry", "fmus.slaves.record", "fmus.archive_checks",
+             "fmus.cross_check_case"}
 #: layer -> the ``fmus`` modules it may reach (layers not named here may reach all of ``fmus``)
 FMUS_ALLOWED = {
     "orchestrator.inputs": FMUS_READ,

@@ -141,6 +141,36 @@ def lifetime_del(cycles_per_run: Sequence[RainflowCycles], weights: Sequence[flo
 
 
 @dataclass(frozen=True)
+class LargestCycle:
+    """The counted cycle that does the most of a lifetime damage: how far the figure rests on one event.
+
+    With steep S-N curves (tooth loads m = 8.7, beyond a knee m = 16) and short records one cycle, often the
+    half cycle of the residue that spans a record's slow drift, can carry most of D_life; the figure then
+    changes with any window that cuts that cycle, and says little about the turbine's life.
+
+    Attributes
+    ----------
+    share : float
+        ``w_r d_ri / D_life`` [-] of that cycle.
+    run : int
+        Index of its run (in the order of ``cycles_per_run``).
+    range : float
+        Its range S [unit of the load].
+    count : float
+        1 (a full cycle) or 0.5 (a half cycle of the residue).
+    """
+
+    share: float
+    run: int
+    range: float
+    count: float
+
+
+#: above this share of D_life from one cycle, a lifetime damage is reported as resting on one event
+ONE_EVENT_SHARE = 0.5
+
+
+@dataclass(frozen=True)
 class LifetimeDamage:
     """Miner damage of one load channel over the design life.
 
@@ -154,12 +184,15 @@ class LifetimeDamage:
         ``w_r D_r``: each run's part of D_life.
     by_bin : ndarray, shape (B,)
         Sum of the contributions per bin.
+    largest_cycle : LargestCycle or None
+        The one counted cycle that does the most of D_life (None without damage).
     """
 
     total: float
     per_run: np.ndarray
     contribution: np.ndarray
     by_bin: np.ndarray
+    largest_cycle: LargestCycle | None = None
 
     @property
     def share_by_bin(self) -> np.ndarray:
@@ -186,7 +219,16 @@ def lifetime_damage(cycles_per_run: Sequence[RainflowCycles], weights: Sequence[
     bins = np.asarray(run_bins, dtype=int)
     if ws.size != len(cycles_per_run) or bins.size != ws.size:
         raise ParameterError("weights", ws.size, f"one weight and bin per run ({len(cycles_per_run)})")
-    per_run = np.array([curve.damage(c.ranges, c.means, c.counts) for c in cycles_per_run], dtype=float)
+    per_cycle = [curve.cycle_damage(c.ranges, c.means, c.counts) for c in cycles_per_run]
+    per_run = np.array([float(d.sum()) for d in per_cycle], dtype=float)
     contribution = ws * per_run
     by_bin = np.bincount(bins, weights=contribution, minlength=n_bins) if bins.size else np.zeros(n_bins)
-    return LifetimeDamage(float(contribution.sum()), per_run, contribution, by_bin)
+    total = float(contribution.sum())
+    largest = None
+    if total > 0.0:
+        run = max((r for r in range(len(per_cycle)) if per_cycle[r].size),
+                  key=lambda r: ws[r] * float(per_cycle[r].max()))
+        i = int(np.argmax(per_cycle[run]))
+        c = cycles_per_run[run]
+        largest = LargestCycle(float(ws[run] * per_cycle[run][i] / total), run, float(c.ranges[i]), float(c.counts[i]))
+    return LifetimeDamage(total, per_run, contribution, by_bin, largest)

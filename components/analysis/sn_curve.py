@@ -131,13 +131,17 @@ class SNCurve:
                                  f"> the largest cycle mean |S_m| = {worst:g} for the Goodman correction")
         return s / (1.0 - ratio)
 
-    def damage(self, ranges: np.ndarray, means: np.ndarray, counts: np.ndarray) -> float:
-        """Palmgren-Miner damage ``sum n_i / N(S_eq,i)`` of counted cycles [-]."""
+    def cycle_damage(self, ranges: np.ndarray, means: np.ndarray, counts: np.ndarray) -> np.ndarray:
+        """Each counted cycle's Palmgren-Miner damage ``n_i / N(S_eq,i)`` [-]."""
         s = self.equivalent_ranges(ranges, means)
         if s.size == 0:
-            return 0.0
+            return np.zeros(0)
         inverse = np.where(s > 0.0, 1.0 / self.cycles_to_failure(np.where(s > 0.0, s, 1.0)), 0.0)
-        return float(np.sum(np.asarray(counts, dtype=float) * inverse))
+        return np.asarray(counts, dtype=float) * inverse
+
+    def damage(self, ranges: np.ndarray, means: np.ndarray, counts: np.ndarray) -> float:
+        """Palmgren-Miner damage ``sum n_i / N(S_eq,i)`` of counted cycles [-]."""
+        return float(np.sum(self.cycle_damage(ranges, means, counts)))
 
     def describe(self) -> str:
         """One line for reports."""

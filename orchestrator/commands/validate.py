@@ -7,7 +7,8 @@ and ``resources/requirements.txt`` present) and its declared requirements agains
 this interpreter (what is missing stops the FMU from starting and fails the
 check; a version outside the tested range is a warning). A file that is not a
 zip or has a broken ``modelDescription.xml`` is reported as such, without a
-traceback. ``--host`` also runs each valid dtcosim FMU once in a fresh virtual
+traceback. ``--cross-check RESULT.csv`` compares another host's run of an FMU with the
+reference it carries (:mod:`fmus.cross_check`). ``--host`` also runs each valid dtcosim FMU once in a fresh virtual
 environment holding only its declared requirements and fmpy (:mod:`fmus.selftest`).
 """
 
@@ -37,7 +38,33 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "only the declared requirements (and fmpy) installed; needs pip access to the package index")
     p.add_argument("--venv", type=Path, default=None, metavar="DIR",
                    help="with --host: create (or reuse) the environment in DIR and keep it (default: a temporary one)")
+    p.add_argument("--cross-check", type=Path, default=None, metavar="RESULT.csv", dest="cross_check",
+                   help="compare another host's run of the FMU (one FMU path) with the reference the FMU carries in "
+                        "documentation/cross-check/ (FMI Cross-Check layout: run <Model>_in.csv with the options of "
+                        "<Model>_ref.opt, write every output as CSV); exit code 1 if it differs")
+    p.add_argument("--rel-tol", type=float, default=None, metavar="R",
+                   help="with --cross-check: largest deviation of an output relative to its reference's range "
+                        "(default: RelTol of <Model>_ref.opt, 1e-4)")
     p.set_defaults(func=run)
+
+
+def _cross_check(fmu: Path, result: Path, rel_tol: float | None) -> int:
+    """Print the comparison of a host's result with the FMU's reference; 0 if it passed, 1 otherwise."""
+    from fmus.cross_check import compare
+
+    report = compare(fmu, result, rel_tol)
+    rule = "passed" if report.rule_problem is None else f"FAILED: {report.rule_problem}"
+    print(f"{fmu} against {result}: FMI Cross-Check rule (10 % band, at most 10 % of samples outside) {rule}")
+    if report.missing:
+        print(f"  missing outputs: {', '.join(report.missing)}")
+    worst = report.worst
+    if worst is not None:
+        over = [d for d in report.deviations if d.relative > report.rel_tol]
+        print(f"  largest deviation: {worst.name} {worst.max_abs:.3g} = {worst.relative:.3g} of its reference's range "
+              f"(bound {report.rel_tol:g}); {len(over)} of {len(report.deviations)} outputs over it"
+              + (f": {', '.join(d.name for d in over[:8])}{' ...' if len(over) > 8 else ''}" if over else ""))
+    print(f"{fmu}: cross-check {'passed' if report.passed else 'FAILED'}")
+    return 0 if report.passed else 1
 
 
 def _environment_lines(path: Path) -> tuple[list[str], list[str]]:
@@ -74,6 +101,11 @@ def _describe(path: Path) -> str:
 def run(args: argparse.Namespace) -> int:
     """Validate and print the problems; 0 if every FMU is valid and can run here, 1 otherwise."""
     files = fmu_files(args.paths)
+    if args.cross_check is not None:
+        if len(files) != 1:
+            print(f"--cross-check compares one FMU with one result: give one FMU path (found {len(files)})")
+            return 1
+        return _cross_check(files[0], args.cross_check, args.rel_tol)
     if not files:
         print(f"no FMU found in {', '.join(map(str, args.paths))}")
         return 1

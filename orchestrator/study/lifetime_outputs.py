@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from components import units
+from components.analysis.lifetime import ONE_EVENT_SHARE
 
 from .engine import OK
 from .journal import JOURNAL_FILE, latest_by_key, read_journal
@@ -156,8 +157,34 @@ def report_text(res: LifetimeResults) -> str:
         for rank, (b, share) in enumerate(ranked_bins(res, col), 1):
             lines.append(f"  {rank:2d}. {plc.bins[b].label:<16} {100 * share:7.2f} %  (probability "
                          f"{plc.bins[b].probability:.4f})")
+        one = one_event_note(res, col)
+        if one:
+            lines.append(f"  NOTE: {one}")
         lines.append("")
     return "\n".join(lines)
+
+
+def _largest_cycle(res: LifetimeResults, col: str) -> dict[str, Any] | None:
+    cl = res.channels[col]
+    big = None if cl.damage is None else cl.damage.largest_cycle
+    if big is None:
+        return None
+    case = next(c for c in res.plc.cases if c.index == res.runs[big.run].case_index)
+    return {"share": big.share, "range": big.range, "count": big.count, "run": case.index,
+            "bin": res.plc.bins[case.bin].label}
+
+
+def one_event_note(res: LifetimeResults, col: str) -> str:
+    """A sentence when one counted cycle carries more than ONE_EVENT_SHARE of a channel's lifetime damage, else ''."""
+    big = _largest_cycle(res, col)
+    if big is None or big["share"] <= ONE_EVENT_SHARE:
+        return ""
+    kind = "a half cycle of the residue (typically a record's slow drift)" if big["count"] < 1.0 \
+        else "one full cycle"
+    return (f"{100 * big['share']:.0f} % of this lifetime damage comes from one cycle, {kind}, range "
+            f"{big['range']:.5g} {res.channels[col].channel.unit} in run {big['run']} (bin {big['bin']}): the "
+            "figure rests on one event and moves with any window that cuts it; analyse longer or more records "
+            "(IEC 61400-1: six 10-minute seeds per bin) before using it")
 
 
 def summary(res: LifetimeResults) -> dict[str, Any]:
@@ -177,6 +204,7 @@ def summary(res: LifetimeResults) -> dict[str, Any]:
                            "lifetime_del": {f"m={m:g}": v for m, v in cl.lifetime_del.items()},
                            "sn_curve": None if cl.curve is None else cl.curve.as_dict(),
                            "lifetime_damage": None if cl.damage is None else cl.damage.total,
+                           "largest_cycle": _largest_cycle(res, col),
                            "damage_share_by_bin": [float(x) for x in cl.ranking_share],
                            "gears": [g for g, _ in cl.channel.gears]}
                      for col, cl in res.channels.items()},

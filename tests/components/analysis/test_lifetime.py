@@ -161,3 +161,24 @@ def test_operating_law_region_2_and_region_3():
 def test_cycles_of_rainflow_counts_are_what_the_lifetime_combines():
     c = RainflowCycles(np.array([2.0, 4.0]), np.zeros(2), np.array([1.0, 0.5]))
     assert lifetime_del([c, c], [1.0, 3.0], 2.0, 8.0) == pytest.approx(math.sqrt((4 * (4 + 8)) / 8))
+
+
+def test_the_largest_cycle_and_its_share_of_the_lifetime_damage_by_hand():
+    # run 0: 10 cycles of 100 and a residue half cycle of 300; run 1: 4 cycles of 200; m = 5, no knee
+    runs = [RainflowCycles(np.array([100.0, 300.0]), np.zeros(2), np.array([10.0, 0.5])),
+            RainflowCycles(np.array([200.0]), np.zeros(1), np.array([4.0]))]
+    weights = [3.0, 2.0]
+    curve = SNCurve(5.0, 1000.0, 1e6)
+    dmg = lifetime_damage(runs, weights, [0, 1], 2, curve)
+    d = {s: (s / 1000.0) ** 5 / 1e6 for s in (100.0, 200.0, 300.0)}  # 1 / N(S)
+    total = 3.0 * (10 * d[100.0] + 0.5 * d[300.0]) + 2.0 * 4 * d[200.0]
+    assert dmg.total == pytest.approx(total, rel=1e-12)
+    big = dmg.largest_cycle
+    assert (big.run, big.range, big.count) == (0, 300.0, 0.5)
+    assert big.share == pytest.approx(3.0 * 0.5 * d[300.0] / total, rel=1e-12)
+    assert 0.5 < big.share < 1.0  # 0.688: the figure rests on one event
+
+
+def test_no_largest_cycle_without_damage():
+    runs = [RainflowCycles(np.zeros(0), np.zeros(0), np.zeros(0))]
+    assert lifetime_damage(runs, [1.0], [0], 1, SNCurve(5.0, 1000.0, 1e6)).largest_cycle is None

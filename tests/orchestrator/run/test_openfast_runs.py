@@ -13,9 +13,11 @@ import shutil
 import fmpy
 import numpy as np
 import pytest
+from fmpy.util import write_csv
 
 from components.model.time_series import Interpolant
 from components.model.torque_controller import TorqueLawParameters, law_torque_nm
+from fmus.cross_check import compare, read_reference
 from orchestrator.provision.project_fmus import ensure_fmus
 from orchestrator.provision.series_fmus import ensure_series_fmu
 from orchestrator.cosim.system import resolve_system
@@ -201,6 +203,12 @@ interpolation = "linear"
     f = Interpolant(t, speed * rpm, "pchip")
     assert fine["w"] == pytest.approx([f.value(x) for x in fine["time"]], rel=1e-13)
     assert fine["phi"] == pytest.approx([f.integral(x) for x in fine["time"]], rel=1e-12, abs=1e-14)
+    # it carries its own cross-check (fmus.cross_check): the record's first second, which a host's run meets
+    model, ref, opts = read_reference(moved)
+    assert (opts["StartTime"], opts["StopTime"]) == (0.0, 1.0) and list(ref.dtype.names) == ["time", "w", "phi", "GenTq"]
+    host = fmpy.simulate_fmu(str(moved), stop_time=1.0, step_size=opts["StepSize"], output_interval=opts["StepSize"])
+    write_csv(tmp_path / "host.csv", host)
+    assert compare(moved, tmp_path / "host.csv").passed
 
 
 def test_build_validate_and_export_ssp_with_the_new_fmus(fmu_home, tmp_path, capsys):

@@ -126,3 +126,16 @@ def test_four_runs_play_four_records_and_the_report_ranks_the_bins(ran):
     hss_rows = [r for r in _rows(out / "damage_by_bin.csv") if r["channel"] == "gearbox.hss_coupling.torque"]
     assert float(hss_rows[0]["damage [-]"]) > 0 and hss_rows[0]["bin"] == "lifetime"
     assert sum(float(r["share [-]"]) for r in hss_rows[1:]) == pytest.approx(1.0, rel=1e-9)
+
+
+@pytest.mark.slow
+def test_the_report_says_when_one_cycle_carries_the_mesh_lifetime(ran):
+    # the 10 s records drift (the rotor slows from 12.1 to 11.3-11.6 rpm): with m = 8.7 one half cycle of the
+    # residue in the 14 m/s run, spanning that drift, carries almost all of each mesh's lifetime damage
+    out = ran[2]
+    summary = json.loads((out / "lifetime.json").read_text())
+    big = summary["channels"]["gearbox.high_speed.F_mesh"]["largest_cycle"]
+    assert big["count"] == 0.5 and big["bin"] == "[13, 15) m/s" and big["share"] > 0.9
+    report = (out / "lifetime_report.txt").read_text()
+    mesh = report.split("high_speed parallel mesh (gearbox.high_speed.F_mesh)")[1].split("\n\n")[0]
+    assert f"NOTE: {100 * big['share']:.0f} % of this lifetime damage comes from one cycle, a half cycle" in mesh

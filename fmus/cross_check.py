@@ -1,0 +1,183 @@
+"""Each FMU's own cross-check: reference outputs of a stand-alone run with stated inputs, and the comparison.
+
+An FMU dtcosim builds carries, in ``documentation/cross-check/``, the files of the FMI Cross-Check layout
+(https://github.com/modelica/fmi-cross-check) for a stand-alone run of itself:
+
+``<Model>_in.csv``
+    The stated inputs: one row per communication point, ``"time"`` first, every input of the FMU (at its
+    start value, except the ramps its :class:`CrossCheckCase` declares; angles are the exact integrals of
+    their speeds, so that the inputs are consistent). A host sets each input to its row's value at each
+    communication point.
+``<Model>_ref.opt``
+    ``StartTime``, ``StopTime``, ``StepSize`` (the communication step) and ``RelTol``.
+``<Model>_ref.csv``
+    Every output at every communication point, as this build computed it (fmpy as the host).
+
+``dtcosim validate FMU --cross-check RESULT.csv`` compares another host's run of those inputs against the
+reference: by the FMI Cross-Check's own rule (fmpy's ``cross_check.validate_result``: a band of 10 % of each
+signal's range around the reference, at most 10 % of the samples outside it) and, stricter, by the largest
+deviation of each output relative to its reference's range (at most ``RelTol`` by default), which is what a
+host that runs the same binary with the same inputs should meet.
+"""
+
+from __future__ import annotations
+
+import io
+import zipfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .cross_check_case import CrossCheckCase, CrossCheckError, stated_inputs
+
+#: where in the FMU the cross-check files are
+MEMBER_DIR = "documentation/cross-check"
+#: the RelTol written into ``<Model>_ref.opt``: the stricter comparison's default bound
+REL_TOL = 1e-4
+
+
+def _csv_text(table: np.ndarray) -> str:
+    out = io.StringIO()
+    out.write(",".join(f'"{n}"' for n in table.dtype.names) + "\n")
+    for row in table:
+        out.write(",".join(repr(float(x)) for x in row) + "\n")
+    return out.getvalue()
+
+
+def _step_of(md) -> float:
+    de = md.defaultExperiment
+    return float(de.stepSize) if de is not None and de.stepSize not in (None, "") else 1e-3
+
+
+def reference_members(fmu_path: Path, case: CrossCheckCase) -> dict[str, bytes]:
+    """Run the FMU stand-alone (fmpy) with the stated inputs; the cross-check files by archive member name."""
+    from fmpy import read_model_description, simulate_fmu
+
+    md = read_model_description(str(fmu_path))
+    model = md.coSimulation.modelIdentifier
+    step = _step_of(md)
+    inputs = stated_inputs(case, md, step)
+    outputs = [v.name for v in md.modelVariables if v.causality == "output"]
+    result = simulate_fmu(str(fmu_path), start_time=case.start_time, stop_time=case.stop_time, step_size=step,
+                          output_interval=step, input=inputs if len(inputs.dtype.names) > 1 else None,
+                          output=outputs, validate=False)
+    opt = f"StartTime,{case.start_time!r}\nStopTime,{case.stop_time!r}\nStepSize,{step!r}\nRelTol,{REL_TOL:g}\n"
+    return {f"{MEMBER_DIR}/{model}_in.csv": _csv_text(inputs).encode(),
+            f"{MEMBER_DIR}/{model}_ref.opt": opt.encode(),
+            f"{MEMBER_DIR}/{model}_ref.csv": _csv_text(result[["time", *outputs]]).encode()}
+
+
+# ----------------------------------------------------------------------------- comparison
+@dataclass(frozen=True)
+class SignalDeviation:
+    """One output: the largest |result - reference| at the reference's times, relative to the reference's range."""
+
+    name: str
+    max_abs: float
+    relative: float
+
+
+@dataclass(frozen=True)
+class CrossCheckReport:
+    """Another host's result against an FMU's reference.
+
+    Attributes
+    ----------
+    model : str
+    rule_problem : str or None
+        The FMI Cross-Check rule's verdict (None: passed).
+    deviations : tuple of SignalDeviation
+        Every output of the reference, worst first.
+    rel_tol : float
+        Bound of the stricter comparison.
+    missing : tuple of str
+        Reference outputs the result lacks.
+    """
+
+    model: str
+    rule_problem: str | None
+    deviations: tuple[SignalDeviation, ...]
+    rel_tol: float
+    missing: tuple[str, ...]
+
+    @property
+    def worst(self) -> SignalDeviation | None:
+        return self.deviations[0] if self.deviations else None
+
+    @property
+    def passed(self) -> bool:
+        return self.rule_problem is None and not self.missing and \
+            all(d.relative <= self.rel_tol for d in self.deviations)
+
+
+def _read_member_csv(archive: zipfile.ZipFile, name: str, what: str, fmu: Path) -> np.ndarray:
+    from fmpy.util import read_csv
+
+    try:
+        data = archive.read(name)
+    except KeyError:
+        raise CrossCheckError(f"{fmu}: no {what} ({name}): the FMU was not built with a cross-check "
+                              "(rebuild it with this dtcosim: `dtcosim build`)") from None
+    return _parse_csv(data.decode(), f"{fmu}!{name}", read_csv)
+
+
+def _parse_csv(text: str, where: str, read_csv) -> np.ndarray:
+    import tempfile
+
+    with tempfile.NamedTemporaryFile("w", suffix=".csv", delete=False) as tmp:
+        tmp.write(text)
+    try:
+        table = read_csv(tmp.name)
+    except (ValueError, IndexError) as exc:
+        raise CrossCheckError(f"{where}: not a CSV of the FMI Cross-Check layout (a header of quoted names, "
+                              f"\"time\" first, one number per cell): {exc}") from None
+    finally:
+        Path(tmp.name).unlink()
+    if not table.dtype.names or table.dtype.names[0] != "time":
+        raise CrossCheckError(f"{where}: the first column must be \"time\" (FMI Cross-Check rules)")
+    return table
+
+
+def read_reference(fmu: Path) -> tuple[str, np.ndarray, dict[str, float]]:
+    """``(model identifier, reference table, options)`` of the cross-check an FMU carries."""
+    from fmpy import read_model_description
+
+    model = read_model_description(str(fmu)).coSimulation.modelIdentifier
+    with zipfile.ZipFile(fmu) as z:
+        ref = _read_member_csv(z, f"{MEMBER_DIR}/{model}_ref.csv", "cross-check reference", fmu)
+        try:
+            lines = z.read(f"{MEMBER_DIR}/{model}_ref.opt").decode().splitlines()
+        except KeyError:
+            raise CrossCheckError(f"{fmu}: no {MEMBER_DIR}/{model}_ref.opt") from None
+    opts = {k.strip(): float(v) for k, v in (line.split(",", 1) for line in lines if "," in line)}
+    return model, ref, opts
+
+
+def compare(fmu: str | Path, result_csv: str | Path, rel_tol: float | None = None) -> CrossCheckReport:
+    """Compare a host's result (a CSV of the FMI Cross-Check layout) with the reference the FMU carries."""
+    from fmpy.cross_check import validate_result
+    from fmpy.util import read_csv
+
+    fmu, result_csv = Path(fmu), Path(result_csv)
+    model, ref, opts = read_reference(fmu)
+    try:
+        text = result_csv.read_text()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise CrossCheckError(f"{result_csv}: cannot read it: {exc}") from None
+    result = _parse_csv(text, str(result_csv), read_csv)
+    rule = validate_result(result=result, reference=ref, t_start=opts["StartTime"], t_stop=opts["StopTime"])
+    names = ref.dtype.names[1:]
+    missing = tuple(n for n in names if n not in result.dtype.names)
+    t_res, t_ref = result["time"], ref["time"]
+    devs = []
+    for name in names:
+        if name in missing:
+            continue
+        y = np.interp(t_ref, t_res, result[name])
+        err = float(np.max(np.abs(y - ref[name])))
+        scale = max(float(np.ptp(ref[name])), 1e-2 * float(np.max(np.abs(ref[name]))), 1e-300)
+        devs.append(SignalDeviation(name, err, err / scale))
+    devs.sort(key=lambda d: -d.relative)
+    return CrossCheckReport(model, rule, tuple(devs), rel_tol if rel_tol is not None else opts.get("RelTol", REL_TOL),
+                            missing)
