@@ -332,6 +332,9 @@ class Scenario:
         Settings of the result analyses (``[analysis]``).
     results_format : {"auto", "csv", "parquet"}
         File the samples go to (``[record] format``, :mod:`orchestrator.inputs.results_format`).
+    import_notes : tuple of str
+        What the SSP import passed over (other tools' annotations, skipped mapping
+        entries, parameter values not applied); listed in the run's summary.
     """
 
     name: str
@@ -346,6 +349,7 @@ class Scenario:
     events: tuple[ScenarioEvent, ...] = ()
     analysis: AnalysisSettings = field(default_factory=AnalysisSettings)
     results_format: str = "auto"
+    import_notes: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         src = self.source
