@@ -84,11 +84,13 @@ def _check_archive_size(path: Path, zf: zipfile.ZipFile) -> None:
                        "zip bombs); split the system or unpack it and run the folder")
     total = sum(i.file_size for i in infos)
     if total > MAX_SSP_BYTES:
-        raise SspError(f"{path}: expands to {total / 2**20:.0f} MiB, expected at most {MAX_SSP_BYTES / 2**20:.0f} MiB")
+        raise SspError(f"{path}: expands to {total / 2**20:.0f} MiB, expected at most {MAX_SSP_BYTES / 2**20:.0f} MiB "
+                       "(a limit against zip bombs); unpack it yourself and run the folder")
     for info in infos:
         if info.file_size > MAX_SSP_RATIO * max(info.compress_size, 1) and info.file_size > 1 << 20:
             raise SspError(f"{path}: archive member {info.filename!r} expands {info.file_size / max(info.compress_size, 1):.0f} "
-                           f"times ({info.compress_size} -> {info.file_size} bytes), expected at most {MAX_SSP_RATIO} times")
+                           f"times ({info.compress_size} -> {info.file_size} bytes), expected at most {MAX_SSP_RATIO} times "
+                           "(a limit against zip bombs); unpack it yourself and run the folder")
 
 
 def _extract_ssp(path: Path) -> Path:
@@ -103,7 +105,8 @@ def _extract_ssp(path: Path) -> Path:
                 for member in zf.namelist():
                     dest = (target / member).resolve()
                     if not str(dest).startswith(str(target.resolve())):
-                        raise SspError(f"{path}: archive member {member!r} points outside the archive")
+                        raise SspError(f"{path}: archive member {member!r} points outside the archive (refused: "
+                                       "it would write elsewhere); repack the SSP with relative member names")
                 zf.extractall(target)
         except zipfile.BadZipFile as exc:
             raise SspError(f"{path}: not a zip archive ({exc}; SSP 1.0: an .ssp file is a zip archive); pack the SSD "
@@ -115,7 +118,7 @@ def _extract_ssp(path: Path) -> Path:
 def locate_ssd(path: Path) -> tuple[Path, Path]:
     """(the SSD file, the folder component sources are relative to) of an archive, folder or ``.ssd``."""
     if not path.exists():
-        raise SspError(f"{path}: no such file or directory")
+        raise SspError(f"{path}: no such file or directory; name an .ssp archive, an SSP folder or an .ssd file")
     if path.is_dir():
         ssd, base = path / SSD_NAME, path
     elif path.suffix == ".ssp":
