@@ -28,6 +28,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("scenario", nargs="?", default=None, metavar="SCENARIO",
                    help="scenario TOML/SSP file or packaged scenario name (default: paper-60s)")
     p.add_argument("--out", type=Path, required=True, metavar="FILE.ssp", help="output archive")
+    p.add_argument("--target", choices=("dtcosim", "libcosim", "ecos"), default="dtcosim",
+                   help="the host the archive is for: libcosim and ecos step with Jacobi, so the export sets that "
+                        "algorithm and says (SSD and output) which algorithm its step was chosen for; give the step "
+                        "the coupling study finds for Jacobi with --step (python benchmarks/coupling_study.py)")
     add_fmu_arguments(p)
     scenario_options.add_arguments(p)
     p.set_defaults(func=run)
@@ -43,13 +47,14 @@ def run(args: argparse.Namespace) -> int:
     from ..provision.staleness import stale_project_fmus
 
     scenario = scenario_options.apply(scenario_options.load(args.scenario, args, "export-ssp"), args, "export-ssp")
+    scenario, tuning, tuning_text = _tuned_for(scenario, args)
     paths = ensure_fmus(scenario, args.fmu_dir, build=not args.no_build,
                         report=lambda m: print(m, file=sys.stderr))
     for warning in stale_project_fmus(paths):
         print(f"dtcosim export-ssp: warning: {warning}", file=sys.stderr)
     system = resolve_system(scenario, fmu_paths=paths)
     initial = CoSimulation(system).initial_values() if scenario.initial else {}
-    out = export_ssp(system, args.out, initial)
+    out = export_ssp(system, args.out, initial, tuning)
     for warning in stale_warnings(system, initial):
         print(f"dtcosim export-ssp: warning: {warning}", file=sys.stderr)
     unbaked = unbaked_components(system, initial)
@@ -58,5 +63,39 @@ def run(args: argparse.Namespace) -> int:
               f"parameter values are only in the parameter set '{PARAMETER_SET}', which a host must apply (ecos: "
               f"--parameterSet {PARAMETER_SET})", file=sys.stderr)
     print(f"{out}: {len(scenario.components)} components, {len(scenario.connections)} connections"
-          + (f", initial values {', '.join(f'{k} = {v:.10g}' for k, v in initial.items())}" if initial else ""))
+          + (f", initial values {', '.join(f'{k} = {v:.10g}' for k, v in initial.items())}" if initial else "")
+          + f"; {tuning_text}")
     return 0
+
+
+def _tuned_for(scenario, args: argparse.Namespace):
+    """(the scenario with the target host's algorithm, ExportTuning, what it was tuned for as text); warns on stderr.
+
+    The step is the one the scenario gives (chosen for the scenario's own algorithm) unless
+    ``--step`` gives one; a target that steps with another algorithm without ``--step`` is
+    warned about: the step's accuracy was established for the scenario's algorithm only.
+    """
+    from ..errors import ScenarioError
+    from ..interop.ssp_export import HOST_ALGORITHMS, ExportTuning
+
+    own = scenario.simulation.algorithm
+    algorithm = HOST_ALGORITHMS[args.target] or own
+    if args.algorithm is not None and args.algorithm != algorithm:
+        raise ScenarioError("--algorithm", args.algorithm, f"{algorithm}: --target {args.target} steps with "
+                            f"{algorithm}; leave --algorithm out or choose another --target", scenario.source)
+    step_ms = f"{scenario.simulation.step_s * 1e3:g} ms"
+    if args.step is not None:
+        tuned_for = algorithm
+        text = f"target {args.target}: {algorithm} at H = {step_ms} (given with --step)"
+    else:
+        tuned_for = own if args.algorithm is None else scenario.simulation.algorithm
+        text = f"target {args.target}: {algorithm} at H = {step_ms}, the scenario's step, chosen for {tuned_for}"
+        if algorithm != tuned_for:
+            print(f"dtcosim export-ssp: warning: {args.target} steps with {algorithm}, but H = {step_ms} is the "
+                  f"scenario's step, chosen for {tuned_for}: its accuracy against the monolithic reference holds "
+                  f"for {tuned_for} only; find the largest step within the coupling study's criteria for "
+                  f"{algorithm} (python benchmarks/coupling_study.py --algorithms {algorithm}) and give it with "
+                  "--step", file=sys.stderr)
+    if algorithm != scenario.simulation.algorithm:
+        scenario = scenario.with_simulation(algorithm=algorithm)
+    return scenario, ExportTuning(args.target, tuned_for), text

@@ -117,3 +117,35 @@ def test_the_command_line_states_what_the_fmus_do_not(masses, tmp_path):
     assert proc.returncode == 0, proc.stderr
     proc = dtcosim("run", str(undeclared), "--no-feedthrough", "massC", "--check", cwd=tmp_path)
     assert proc.returncode != 0 and "--no-feedthrough = 'massC'" in proc.stderr and "massA, massB" in proc.stderr
+
+
+def _dtc_simulation(ssp: Path) -> dict:
+    from lxml import etree
+
+    with zipfile.ZipFile(ssp) as zf:
+        root = etree.fromstring(zf.read("SystemStructure.ssd"))
+    el = root.find(".//{https://dtcosim.org/SSP/Annotations}Simulation")
+    return dict(el.attrib)
+
+
+@pytest.mark.slow
+def test_an_export_for_a_jacobi_host_says_what_its_step_was_tuned_for(toy_scenario, tmp_path):
+    scenario = toy_scenario()
+    proc = dtcosim("export-ssp", str(scenario), "--target", "libcosim", "--out", str(tmp_path / "a.ssp"), cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    attrs = _dtc_simulation(tmp_path / "a.ssp")
+    # the scenario's own step was chosen for its Gauss-Seidel master: said in the SSD, the output, and warned about
+    assert (attrs["algorithm"], attrs["target"], attrs["stepTunedFor"]) == ("jacobi", "libcosim", "gauss-seidel")
+    assert "target libcosim: jacobi at H = 10 ms, the scenario's step, chosen for gauss-seidel" in proc.stdout
+    assert "warning: libcosim steps with jacobi" in proc.stderr and "--algorithms jacobi" in proc.stderr
+    proc = dtcosim("export-ssp", str(scenario), "--target", "ecos", "--step", "0.005", "--out",
+                   str(tmp_path / "b.ssp"), cwd=tmp_path)
+    assert proc.returncode == 0 and "steps with jacobi" not in proc.stderr, proc.stderr
+    attrs = _dtc_simulation(tmp_path / "b.ssp")
+    assert (attrs["algorithm"], attrs["target"], attrs["stepTunedFor"], attrs["step"]) == \
+        ("jacobi", "ecos", "jacobi", "0.005")
+    assert "target ecos: jacobi at H = 5 ms (given with --step)" in proc.stdout
+    proc = dtcosim("export-ssp", str(scenario), "--target", "ecos", "--algorithm", "gauss-seidel", "--out",
+                   str(tmp_path / "c.ssp"), cwd=tmp_path)
+    assert proc.returncode != 0 and "--target ecos steps with jacobi" in proc.stderr
+    assert not (tmp_path / "c.ssp").exists()
