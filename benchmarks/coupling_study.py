@@ -136,9 +136,10 @@ def step_study(args) -> None:
     rows = [(h, r) for a, h, r in rows if a == algorithms[0]]
     costs = [r["loop_cpu_per_s"] for h, r in rows if h >= 5e-3]
     print()
-    print(f"cost per simulated second non-increasing from 5 ms up: "
-          f"{'yes' if all(b <= a for a, b in zip(costs, costs[1:])) else 'NO'} "
-          f"({', '.join(f'{c:.4f}' for c in costs)} s)")
+    if len(costs) > 1:
+        print(f"cost per simulated second non-increasing from 5 ms up: "
+              f"{'yes' if all(b <= a for a, b in zip(costs, costs[1:])) else 'NO'} "
+              f"({', '.join(f'{c:.4f}' for c in costs)} s)")
     limits = (f"every Table 7 statistic within {args.margin:g} x {args.tolerance:g} and generator-speed RMS < "
               f"{args.margin:g} x {args.omega_tolerance:g} rad/s")
     for algorithm, h in largest.items():
