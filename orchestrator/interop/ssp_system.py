@@ -287,13 +287,13 @@ def _assign(flat: FlatSystem, owner, name: str, v: BoundValue, el, ssd_path: Pat
             try:
                 conversion = unit_conversion(v.unit, connector.unit, {**units, **v.units})
             except ValueError as exc:
-                raise SspError(f"{v.origin}: parameter {v.name!r}: {exc} (SSP 1.0: a value is converted to its "
+                raise SspError(f"{v.origin}: <ssv:Parameter> {v.name!r}: {exc} (SSP 1.0: a value is converted to its "
                                "connector's unit); define the unit in the parameter set's ssv:Units or the SSD's "
                                "ssd:Units, or give the value in the connector's unit") from None
         value = v.target_value(conversion)
         if transform is not None:
             if isinstance(transform, LinearTransformation) and v.type != "Real":
-                raise SspError(f"{v.origin}: parameter {v.name!r} is {v.type}; the connection to "
+                raise SspError(f"{v.origin}: <ssv:Parameter> {v.name!r} is {v.type}; the connection to "
                                f"{node[1]}.{node[2]} has a linear transformation (SSP 1.0: for Real values only); "
                                "give a Real value or use a mapping transformation on the connection")
             value = transform.apply(value)
@@ -327,19 +327,19 @@ def _collect_links(flat: FlatSystem, ssd_path: Path) -> None:
             link = ((node[1], node[2]), (comp, var))
             if target.kind == "input":
                 if con.kind != "output":
-                    raise SspError(f"{target.origin}: input {comp}.{var} is driven by calculatedParameter "
+                    raise SspError(f"{target.origin}: <ssd:Connector> input {comp}.{var} is driven by calculatedParameter "
                                    f"{node[1]}.{node[2]}: not supported (dtcosim sets inputs from outputs at "
                                    "every step); connect an output, or the calculatedParameter to a parameter")
                 flat.connections.append((*link, transform, target.origin))
             elif target.kind == "parameter":
                 if transform is not None:
-                    raise SspError(f"{target.origin}: parameter {comp}.{var} is set at initialisation from "
+                    raise SspError(f"{target.origin}: <ssd:Connector> parameter {comp}.{var} is set at initialisation from "
                                    f"{node[1]}.{node[2]} through a transformation: not supported (dtcosim's "
                                    "initial bindings copy values); remove the transformation from the connections "
                                    "on the way, or compute the value in the FMU")
                 flat.initial.append((*link, target.origin))
             else:
-                raise SspError(f"{target.origin}: {comp}.{var} (kind {target.kind}) cannot receive data (SSP 1.0: "
+                raise SspError(f"{target.origin}: <ssd:Connector> {comp}.{var} (kind {target.kind}) cannot receive data (SSP 1.0: "
                                "only inputs and parameters do); connect it as the start of the connection or "
                                "correct its kind")
 

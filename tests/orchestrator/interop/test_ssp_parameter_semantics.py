@@ -268,6 +268,14 @@ def _refusal_cases():
             '</ssd:Elements></ssd:System>', 'type="application/x-ssp-package"', "ssd:Component",
             r"type 'application/x-ssp-package' is not supported \(dtcosim runs FMUs.*\); export the element as an "
             r"FMU, or copy its system into this SSD"),
+        "calculatedParameter driving an input": (
+            TYPED_LINK.format(a=feedthrough("a", real("Float64_continuous_input", "input")
+                                            + real("calc", "calculatedParameter")),
+                              b=feedthrough("b", real("Float64_continuous_input", "input")),
+                              out="calc", inp="Float64_continuous_input"),
+            'kind="input"><ssc:Real/></ssd:Connector></ssd:Connectors>', "ssd:Connector",
+            r"input b\.Float64_continuous_input is driven by calculatedParameter a\.calc: not supported \(dtcosim "
+            r"sets inputs from outputs at every step\); connect an output"),
         "linear transformation on an Integer": (
             f'<ssd:System name="top"><ssd:Elements>{feedthrough("a", PORTS, FILE_BINDING)}</ssd:Elements></ssd:System>'
             .replace("{mapping}", '<ssd:ParameterMapping><ssm:ParameterMapping><ssm:MappingEntry source="n" '
