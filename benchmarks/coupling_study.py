@@ -17,7 +17,8 @@ then the largest H that keeps every Table 7 statistic within ``--tolerance``
 1e-4 rad/s), each with ``--margin`` (0.8): the ``step`` the packaged scenarios use.
 ``--algorithms`` (default ``gauss-seidel,jacobi``) gives one table and one largest H
 per master algorithm: the Jacobi column is the step for hosts that step with Jacobi
-(libcosim, ecos), e.g. ``dtcosim export-ssp --target libcosim --step H``.
+(libcosim, ecos). ``--json FILE`` writes the largest step per algorithm, which
+``dtcosim export-ssp --target libcosim --tuning FILE`` uses.
 
 Then, at that H, the Gearbox FMU's internal error control (``solver.rtol``,
 ``solver.atol_q``, ``solver.atol_v``) at ``--tolerance-scales`` times the FMU's
@@ -133,6 +134,7 @@ def step_study(args) -> None:
         print(f"| {algorithm} | {h * 1e3:g} | {r['mean']:.2e} | {r['std']:.2e} | {r['omega_rms']:.2e} | "
               f"{r['force_rms']:.2e} | {r['loop_cpu_per_s']:.4f} | {r['cpu_per_s']:.4f} | {'yes' if ok else 'no'} |")
     chosen = largest.get(algorithms[0])
+    all_rows = rows
     rows = [(h, r) for a, h, r in rows if a == algorithms[0]]
     costs = [r["loop_cpu_per_s"] for h, r in rows if h >= 5e-3]
     print()
@@ -144,11 +146,31 @@ def step_study(args) -> None:
               f"{args.margin:g} x {args.omega_tolerance:g} rad/s")
     for algorithm, h in largest.items():
         print(f"{algorithm}: " + (f"no H meets {limits}" if h is None else f"largest H with {limits}: {h * 1e3:g} ms"))
+    if args.json:
+        _write_steps(args, base, largest, all_rows, limits)
     if chosen is not None:
         if args.tolerance_scales:
             tolerance_study(args, base, paths, setup, chosen, reference if chosen == min(steps) else None)
     if args.interfaces:
         interface_study(args, base, paths, setup, steps)
+
+
+def _write_steps(args, base, largest: dict, rows: list, limits: str) -> None:
+    """The largest step per algorithm as JSON, for ``dtcosim export-ssp --target HOST --tuning FILE``."""
+    import json
+    from pathlib import Path
+
+    data = {
+        "scenario": base.name,
+        "start_s": base.simulation.start_s,
+        "stop_s": base.simulation.stop_s,
+        "window_s": list(base.simulation.window_s),
+        "criteria": limits,
+        "largest_step_s": largest,
+        "rows": [{"algorithm": a, "step_s": h, **r} for a, h, r in rows],
+    }
+    Path(args.json).write_text(json.dumps(data, indent=1) + "\n", encoding="utf-8")
+    print(f"written {args.json}")
 
 
 #: the Gearbox's interface to the generator and the rotor: the scenario's, and the alternatives it replaced
@@ -306,6 +328,8 @@ def main() -> None:
     parser.add_argument("--algorithms", default="gauss-seidel,jacobi", help="master algorithms of the step table, "
                         "comma separated; the tolerance and interface tables use the first (default "
                         "gauss-seidel,jacobi)")
+    parser.add_argument("--json", default=None, metavar="FILE", help="also write the largest step per algorithm "
+                        "(and every row) to FILE, for dtcosim export-ssp --tuning FILE")
     parser.add_argument("--variants", action="store_true", help="compare master variants instead")
     parser.add_argument("--fmu-dir", default=None, help="FMU directory (default: the FMU folder `dtcosim run` uses, $DTCOSIM_FMU_DIR or ~/.cache/dtcosim/fmus)")
     args = parser.parse_args()

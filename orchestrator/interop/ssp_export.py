@@ -208,10 +208,11 @@ HOST_ALGORITHMS = {"dtcosim": None, "libcosim": "jacobi", "ecos": "jacobi"}
 
 @dataclass(frozen=True)
 class ExportTuning:
-    """What an export was tuned for: the ``target`` host and the algorithm its step was chosen for."""
+    """What an export was tuned for: the ``target`` host, the algorithm its step was chosen for, the criteria met."""
 
     target: str
     step_tuned_for: str
+    criteria: str = ""
 
 
 def system_structure(system: ResolvedSystem, initial_values: Mapping[str, float] | None = None,
@@ -311,6 +312,8 @@ def system_structure(system: ResolvedSystem, initial_values: Mapping[str, float]
     if tuning is not None:
         settings.set("target", tuning.target)
         settings.set("stepTunedFor", tuning.step_tuned_for)
+        if tuning.criteria:
+            settings.set("stepCriteria", tuning.criteria)
     if sim.order:
         settings.set("order", " ".join(sim.order))
     if sim.algebraic_loops != "refuse":

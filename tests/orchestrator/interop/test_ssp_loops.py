@@ -149,3 +149,29 @@ def test_an_export_for_a_jacobi_host_says_what_its_step_was_tuned_for(toy_scenar
                    str(tmp_path / "c.ssp"), cwd=tmp_path)
     assert proc.returncode != 0 and "--target ecos steps with jacobi" in proc.stderr
     assert not (tmp_path / "c.ssp").exists()
+
+
+@pytest.mark.slow
+def test_an_export_takes_the_step_the_coupling_study_measured_for_the_targets_algorithm(toy_scenario, tmp_path):
+    import json
+
+    scenario = toy_scenario()
+    criteria = "every Table 7 statistic within 0.8 x 0.0001 and generator-speed RMS < 0.8 x 0.0001 rad/s"
+    tuning = tmp_path / "steps.json"  # as benchmarks/coupling_study.py --json writes it
+    tuning.write_text(json.dumps({"scenario": "toy", "window_s": [5.0, 60.0], "criteria": criteria,
+                                  "largest_step_s": {"gauss-seidel": 0.01, "jacobi": 0.002}}))
+    proc = dtcosim("export-ssp", str(scenario), "--target", "libcosim", "--tuning", str(tuning), "--out",
+                   str(tmp_path / "a.ssp"), cwd=tmp_path)
+    assert proc.returncode == 0 and "steps with jacobi" not in proc.stderr, proc.stderr
+    attrs = _dtc_simulation(tmp_path / "a.ssp")
+    assert (attrs["algorithm"], attrs["step"], attrs["stepTunedFor"]) == ("jacobi", "0.002", "jacobi")
+    assert attrs["stepCriteria"] == criteria + ", measured with the window [5, 60] s"
+    assert "target libcosim: jacobi at H = 2 ms, the largest step within the coupling study's criteria" in proc.stdout
+    for change, key in [({"scenario": "paper-60s"}, "scenario = 'paper-60s'"),
+                        ({"largest_step_s": {"gauss-seidel": 0.01, "jacobi": None}}, "largest_step_s.jacobi = None")]:
+        tuning.write_text(json.dumps({"scenario": "toy", "criteria": criteria,
+                                      "largest_step_s": {"jacobi": 0.002}, **change}))
+        proc = dtcosim("export-ssp", str(scenario), "--target", "ecos", "--tuning", str(tuning), "--out",
+                       str(tmp_path / "b.ssp"), cwd=tmp_path)
+        assert proc.returncode != 0 and "steps.json" in proc.stderr and key in proc.stderr, proc.stderr
+        assert not (tmp_path / "b.ssp").exists()
