@@ -14,7 +14,11 @@ monolithic solution of the same scenario (same seed):
 
 then the largest H that keeps every Table 7 statistic within ``--tolerance``
 (default 1e-4) and the generator-speed RMS below ``--omega-tolerance`` (default
-1e-4 rad/s): the ``step`` the packaged scenarios use.
+1e-4 rad/s), each with ``--margin`` (0.8): the ``step`` the packaged scenarios use.
+``--algorithms`` (default ``gauss-seidel,jacobi``) gives one table and one largest H
+per master algorithm: the Jacobi column is the step for hosts that step with Jacobi
+(libcosim, ecos). ``--json FILE`` writes the largest step per algorithm, which
+``dtcosim export-ssp --target libcosim --tuning FILE`` uses.
 
 Then, at that H, the Gearbox FMU's internal error control (``solver.rtol``,
 ``solver.atol_q``, ``solver.atol_v``) at ``--tolerance-scales`` times the FMU's
@@ -103,43 +107,70 @@ def step_study(args) -> None:
           f"reference on the same grid); Gearbox kernel: {kernel}; monolithic reference at "
           f"{min(steps) * 1e3:g} ms output: integration {reference.info['cpu_time_s']:.2f} s CPU, total "
           f"{reference_cpu:.2f} s CPU\n")
+    algorithms = [a.strip() for a in args.algorithms.split(",") if a.strip()]
     rows = []
-    for h in steps:
-        sc = base.with_simulation(step_s=h, output_interval_s=h)
-        system = resolve_system(sc, fmu_paths=paths)
-        CoSimulation(system).run(handle_sigint=False)  # warm-up: the first run also loads the compiled kernels
-        outcome = CoSimulation(system).run(handle_sigint=False)
-        if not outcome.complete:
-            raise SystemExit(f"H = {h * 1e3:g} ms: {outcome.error}")
-        ref_h = reference if h == min(steps) else run_reference(system, setup)
-        rows.append((h, accuracy_and_cost(outcome, ref_h, system, setup)))
+    references = {min(steps): reference}
+    for algorithm in algorithms:
+        for h in steps:
+            sc = base.with_simulation(step_s=h, output_interval_s=h, algorithm=algorithm)
+            system = resolve_system(sc, fmu_paths=paths)
+            CoSimulation(system).run(handle_sigint=False)  # warm-up: the first run also loads the compiled kernels
+            outcome = CoSimulation(system).run(handle_sigint=False)
+            if not outcome.complete:
+                raise SystemExit(f"{algorithm}, H = {h * 1e3:g} ms: {outcome.error}")
+            if h not in references:  # the reference on each output grid, once for all algorithms
+                references[h] = run_reference(system, setup)
+            rows.append((algorithm, h, accuracy_and_cost(outcome, references[h], system, setup)))
     print(f"Gearbox tolerances of the scenario: {_tolerance_text(base)}\n")
-    print("| H [ms] | max rel. diff. mean (contact forces) | max rel. diff. std (contact forces) | "
+    print("| algorithm | H [ms] | max rel. diff. mean (contact forces) | max rel. diff. std (contact forces) | "
           "generator-speed RMS error [rad/s] | max RMS difference / std (contact forces) | "
           "stepping CPU per simulated s [s] | run CPU per simulated s [s] | within |")
-    print("|---|---|---|---|---|---|---|---|")
-    chosen = None
-    for h, r in rows:
+    print("|---|---|---|---|---|---|---|---|---|")
+    largest: dict[str, float | None] = {a: None for a in algorithms}
+    for algorithm, h, r in rows:
         ok = _within(r, args)
-        if ok and (chosen is None or h > chosen):
-            chosen = h
-        print(f"| {h * 1e3:g} | {r['mean']:.2e} | {r['std']:.2e} | {r['omega_rms']:.2e} | {r['force_rms']:.2e} | "
-              f"{r['loop_cpu_per_s']:.4f} | {r['cpu_per_s']:.4f} | {'yes' if ok else 'no'} |")
+        if ok and (largest[algorithm] is None or h > largest[algorithm]):
+            largest[algorithm] = h
+        print(f"| {algorithm} | {h * 1e3:g} | {r['mean']:.2e} | {r['std']:.2e} | {r['omega_rms']:.2e} | "
+              f"{r['force_rms']:.2e} | {r['loop_cpu_per_s']:.4f} | {r['cpu_per_s']:.4f} | {'yes' if ok else 'no'} |")
+    chosen = largest.get(algorithms[0])
+    all_rows = rows
+    rows = [(h, r) for a, h, r in rows if a == algorithms[0]]
     costs = [r["loop_cpu_per_s"] for h, r in rows if h >= 5e-3]
     print()
-    print(f"cost per simulated second non-increasing from 5 ms up: "
-          f"{'yes' if all(b <= a for a, b in zip(costs, costs[1:])) else 'NO'} "
-          f"({', '.join(f'{c:.4f}' for c in costs)} s)")
+    if len(costs) > 1:
+        print(f"cost per simulated second non-increasing from 5 ms up: "
+              f"{'yes' if all(b <= a for a, b in zip(costs, costs[1:])) else 'NO'} "
+              f"({', '.join(f'{c:.4f}' for c in costs)} s)")
     limits = (f"every Table 7 statistic within {args.margin:g} x {args.tolerance:g} and generator-speed RMS < "
               f"{args.margin:g} x {args.omega_tolerance:g} rad/s")
-    if chosen is None:
-        print(f"no H meets {limits}")
-    else:
-        print(f"largest H with {limits}: {chosen * 1e3:g} ms")
+    for algorithm, h in largest.items():
+        print(f"{algorithm}: " + (f"no H meets {limits}" if h is None else f"largest H with {limits}: {h * 1e3:g} ms"))
+    if args.json:
+        _write_steps(args, base, largest, all_rows, limits)
+    if chosen is not None:
         if args.tolerance_scales:
             tolerance_study(args, base, paths, setup, chosen, reference if chosen == min(steps) else None)
     if args.interfaces:
         interface_study(args, base, paths, setup, steps)
+
+
+def _write_steps(args, base, largest: dict, rows: list, limits: str) -> None:
+    """The largest step per algorithm as JSON, for ``dtcosim export-ssp --target HOST --tuning FILE``."""
+    import json
+    from pathlib import Path
+
+    data = {
+        "scenario": base.name,
+        "start_s": base.simulation.start_s,
+        "stop_s": base.simulation.stop_s,
+        "window_s": list(base.simulation.window_s),
+        "criteria": limits,
+        "largest_step_s": largest,
+        "rows": [{"algorithm": a, "step_s": h, **r} for a, h, r in rows],
+    }
+    Path(args.json).write_text(json.dumps(data, indent=1) + "\n", encoding="utf-8")
+    print(f"written {args.json}")
 
 
 #: the Gearbox's interface to the generator and the rotor: the scenario's, and the alternatives it replaced
@@ -294,6 +325,11 @@ def main() -> None:
                         "defaults) tried at the chosen H, comma separated (default 0.3,1,3,10; empty: skip)")
     parser.add_argument("--interfaces", action="store_true", help="also the table of the Gearbox's interface "
                         "options (generator_interface, rotor_derivatives) at every H")
+    parser.add_argument("--algorithms", default="gauss-seidel,jacobi", help="master algorithms of the step table, "
+                        "comma separated; the tolerance and interface tables use the first (default "
+                        "gauss-seidel,jacobi)")
+    parser.add_argument("--json", default=None, metavar="FILE", help="also write the largest step per algorithm "
+                        "(and every row) to FILE, for dtcosim export-ssp --tuning FILE")
     parser.add_argument("--variants", action="store_true", help="compare master variants instead")
     parser.add_argument("--fmu-dir", default=None, help="FMU directory (default: the FMU folder `dtcosim run` uses, $DTCOSIM_FMU_DIR or ~/.cache/dtcosim/fmus)")
     args = parser.parse_args()

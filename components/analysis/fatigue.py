@@ -33,6 +33,15 @@ Load duration distribution (LDD)
 --------------------------------
 Time spent in each load bin: :mod:`components.analysis.load_duration`; the run-level
 report below gives one per shaft torque.
+
+Kinds and units
+---------------
+:func:`fatigue_report` is told which signals are loads, which of them are shaft
+torques (those get an LDD) and their units, as the caller knows them from the
+declarations (the FMU's record, its modelDescription units, the scenario's role
+and signals: :mod:`orchestrator.run.analyses`). Only without ``names`` does it fall
+back to the naming of the project's own reference model
+(:mod:`components.reference.results`: ``*.F_*`` forces, ``shaft<k>.torque``).
 """
 
 from __future__ import annotations
@@ -40,7 +49,7 @@ from __future__ import annotations
 import csv
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Mapping
+from typing import Mapping, Sequence
 
 import fatpack
 import numpy as np
@@ -430,8 +439,10 @@ def fatigue_report(
     names: list[str] | None = None,
     time_s: np.ndarray | None = None,
     speeds: Mapping[str, str] | None = None,
+    torques: Sequence[str] | None = None,
+    units: Mapping[str, str] | None = None,
 ) -> FatigueReport:
-    """DELs of every contact force and shaft torque and the LDD of every shaft torque.
+    """DELs of every load signal and the LDD of every shaft torque.
 
     Parameters
     ----------
@@ -441,12 +452,20 @@ def fatigue_report(
     window : (float, float), optional
         Analysed window [s] (e.g. the statistics window [5, 60] s).
     names : list of str, optional
-        Load signals; default every ``*.F_*`` force and ``shaft*.torque``.
+        Load signals, as declared (contact forces and shaft torques). Default: the
+        project's reference model's own results, every ``*.F_*`` force and
+        ``shaft<k>.torque``.
     time_s : ndarray, optional
         Sample times for a plain mapping.
     speeds : mapping of str -> str, optional
         Speed series per shaft-torque name for load revolution distributions, e.g.
         ``{"shaft3.torque": "omega_gen"}``.
+    torques : sequence of str, optional
+        Which of ``names`` are shaft torques (an LDD each). Default: with ``names``
+        none; without, the reference model's ``shaft<k>.torque``.
+    units : mapping of str -> str, optional
+        Unit of each signal as declared (its FMU's modelDescription). Default: with
+        ``names`` "" (not declared); without, the reference model's units.
 
     Returns
     -------
@@ -454,18 +473,26 @@ def fatigue_report(
     """
     s = settings or FatigueSettings()
     series, t = series_and_time(result, time_s)
-    names = _default_load_names(series) if names is None else list(names)
+    if names is None:  # the reference model's own results: its naming is its declaration
+        names = _default_load_names(series)
+        torques = [n for n in names if is_shaft_torque(n)] if torques is None else torques
+        units = {n: unit_of(n) for n in names} if units is None else units
+    names = list(names)
+    torques = list(torques or ())
+    units = dict(units or {})
     missing = [n for n in names if n not in series]
     if missing:
         raise ParameterError("names", missing, "recorded load signals")
-    loads = {n: fatigue_loads(t, series[n], s, window, n) for n in names}
+    stray = [n for n in torques if n not in names]
+    if stray:
+        raise ParameterError("torques", stray, "a subset of the load signals (names)")
+    loads = {n: fatigue_loads(t, series[n], s, window, n, units.get(n, "")) for n in names}
     speeds = speeds or {}
     ldd = {
         n: load_duration_distribution(
-            t, series[n], s.ldd_bins, window, series[speeds[n]] if n in speeds else None, n
+            t, series[n], s.ldd_bins, window, series[speeds[n]] if n in speeds else None, n, units.get(n, "")
         )
-        for n in names
-        if n.endswith("torque")
+        for n in torques
     }
     return FatigueReport(loads, ldd, s, window)
 

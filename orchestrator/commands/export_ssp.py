@@ -28,6 +28,14 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("scenario", nargs="?", default=None, metavar="SCENARIO",
                    help="scenario TOML/SSP file or packaged scenario name (default: paper-60s)")
     p.add_argument("--out", type=Path, required=True, metavar="FILE.ssp", help="output archive")
+    p.add_argument("--target", choices=("dtcosim", "libcosim", "ecos"), default="dtcosim",
+                   help="the host the archive is for: libcosim and ecos step with Jacobi, so the export sets that "
+                        "algorithm and says (SSD and output) which algorithm its step was chosen for; give the step "
+                        "the coupling study finds for Jacobi with --step, or its --json file with --tuning")
+    p.add_argument("--tuning", type=Path, default=None, metavar="FILE.json",
+                   help="the largest steps per algorithm that the coupling study measured (python "
+                        "benchmarks/coupling_study.py --json FILE.json): the export uses the one of the target's "
+                        "algorithm")
     add_fmu_arguments(p)
     scenario_options.add_arguments(p)
     p.set_defaults(func=run)
@@ -43,13 +51,14 @@ def run(args: argparse.Namespace) -> int:
     from ..provision.staleness import stale_project_fmus
 
     scenario = scenario_options.apply(scenario_options.load(args.scenario, args, "export-ssp"), args, "export-ssp")
+    scenario, tuning, tuning_text = _tuned_for(scenario, args)
     paths = ensure_fmus(scenario, args.fmu_dir, build=not args.no_build,
                         report=lambda m: print(m, file=sys.stderr))
     for warning in stale_project_fmus(paths):
         print(f"dtcosim export-ssp: warning: {warning}", file=sys.stderr)
     system = resolve_system(scenario, fmu_paths=paths)
     initial = CoSimulation(system).initial_values() if scenario.initial else {}
-    out = export_ssp(system, args.out, initial)
+    out = export_ssp(system, args.out, initial, tuning)
     for warning in stale_warnings(system, initial):
         print(f"dtcosim export-ssp: warning: {warning}", file=sys.stderr)
     unbaked = unbaked_components(system, initial)
@@ -58,5 +67,78 @@ def run(args: argparse.Namespace) -> int:
               f"parameter values are only in the parameter set '{PARAMETER_SET}', which a host must apply (ecos: "
               f"--parameterSet {PARAMETER_SET})", file=sys.stderr)
     print(f"{out}: {len(scenario.components)} components, {len(scenario.connections)} connections"
-          + (f", initial values {', '.join(f'{k} = {v:.10g}' for k, v in initial.items())}" if initial else ""))
+          + (f", initial values {', '.join(f'{k} = {v:.10g}' for k, v in initial.items())}" if initial else "")
+          + f"; {tuning_text}")
     return 0
+
+
+def _tuned_for(scenario, args: argparse.Namespace):
+    """(the scenario with the target host's algorithm and step, ExportTuning, what it was tuned for as text).
+
+    The step is, in this order, the one ``--tuning`` measured for the target's algorithm,
+    the one ``--step`` gives, or the scenario's (chosen for the scenario's own algorithm;
+    a target that steps with another algorithm is warned about on stderr).
+    """
+    from ..errors import ScenarioError
+    from ..interop.ssp_export import HOST_ALGORITHMS, ExportTuning
+
+    own = scenario.simulation.algorithm
+    algorithm = HOST_ALGORITHMS[args.target] or own
+    if args.algorithm is not None and args.algorithm != algorithm:
+        raise ScenarioError("--algorithm", args.algorithm, f"{algorithm}: --target {args.target} steps with "
+                            f"{algorithm}; leave --algorithm out or choose another --target", scenario.source)
+    criteria = ""
+    if args.tuning is not None:
+        if args.step is not None:
+            raise ScenarioError("--step", args.step, "no --step together with --tuning (which gives the step)",
+                                scenario.source)
+        step, criteria = _measured_step(args.tuning, scenario.name, algorithm)
+        scenario = scenario.with_simulation(step_s=step)
+    step_ms = f"{scenario.simulation.step_s * 1e3:g} ms"
+    if args.tuning is not None:
+        tuned_for = algorithm
+        text = (f"target {args.target}: {algorithm} at H = {step_ms}, the largest step within the coupling study's "
+                f"criteria for {algorithm} ({criteria}; {args.tuning})")
+    elif args.step is not None:
+        tuned_for = algorithm
+        text = f"target {args.target}: {algorithm} at H = {step_ms} (given with --step)"
+    else:
+        tuned_for = own if args.algorithm is None else scenario.simulation.algorithm
+        text = f"target {args.target}: {algorithm} at H = {step_ms}, the scenario's step, chosen for {tuned_for}"
+        if algorithm != tuned_for:
+            print(f"dtcosim export-ssp: warning: {args.target} steps with {algorithm}, but H = {step_ms} is the "
+                  f"scenario's step, chosen for {tuned_for}: its accuracy against the monolithic reference holds "
+                  f"for {tuned_for} only; measure the largest step within the coupling study's criteria for "
+                  f"{algorithm} (python benchmarks/coupling_study.py --algorithms {algorithm} --json FILE) and give "
+                  "it with --tuning FILE or --step", file=sys.stderr)
+    if algorithm != scenario.simulation.algorithm:
+        scenario = scenario.with_simulation(algorithm=algorithm)
+    return scenario, ExportTuning(args.target, tuned_for, criteria), text
+
+
+def _measured_step(path: Path, scenario_name: str, algorithm: str) -> tuple[float, str]:
+    """(largest step for ``algorithm``, the criteria) from a coupling-study JSON file (``--json``) of this scenario."""
+    import json
+    import math
+
+    from ..errors import ScenarioError
+
+    try:
+        data = json.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        raise ScenarioError("--tuning", str(path), f"a JSON file of benchmarks/coupling_study.py --json ({exc})") \
+            from None
+    if not isinstance(data, dict) or not isinstance(data.get("largest_step_s"), dict):
+        raise ScenarioError("largest_step_s", None, "a table of the largest step per algorithm (benchmarks/"
+                            "coupling_study.py --json)", str(path))
+    if data.get("scenario") != scenario_name:
+        raise ScenarioError("scenario", data.get("scenario"), f"the exported scenario {scenario_name!r}: the steps "
+                            "were measured on another scenario", str(path))
+    step = data["largest_step_s"].get(algorithm)
+    if not isinstance(step, (int, float)) or isinstance(step, bool) or not math.isfinite(step) or step <= 0:
+        raise ScenarioError(f"largest_step_s.{algorithm}", step, f"a step [s] > 0: the study found none within its "
+                            f"criteria for {algorithm} (measure smaller steps: --steps)", str(path))
+    window = data.get("window_s")
+    span = (f", measured with the window [{window[0]:g}, {window[1]:g}] s" if isinstance(window, list) and len(window) == 2
+            and all(isinstance(w, (int, float)) for w in window) else "")
+    return float(step), str(data.get("criteria", "")) + span

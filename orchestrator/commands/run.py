@@ -90,6 +90,8 @@ def run(args: argparse.Namespace) -> int:
     for warning in stale_project_fmus(paths):
         print(f"dtcosim run: warning: {warning}", file=sys.stderr)
     system = resolve_system(scenario, fmu_paths=paths)
+    for note in system.notes:
+        print(f"dtcosim run: note: {note}", file=sys.stderr)
     if args.check:
         print(f"{scenario.name}: valid ({len(scenario.components)} FMUs, {len(scenario.connections)} connections, "
               f"{len(system.recorded)} recorded variables, {len(system.events)} load event(s); stepping order {', '.join(system.order)}; "

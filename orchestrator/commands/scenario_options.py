@@ -12,11 +12,12 @@ import json
 import sys
 from pathlib import Path
 
-from ..inputs.master_options import ALGORITHMS, EXTRAPOLATIONS
+from ..inputs.master_options import ALGEBRAIC_LOOPS, ALGORITHMS, EXTRAPOLATIONS
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    """``--step``, ``--stop``, ``--window``, ``--output-interval``, ``--algorithm``, ``--extrapolation``, ``--set``."""
+    """``--step``, ``--stop``, ``--window``, ``--output-interval``, ``--algorithm``, ``--extrapolation``, ``--set``,
+    ``--algebraic-loops``, ``--no-feedthrough``."""
     p.add_argument("--step", type=float, default=None, metavar="H", help="override the communication step [s]")
     p.add_argument("--stop", type=float, default=None, metavar="T",
                    help="override the stop time [s] (a window beyond it is clipped, a window that ended at the "
@@ -28,6 +29,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--extrapolation", choices=EXTRAPOLATIONS, default=None, help="override the input extrapolation")
     p.add_argument("--set", action="append", default=[], metavar="COMPONENT.PARAMETER=VALUE",
                    help="override a parameter value, e.g. --set wind.seed=7 (repeatable)")
+    p.add_argument("--algebraic-loops", choices=ALGEBRAIC_LOOPS, default=None,
+                   help="override what the master does with an algebraic loop: refuse it, or iterate it at every "
+                        "communication point ([simulation] algebraic_loops)")
+    p.add_argument("--no-feedthrough", action="append", default=[], metavar="COMPONENT[.OUTPUT]",
+                   help="an output (or, with COMPONENT alone, every output without declared dependencies) that "
+                        "does not depend directly on the FMU's inputs, for FMUs whose model description does not "
+                        "say (repeatable; [components.X] no_feedthrough)")
 
 
 def load(spec, args: argparse.Namespace, command: str):
@@ -60,6 +68,10 @@ def apply(scenario, args: argparse.Namespace, command: str):
     scenario, notes = overrides.apply(scenario)
     for note in notes:
         print(f"dtcosim {command}: warning: {note}", file=sys.stderr)
+    if args.algebraic_loops is not None:
+        scenario = scenario.with_simulation(algebraic_loops=args.algebraic_loops)
+    for item in args.no_feedthrough:
+        scenario = scenario.with_no_feedthrough(item.strip())
     return apply_parameters(scenario, dict(parse_assignment(item) for item in args.set))
 
 
@@ -67,12 +79,14 @@ def given_overrides(args: argparse.Namespace) -> list[str]:
     """The scenario-changing options on the command line, as typed (``["--stop 3", "--set wind.seed=7"]``)."""
     out = []
     for option, value in (("--stop", args.stop), ("--step", args.step), ("--output-interval", args.output_interval),
-                          ("--algorithm", args.algorithm), ("--extrapolation", args.extrapolation)):
+                          ("--algorithm", args.algorithm), ("--extrapolation", args.extrapolation),
+                          ("--algebraic-loops", args.algebraic_loops)):
         if value is not None:
             out.append(f"{option} {value:g}" if isinstance(value, float) else f"{option} {value}")
     if args.window is not None:
         out.append(f"--window {args.window[0]:g} {args.window[1]:g}")
     out += [f"--set {item.strip()}" for item in args.set]
+    out += [f"--no-feedthrough {item.strip()}" for item in args.no_feedthrough]
     return out
 
 

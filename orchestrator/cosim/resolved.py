@@ -69,6 +69,9 @@ class ResolvedSystem:
     algebraic_loops : tuple of tuple of str
         With ``simulation.algebraic_loops = "iterate"``: the components of each algebraic
         loop, which the master solves by iteration (:mod:`orchestrator.cosim.algebraic_loops`).
+    notes : tuple of str
+        What the checks accepted with a caveat (a loop through outputs that declare no
+        dependencies, run with Jacobi); printed by ``dtcosim run`` and kept in the summary.
     """
 
     scenario: Scenario
@@ -80,6 +83,7 @@ class ResolvedSystem:
     events: tuple[AssignedEvent, ...] = ()
     roles: Mapping[str, ComponentRole] = field(default_factory=dict)
     algebraic_loops: tuple[tuple[str, ...], ...] = ()
+    notes: tuple[str, ...] = ()
 
     def with_role(self, role: str) -> list[ComponentRole]:
         """The components declared with ``role``, in scenario order."""

@@ -7,10 +7,14 @@ scenario uses: each FMU is FMI 2.0 co-simulation with a binary for this platform
 parameters and start values exist, may be set before initialisation (FMI 2.0:
 parameters, inputs and variables with ``initial="exact"`` or ``"approx"``) and have
 the right type; connections join an output to an input of the same type (Real,
-Integer, Boolean, String, or Enumeration of the same declared type); initial
-bindings join an output to a parameter or input of the same type; record
-patterns match variables (any type); no algebraic loop (with the scenario's
-``no_feedthrough`` declarations for FMUs that omit their output dependencies);
+Integer, Boolean, String, or Enumeration of the same declared type; an Integer
+and an Enumeration connect); initial bindings join an output to a parameter or
+input of the same type; record patterns match variables (any type); no algebraic
+loop (with the scenario's ``no_feedthrough`` declarations for FMUs that omit their
+output dependencies, ``"*"`` for all of a component's; iterated with
+``algebraic_loops = "iterate"``; with Jacobi, a loop that passes an output without
+declared dependencies is run as libcosim runs it, with a note in
+``ResolvedSystem.notes``);
 every value within what the FMU accepts (FMI Integer range, declared bounds, a
 dtcosim model's own validation: :mod:`orchestrator.cosim.parameter_checks`); the
 results within the size limits (:func:`check_sizes`). The first problem raises
@@ -211,6 +215,12 @@ def resolve_system(scenario: Scenario, fmu_paths: Mapping[str, Path] | None = No
     links = [(str(c.source), str(c.target)) for c in scenario.connections]
     loop = find_algebraic_loop(links, feedthrough)
     loops: tuple[tuple[str, ...], ...] = ()
+    notes: list[str] = []
+    if loop is not None and scenario.simulation.algebraic_loops != "iterate" \
+            and scenario.simulation.algorithm == "jacobi" \
+            and find_algebraic_loop(links, _feedthrough(scenario, interfaces, declared_only=True)) is None:
+        notes.append(_jacobi_note(loop, interfaces))  # every loop passes an output without declared dependencies
+        loop = None
     if loop is not None:
         if scenario.simulation.algebraic_loops != "iterate":
             raise AlgebraicLoopError(loop, src, _loop_hint(loop, interfaces))
@@ -231,6 +241,7 @@ def resolve_system(scenario: Scenario, fmu_paths: Mapping[str, Path] | None = No
         events=events,
         roles=FrozenMap(declared_roles(scenario, interfaces)),
         algebraic_loops=loops,
+        notes=tuple(notes),
     )
     problem = model_problem(system)
     if problem is not None:
@@ -277,27 +288,57 @@ def _enumeration_items_as_values(scenario: Scenario, interfaces: Mapping[str, Fm
     return scenario
 
 
-def _feedthrough(scenario: Scenario, interfaces: Mapping[str, FmuInterface]) -> dict[str, list[str]]:
-    """``"comp.input" -> ["comp.output", ...]`` direct dependencies, less the scenario's ``no_feedthrough``."""
+def _feedthrough(scenario: Scenario, interfaces: Mapping[str, FmuInterface],
+                 declared_only: bool = False) -> dict[str, list[str]]:
+    """``"comp.input" -> ["comp.output", ...]`` direct dependencies, less the scenario's ``no_feedthrough``.
+
+    ``no_feedthrough = ["*"]`` means every output of the component whose model description
+    declares no dependencies; ``declared_only`` leaves out all such outputs (only the
+    dependencies the FMUs state).
+    """
     src = scenario.source
     feedthrough: dict[str, list[str]] = {}
     for comp in scenario.components:
         iface = interfaces[comp.name]
         for i, out in enumerate(comp.no_feedthrough):
+            if out == "*":
+                continue
             key = f"components.{comp.name}.no_feedthrough[{i}]"
             var = iface.variables.get(out)
             if var is None or var.causality != "output":
-                raise ScenarioError(key, out, f"an output of {iface.model_name}{suggestion(out, iface.outputs)}", src)
+                raise ScenarioError(key, out, f"an output of {iface.model_name}{suggestion(out, iface.outputs)} "
+                                    "(or \"*\": every output without declared dependencies)", src)
             declared = iface.output_dependencies.get(out)
             if declared:
                 raise ScenarioError(key, out, f"an output whose model description does not declare direct "
                                     f"dependencies; {out} depends on {', '.join(declared)}", src)
+        every_undeclared = declared_only or "*" in comp.no_feedthrough
         for out in iface.outputs:
-            if out in comp.no_feedthrough:
+            if out in comp.no_feedthrough or (every_undeclared and iface.output_dependencies.get(out) is None):
                 continue
             for inp in iface.direct_inputs_of(out):
                 feedthrough.setdefault(f"{comp.name}.{inp}", []).append(f"{comp.name}.{out}")
     return feedthrough
+
+
+def _undeclared_on(cycle: list[str], interfaces: Mapping[str, FmuInterface]) -> list[str]:
+    """The outputs on a cycle whose model description declares no dependencies (FMI 2: on every input)."""
+    out = []
+    for name in cycle:
+        comp, _, var = name.partition(".")
+        iface = interfaces[comp]
+        if var in iface.outputs and iface.output_dependencies.get(var) is None and name not in out:
+            out.append(name)
+    return out
+
+
+def _jacobi_note(cycle: list[str], interfaces: Mapping[str, FmuInterface]) -> str:
+    undeclared = _undeclared_on(cycle, interfaces)
+    return (f"the connections close a loop ({' -> '.join(cycle)}) only through outputs that declare no "
+            f"dependencies ({', '.join(undeclared)}; FMI 2 reads that as depending directly on every input); "
+            "Jacobi gives every FMU its partners' outputs of the previous communication point, so it runs the "
+            "system without an order, as libcosim does; where such an output does depend directly on its inputs, "
+            "the coupling lags one step: --algebraic-loops iterate solves the loop at each point instead")
 
 
 def _iterated_loops(scenario: Scenario, interfaces: Mapping[str, FmuInterface],
@@ -324,20 +365,18 @@ def _iterated_loops(scenario: Scenario, interfaces: Mapping[str, FmuInterface],
 
 def _loop_hint(cycle: list[str], interfaces: Mapping[str, FmuInterface]) -> str:
     """How to state that an output on the loop does not feed through, for FMUs that do not say, or to iterate."""
-    iterate = 'or, for a loop that is really there, let the master iterate it: [simulation] algebraic_loops = "iterate"'
-    undeclared = []
-    for name in cycle:
-        comp, _, var = name.partition(".")
-        iface = interfaces[comp]
-        if var in iface.outputs and iface.output_dependencies.get(var) is None and name not in undeclared:
-            undeclared.append(name)
+    iterate = ('or, for a loop that is really there, let the master iterate it: --algebraic-loops iterate on the '
+               'command line (a TOML scenario: [simulation] algebraic_loops = "iterate")')
+    undeclared = _undeclared_on(cycle, interfaces)
     if not undeclared:
         return iterate
+    options = " ".join(f"--no-feedthrough {n}" for n in undeclared)
     tables = "; ".join(f'[components.{n.partition(".")[0]}] no_feedthrough = ["{n.partition(".")[2]}"]'
                        for n in undeclared)
     return (f"{', '.join(undeclared)} {'has' if len(undeclared) == 1 else 'have'} no declared dependencies, which "
-            f"FMI 2 reads as depending directly on every input; if an output does not, say so in the scenario: "
-            f"{tables}; {iterate}")
+            f"FMI 2 reads as depending directly on every input; if an output does not, say so on the command line: "
+            f"{options} (--no-feedthrough COMPONENT for all its outputs; a TOML scenario: {tables}); or run it "
+            f"with --algorithm jacobi, which needs no order (as libcosim does); {iterate}")
 
 
 def _resolve_record(scenario: Scenario, interfaces: Mapping[str, FmuInterface]) -> tuple[RecordedVariable, ...]:

@@ -35,7 +35,14 @@ FUNCTION_FAMILY = {"Integer": "Integer", "Enumeration": "Integer", "Boolean": "B
 
 
 def type_mismatch(source: FmuVariable, target: FmuVariable) -> str | None:
-    """Why ``source`` cannot drive ``target`` (different FMI types or enumeration types), or None."""
+    """Why ``source`` cannot drive ``target`` (different FMI types or enumeration types), or None.
+
+    An Integer and an Enumeration connect (both directions): FMI 2 exchanges an
+    Enumeration as an Integer (``fmi2SetInteger``) and SSP 1.0 gives Enumeration
+    the underlying type Integer.
+    """
+    if {source.type, target.type} == {"Integer", "Enumeration"}:
+        return None
     if source.type != target.type:
         return f"{source.name} is {source.type}, {target.name} is {target.type}"
     if source.type == "Enumeration" and source.declared_type != target.declared_type:

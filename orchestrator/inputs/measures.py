@@ -35,7 +35,10 @@ Measures are written as text in a study file:
     rainflow-counted over the window with :class:`components.analysis.fatigue.FatigueSettings`'
     defaults (``N_ref`` = 1 Hz x window length, half-cycle residue), the value a
     run's ``fatigue_del.csv`` gives with a default ``[analysis]``. Units as in
-    ``timeseries.csv`` (SI).
+    ``timeseries.csv`` (SI): for a scenario base the unit the variable's FMU
+    declares (set by :func:`orchestrator.study.prepare.prepare_study`; ``-`` when
+    it declares none); the unit parsed here from the name is the built-in
+    reference model's own, and stands only for a model base.
 """
 
 from __future__ import annotations

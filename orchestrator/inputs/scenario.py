@@ -102,7 +102,8 @@ class Component:
     no_feedthrough : tuple of str
         Outputs that do not depend directly on any input, for an FMU whose model
         description does not say (no ``dependencies`` attribute: FMI 2 then means
-        "depends on all inputs"); a loop through them is not algebraic.
+        "depends on all inputs"); a loop through them is not algebraic. ``"*"``:
+        every output of the FMU without declared dependencies (``--no-feedthrough COMPONENT``).
     """
 
     name: str
@@ -332,6 +333,9 @@ class Scenario:
         Settings of the result analyses (``[analysis]``).
     results_format : {"auto", "csv", "parquet"}
         File the samples go to (``[record] format``, :mod:`orchestrator.inputs.results_format`).
+    import_notes : tuple of str
+        What the SSP import passed over (other tools' annotations, skipped mapping
+        entries, parameter values not applied); listed in the run's summary.
     """
 
     name: str
@@ -346,6 +350,7 @@ class Scenario:
     events: tuple[ScenarioEvent, ...] = ()
     analysis: AnalysisSettings = field(default_factory=AnalysisSettings)
     results_format: str = "auto"
+    import_notes: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         src = self.source
@@ -433,6 +438,20 @@ class Scenario:
         )
         if component not in self.component_names:
             raise ScenarioError("components", component, "a declared component: " + ", ".join(self.component_names), self.source)
+        return replace(self, components=comps)
+
+    def with_no_feedthrough(self, item: str) -> "Scenario":
+        """Copy where ``"component.output"`` (or ``"component"``: all its undeclared outputs) does not feed through.
+
+        The command line's ``--no-feedthrough``; the FMU's model description is checked
+        when the system is resolved (:func:`orchestrator.cosim.system.resolve_system`).
+        """
+        component, _, output = str(item).partition(".")
+        if component not in self.component_names:
+            raise ScenarioError("--no-feedthrough", item, "COMPONENT or COMPONENT.OUTPUT of a declared component: "
+                                + ", ".join(self.component_names), self.source)
+        comps = tuple(replace(c, no_feedthrough=c.no_feedthrough + (output or "*",)) if c.name == component else c
+                      for c in self.components)
         return replace(self, components=comps)
 
     def fmu_candidates(self, component: Component, fmu_dir: Path | None = None) -> list[Path]:

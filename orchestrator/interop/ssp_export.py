@@ -15,7 +15,8 @@ of them at once), the ``ssd:Connections``, and an ``ssd:DefaultExperiment``
 * ``com.opensimulationplatform``: ``osp:FixedStepAlgorithm baseStepSize = H``,
   which libcosim's SSP loader needs;
 * ``org.dtcosim.scenario``: what SSP 1.0 has no element for - sampling interval,
-  analysis window, algorithm, extrapolation, stepping order, recorded variables
+  analysis window, algorithm (with ``target`` and ``stepTunedFor`` when the export
+  names its host: the algorithm the step was chosen for), extrapolation, stepping order, recorded variables
   and the initial bindings (``[[initial]]``), and the ``[analysis]`` settings when
   they differ from the defaults. Load events (``[[events]]``) need no annotation:
   they are the generator FMU's event-slot parameters in the parameter set.
@@ -46,6 +47,7 @@ import math
 import tempfile
 import xml.etree.ElementTree as ET
 import zipfile
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -200,7 +202,21 @@ def _resource_names(system: ResolvedSystem, baked: Mapping[str, Mapping[str, Any
     return out
 
 
-def system_structure(system: ResolvedSystem, initial_values: Mapping[str, float] | None = None) -> ET.ElementTree:
+#: the master algorithm each export target steps with (libcosim's and ecos's fixed-step algorithm is Jacobi)
+HOST_ALGORITHMS = {"dtcosim": None, "libcosim": "jacobi", "ecos": "jacobi"}
+
+
+@dataclass(frozen=True)
+class ExportTuning:
+    """What an export was tuned for: the ``target`` host, the algorithm its step was chosen for, the criteria met."""
+
+    target: str
+    step_tuned_for: str
+    criteria: str = ""
+
+
+def system_structure(system: ResolvedSystem, initial_values: Mapping[str, float] | None = None,
+                     tuning: ExportTuning | None = None) -> ET.ElementTree:
     """The ``SystemStructure.ssd`` document of a checked scenario.
 
     Parameters
@@ -209,6 +225,9 @@ def system_structure(system: ResolvedSystem, initial_values: Mapping[str, float]
     initial_values : mapping of str -> float, optional
         Values the initial bindings produced (``"generator.initial_speed": 167.3``),
         written into the parameter sets for hosts without dtcosim's initialisation.
+    tuning : ExportTuning, optional
+        The host the export is for and the algorithm its step was chosen for, written
+        as ``target`` and ``stepTunedFor`` of ``dtc:Simulation``.
     """
     sc = system.scenario
     sim = sc.simulation
@@ -290,6 +309,11 @@ def system_structure(system: ResolvedSystem, initial_values: Mapping[str, float]
         windowStart=_num(sim.window_s[0]), windowEnd=_num(sim.window_s[1]), algorithm=sim.algorithm,
         extrapolation=sim.extrapolation,
     )
+    if tuning is not None:
+        settings.set("target", tuning.target)
+        settings.set("stepTunedFor", tuning.step_tuned_for)
+        if tuning.criteria:
+            settings.set("stepCriteria", tuning.criteria)
     if sim.order:
         settings.set("order", " ".join(sim.order))
     if sim.algebraic_loops != "refuse":
@@ -312,7 +336,8 @@ def system_structure(system: ResolvedSystem, initial_values: Mapping[str, float]
     return ET.ElementTree(root)
 
 
-def export_ssp(system: ResolvedSystem, path: str | Path, initial_values: Mapping[str, float] | None = None) -> Path:
+def export_ssp(system: ResolvedSystem, path: str | Path, initial_values: Mapping[str, float] | None = None,
+               tuning: ExportTuning | None = None) -> Path:
     """Write a ``.ssp`` archive: ``SystemStructure.ssd`` and the FMUs under ``resources/``.
 
     Parameters
@@ -322,12 +347,14 @@ def export_ssp(system: ResolvedSystem, path: str | Path, initial_values: Mapping
         Output file (``.ssp``).
     initial_values : mapping, optional
         See :func:`system_structure`.
+    tuning : ExportTuning, optional
+        See :func:`system_structure`.
     """
     path = Path(path)
     if path.suffix != ".ssp":
         raise SspError(f"{path}: an SSP archive must have the extension .ssp")
     path.parent.mkdir(parents=True, exist_ok=True)
-    tree = system_structure(system, initial_values)
+    tree = system_structure(system, initial_values, tuning)
     baked = baked_values(system, initial_values)
     resources = _resource_names(system, baked)
     tmp = path.with_name(path.name + ".tmp")

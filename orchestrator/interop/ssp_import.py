@@ -22,8 +22,11 @@ What is read
   ``--stop``, else the FMUs' DefaultExperiment ``stopTime``, else an error naming
   ``--stop``.
 
-Everything else in the file that dtcosim does not support is refused naming the
-element, the file and the line (:func:`orchestrator.interop.ssp_xml.check_supported`);
+An SSP whose system holds no FMU component is refused first, saying so. Parameter
+values follow SSP 1.0, 5.2.3 (:mod:`orchestrator.interop.ssp_parameters`): a name
+that reaches no variable is ignored and reported. Everything else in the file that
+dtcosim does not support is refused naming the element, the file, the line, the
+rule or feature and what to do (:func:`orchestrator.interop.ssp_xml.check_supported`);
 annotations of other tools are reported as notes.
 """
 
@@ -51,7 +54,7 @@ from ..inputs.scenario import (
     SimulationSettings,
     VariableRef,
 )
-from .ssp_system import flatten
+from .ssp_system import FMU_TYPE, flatten
 from .ssp_xml import (
     DTCOSIM_ANNOTATION,
     NS,
@@ -77,14 +80,17 @@ def _check_archive_size(path: Path, zf: zipfile.ZipFile) -> None:
     """Refuse an archive that would expand beyond the limits of :mod:`orchestrator.inputs.limits` (a zip bomb)."""
     infos = zf.infolist()
     if len(infos) > MAX_SSP_MEMBERS:
-        raise SspError(f"{path}: {len(infos)} archive members, expected at most {MAX_SSP_MEMBERS}")
+        raise SspError(f"{path}: {len(infos)} archive members, expected at most {MAX_SSP_MEMBERS} (a limit against "
+                       "zip bombs); split the system or unpack it and run the folder")
     total = sum(i.file_size for i in infos)
     if total > MAX_SSP_BYTES:
-        raise SspError(f"{path}: expands to {total / 2**20:.0f} MiB, expected at most {MAX_SSP_BYTES / 2**20:.0f} MiB")
+        raise SspError(f"{path}: expands to {total / 2**20:.0f} MiB, expected at most {MAX_SSP_BYTES / 2**20:.0f} MiB "
+                       "(a limit against zip bombs); unpack it yourself and run the folder")
     for info in infos:
         if info.file_size > MAX_SSP_RATIO * max(info.compress_size, 1) and info.file_size > 1 << 20:
             raise SspError(f"{path}: archive member {info.filename!r} expands {info.file_size / max(info.compress_size, 1):.0f} "
-                           f"times ({info.compress_size} -> {info.file_size} bytes), expected at most {MAX_SSP_RATIO} times")
+                           f"times ({info.compress_size} -> {info.file_size} bytes), expected at most {MAX_SSP_RATIO} times "
+                           "(a limit against zip bombs); unpack it yourself and run the folder")
 
 
 def _extract_ssp(path: Path) -> Path:
@@ -99,10 +105,12 @@ def _extract_ssp(path: Path) -> Path:
                 for member in zf.namelist():
                     dest = (target / member).resolve()
                     if not str(dest).startswith(str(target.resolve())):
-                        raise SspError(f"{path}: archive member {member!r} points outside the archive")
+                        raise SspError(f"{path}: archive member {member!r} points outside the archive (refused: "
+                                       "it would write elsewhere); repack the SSP with relative member names")
                 zf.extractall(target)
         except zipfile.BadZipFile as exc:
-            raise SspError(f"{path}: not a zip archive ({exc})") from None
+            raise SspError(f"{path}: not a zip archive ({exc}; SSP 1.0: an .ssp file is a zip archive); pack the SSD "
+                           "and its resources with zip, or name the SSP folder or its .ssd") from None
         _EXTRACTED[digest] = target
     return _EXTRACTED[digest]
 
@@ -110,7 +118,7 @@ def _extract_ssp(path: Path) -> Path:
 def locate_ssd(path: Path) -> tuple[Path, Path]:
     """(the SSD file, the folder component sources are relative to) of an archive, folder or ``.ssd``."""
     if not path.exists():
-        raise SspError(f"{path}: no such file or directory")
+        raise SspError(f"{path}: no such file or directory; name an .ssp archive, an SSP folder or an .ssd file")
     if path.is_dir():
         ssd, base = path / SSD_NAME, path
     elif path.suffix == ".ssp":
@@ -119,7 +127,8 @@ def locate_ssd(path: Path) -> tuple[Path, Path]:
     else:
         ssd, base = path, path.parent
     if not ssd.is_file():
-        raise SspError(f"{path}: no {SSD_NAME}")
+        raise SspError(f"{path}: no {SSD_NAME} (SSP 1.0: the system structure of a package is in that file); "
+                       f"name the .ssd file itself, or add {SSD_NAME} at the top of the package")
     return ssd, base
 
 
@@ -131,16 +140,19 @@ def _osp_step(annotation, ssd: Path) -> float | None:
             continue
         qname = etree.QName(el)
         if qname.namespace not in OSP_NAMESPACES or qname.localname != "Algorithm":
-            raise element_error(el, ssd, "is not supported in the OSP annotation (dtcosim reads osp:Algorithm)")
+            raise element_error(el, ssd, "is not supported in the OSP annotation (dtcosim reads osp:Algorithm)",
+                                "remove it, or give the step on the command line (--step H) and drop the annotation")
         for alg in el:
             if not isinstance(alg.tag, str):
                 continue
             q = etree.QName(alg)
             if q.namespace not in OSP_NAMESPACES or q.localname != "FixedStepAlgorithm":
-                raise element_error(alg, ssd, "is not supported (dtcosim runs osp:FixedStepAlgorithm)")
+                raise element_error(alg, ssd, "is not supported (dtcosim runs osp:FixedStepAlgorithm)",
+                                    "use osp:FixedStepAlgorithm baseStepSize=\"H\" or give --step H")
             step = float_attr(alg, "baseStepSize", ssd)
             if step is None:
-                raise element_error(alg, ssd, "has no baseStepSize")
+                raise element_error(alg, ssd, "has no baseStepSize (the OSP annotation requires it)",
+                                    "add baseStepSize=\"H\" (seconds)")
     return step
 
 
@@ -153,7 +165,8 @@ def _dtcosim_settings(annotation, ssd: Path, source: str) -> tuple[dict, list, l
     step = None
     scenario_el = child(annotation, "dtc:Scenario")
     if scenario_el is None:
-        raise element_error(annotation, ssd, "of type org.dtcosim.scenario has no dtc:Scenario")
+        raise element_error(annotation, ssd, "of type org.dtcosim.scenario has no dtc:Scenario (dtcosim's "
+                            "annotation holds one)", "remove the annotation or export the scenario again")
     for el in scenario_el:
         if not isinstance(el.tag, str):
             continue
@@ -186,7 +199,8 @@ def _dtcosim_settings(annotation, ssd: Path, source: str) -> tuple[dict, list, l
         elif name == "dtc:Analysis":
             analysis = _analysis_settings(el, ssd, source)
         else:
-            raise element_error(el, ssd, "is not an element of dtcosim's annotation")
+            raise element_error(el, ssd, "is not an element of dtcosim's annotation (dtc:Simulation, dtc:Initial, "
+                                "dtc:Record, dtc:Analysis)", "remove it or export the scenario again")
     return sim, initial, record, analysis, step
 
 
@@ -204,7 +218,8 @@ def _analysis_settings(el, ssd: Path, source: str) -> AnalysisSettings:
         if el.get("contactLossThresholdN"):
             kwargs["contact_loss_threshold_n"] = float(el.get("contactLossThresholdN"))
     except ValueError as exc:
-        raise element_error(el, ssd, f"has a malformed number ({exc})") from None
+        raise element_error(el, ssd, f"has a malformed number ({exc})", "write the attribute as decimal "
+                            "numbers separated by spaces") from None
     for attr, key in (("rainflowResidue", "rainflow_residue"), ("spectrum", "spectrum")):
         if el.get(attr):
             kwargs[key] = el.get(attr)
@@ -214,20 +229,33 @@ def _analysis_settings(el, ssd: Path, source: str) -> AnalysisSettings:
         raise ScenarioError(exc.key, exc.value, exc.expected, source) from None
 
 
-def _fmu_defaults(components: dict[str, str], base: Path) -> tuple[float | None, float | None]:
-    """(smallest DefaultExperiment stepSize, smallest stopTime) among the components' FMUs that give one."""
+def _fmu_interfaces(components: dict[str, str], base: Path) -> dict[str, Any]:
+    """The model descriptions of the components' FMUs that exist (a missing one is reported by the run's checks)."""
     from ..cosim.fmu_interface import read_fmu_interface
 
-    steps, stops = [], []
-    for name, source in components.items():
-        path = base / source
-        if path.is_file():
-            iface = read_fmu_interface(path, f"components.{name}.fmu")
-            if iface.default_step_s:
-                steps.append(iface.default_step_s)
-            if iface.default_stop_s:
-                stops.append(iface.default_stop_s)
+    return {name: read_fmu_interface(base / source, f"components.{name}.fmu")
+            for name, source in components.items() if (base / source).is_file()}
+
+
+def _fmu_defaults(interfaces: dict[str, Any]) -> tuple[float | None, float | None]:
+    """(smallest DefaultExperiment stepSize, smallest stopTime) among the FMUs that give one."""
+    steps = [i.default_step_s for i in interfaces.values() if i.default_step_s]
+    stops = [i.default_stop_s for i in interfaces.values() if i.default_stop_s]
     return (min(steps) if steps else None), (min(stops) if stops else None)
+
+
+def _check_has_fmu(root, ssd: Path, source: str) -> None:
+    """Refuse, before anything else, an SSP whose system has no FMU component (there is nothing to simulate)."""
+    components = [el for el in root.iter() if isinstance(el.tag, str) and tag(el) == "ssd:Component"]
+    fmus = [el for el in components if (el.get("type") or FMU_TYPE) == FMU_TYPE]
+    if fmus:
+        return
+    others = sorted({el.get("type") for el in components})
+    held = (f"its {len(components)} component(s) are of type {', '.join(others)}" if components
+            else "it has no ssd:Component at all")
+    raise SspError(f"{source}: holds no FMU: {ssd.name} has no ssd:Component of type {FMU_TYPE} ({held}); dtcosim "
+                   "simulates systems of FMI 2.0 co-simulation FMUs, so there is nothing to run; add the FMUs "
+                   "(resources/*.fmu) with an ssd:Component for each, or run the SSP in the tool that made it")
 
 
 def import_ssp(path: str | Path, step_s: float | None = None, stop_s: float | None = None,
@@ -241,7 +269,10 @@ def import_ssp(path: str | Path, step_s: float | None = None, stop_s: float | No
         Communication step and stop time to use where the SSP gives none
         (``--step``/``--stop``; see the module docstring).
     report : callable(str), optional
-        Receives notes (annotations of other tools that were passed over).
+        Receives notes: annotations of other tools that were passed over, mapping
+        entries with an empty source, parameter values not applied (no mapping
+        entry in a binding with a mapping; a name that reaches no variable). The
+        scenario keeps them (``Scenario.import_notes``; the run's summary lists them).
 
     Raises
     ------
@@ -255,11 +286,21 @@ def import_ssp(path: str | Path, step_s: float | None = None, stop_s: float | No
     source = str(path)
     root = parse(ssd)
     if tag(root) != "ssd:SystemStructureDescription":
-        raise element_error(root, ssd, "is not ssd:SystemStructureDescription (the root of an SSD)")
+        raise element_error(root, ssd, "is not ssd:SystemStructureDescription (the root of an SSD, SSP 1.0)",
+                            f"name an SSP 1.0 {SSD_NAME}, .ssp archive or SSP folder")
+    _check_has_fmu(root, ssd, source)
     notes: list[str] = []
     check_supported(root, ssd, notes)
     units = unit_definitions(child(root, "ssd:Units"), ssd)
     flat = flatten(root, ssd, units, notes)
+    interfaces = _fmu_interfaces(flat.components, base)
+    ignored = list(flat.ignored)
+    for (comp, var), (value, origin) in list(flat.values.items()):
+        if comp in interfaces and var not in interfaces[comp].variables:
+            del flat.values[(comp, var)]
+            ignored.append(f"{var} ({origin}): {flat.components[comp]} ({interfaces[comp].model_name}) has no "
+                           f"variable {var!r}")
+    notes += [f"parameter value ignored (SSP 1.0, 5.2.3: its name reaches no variable): {entry}" for entry in ignored]
     system = children(root, "ssd:System")[0]
     name = re.sub(r"[^A-Za-z0-9_\-]", "-", root.get("name") or system.get("name") or path.stem)
 
@@ -279,7 +320,7 @@ def import_ssp(path: str | Path, step_s: float | None = None, stop_s: float | No
             sim_kwargs, initial, record, analysis, dtc_step = _dtcosim_settings(ann, ssd, source)
             step = dtc_step if dtc_step is not None else step
     if step is None or stop is None:
-        fmu_step, fmu_stop = _fmu_defaults(flat.components, base)
+        fmu_step, fmu_stop = _fmu_defaults(interfaces)
         if step is None:
             step = step_s if step_s is not None else fmu_step
         if stop is None:
@@ -314,7 +355,7 @@ def import_ssp(path: str | Path, step_s: float | None = None, stop_s: float | No
     return Scenario(
         name=name, description=system.get("description", ""), components=components, connections=connections,
         initial=tuple(initial), simulation=settings, recorded=tuple(record), analysis=analysis, base_dir=base,
-        source=source,
+        source=source, import_notes=tuple(notes),
     )
 
 

@@ -90,9 +90,13 @@ def where(el, path: Path | str) -> str:
     return f"{path}, line {el.sourceline}"
 
 
-def element_error(el, path: Path | str, problem: str) -> SspError:
-    """An SspError naming the element, its file and line."""
-    return SspError(f"{where(el, path)}: <{tag(el)}> {problem}")
+def element_error(el, path: Path | str, problem: str, remedy: str) -> SspError:
+    """An SspError naming the element, its file and line, what is wrong (the rule or the feature) and the remedy.
+
+    ``problem`` says which rule of SSP 1.0 the element breaks or which feature
+    dtcosim does not support; ``remedy`` what the user can do about it.
+    """
+    return SspError(f"{where(el, path)}: <{tag(el)}> {problem}; {remedy}")
 
 
 def parse(path: Path) -> Any:
@@ -134,7 +138,9 @@ def check_supported(root, path: Path, notes: list[str]) -> None:
             allowed = SUPPORTED_CHILDREN.get(name)
             if allowed is None or child_name not in allowed:
                 raise element_error(child, path, f"is not supported by dtcosim (inside <{name}>"
-                                    + (f" it reads {', '.join(sorted(allowed))}" if allowed else "") + ")")
+                                    + (f" it reads {', '.join(sorted(allowed))}" if allowed else "") + ")",
+                                    "remove the element or express it with what dtcosim reads (docs/orchestrator.md, "
+                                    "'SSP export and import')")
             visit(child)
 
     visit(root)
@@ -167,9 +173,11 @@ def float_attr(el, name: str, path: Path | str, default: float | None = None) ->
     try:
         out = float(value)
     except ValueError:
-        raise element_error(el, path, f"attribute {name}={value!r} is not a number") from None
+        raise element_error(el, path, f"attribute {name}={value!r} is not a number (an xs:double)",
+                            "write a decimal number such as 0.02 or 2e-2") from None
     if not math.isfinite(out):
-        raise element_error(el, path, f"attribute {name}={value!r} is not finite")
+        raise element_error(el, path, f"attribute {name}={value!r} is not finite (dtcosim needs a finite "
+                            "number here)", "write a finite decimal number")
     return out
 
 
@@ -181,7 +189,8 @@ def int_attr(el, name: str, path: Path | str, default: int | None = None) -> int
     try:
         return int(value.strip())
     except ValueError:
-        raise element_error(el, path, f"attribute {name}={value!r} is not a whole number") from None
+        raise element_error(el, path, f"attribute {name}={value!r} is not a whole number (an xs:int)",
+                            "write an integer such as 40") from None
 
 
 def bool_text(value: str, el, path: Path | str) -> bool:
@@ -190,7 +199,8 @@ def bool_text(value: str, el, path: Path | str) -> bool:
         return True
     if text in ("false", "0"):
         return False
-    raise element_error(el, path, f"value {value!r} is not an xs:boolean (true, false, 1, 0)")
+    raise element_error(el, path, f"value {value!r} is not an xs:boolean (SSP 1.0 schema)",
+                        "write true, false, 1 or 0")
 
 
 def parameter_value(param, path: Path | str) -> tuple[str, Any, str]:
@@ -201,7 +211,8 @@ def parameter_value(param, path: Path | str) -> tuple[str, Any, str]:
         kind = tag(value_el).split(":")[1]
         text = value_el.get("value")
         if text is None:
-            raise element_error(value_el, path, "has no value attribute")
+            raise element_error(value_el, path, "has no value attribute (SSP 1.0 requires one)",
+                                "give the parameter's value in a value attribute")
         try:
             if kind == "Real":
                 value = float(text)
@@ -212,9 +223,12 @@ def parameter_value(param, path: Path | str) -> tuple[str, Any, str]:
             else:
                 value = text
         except ValueError:
-            raise element_error(value_el, path, f"value {text!r} is not a valid {kind}") from None
+            raise element_error(value_el, path, f"value {text!r} is not a valid {kind} (SSP 1.0 schema)",
+                                f"write a {kind} value or change the element's type") from None
         return kind, value, value_el.get("unit") or ""
-    raise element_error(param, path, "has no ssv:Real, ssv:Integer, ssv:Boolean, ssv:String or ssv:Enumeration value")
+    raise element_error(param, path, "has no ssv:Real, ssv:Integer, ssv:Boolean, ssv:String or ssv:Enumeration "
+                        "value (dtcosim reads these; ssv:Binary is not supported)",
+                        "give the value as one of these elements or remove the parameter")
 
 
 def transformation(el, path: Path | str) -> Transformation | None:
@@ -232,19 +246,23 @@ def transformation(el, path: Path | str) -> Transformation | None:
             for side in ("source", "target"):
                 text = entry.get(side)
                 if text is None:
-                    raise element_error(entry, path, f"has no {side} attribute")
+                    raise element_error(entry, path, f"has no {side} attribute (SSP 1.0 requires source and "
+                                        "target)", f"add the {side} value of the map entry")
                 if kind == "Boolean":
                     pair.append(bool_text(text, entry, path))
                 elif kind == "Integer":
                     try:
                         pair.append(int(text))
                     except ValueError:
-                        raise element_error(entry, path, f"{side}={text!r} is not an integer") from None
+                        raise element_error(entry, path, f"{side}={text!r} is not an integer (an "
+                                            "IntegerMappingTransformation maps xs:int values)",
+                                            f"write an integer {side}") from None
                 else:
                     pair.append(text)
             entries.append(tuple(pair))
         if not entries:
-            raise element_error(t, path, "has no ssc:MapEntry")
+            raise element_error(t, path, "has no ssc:MapEntry (SSP 1.0: a mapping needs at least one)",
+                                "add the map entries or remove the transformation")
         return MappingTransformation(kind, tuple(entries))
     return None
 
@@ -269,14 +287,16 @@ def unit_definitions(units_el, path: Path | str) -> dict[str, UnitDefinition]:
     for unit in children(units_el, "ssc:Unit"):
         base = child(unit, "ssc:BaseUnit")
         if unit.get("name") is None or base is None:
-            raise element_error(unit, path, "needs a name and an ssc:BaseUnit")
+            raise element_error(unit, path, "needs a name and an ssc:BaseUnit (SSP 1.0 schema)",
+                                "give the unit a name and its SI base-unit exponents in ssc:BaseUnit")
         exps = []
         for k in _BASE:
             if base.get(k) not in (None, "0"):
                 try:
                     exps.append((k, int(base.get(k))))
                 except ValueError:
-                    raise element_error(base, path, f"exponent {k}={base.get(k)!r} is not an integer") from None
+                    raise element_error(base, path, f"exponent {k}={base.get(k)!r} is not an integer (SSP 1.0 "
+                                        "schema: xs:int)", "write the exponent as an integer") from None
         out[unit.get("name")] = UnitDefinition(tuple(exps), float_attr(base, "factor", path, 1.0),
                                                float_attr(base, "offset", path, 0.0))
     return out

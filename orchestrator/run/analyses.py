@@ -242,7 +242,9 @@ def analyse_run(system: ResolvedSystem, outcome: RunOutcome, out_dir: str | Path
     else:
         speeds = {name: cands[0] for name, cands in sig.shaft_speed.items() if cands}
         try:
-            report = fatigue_report(series, settings.fatigue_settings(), window, loads, time_s=t, speeds=speeds)
+            units = {c.column: c.unit for c in outcome.columns}  # as the FMUs' model descriptions declare them
+            report = fatigue_report(series, settings.fatigue_settings(), window, loads, time_s=t, speeds=speeds,
+                                    torques=torques, units=units)
         except DtcosimError as exc:
             result.skip("fatigue", str(exc))
         else:

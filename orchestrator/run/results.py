@@ -30,6 +30,11 @@
     written), ``post_processing`` when analyses or plots were not done. ``files``
     lists the whole files by role, ``files_incomplete`` those that are there but
     not whole (with the reason and the rows they hold).
+
+    ``import_notes`` (an SSP scenario): what the import passed over, among them
+    every parameter value it did not apply and why (SSP 1.0, 5.2.3); ``notes``:
+    what the checks of the system accepted with a caveat (a loop through outputs
+    without declared dependencies, run with Jacobi).
 """
 
 from __future__ import annotations
@@ -156,6 +161,10 @@ def build_summary(system: ResolvedSystem, outcome: RunOutcome, *, wall_time_s: f
             summary["signal"] = outcome.stop_signal
     if problems:
         summary["problems"] = list(problems)
+    if sc.import_notes:
+        summary["import_notes"] = list(sc.import_notes)
+    if system.notes:
+        summary["notes"] = list(system.notes)
     summary["samples"] = int(outcome.time_s.size)
     summary.update({
         "window_s": list(sim.window_s),

@@ -295,6 +295,7 @@ def _prepare_scenario(study: Study, fmu_dir,
     _check_measure_engines(study)
 
     series_names: dict[str, str] = {}
+    declared_units: dict[str, str] = {}
     gearbox = system.with_role(GEARBOX)
     if study.engine == "cosim":
         extra = []
@@ -319,6 +320,7 @@ def _prepare_scenario(study: Study, fmu_dir,
                 if fv is None or fv.type != "Real":
                     choices = [f"{c}.{n}" for c, f in system.interfaces.items() for n, v in f.variables.items() if v.type == "Real"]
                     raise StudyError(f"measures[{i}]", m.name, f"a Real variable of the base scenario's FMUs{suggestion(variable, choices)}", src)
+                declared_units[m.name] = fv.unit or "-"  # the unit its FMU declares, never one read from the name
             if scenario.recorded and variable not in {r.column for r in system.recorded}:
                 extra.append(variable)
         if extra:
@@ -329,7 +331,9 @@ def _prepare_scenario(study: Study, fmu_dir,
         for each in [system] + list(variants.systems.values() if variants else ()):
             for comp, path in each.fmu_paths.items():
                 blobs[each.interfaces[comp].sha256] = Path(path).read_bytes()
-        payload = StudyPayload(study=study.name, engine="cosim", measures=study.measures, system=system,
+        measures = tuple(replace(m, unit=declared_units[m.name]) if m.name in declared_units else m
+                         for m in study.measures)
+        payload = StudyPayload(study=study.name, engine="cosim", measures=measures, system=system,
                                window_s=scenario.simulation.window_s, series_names=series_names, fmu_blobs=blobs)
         settings = None
     else:
@@ -355,8 +359,14 @@ def _prepare_scenario(study: Study, fmu_dir,
                     raise StudyError(f"measures[{i}]", m.name, "a variable of the scenario with a counterpart in the "
                                      "monolithic model (e.g. gearbox.stage1.F_sp[1], generator.omega, wind.omega)", src)
                 series_names[m.variable] = name
+                comp, var = split_parameter(m.variable)
+                fv = system.interfaces[comp].variables.get(var) if comp in system.interfaces else None
+                if fv is not None:
+                    declared_units[m.name] = fv.unit or "-"  # as the scenario's FMU declares it
+        measures = tuple(replace(m, unit=declared_units[m.name]) if m.name in declared_units else m
+                         for m in study.measures)
         payload = StudyPayload(
-            study=study.name, engine="monolithic", measures=study.measures, system=system,
+            study=study.name, engine="monolithic", measures=measures, system=system,
             window_s=scenario.simulation.window_s, series_names=series_names,
             solver={k: getattr(settings, k) for k in ("rtol", "atol_angle_rad", "atol_speed_rad_s", "max_step_s", "max_steps")},
         )
@@ -435,6 +445,7 @@ def prepare_study(study: Study, fmu_dir: str | Path | None = None, build: bool =
         "code": code_version(),
     }
     payload = replace(payload, timeout_s=study.timeout_s)  # not in the identity: it changes no result
+    study = replace(study, measures=payload.measures)  # units as the base scenario's FMUs declare them
     points = tuple(study.expand())
     keys = tuple(point_key(identity, p) for p in points)
     return PreparedStudy(study, points, keys, payload, identity, fmu_paths, notes)

@@ -19,6 +19,8 @@ ToyInit        parameter p0 (initial value); output y = p0 + u_start; input u
 ToyTyped       no inputs; outputs n (Integer: steps done), odd (Boolean: n odd), label (String "step n, ...")
 ToyGenerator   a third-party generator rotor: input shaft_torque; outputs omega, phi and a force-named
                output F_x (= shaft_torque / 1 m); parameters inertia, counter_torque, initial_speed
+ToyGearbox     a third-party gearbox whose names mislead: F_x [N.m] = 2000 + amplitude sin(2 pi t) (its shaft
+               torque; amplitude 1000), shaft1.torque [N] = 500 cos(2 pi t) (a contact force), at the step's end
 """
 
 from __future__ import annotations
@@ -237,6 +239,21 @@ class ToyGenerator(Fmi2Slave):
         self.F_x = self.shaft_torque / 1.0
         return True
 """,
+    "ToyGearbox": """
+class ToyGearbox(Fmi2Slave):
+    def __init__(self, **kw):
+        super().__init__(**kw)
+        self.amplitude = 1000.0
+        self.F_x = 2000.0
+        self.force = 500.0
+        self.register_variable(Real("amplitude", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed))
+        self.register_variable(Real("F_x", causality=Fmi2Causality.output))
+        self.register_variable(Real("shaft1.torque", causality=Fmi2Causality.output, getter=lambda: self.force))
+    def do_step(self, t, h):
+        self.F_x = 2000.0 + self.amplitude * math.sin(2 * math.pi * (t + h))
+        self.force = 500.0 * math.cos(2 * math.pi * (t + h))
+        return True
+""",
     "ToyTyped": """
 class ToyTyped(Fmi2Slave):
     def __init__(self, **kw):
@@ -258,7 +275,8 @@ class ToyTyped(Fmi2Slave):
 #: toys whose outputs depend directly on their inputs (no dependencies attribute added)
 FEEDTHROUGH = {"ToyGain", "ToyAdder", "ToyInit"}
 
-UNITS = {("ToyMassA", "x"): "m", ("ToyMassA", "v"): "m/s", ("ToyMassB", "F"): "N"}
+UNITS = {("ToyMassA", "x"): "m", ("ToyMassA", "v"): "m/s", ("ToyMassB", "F"): "N", ("ToyGearbox", "F_x"): "N.m",
+         ("ToyGearbox", "shaft1.torque"): "N"}
 
 
 def _patch_model_description(fmu: Path, model: str) -> None:

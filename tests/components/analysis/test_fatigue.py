@@ -209,3 +209,22 @@ def test_fatigue_report_of_fmu_style_columns(wind_run):
     assert report.loads["gearbox.stage3.F_mesh"].del_by_exponent == direct.loads["stage3.F_mesh"].del_by_exponent
     with pytest.raises(ParameterError, match="time_s"):
         fatigue_report(series)
+
+
+def test_declared_kinds_and_units_not_names_choose_the_ldd_and_the_units():
+    # a foreign gearbox: its shaft torque is called F_x, its contact force shaft1.torque
+    t = np.linspace(0.0, 2.0, 2001)
+    series = {"g.F_x": 2000.0 + 1000.0 * np.sin(2 * np.pi * t), "g.shaft1.torque": 500.0 * np.cos(2 * np.pi * t)}
+    report = fatigue_report(series, time_s=t, names=["g.F_x", "g.shaft1.torque"], torques=["g.F_x"],
+                            units={"g.F_x": "N.m", "g.shaft1.torque": "N"})
+    assert list(report.ldd) == ["g.F_x"] and report.ldd["g.F_x"].unit == "N.m"
+    assert report.ldd["g.F_x"].time_s.sum() == pytest.approx(2.0, rel=1e-12)
+    assert {n: fl.unit for n, fl in report.loads.items()} == {"g.F_x": "N.m", "g.shaft1.torque": "N"}
+    # reversals 2000 3000 1000 3000 1000 2000: one cycle of range 2000 (1000-3000), residue 2000 3000 1000 2000 as
+    # half cycles of 1000, 2000, 1000: DEL_3 = ((2000^3 + (1000^3 + 2000^3 + 1000^3) / 2) / (1 Hz * 2 s))^(1/3)
+    assert report.loads["g.F_x"].del_by_exponent[3.0] == pytest.approx(6.5e9 ** (1 / 3), rel=1e-9)
+    # given names without declared units, none is made up from a name
+    plain = fatigue_report(series, time_s=t, names=["g.F_x"])
+    assert plain.loads["g.F_x"].unit == "" and plain.ldd == {}
+    with pytest.raises(ParameterError, match="torques"):
+        fatigue_report(series, time_s=t, names=["g.F_x"], torques=["g.shaft1.torque"])

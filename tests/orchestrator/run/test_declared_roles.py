@@ -130,3 +130,32 @@ def test_a_role_contradicting_the_fmus_record_is_refused(foreign_scenario):
     with pytest.raises(ScenarioError, match="the role Gearbox.fmu declares in its record") as info:
         resolve_system(load_scenario(path))
     assert info.value.key == "components.gearbox.role"
+
+
+FOREIGN_GEARBOX = """
+name = "foreign-gearbox"
+[simulation]
+stop = 2.0
+step = 0.01
+[components.gearbox]
+fmu = "ToyGearbox.fmu"
+role = "gearbox"
+signals = { shaft_torque = "F_x", contact_force = "shaft1.torque" }
+"""
+
+
+def test_a_foreign_gearbox_gets_its_analyses_by_declared_kind_and_unit_not_by_name(toy_dir, tmp_path):
+    from orchestrator.cosim.master import CoSimulation
+    from orchestrator.run.analyses import analyse_run
+
+    shutil.copy(toy_dir / "ToyGearbox.fmu", tmp_path / "ToyGearbox.fmu")
+    system = resolve_system(load_scenario(write_scenario(tmp_path, FOREIGN_GEARBOX)))
+    outcome = CoSimulation(system).run(handle_sigint=False)
+    assert outcome.complete, outcome.error
+    fatigue = analyse_run(system, outcome, tmp_path, plots=False).summary["fatigue"]
+    # the declared shaft torque F_x has the LDD, the contact force called shaft1.torque none
+    assert list(fatigue["ldd"]) == ["gearbox.F_x"] and fatigue["shaft_torques"] == ["gearbox.F_x"]
+    assert fatigue["ldd"]["gearbox.F_x"]["unit"] == "N.m"
+    # units from the modelDescription, not from the names
+    assert fatigue["del"]["gearbox.F_x"]["unit"] == "N.m" and fatigue["del"]["gearbox.shaft1.torque"]["unit"] == "N"
+    assert fatigue["del"]["gearbox.F_x"]["max_range"] == pytest.approx(2000.0, rel=1e-9)  # 2000 +- 1000 sampled at peaks

@@ -63,3 +63,40 @@ def test_cells_combine_dels_by_damage_and_other_measures_arithmetically(fmu_dir)
     np.testing.assert_allclose(dels[0], [np.mean(values[1:] ** 4) ** 0.25] + [np.mean(values**4) ** 0.25] * 2)
     stds, _, _ = grid(prepared, recs, "generator.omega:std", 0, None)
     np.testing.assert_allclose(stds[0], [values[1:].mean(), values.mean(), values.mean()])
+
+
+TOY_GEARBOX_SCENARIO = """
+name = "foreign-gearbox"
+[simulation]
+stop = 1.0
+step = 0.01
+[components.gearbox]
+fmu = "ToyGearbox.fmu"
+"""
+TOY_GEARBOX_STUDY = """
+name = "units"
+engine = "cosim"
+measures = ["gearbox.F_x:max", "gearbox.shaft1.torque:del4", "cpu_time"]
+[base]
+scenario = "scenario.toml"
+[[axes]]
+parameter = "gearbox.amplitude"
+values = [500.0, 1000.0]
+"""
+
+
+def test_a_study_measure_has_the_unit_its_fmu_declares_not_one_read_from_its_name(toy_dir, tmp_path):
+    import shutil
+
+    from orchestrator.inputs.study_file import load_study
+    from orchestrator.study.prepare import prepare_study
+
+    shutil.copy(toy_dir / "ToyGearbox.fmu", tmp_path / "ToyGearbox.fmu")
+    (tmp_path / "scenario.toml").write_text(TOY_GEARBOX_SCENARIO)
+    (tmp_path / "study.toml").write_text(TOY_GEARBOX_STUDY)
+    study = load_study(tmp_path / "study.toml")
+    prepared = prepare_study(study, build=False)
+    # F_x is declared in N.m (a name starting F_ would say N), shaft1.torque in N (the name would say N.m)
+    assert [m.column for m in prepared.study.measures] == ["gearbox.F_x:max [N.m]", "gearbox.shaft1.torque:del4 [N]",
+                                                          "cpu_time [s]"]
+    assert prepared.payload.measures == prepared.study.measures
