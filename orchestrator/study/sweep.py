@@ -303,9 +303,10 @@ def _execute(prepared: PreparedStudy, todo: list[int], journal: Journal, report:
                     "error_type": result.get("error_type"), "worker": result.get("worker"),
                     "task_wall_time_s": result.get("task_wall_time_s"), "code_version": code, "finished_at": _now(),
                 }
-                if on_result is not None and record["status"] == OK:
-                    record.update(on_result(i, result))
+                # storing a run's data and journaling it is one step: a signal during it is raised after both
                 with interrupts.critical_section():
+                    if on_result is not None and record["status"] == OK:
+                        record.update(on_result(i, result))
                     journal.append(record)
                 if record["status"] == OK:
                     report.ok += 1

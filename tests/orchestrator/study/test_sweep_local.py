@@ -125,3 +125,23 @@ def test_progress_bar_on_a_terminal_quiet_and_check(write_study, tmp_path):
     assert len(quiet) == 1 and quiet[0].startswith("dtcosim sweep: warning: 1 points failed")  # warnings only
     check = _on_terminal(["sweep", str(path), "--out", out, "--check", "--retry-failed"], tmp_path)
     assert "small: valid" in check and "4 points" in check and "1 to run" in check
+
+
+def test_a_stop_signal_while_a_result_is_stored_is_raised_after_its_journal_record(write_study, tmp_path):
+    """A SIGTERM that landed in ``on_result`` (a load set storing a run: numpy's savez) interrupted the write and
+    reached the user as a ValueError traceback from zipfile; storing and journaling are now one critical step."""
+    prepared = prepare_study(load_study(write_study(SMALL_STUDY)))
+    out = tmp_path / "out"
+    stored = []
+
+    def on_result(i, result):
+        if not stored:
+            os.kill(os.getpid(), signal.SIGTERM)  # delivered while the result is being stored
+        stored.append(i)
+        return {"stored": True}
+
+    report = run_sweep(prepared, out, workers=1, plots=False, on_result=on_result)
+    assert report.interrupted and report.signal == signal.SIGTERM
+    records = read_journal(out / "journal.jsonl")
+    assert len(stored) == 1 and [r["index"] for r in records] == stored  # the stored run is journaled, then the stop
+    assert records[0]["stored"] is True and records[0]["status"] == "ok"
