@@ -172,3 +172,26 @@ def test_a_file_a_failed_stage_wrote_but_never_listed_is_removed_when_the_run_en
     assert sorted(p.name for p in out.iterdir()) == ["listed.csv", "summary.json"]
     write_bytes_atomic(out / "after.txt", b"3")  # once released, the folder is claimed no more
     assert "files_being_written" not in summary_of(out)
+
+
+def test_a_signal_with_a_results_file_not_written_is_not_told_as_a_whole_run(toy_scenario, tmp_path, monkeypatch,
+                                                                            capsys):
+    """Issue 35.5: a Ctrl-C and a failed Parquet conversion; stderr said the folder "holds the whole run"."""
+    from orchestrator.run import parquet_writer
+
+    def interrupted_conversion(stream, parquet, where="auto"):
+        signal.raise_signal(signal.SIGINT)  # the run's stop handling takes it
+        raise OSError(f"{parquet}: the Parquet conversion of {stream.name} was killed by signal 2: KeyboardInterrupt")
+
+    monkeypatch.setattr(parquet_writer, "convert_stream", interrupted_conversion)
+    out = tmp_path / "out"
+    assert cli.main(["run", str(toy_scenario()), "--out", str(out), "--no-build", "-q", "--results", "parquet"]) == 130
+    summary = summary_of(out)
+    assert summary["status"] == "failed" and summary["files"] == {"summary": "summary.json"}
+    assert summary["files_incomplete"]["timeseries"]["file"] == "timeseries.parquet.partial"
+    assert sorted(p.name for p in out.iterdir()) == ["summary.json", "timeseries.parquet.partial"]
+    err = capsys.readouterr().err
+    assert "holds the whole run" not in err
+    assert err.strip().splitlines()[-1] == (f"dtcosim run: interrupted (SIGINT); the co-simulation completed but not "
+                                            f"every result was written: {out} holds part of the run "
+                                            f"({out / 'summary.json'} lists what it holds)")
