@@ -10,6 +10,11 @@ already (a notebook, a test), where converting here costs nothing more. The
 child's peak adds to the run's only while it runs, when the run holds the least
 (measured: ``python benchmarks/bench_long_run.py``, the ``converter`` column).
 
+Signals: the child runs in a process group of its own (a Ctrl-C on the terminal goes
+to the run alone, which finishes the conversion and then stops) and ignores SIGINT
+from its first statement on (a SIGINT sent to it directly); a run that is stopped
+waits for the conversion, which takes a second or two for an hour of samples.
+
 Errors keep their meaning across the process boundary: an ``OSError`` of the
 child (a full disk, a file-size limit) is raised here with its errno, message and
 file name (pyarrow's own, which have no errno, with their text, which names the
@@ -32,8 +37,9 @@ from typing import Literal
 PACKAGE_ROOT = Path(__file__).resolve().parents[1]
 #: exit status of a child whose conversion raised OSError (its fields as JSON on stderr)
 EXIT_OS_ERROR = 3
-#: the child's program: this module's :func:`main` with the same package first on sys.path
-CHILD_CODE = ("import sys; sys.path.insert(0, sys.argv[1]); "
+#: the child's program: SIGINT ignored first, then this module's :func:`main` with the same package first on sys.path
+CHILD_CODE = ("import signal; signal.signal(signal.SIGINT, signal.SIG_IGN); "
+              "import sys; sys.path.insert(0, sys.argv[1]); "
               "from orchestrator.parquet_conversion import main; sys.exit(main(sys.argv[2:]))")
 
 Where = Literal["auto", "child", "here"]
@@ -87,8 +93,10 @@ def convert_stream(stream_path: str | Path, parquet_path: str | Path, where: Whe
 def _convert_in_child(stream_path: Path, parquet_path: Path) -> None:
     cmd = [sys.executable, "-c", CHILD_CODE, str(PACKAGE_ROOT), str(stream_path), str(parquet_path)]
     try:
+        # a process group of its own: a terminal's Ctrl-C (sent to the foreground process group) never reaches
+        # the child, from its first instruction on; the run's own stop handling decides what a signal means
         proc = subprocess.run(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                              text=True)
+                              text=True, process_group=0)
     except OSError as exc:  # no process to start (the process limit, no memory to fork)
         raise OSError(exc.errno, f"could not start the Parquet conversion of {stream_path.name}: {exc.strerror}",
                       str(parquet_path)) from exc
@@ -112,7 +120,7 @@ def _convert_in_child(stream_path: Path, parquet_path: Path) -> None:
 
 def main(argv: list[str]) -> int:
     """The child: convert ``argv[0]`` (stream) to ``argv[1]`` (Parquet); 0, or :data:`EXIT_OS_ERROR` with JSON."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the run's to handle; the conversion is short
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # as CHILD_CODE does first: Ctrl-C is the run's to handle
     from .columnar_files import stream_to_parquet
 
     stream_path, parquet_path = argv

@@ -123,8 +123,10 @@ def run(args: argparse.Namespace) -> int:
     if "window_warning" in s:
         print(f"dtcosim run: warning: {s['window_warning']}", file=sys.stderr)
     if not outcome.time_s.size:  # stopped before the first sample: nothing to show
-        print(f"dtcosim run: {outcome.error}; nothing was simulated ({out_dir / 'summary.json'} says so)",
-              file=sys.stderr)
+        told = f"{out_dir / 'summary.json'} says so" if "summary" in report.files else "no summary was written"
+        for problem in report.problems[1:] if outcome.stage == "writing" else report.problems:
+            print(f"dtcosim run: error: {problem}", file=sys.stderr)  # the first write error is the outcome's
+        print(f"dtcosim run: {outcome.error}; nothing was simulated ({told})", file=sys.stderr)
         return report.exit_status
     if not quiet:
         import textwrap
@@ -173,9 +175,13 @@ def run(args: argparse.Namespace) -> int:
         print(f"dtcosim run: {post['stopped']}; not done: {', '.join(post['not_done'])}", file=sys.stderr)
     if not outcome.complete:
         print(f"dtcosim run: {outcome.error}; partial results written to {out_dir}", file=sys.stderr)
-    elif report.exit_status > 128 and not post:  # a signal after every result was written
+    elif report.exit_status > 128 and not post and not report.problems:  # a signal after every result was written
         print(f"dtcosim run: interrupted ({signal_name(report.exit_status - 128)}) after every result was written: "
               f"{out_dir} holds the whole run", file=sys.stderr)
+    elif report.exit_status > 128:  # a signal, and a result that could not be written (said above)
+        told = f"{out_dir / 'summary.json'} lists what it holds" if "summary" in report.files else "it holds no summary"
+        print(f"dtcosim run: interrupted ({signal_name(report.exit_status - 128)}); the co-simulation completed but "
+              f"not every result was written: {out_dir} holds part of the run ({told})", file=sys.stderr)
     return report.exit_status
 
 

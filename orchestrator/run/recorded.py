@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..atomic_files import atomic_path
 from ..cosim.outcome import RunOutcome
 from ..cosim.roles import ROLES
 from ..cosim.resolved import ResolvedSystem
@@ -90,8 +91,11 @@ def plot_recorded(system: ResolvedSystem, outcome: RunOutcome, out_dir: str | Pa
     fig.suptitle(f"{system.scenario.name}: simulated against recorded channels (analysis window shaded)")
     fig.tight_layout()
     path = Path(out_dir) / "recorded_vs_simulated.png"
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    try:
+        with atomic_path(path) as tmp:  # whole or not there
+            fig.savefig(tmp, dpi=110)
+    finally:
+        plt.close(fig)
     return path
 
 
@@ -118,6 +122,9 @@ def plot_contact_loss_counts(summary_contact_loss: dict, out_dir: str | Path, ti
     ax.grid(axis="y", alpha=0.3)
     fig.tight_layout()
     path = Path(out_dir) / "contact_loss_counts.png"
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    try:
+        with atomic_path(path) as tmp:  # whole or not there
+            fig.savefig(tmp, dpi=110)
+    finally:
+        plt.close(fig)
     return path

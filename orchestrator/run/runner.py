@@ -149,66 +149,84 @@ def run_scenario(system: ResolvedSystem, out_dir: str | Path, *, compare_referen
     """
     wall0 = time.perf_counter()
     sc = system.scenario
+    # the stop handling is in place before the folder holds any file: a signal from here on ends the run with a
+    # summary that says so (a signal while the folder is prepared stops the run before its first FMU steps)
+    with StopRequests(enabled=handle_sigint) as stop:
+        folder = RunFolder.prepare(out_dir, {"scenario": sc.name, "description": sc.description,
+                                             "scenario_file": sc.source})
+        try:
+            return _run_in(folder, stop, system, wall0, compare_reference=compare_reference, plots=plots,
+                           progress=progress, profile=profile, results_format=results_format)
+        except BaseException as exc:  # a second signal, a bug: the summary says how the run ended, never "running"
+            folder.abandon(exc)
+            raise
+        finally:
+            folder.release()
+
+
+def _run_in(folder: RunFolder, stop: StopRequests, system: ResolvedSystem, wall0: float, *, compare_reference: bool,
+            plots: bool, progress, profile: bool, results_format: str | None) -> RunReport:
+    """:func:`run_scenario` once the folder is prepared."""
+    sc = system.scenario
     sim = sc.simulation
-    folder = RunFolder.prepare(out_dir, {"scenario": sc.name, "description": sc.description,
-                                         "scenario_file": sc.source})
     out = folder.path
     writer = results_writer(results_format or sc.results_format, out, sim, len(system.recorded))
     folder.header["results_format"] = writer.format
     problems: list[str] = []
-    with StopRequests(enabled=handle_sigint) as stop:
-        cosim = CoSimulation(system, profile=profile)
+    cosim = CoSimulation(system, profile=profile)
+    try:
+        folder.claim(writer.path)
+        writer.open(result_columns(system.recorded))
+        folder.mark_incomplete("timeseries", writer.partial_path, "being written by the run")
+    except OSError as exc:
+        writer.abandon()
+        problems.append(describe_os_error(exc))
+        outcome = RunOutcome.empty(system.recorded, sim.start_s, f"results not written: {problems[-1]}", "writing")
+    else:
         try:
-            writer.open(result_columns(system.recorded))
-            folder.mark_incomplete("timeseries", writer.partial_path, "being written by the run")
+            outcome = cosim.run(progress=progress, sink=writer, stop=stop)
+        except (FmuStepError, InitializationError) as exc:
+            outcome = RunOutcome.empty(system.recorded, sim.start_s, str(exc), _stage_of(exc),
+                                       fmu_log={n: list(i.log) for n, i in cosim.instances.items()})
+        except RunInterrupted as exc:
+            outcome = RunOutcome.empty(system.recorded, sim.start_s, str(exc), exc.stage, interrupted=True,
+                                       stop_signal=stop.signal_name or signal_name(exc.signum))
+        _finish_timeseries(writer, outcome, folder, problems)
+    derived: dict[str, Any] = {}
+    skipped: list[dict[str, str]] = []
+    comparison = None
+    comparison_text = ""
+    post = _PostProcessing(stop, folder)
+    if outcome.time_s.size and not problems:
+        try:
+            comparison, comparison_text = _post_process(system, outcome, out, post, derived, skipped,
+                                                        compare_reference, plots)
         except OSError as exc:
-            writer.abandon()
             problems.append(describe_os_error(exc))
-            outcome = RunOutcome.empty(system.recorded, sim.start_s, f"results not written: {problems[-1]}", "writing")
-        else:
-            try:
-                outcome = cosim.run(progress=progress, sink=writer, stop=stop)
-            except (FmuStepError, InitializationError) as exc:
-                outcome = RunOutcome.empty(system.recorded, sim.start_s, str(exc), _stage_of(exc),
-                                           fmu_log={n: list(i.log) for n, i in cosim.instances.items()})
-            except RunInterrupted as exc:
-                outcome = RunOutcome.empty(system.recorded, sim.start_s, str(exc), exc.stage, interrupted=True,
-                                           stop_signal=stop.signal_name or signal_name(exc.signum))
-            _finish_timeseries(writer, outcome, folder, problems)
-        derived: dict[str, Any] = {}
-        skipped: list[dict[str, str]] = []
-        comparison = None
-        comparison_text = ""
-        post = _PostProcessing(stop, folder)
-        if outcome.time_s.size and not problems:
-            try:
-                comparison, comparison_text = _post_process(system, outcome, out, post, derived, skipped,
-                                                            compare_reference, plots)
-            except OSError as exc:
-                problems.append(describe_os_error(exc))
-                post.stopped = f"stopped: {problems[-1]}"
-        if post.stopped:
-            derived["post_processing"] = {"stopped": post.stopped, "not_done": post.not_done}
-        derived["analyses_skipped"] = skipped
-        if outcome.start_values:
-            derived.update(_settling(system, outcome))
-        summary = build_summary(system, outcome, wall_time_s=time.perf_counter() - wall0, derived=derived,
-                                comparison=comparison, listing=folder.listing(), header=folder.header,
-                                problems=problems)
-        files = {role: out / name for role, name in folder.files.items()}
-        try:
-            files["summary"] = folder.save(summary)
-        except OSError as exc:
-            problems.append(f"summary not written: {describe_os_error(exc)}")
-        signum = stop.signum if stop.signum is not None else (
-            signal_number(outcome.stop_signal) if outcome.stop_signal else None)
-        if signum is not None:
-            status = exit_status(signum)
-        elif outcome.complete and not problems:
-            status = 0
-        else:
-            status = 1
-    folder.release()
+            post.stopped = f"stopped: {problems[-1]}"
+    if post.stopped:
+        derived["post_processing"] = {"stopped": post.stopped, "not_done": post.not_done}
+    derived["analyses_skipped"] = skipped
+    if outcome.start_values:
+        derived.update(_settling(system, outcome))
+    summary = build_summary(system, outcome, wall_time_s=time.perf_counter() - wall0, derived=derived,
+                            comparison=comparison, listing=folder.listing(), header=folder.header,
+                            problems=problems)
+    files = {role: out / name for role, name in folder.files.items()}
+    try:
+        files["summary"] = folder.finish(summary)
+        if folder.shortened:
+            problems.append(folder.shortened)
+    except OSError as exc:
+        problems.append(f"summary.json not written ({describe_os_error(exc)}): {out} holds no summary of this run")
+    signum = stop.signum if stop.signum is not None else (
+        signal_number(outcome.stop_signal) if outcome.stop_signal else None)
+    if signum is not None:
+        status = exit_status(signum)
+    elif outcome.complete and not problems:
+        status = 0
+    else:
+        status = 1
     return RunReport(outcome, summary, files, comparison_text, problems, list(folder.replaced), status)
 
 

@@ -20,3 +20,29 @@ class FillingDisk:
 
     def __getattr__(self, name):
         return getattr(self.fh, name)
+
+
+class FullDisk:
+    """``write_summary`` on a disk that is full for some summaries (a stand-in for a completely full disk).
+
+    ``refuse(summary, old_there)`` says which writes fail with ENOSPC (``old_there``: a
+    ``summary.json`` is in place, as an atomic write needs room for the new file
+    beside the old one); the default refuses every write. ``writes`` counts the
+    attempts, ``refused`` the ENOSPC.
+    """
+
+    def __init__(self, refuse=lambda summary, old_there: True) -> None:
+        self.refuse = refuse
+        self.writes = self.refused = 0
+
+    def __call__(self, path, summary):
+        from pathlib import Path
+
+        from orchestrator.result_files import write_summary
+
+        self.writes += 1
+        path = Path(path)
+        if self.refuse(summary, path.exists()):
+            self.refused += 1
+            raise OSError(errno.ENOSPC, "No space left on device", str(path))
+        return write_summary(path, summary)

@@ -141,3 +141,42 @@ def test_without_a_python_to_start_auto_converts_here(tmp_path):
 def test_where_must_be_one_of_three():
     with pytest.raises(ValueError, match=r"where='elsewhere': expected 'auto', 'child' or 'here'"):
         convert_stream("a", "b", where="elsewhere")
+
+
+# the run's process: a stop flag for SIGINT (as a run's StopRequests), then the conversion in a child whose program
+# is changed to receive a SIGINT at a chosen point; prints the outcome and whether the Parquet file is there
+SIGNALLED_CONVERSION = """
+import os, signal, sys
+sys.path.insert(0, {root!r})
+from orchestrator import parquet_conversion as pc
+seen = []
+signal.signal(signal.SIGINT, lambda signum, frame: seen.append(signum))
+pc.CHILD_CODE = pc.CHILD_CODE.replace({anchor!r}, {injected!r} + {anchor!r})
+try:
+    pc.convert_stream({stream!r}, {parquet!r}, where="child")
+    outcome = "converted"
+except OSError as exc:
+    outcome = "failed: " + str(exc)
+print(outcome, os.path.exists({parquet!r}), seen)
+"""
+
+
+@pytest.mark.parametrize("anchor, injected", [
+    # a Ctrl-C on the terminal: SIGINT to the run's whole process group, as the child starts (before sys.path)
+    ("import sys;", "import os, signal; os.killpg(os.getpgid(os.getppid()), signal.SIGINT); "),
+    # a SIGINT to the child itself, before its conversion starts
+    ("from orchestrator.parquet_conversion import main;", "import os, signal; os.kill(os.getpid(), signal.SIGINT); "),
+], ids=["ctrl-c-to-the-process-group", "sigint-to-the-child"])
+def test_a_sigint_never_kills_the_conversion_child(tmp_path, anchor, injected):
+    """Issue 35.5: the child ignored SIGINT only once inside main(); a Ctrl-C before that killed the conversion."""
+    stream = write_stream(tmp_path / "timeseries.parquet.partial")
+    parquet = tmp_path / "timeseries.parquet"
+    code = SIGNALLED_CONVERSION.format(root=str(PACKAGE_ROOT), anchor=anchor, injected=injected,
+                                       stream=str(stream), parquet=str(parquet))
+    # a session of its own, so the signal to "the run's process group" reaches no test process
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120,
+                          start_new_session=True)
+    assert proc.returncode == 0, proc.stderr
+    expect_seen = "[2]" if "killpg" in injected else "[]"  # the run itself still receives the Ctrl-C
+    assert proc.stdout.strip() == f"converted True {expect_seen}", proc.stdout
+    assert read_columnar(parquet).data.shape == (300, 3)
