@@ -178,7 +178,7 @@ def run(args: argparse.Namespace) -> int:
     elif report.exit_status > 128 and not post and not report.problems:  # a signal after every result was written
         print(f"dtcosim run: interrupted ({signal_name(report.exit_status - 128)}) after every result was written: "
               f"{out_dir} holds the whole run", file=sys.stderr)
-    elif report.exit_status > 128:  # a signal, and a result that could not be written (said above)
+    elif report.exit_status > 128 and not post:  # a signal, and a result that could not be written (said above)
         told = f"{out_dir / 'summary.json'} lists what it holds" if "summary" in report.files else "it holds no summary"
         print(f"dtcosim run: interrupted ({signal_name(report.exit_status - 128)}); the co-simulation completed but "
               f"not every result was written: {out_dir} holds part of the run ({told})", file=sys.stderr)
