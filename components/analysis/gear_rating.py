@@ -157,6 +157,15 @@ class LifeFactorCurve:
                 return f0 * (f1 / f0) ** (math.log(n / n0) / math.log(n1 / n0))
         return pts[-1][1]
 
+    def strength_at(self, cycles: float) -> float:
+        """The stress ratio that fails in N cycles: :meth:`factor`, with the first segment extended below its
+        cycles (the inverse of :meth:`cycles_to_failure`; above the static factor for N below the first point)."""
+        (n0, f0), (n1, f1) = self.points[0], self.points[1]
+        n = positive("cycles", cycles)
+        if n >= n0:
+            return self.factor(n)
+        return f0 * (f1 / f0) ** (math.log(n / n0) / math.log(n1 / n0))
+
     def slopes(self) -> tuple[float, ...]:
         """The Woehler exponent ``k`` of each segment (``N ~ sigma^-k``)."""
         return tuple(math.log(n1 / n0) / math.log(f0 / f1) for (n0, f0), (n1, f1) in zip(self.points, self.points[1:]))
@@ -710,7 +719,7 @@ def gear_damage(stress: GearStress, forces_n: np.ndarray, cycles: np.ndarray) ->
     d_f = miner_damage(sf, n, stress.root_reference_pa, stress.bending_curve)
 
     def equivalent(damage: float, reference: float, curve: LifeFactorCurve) -> float | None:
-        return reference * curve.factor(total / damage) if damage > 0.0 and total > 0.0 else None
+        return reference * curve.strength_at(total / damage) if damage > 0.0 and total > 0.0 else None
 
     sh_eq = equivalent(d_h, stress.contact_reference_pa, stress.contact_curve)
     sf_eq = equivalent(d_f, stress.root_reference_pa, stress.bending_curve)
