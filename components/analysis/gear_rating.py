@@ -68,7 +68,10 @@ Miner damage (ISO 6336-6)::
 over the load cycles ``n_i`` of each gear at each force level (a gear's tooth is loaded once per
 revolution by each mesh it is in, relative to the carrier for planetary gears). The equivalent
 stress is the constant stress with the same damage in the same cycles ``N_L = sum n_i``:
-``sigma_eq = sigma_G(N_L / D)``, so that ``S_eq = sigma_G(N_L) / sigma_eq`` is 1 where ``D = 1``.
+``sigma_eq = sigma_G(N_L / D)`` (none where ``D = 0``). The spectrum's safety factor
+(:func:`spectrum_safety`, ISO 6336-6) is the factor ``S`` on every stress with ``D(S sigma_i) = 1``:
+1 where ``D = 1``, above 1 where the life is reached with a margin, finite also where every stress
+is below the endurance limit.
 """
 
 from __future__ import annotations
@@ -657,6 +660,9 @@ class GearDamage:
         The constant mesh forces of those.
     sigma_hg_static_pa, sigma_hg_life_pa, sigma_fg_static_pa, sigma_fg_life_pa : float
         Strengths at the static point and at N_L.
+    safety_contact_life, safety_bending_life : float
+        The spectrum's safety factors (:func:`spectrum_safety`): the factor on every stress of the
+        spectrum that makes its damage 1 (inf without cycles).
     """
 
     cycles: float
@@ -673,6 +679,8 @@ class GearDamage:
     sigma_hg_life_pa: float
     sigma_fg_static_pa: float
     sigma_fg_life_pa: float
+    safety_contact_life: float = math.inf
+    safety_bending_life: float = math.inf
 
     @property
     def safety_contact_static(self) -> float:
@@ -684,15 +692,6 @@ class GearDamage:
         """S_F at the largest force against the static strength."""
         return self.sigma_fg_static_pa / self.sigma_f_max_pa if self.sigma_f_max_pa > 0 else math.inf
 
-    @property
-    def safety_contact_life(self) -> float:
-        """S_H at the equivalent stress against the strength at N_L (inf without damage)."""
-        return self.sigma_hg_life_pa / self.sigma_h_eq_pa if self.sigma_h_eq_pa else math.inf
-
-    @property
-    def safety_bending_life(self) -> float:
-        """S_F at the equivalent stress against the strength at N_L (inf without damage)."""
-        return self.sigma_fg_life_pa / self.sigma_f_eq_pa if self.sigma_f_eq_pa else math.inf
 
 
 def miner_damage(stress_pa: np.ndarray, cycles: np.ndarray, reference_pa: float, curve: LifeFactorCurve) -> float:
@@ -703,6 +702,39 @@ def miner_damage(stress_pa: np.ndarray, cycles: np.ndarray, reference_pa: float,
         raise ParameterError("cycles", n.shape, f"one count per stress ({s.shape})")
     life = curve.cycles_to_failure(s / positive("reference_strength", reference_pa))
     return float(np.sum(np.where(np.isfinite(life), n / np.where(np.isfinite(life), life, 1.0), 0.0)))
+
+
+def spectrum_safety(stress_pa: np.ndarray, cycles: np.ndarray, reference_pa: float, curve: LifeFactorCurve) -> float:
+    """The safety factor of a stress spectrum: the factor ``S`` on every stress with ``D(S sigma_i) = 1``.
+
+    ISO 6336-6's safety factor under a load spectrum (with the stresses as the load); for a
+    spectrum on one segment of the curve ``S = D^(-1/k)``, and ``S = 1`` where ``D = 1``. It is
+    finite also where every stress is below the endurance limit (``D = 0``). inf without cycles.
+    """
+    s = np.asarray(stress_pa, dtype=float)
+    n = np.asarray(cycles, dtype=float)
+    keep = (n > 0) & (s > 0)
+    if not keep.any():
+        return math.inf
+    s, n = s[keep], n[keep]
+
+    def excess(log_factor: float) -> float:
+        return miner_damage(s * math.exp(log_factor), n, reference_pa, curve) - 1.0
+
+    lo, hi = -1.0, 1.0
+    while excess(lo) > 0.0:
+        lo *= 2.0
+    while excess(hi) <= 0.0:
+        hi *= 2.0
+    for _ in range(200):  # bisection in log S: D is monotonic, with jumps at the endurance limit
+        mid = 0.5 * (lo + hi)
+        if excess(mid) > 0.0:
+            hi = mid
+        else:
+            lo = mid
+        if hi - lo < 1e-13:
+            break
+    return math.exp(0.5 * (lo + hi))
 
 
 def gear_damage(stress: GearStress, forces_n: np.ndarray, cycles: np.ndarray) -> GearDamage:
@@ -729,4 +761,5 @@ def gear_damage(stress: GearStress, forces_n: np.ndarray, cycles: np.ndarray) ->
         None if sh_eq is None else (sh_eq / stress.contact_per_sqrt_n) ** 2,
         None if sf_eq is None else sf_eq / stress.root_per_n,
         stress.contact_reference_pa * c.static, stress.contact_reference_pa * c.factor(max(total, 1.0)),
-        stress.root_reference_pa * b.static, stress.root_reference_pa * b.factor(max(total, 1.0)))
+        stress.root_reference_pa * b.static, stress.root_reference_pa * b.factor(max(total, 1.0)),
+        spectrum_safety(sh, n, stress.contact_reference_pa, c), spectrum_safety(sf, n, stress.root_reference_pa, b))

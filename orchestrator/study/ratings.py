@@ -17,11 +17,12 @@ Gears
 -----
 Per mesh and gear (:func:`components.analysis.gear_rating.gear_damage`): the stresses at the
 largest force and at the equivalent one, the strengths, the safety factors and the Miner damage in
-contact and bending over the design life. Per gear, over its meshes: a tooth flank sums the
-damage of every mesh that loads it (the sun's flank meets every planet, the ring's too), the
-planet's two flanks (sun side, ring side) are two flanks, so its contact damage is the larger;
+contact and bending over the design life, from that mesh's cycles. Per gear, over its meshes: a
+tooth flank takes the cycles of every mesh that loads it together (the sun's flank meets every
+planet, the ring's too: damage and the spectrum's safety factor of the combined spectrum); the
+planet's two flanks (sun side, ring side) are two flanks, so its contact rating is the worse one;
 its root sees one alternating cycle per revolution from its two meshes (``Y_M``), so its bending
-damage is the larger of the two meshes' as well.
+rating is the worse of the two meshes' as well.
 
 Bearings
 --------
@@ -58,6 +59,7 @@ class GearRow:
     damage: GearDamage
     contact_by_bin: np.ndarray
     bending_by_bin: np.ndarray
+    spectrum: tuple[np.ndarray, np.ndarray] = (np.zeros(0), np.zeros(0))  # forces [N], lifetime load cycles
 
     @property
     def gear(self) -> str:
@@ -80,7 +82,7 @@ class GearTotal:
     meshes: int
     contact_damage: float
     bending_damage: float
-    safety_contact: float  # the smallest S_H at the life's equivalent stress over its meshes
+    safety_contact: float  # the spectrum's S_H (ISO 6336-6) of its most damaged flank, its meshes' cycles together
     safety_bending: float
     safety_contact_static: float
     safety_bending_static: float
@@ -145,26 +147,25 @@ def _totals(rows: list[GearRow], n_bins: int) -> list[GearTotal]:
     out = []
     for gear in dict.fromkeys(r.gear for r in rows):
         mine = [r for r in rows if r.gear == gear]
-        idler = mine[0].member == "planet"
         flanks: dict[str, list[GearRow]] = {}
-        for r in mine:  # a flank per mesh kind (the planet's sun and ring sides)
+        for r in mine:  # a flank per mesh kind (the planet's sun and ring sides); its meshes share one stress law
             flanks.setdefault(r.mesh.mesh, []).append(r)
-
-        def combine(attr: str, by_bin: str, alternating: bool):
-            sums = {k: (sum(getattr(r.damage, attr) for r in rs), sum(getattr(r, by_bin) for r in rs))
-                    for k, rs in flanks.items()}
-            if alternating or len(sums) > 1:  # the larger flank (contact) or the alternating root of an idler
-                return max(sums.values(), key=lambda v: v[0])
-            return next(iter(sums.values()))
-
-        d_h, h_bins = combine("contact_damage", "contact_by_bin", False)
-        d_f, f_bins = combine("bending_damage", "bending_by_bin", idler)
-        out.append(GearTotal(gear, mine[0].mesh.stage, mine[0].member, len(mine), d_h, d_f,
-                             min(r.damage.safety_contact_life for r in mine), min(r.damage.safety_bending_life for r in mine),
-                             min(r.damage.safety_contact_static for r in mine),
-                             min(r.damage.safety_bending_static for r in mine),
-                             _share(np.asarray(h_bins, dtype=float) + np.zeros(n_bins)),
-                             _share(np.asarray(f_bins, dtype=float) + np.zeros(n_bins))))
+        rated = []
+        for rs in flanks.values():
+            stress = rs[0].mesh.stresses[rs[0].index]
+            levels = np.concatenate([r.spectrum[0] for r in rs])
+            counts = np.concatenate([r.spectrum[1] for r in rs])
+            rated.append((gear_damage(stress, levels, counts), sum(r.contact_by_bin for r in rs),
+                          sum(r.bending_by_bin for r in rs)))
+        # contact: the most damaged flank; bending: the sum over the meshes of one flank side, for an idler
+        # (planet) the larger side's (its alternating root, Y_M): the same rule, a flank per mesh kind
+        contact = max(rated, key=lambda x: (x[0].contact_damage, -x[0].safety_contact_life))
+        bending = max(rated, key=lambda x: (x[0].bending_damage, -x[0].safety_bending_life))
+        out.append(GearTotal(gear, mine[0].mesh.stage, mine[0].member, len(mine), contact[0].contact_damage,
+                             bending[0].bending_damage, contact[0].safety_contact_life, bending[0].safety_bending_life,
+                             min(x[0].safety_contact_static for x in rated), min(x[0].safety_bending_static for x in rated),
+                             _share(np.asarray(contact[1], dtype=float) + np.zeros(n_bins)),
+                             _share(np.asarray(bending[2], dtype=float) + np.zeros(n_bins))))
     return out
 
 
@@ -181,7 +182,7 @@ def compute_ratings(res: LifetimeResults) -> Ratings:
             levels, counts, bins = _spectrum(res, mesh.column, stress.gear)
             dmg = gear_damage(stress, levels, counts)
             contact, bending = _by_bin(stress, levels, counts, bins, n_bins)
-            out.gears.append(GearRow(mesh, k, dmg, contact, bending))
+            out.gears.append(GearRow(mesh, k, dmg, contact, bending, (levels, counts)))
     out.totals = _totals(out.gears, n_bins)
     for b in plan.bearings:
         if b.problem:
@@ -264,20 +265,23 @@ def report_lines(res: LifetimeResults, ratings: Ratings) -> list[str]:
         lines.append(plan.gear_note)
     elif ratings.totals:
         lines.append(f"gear ratings (ISO 6336-2/-3/-5/-6; {plan.description}; {GEAR_FILE}): Miner damage over the "
-                     "design life, safety factors at the life's equivalent stress (S_life) and at the largest load "
-                     "(S_static)")
+                     "design life; safety factors of the spectrum (S life: the factor on its stresses that makes D = 1, "
+                     "ISO 6336-6) and at the largest load against the static strength (S static)")
         for t in ratings.totals:
-            top = int(np.argmax(np.maximum(t.contact_share_by_bin, t.bending_share_by_bin)))
             share = t.contact_share_by_bin if t.contact_damage >= t.bending_damage else t.bending_share_by_bin
+            top = int(np.argmax(share))
+            where = (f"most damage in {bins[top].label} ({100 * share[top]:.0f} %)"
+                     if max(t.contact_damage, t.bending_damage) > 0 else "no damage: every stress below the endurance limit")
             lines.append(f"  {t.gear:<22} ({t.member}, {t.meshes} mesh{'es' if t.meshes > 1 else ''})  contact "
                          f"D = {t.contact_damage:.4g}, S_H life {t.safety_contact:.3g} static "
                          f"{t.safety_contact_static:.3g};  bending D = {t.bending_damage:.4g}, S_F life "
-                         f"{t.safety_bending:.3g} static {t.safety_bending_static:.3g};  most damage in "
-                         f"{bins[top].label} ({100 * share[top]:.0f} %)")
+                         f"{t.safety_bending:.3g} static {t.safety_bending_static:.3g};  {where}")
         worst = max(ratings.totals, key=lambda t: max(t.contact_damage, t.bending_damage))
         d = max(worst.contact_damage, worst.bending_damage)
-        lines.append(f"  the most damaged gear: {worst.gear}, D = {d:.4g} "
-                     f"({'within' if d <= 1.0 else 'BEYOND'} the design life)")
+        least = min(ratings.totals, key=lambda t: min(t.safety_contact, t.safety_bending))
+        s_min = min(least.safety_contact, least.safety_bending)
+        lines.append(f"  the most damaged gear: {worst.gear}, D = {d:.4g} ({'within' if d <= 1.0 else 'BEYOND'} the "
+                     f"design life); the least safety factor of a spectrum: {least.gear}, {s_min:.3g}")
     elif res.runs:
         lines.append("gear ratings: no finished run holds the rated forces")
     if plan.bearing_note:

@@ -17,6 +17,7 @@ from components.analysis.gear_rating import (
     mesh_stresses,
     miner_damage,
     root_form_factors,
+    spectrum_safety,
 )
 from components.errors import ParameterError
 
@@ -145,6 +146,20 @@ def test_miner_damage_and_the_equivalent_stress_by_hand():
     dmg = gear_damage(sun, np.array([f]), np.array([n_fail]))
     assert dmg.bending_damage == pytest.approx(1.0, rel=1e-12)
     assert dmg.force_eq_bending_n == pytest.approx(f, rel=1e-9) and dmg.safety_bending_life == pytest.approx(1.0, rel=1e-9)
+    # a tenth of those cycles on the same segment: D = 0.1, and the stress factor to D = 1 is 0.1^(-1/k)
+    tenth = gear_damage(sun, np.array([f]), np.array([0.1 * n_fail]))
+    k = sun.bending_curve.slopes()[1] if n_fail > 3e6 else sun.bending_curve.slopes()[0]
+    assert tenth.bending_damage == pytest.approx(0.1, rel=1e-12)
+    assert tenth.safety_bending_life == pytest.approx(0.1 ** (-1.0 / k), rel=1e-9)
+
+
+def test_the_spectrum_safety_factor_is_finite_below_the_endurance_limit():
+    # every stress below the endurance limit (0.85 at 1e10): D = 0, and S is the factor that lifts the
+    # largest stress to where its cycles do damage 1 (here to the limit itself: 1e10 cycles there)
+    curve = LifeFactorCurve("Y_NT", GearMaterial().bending_life)
+    s = spectrum_safety(np.array([0.5, 0.4]), np.array([2e10, 1e9]), 1.0, curve)
+    assert miner_damage(np.array([0.5, 0.4]), np.array([2e10, 1e9]), 1.0, curve) == 0.0
+    assert s == pytest.approx(0.85 / 0.5, rel=1e-9)
 
 
 @pytest.mark.parametrize("kwargs, match", [
