@@ -34,7 +34,8 @@ from dataclasses import dataclass
 from typing import Any, Mapping
 
 from components.analysis.bearing_life import LIFE_EXPONENTS, LifeModification
-from components.analysis.gear_rating import GearInputs, GearMaterial, GearStress, MeshGeometry, mesh_stresses
+from components.analysis.gear_mesh import MeshGeometry
+from components.analysis.gear_rating import GearInputs, GearMaterial, GearStress, mesh_stresses
 from components.errors import ParameterError
 from components.model.assembly import Assembly
 from components.model.stages import PlanetaryStage

@@ -40,7 +40,7 @@ from typing import Any
 import numpy as np
 
 from components.analysis.bearing_life import BearingLife, bearing_life
-from components.analysis.gear_rating import GearDamage, gear_damage
+from components.analysis.gear_rating import GearDamage, gear_damage, miner_damage
 from components.errors import ParameterError
 
 from .lifetime_results import HOURS, LifetimeResults
@@ -127,8 +127,6 @@ def _hours(res: LifetimeResults) -> tuple[float, float]:
 
 
 def _by_bin(stress, levels, counts, bins, n_bins: int) -> tuple[np.ndarray, np.ndarray]:
-    from components.analysis.gear_rating import miner_damage
-
     contact, bending = np.zeros(n_bins), np.zeros(n_bins)
     for b in np.unique(bins):
         sel = bins == b

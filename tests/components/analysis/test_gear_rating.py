@@ -7,16 +7,15 @@ import math
 import numpy as np
 import pytest
 
+from components.analysis.gear_mesh import MeshGeometry, root_form_factors
 from components.analysis.gear_rating import (
     GearFactors,
     GearInputs,
     GearMaterial,
     LifeFactorCurve,
-    MeshGeometry,
     gear_damage,
     mesh_stresses,
     miner_damage,
-    root_form_factors,
     spectrum_safety,
 )
 from components.errors import ParameterError
