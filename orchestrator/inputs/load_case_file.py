@@ -39,6 +39,7 @@ from .load_cases import (
     OperatingRow,
 )
 from .master_options import ALGORITHMS, EXTRAPOLATIONS
+from .rating_options import BearingLifeTable, GearRatingTable, bearing_life_options, gear_rating_options
 from .overrides import SimulationOverrides
 from .schema import NAME_PATTERN, Table, flatten_parameters, read_document
 _SPEED = "a finite number [m/s]"
@@ -142,6 +143,8 @@ class LoadCaseFile(Table):
     fatigue: _FatigueTable = Field(default_factory=_FatigueTable, description="a [fatigue] table")
     sn_curves: list[_CurveTable] = Field(default_factory=list, description="an array of tables [[sn_curves]]")
     timeout: float | None = Field(None, gt=0, description="a wall-clock time per run > 0 [s]")
+    gear_rating: GearRatingTable | None = Field(None, description="a [gear_rating] table (ISO 6336)")
+    bearing_life: BearingLifeTable | None = Field(None, description="a [bearing_life] table (ISO 281)")
 
 
 def _wind(tab: _WindTable, src: str | None) -> WindDistribution:
@@ -296,6 +299,8 @@ def load_cases_from_dict(data: Mapping[str, Any], name: str | None = None, base_
         law=_law(doc.operating_law, source), rows=tuple(_row(r, i, source) for i, r in enumerate(doc.operating_points)),
         life=life, fatigue=fatigue, curves=tuple(_curve(c, i, source) for i, c in enumerate(doc.sn_curves)),
         timeout_s=doc.timeout, description=doc.description, source=source,
+        gear_rating=gear_rating_options(doc.gear_rating, LoadCaseError, source),
+        bearing_life=bearing_life_options(doc.bearing_life, LoadCaseError, source),
     )
 
 

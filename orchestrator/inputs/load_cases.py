@@ -58,6 +58,7 @@ from components.analysis.wind_distribution import WindDistribution, bin_probabil
 from ..errors import EntryError
 from ..frozen_map import FrozenMap
 from .overrides import SimulationOverrides
+from .rating_options import BearingLifeOptions, GearRatingOptions
 from .schema import NAME_PATTERN, ParameterValue
 
 #: folder of the packaged load-case sets (in the ``orchestrator`` package)
@@ -80,7 +81,7 @@ DEFAULT_LEVELS = 64
 #: ``{seed}`` in a string parameter value is replaced by the run's seed
 SEED_PLACEHOLDER = "{seed}"
 #: signal kinds whose channels a load-case set analyses (every one the gearbox declares), and chosen channels
-CHANNEL_KINDS = ("rotor_torque", "shaft_torque", "contact_force", "recorded")
+CHANNEL_KINDS = ("rotor_torque", "shaft_torque", "contact_force", "recorded", "bearing_force")
 
 
 class LoadCaseError(EntryError):
@@ -230,6 +231,10 @@ class LoadCaseSet:
         Wall-clock limit per run [s].
     description : str
     source : str or None
+    gear_rating : GearRatingOptions
+        ``[gear_rating]``: material, factors and S-N curves of the ISO 6336 ratings.
+    bearing_life : BearingLifeOptions
+        ``[bearing_life]``: reliability and a_ISO of the ISO 281 lives.
     """
 
     name: str
@@ -251,6 +256,8 @@ class LoadCaseSet:
     timeout_s: float | None = None
     description: str = ""
     source: str | None = None
+    gear_rating: GearRatingOptions = field(default_factory=GearRatingOptions)
+    bearing_life: BearingLifeOptions = field(default_factory=BearingLifeOptions)
 
     def __post_init__(self) -> None:
         src = self.source

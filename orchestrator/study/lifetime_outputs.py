@@ -2,7 +2,8 @@
 
 :func:`write_lifetime_outputs` computes the results (:func:`orchestrator.study.lifetime_results.compute_lifetime`)
 and writes ``bins.csv``, ``runs.csv``, ``lifetime_del.csv``, ``damage_by_bin.csv``,
-``ldd.csv``, ``lrd.csv``, ``lifetime.json``, ``lifetime_report.txt`` and the
+``ldd.csv``, ``lrd.csv``, ``gear_rating.csv`` and ``bearing_life.csv`` (:mod:`orchestrator.study.ratings`,
+where there is something to rate), ``lifetime.json``, ``lifetime_report.txt`` and the
 plots ``damage_by_bin.png``, ``ldd.png``, ``lrd.png`` (:mod:`orchestrator.study.lifetime_plots`;
 see ``docs/lifetime.md``).
 """
@@ -26,6 +27,8 @@ from .journal import JOURNAL_FILE, latest_by_key, read_journal
 from .lifetime_plots import plot_damage_by_bin, plot_ldd, plot_lrd
 from .lifetime_results import HOURS, LifetimeResults, compute_lifetime, ranked_bins, ranking_targets
 from .load_cases import PreparedLoadCases
+from .ratings import BEARING_FILE, GEAR_FILE, bearing_rows, compute_ratings, gear_rows, report_lines
+from .ratings import summary as ratings_summary
 
 
 def _write_atomic(path: Path, text: str) -> Path:
@@ -233,13 +236,20 @@ def write_lifetime_outputs(plc: PreparedLoadCases, out_dir: str | Path, plots: b
     ldd, lrd = _ldd_rows(res)
     files["ldd"] = _write_atomic(out / "ldd.csv", _csv(ldd))
     files["lrd"] = _write_atomic(out / "lrd.csv", _csv(lrd))
-    files["report"] = _write_atomic(out / "lifetime_report.txt", report_text(res))
+    ratings = compute_ratings(res)  # ISO 6336 gear ratings and ISO 281 bearing lives (orchestrator.study.ratings)
+    if res.plc.ratings.meshes:
+        files["gear_rating"] = _write_atomic(out / GEAR_FILE, _csv(gear_rows(res, ratings)))
+    if res.plc.ratings.bearings:
+        files["bearing_life"] = _write_atomic(out / BEARING_FILE, _csv(bearing_rows(ratings)))
+    report = report_text(res) + "\n".join(report_lines(res, ratings)) + "\n"
+    files["report"] = _write_atomic(out / "lifetime_report.txt", report)
     if plots and res.runs:
         files["plot:damage_by_bin"] = plot_damage_by_bin(res, out / "damage_by_bin.png")
         files["plot:ldd"] = plot_ldd(res, out / "ldd.png")
         files["plot:lrd"] = plot_lrd(res, out / "lrd.png")
     files["summary"] = out / "lifetime.json"
     doc = summary(res)
+    doc["ratings"] = ratings_summary(ratings)
     doc["files"] = {k: p.name for k, p in files.items()}
     _write_atomic(files["summary"], json.dumps(doc, indent=2) + "\n")
     return files

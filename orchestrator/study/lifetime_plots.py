@@ -45,7 +45,7 @@ def plot_damage_by_bin(res: LifetimeResults, path: Path) -> Path:
 
 
 def _torque_channels(res: LifetimeResults) -> list[str]:
-    return [c for c, cl in res.channels.items() if cl.channel.gears]
+    return [c for c, cl in res.channels.items() if cl.channel.gears and cl.channel.kind in ("shaft_torque", "rotor_torque")]
 
 
 def plot_ldd(res: LifetimeResults, path: Path) -> Path:

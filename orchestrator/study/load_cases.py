@@ -24,8 +24,9 @@ listed (e.g. the record ``DLC1.2_{seed}.outb`` of the bin's own row).
 Channels
 --------
 Every load the gearbox declares (its record's signals): the ``rotor_torque``,
-every ``shaft_torque`` and every ``contact_force``; plus the recorded channels
-the set names. Nothing is chosen by a variable's name. The gears of the load
+every ``shaft_torque``, every ``contact_force`` (with the load cycles of its two
+gears, :mod:`orchestrator.study.rating_plan`) and every ``bearing_force`` (with the
+bearing's revolutions); plus the recorded channels the set names. Nothing is chosen by a variable's name. The gears of the load
 revolution distributions come from the declarations too: a shaft torque acts
 on the bodies at its ``upstream`` and ``downstream`` ends, each with the speed
 the gearbox declares for that body (``body_speed``), an end that is no body of
@@ -41,7 +42,7 @@ re-runs nothing.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -49,6 +50,7 @@ from ..errors import EntryError, ScenarioError, suggestion
 from ..inputs.load_cases import SEED_PLACEHOLDER, LoadBin, LoadCaseError, LoadCaseSet
 from ..inputs.study import Base, Study, StudyError
 from .prepare import PreparedStudy, point_key, prepare_study
+from .rating_plan import RatingPlan, bearing_channels, mesh_channel, plan_ratings
 from .run_data import Channel, RunDataSpec
 
 #: the seed parameter of a run is its listed seed + SEED_STRIDE x its bin index (independent bins)
@@ -115,6 +117,8 @@ class PreparedLoadCases:
     notes: tuple[str, ...] = ()
     #: the base drivetrain's settling time (:meth:`components.analysis.settling.Settling.as_dict`), None without one
     settling: Mapping[str, Any] | None = None
+    #: the meshes and bearings rated by ISO 6336 and ISO 281 (:mod:`orchestrator.study.rating_plan`)
+    ratings: RatingPlan = field(default_factory=RatingPlan)
 
     @property
     def keys(self) -> tuple[str, ...]:
@@ -168,10 +172,12 @@ def _one_role(system, role: str, what: str, src: str | None) -> Any:
     return found[0]
 
 
-def _channels(system, lcs: LoadCaseSet) -> tuple[tuple[Channel, ...], str | None, dict[str, tuple[str, ...]]]:
+def _channels(system, lcs: LoadCaseSet) -> tuple[tuple[Channel, ...], str | None, dict[str, tuple[str, ...]],
+                                                 RatingPlan]:
     src = lcs.source
     gearbox = _one_role(system, "gearbox", "its declared shaft torques and mesh forces are the load channels", src)
     comp = gearbox.component
+    ratings = plan_ratings(system, gearbox, lcs)
     units = {name: v.unit for name, v in system.interfaces[comp].variables.items()}
     bodies = {s.info.get("body"): f"{comp}.{s.variable}" for s in gearbox.of_kind("body_speed")}
     winds = system.with_role("wind_source")
@@ -199,13 +205,14 @@ def _channels(system, lcs: LoadCaseSet) -> tuple[tuple[Channel, ...], str | None
                     hss = column
             out.append(Channel(column, unit, sig.kind, dict(sig.info), tuple(gears)))
         elif sig.kind == "contact_force":
-            out.append(Channel(column, unit, sig.kind, dict(sig.info)))
+            out.append(mesh_channel(ratings, column, unit, sig.kind, sig.info))
             label = f"{sig.info.get('stage', '')} {sig.info.get('mesh', '')}".strip()
             meshes.setdefault(label, []).append(column)
     if hss is None:  # no generator speed declared: the shaft whose downstream end is no gearbox body
         for ch in out:
             if ch.kind == "shaft_torque" and ch.info.get("downstream") and ch.info["downstream"] not in bodies:
                 hss = ch.column
+    out += bearing_channels(ratings, units)
     taken = {c.column for c in out}
     for i, name in enumerate(lcs.fatigue.channels):
         c, _, var = name.partition(".")
@@ -222,7 +229,7 @@ def _channels(system, lcs: LoadCaseSet) -> tuple[tuple[Channel, ...], str | None
     if not out:
         raise LoadCaseError("base.scenario", lcs.base_scenario, "a gearbox that declares shaft torques or contact "
                             "forces, or fatigue.channels", src)
-    return tuple(out), hss, {k: tuple(v) for k, v in meshes.items()}
+    return tuple(out), hss, {k: tuple(v) for k, v in meshes.items()}, ratings
 
 
 def _targets(system, lcs: LoadCaseSet, bins: tuple[LoadBin, ...]) -> dict[str, str]:
@@ -304,7 +311,7 @@ def prepare_load_cases(lcs: LoadCaseSet, fmu_dir: str | Path | None = None, buil
     bins = lcs.bins
     lcs, settling, window_notes = _settled(lcs, fmu_dir, build)
     system = _base_system(lcs, fmu_dir, build)
-    channels, hss, meshes = _channels(system, lcs)
+    channels, hss, meshes, ratings = _channels(system, lcs)
     targets = _targets(system, lcs, bins)
     seed_parameter = _seed_parameter(system, lcs)
     cases = _cases(lcs, bins, targets, seed_parameter)
@@ -327,4 +334,4 @@ def prepare_load_cases(lcs: LoadCaseSet, fmu_dir: str | Path | None = None, buil
     payload = replace(prepared.payload, run_data=spec)
     prepared = replace(prepared, payload=payload, identity=identity, keys=keys)
     return PreparedLoadCases(lcs, bins, cases, channels, prepared, hss, meshes,
-                             tuple(window_notes) + tuple(prepared.notes), settling)
+                             tuple(window_notes) + tuple(prepared.notes), settling, ratings)

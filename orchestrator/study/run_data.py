@@ -45,6 +45,10 @@ class Channel:
         The declared details (stage, mesh, planet; shaft, upstream, downstream).
     gears : tuple of (str, str)
         ``(gear, speed column)`` of each gear the load acts on (load revolution distribution).
+    speed_factors : tuple of float
+        Empty (every factor 1), or one per gear: the gear's revolutions (or load cycles) per
+        revolution of its speed column, e.g. a planet's revolutions relative to the carrier from the
+        planet's absolute speed (:mod:`orchestrator.study.ratings`).
     """
 
     column: str
@@ -52,11 +56,19 @@ class Channel:
     kind: str
     info: Mapping[str, str] = field(default_factory=dict)
     gears: tuple[tuple[str, str], ...] = ()
+    speed_factors: tuple[float, ...] = ()
+
+    def __post_init__(self) -> None:
+        if self.speed_factors and len(self.speed_factors) != len(self.gears):
+            raise ValueError(f"{self.column}: one speed factor per gear ({len(self.gears)}), not {len(self.speed_factors)}")
 
     def as_dict(self) -> dict:
         """Plain dict (JSON-ready)."""
-        return {"column": self.column, "unit": self.unit, "kind": self.kind, "info": dict(self.info),
-                "gears": [list(g) for g in self.gears]}
+        out = {"column": self.column, "unit": self.unit, "kind": self.kind, "info": dict(self.info),
+               "gears": [list(g) for g in self.gears]}
+        if self.speed_factors:
+            out["speed_factors"] = [float(f) for f in self.speed_factors]
+        return out
 
 
 @dataclass(frozen=True)
@@ -115,7 +127,8 @@ def collect_run_data(spec: RunDataSpec, time_s: np.ndarray, column: Callable[[st
         y = np.asarray(column(ch.column), dtype=float)[inside]
         span = float(y.max() - y.min())
         cycles = rainflow(y, spec.gate_fraction * span, spec.residue)
-        speeds = {gear: np.asarray(column(speed), dtype=float)[inside] for gear, speed in ch.gears}
+        factors = ch.speed_factors or (1.0,) * len(ch.gears)
+        speeds = {gear: f * np.asarray(column(speed), dtype=float)[inside] for (gear, speed), f in zip(ch.gears, factors)}
         levels = level_histogram(t, y, speeds)
         out["channels"][ch.column] = {
             "ranges": cycles.ranges, "means": cycles.means, "counts": cycles.counts,
