@@ -34,7 +34,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("set", metavar="SET", help="load-case set TOML file or packaged set name (e.g. paper-turbine)")
     add_cluster_arguments(p)
-    p.add_argument("--out", type=Path, default=None, help="output directory (default: results/loads/<set name>)")
+    p.add_argument("--out", type=Path, default=None, help="output directory (default: results/<set name>)")
     add_fmu_arguments(p, "the base scenario's")
     p.add_argument("--length", type=_seconds_or("to_stop"), default=None, metavar="SECONDS",
                    help='override the analysed length of each run, or "to_stop" (runs.length; changes the run keys)')
@@ -120,7 +120,7 @@ def run(args: argparse.Namespace) -> int:
     from ..study.lifetime_results import check_curves, mark_missing_run_files, store_run_data
     from ..study.load_cases import prepare_load_cases
     from ..study.report import point_records, status_counts
-    from ..study.sweep import check_study_folder, pending_points, run_sweep
+    from ..study.sweep import pending_points, run_sweep
 
     quiet = args.quiet
     if args.workers is not None and args.workers < 1:
@@ -141,8 +141,7 @@ def run(args: argparse.Namespace) -> int:
     check_curves(plc)
     for note in plc.notes:
         print(f"dtcosim loads: warning: {note}", file=sys.stderr)
-    out_dir = args.out if args.out is not None else Path("results") / "loads" / lcs.name
-    check_study_folder(out_dir, lcs.name)  # a run's folder or another study's: refused before anything
+    out_dir = args.out if args.out is not None else Path("results") / lcs.name
     say = (lambda msg: None) if quiet else (lambda msg: print(msg, file=sys.stderr))
     prepared = plc.prepared
     if args.check:

@@ -32,7 +32,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("study", metavar="STUDY", help="study TOML file or packaged study name (e.g. paper-sensitivity)")
     add_cluster_arguments(p)
-    p.add_argument("--out", type=Path, default=None, help="output directory (default: results/sweeps/<study name>)")
+    p.add_argument("--out", type=Path, default=None, help="output directory (default: results/<study name>)")
     add_fmu_arguments(p, "the base scenario's")
     p.add_argument("--retry-failed", action="store_true",
                    help="run points whose journal record says 'failed' again (default: failures are final)")
@@ -76,7 +76,7 @@ def run(args: argparse.Namespace) -> int:
     from ..study.journal import JOURNAL_FILE, read_journal
     from ..study.prepare import prepare_study
     from ..study.report import point_records, status_counts, write_outputs
-    from ..study.sweep import check_study_folder, pending_points, run_sweep
+    from ..study.sweep import pending_points, run_sweep
 
     quiet = args.quiet
     if args.workers is not None and args.workers < 1:
@@ -90,8 +90,7 @@ def run(args: argparse.Namespace) -> int:
     prepared = prepare_study(study, fmu_dir=args.fmu_dir, build=not args.no_build)
     for note in prepared.notes:
         print(f"dtcosim sweep: warning: {note}", file=sys.stderr)
-    out_dir = args.out if args.out is not None else Path("results") / "sweeps" / study.name
-    check_study_folder(out_dir, study.name)  # a run's folder or another study's: refused before anything
+    out_dir = args.out if args.out is not None else Path("results") / study.name
     say = (lambda msg: None) if quiet else (lambda msg: print(msg, file=sys.stderr))
     if args.check:
         todo = pending_points(prepared, read_journal(out_dir / JOURNAL_FILE), args.retry_failed)

@@ -45,7 +45,6 @@ from typing import Any, Mapping
 
 from ..atomic_files import claims_for, describe_os_error
 from ..errors import EntryError, reason_of, signal_name
-from ..folder_kinds import mixing_problem
 from ..result_files import write_summary
 from .writers import PARTIAL_SUFFIX
 
@@ -124,9 +123,6 @@ class RunFolder:
         path = Path(path)
         if path.exists() and not path.is_dir():
             raise OutputFolderError(key, str(path), "a folder for the results (this is a file)")
-        problem = mixing_problem(path, "run")
-        if problem is not None:  # a study's or load set's folder
-            raise OutputFolderError(key, str(path), problem)
         try:
             path.mkdir(parents=True, exist_ok=True)
             probe = path / f"{PROBE_PREFIX}{os.getpid()}"

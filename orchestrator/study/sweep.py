@@ -35,7 +35,6 @@ from pathlib import Path
 from typing import Any, Callable
 
 from ..cosim.stop_requests import STOP_SIGNALS
-from ..folder_kinds import mixing_problem
 from ..import_safe_signals import install, restore
 from ..inputs.study import StudyError
 from .engine import FAILED, OK, PointTask, run_point
@@ -183,19 +182,6 @@ def _close(client, cluster) -> None:
             cluster.close(timeout=20)
 
 
-def check_study_folder(out_dir: str | Path, name: str, key: str = "--out") -> None:
-    """Refuse a folder that holds a run's results or another study's journal (:mod:`orchestrator.folder_kinds`).
-
-    Raises
-    ------
-    StudyError
-        Naming the option, the folder and what it holds.
-    """
-    problem = mixing_problem(out_dir, "study", name)
-    if problem is not None:
-        raise StudyError(key, str(out_dir), problem)
-
-
 def run_sweep(
     prepared: PreparedStudy,
     out_dir: str | Path,
@@ -251,7 +237,6 @@ def run_sweep(
 
     wall0 = time.perf_counter()
     out = Path(out_dir)
-    check_study_folder(out, prepared.study.name)
     out.mkdir(parents=True, exist_ok=True)
     report = SweepReport(total=len(prepared.points), out_dir=out)
     journal_path = out / JOURNAL_FILE

@@ -24,7 +24,7 @@ pytestmark = pytest.mark.slow
 def paper_sweep(tmp_path_factory):
     """The full 49-point study, once, on a LocalCluster of 2 workers: (output dir, completed process)."""
     work = tmp_path_factory.mktemp("paper-sensitivity")
-    out = work / "results" / "sweeps" / "paper-sensitivity"
+    out = work / "results" / "paper-sensitivity"
     proc = run_cli("sweep", "paper-sensitivity", "--workers", "2", cwd=work, timeout=600)
     assert proc.returncode == 0, proc.stderr
     return out, proc
@@ -44,7 +44,7 @@ def test_table_and_heat_maps(paper_sweep):
     import matplotlib.image
 
     out, proc = paper_sweep
-    assert "results in results/sweeps/paper-sensitivity/" in proc.stdout
+    assert "results in results/paper-sensitivity/" in proc.stdout
     rows = read_table(out / "results.csv")
     assert len(rows) == 49 and {r["status"] for r in rows} == {"ok"}
     r1, lam, imax = _matrix(rows, "I_max_acc [rad/s2]")
