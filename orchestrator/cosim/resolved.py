@@ -18,11 +18,6 @@ from .fmu_interface import FmuInterface, FmuVariable
 from .roles import ComponentRole
 
 
-#: what a signal (a variable that changes during a run) is declared as
-SIGNAL_CAUSALITIES = ("output", "local", "input")
-SIGNAL_VARIABILITIES = ("continuous", "discrete")
-
-
 @dataclass(frozen=True)
 class RecordedVariable:
     """A variable sampled into the results.
@@ -35,9 +30,6 @@ class RecordedVariable:
         Unit declared by the FMU ("" if none).
     type : str
         FMI type: ``Real``, ``Integer``, ``Boolean``, ``String`` or ``Enumeration``.
-    signal : bool
-        It can change during the run (causality output, local or input, variability continuous
-        or discrete); False for a parameter or constant, which a run records but no statistic lists.
     """
 
     component: str
@@ -45,13 +37,6 @@ class RecordedVariable:
     value_reference: int
     unit: str
     type: str = "Real"
-    signal: bool = True
-
-    @classmethod
-    def of(cls, component: str, var: FmuVariable) -> "RecordedVariable":
-        """The recorded ``component.var``, a signal or not by its declared causality and variability."""
-        signal = var.causality in SIGNAL_CAUSALITIES and var.variability in SIGNAL_VARIABILITIES
-        return cls(component, var.name, var.value_reference, var.unit, var.type, signal)
 
     @property
     def column(self) -> str:

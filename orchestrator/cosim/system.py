@@ -403,7 +403,7 @@ def _resolve_record(scenario: Scenario, interfaces: Mapping[str, FmuInterface]) 
     def add(comp: str, var: FmuVariable) -> None:
         if (comp, var.name) not in seen:
             seen.add((comp, var.name))
-            out.append(RecordedVariable.of(comp, var))
+            out.append(RecordedVariable(comp, var.name, var.value_reference, var.unit, var.type))
 
     if not scenario.recorded:
         for comp in scenario.component_names:

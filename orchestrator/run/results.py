@@ -110,9 +110,9 @@ def write_timeseries(path: str | Path, outcome: RunOutcome, chunk_rows: int | No
 
 
 def statistics(outcome: RunOutcome, window: tuple[float, float]) -> dict[str, dict[str, float]]:
-    """Mean, std, min, max of every recorded signal over ``window`` [s] (not of parameters, constants, strings)."""
+    """Mean, std, min, max of every recorded variable over ``window`` [s]."""
     return {c.column: window_statistics(outcome.time_s, outcome.values[:, i], window)
-            for i, c in enumerate(outcome.columns) if c.signal and c.type != "String"}
+            for i, c in enumerate(outcome.columns) if c.type != "String"}
 
 
 def run_status(outcome: RunOutcome, problems: list[str] | None = None) -> str:

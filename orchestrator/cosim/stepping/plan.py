@@ -232,14 +232,14 @@ def build_plan(system: ResolvedSystem, instances: Mapping[str, FmuInstance]) -> 
     for name in names:
         first_column[name] = len(columns)
         variables = system.interfaces[name].variables
-        columns += [RecordedVariable.of(name, variables[v]) for v in real_out[name]]
+        columns += [RecordedVariable(name, v, variables[v].value_reference, variables[v].unit) for v in real_out[name]]
     typed_column: dict[tuple[str, str], int] = {}  # float column, or TextStore column for a String
     typed_outputs: dict[str, list[tuple[str, str, int]]] = {name: [] for name in names}
     n_text = 0
     for name in names:
         for v in typed_out[name]:
             var = system.interfaces[name].variables[v]
-            columns.append(RecordedVariable.of(name, var))
+            columns.append(RecordedVariable(name, v, var.value_reference, var.unit, var.type))
             if var.type == "String":
                 col, n_text = n_text, n_text + 1
             else:
