@@ -47,8 +47,6 @@ from .values import transformation_problem, type_mismatch
 SETTABLE_CAUSALITIES = ("parameter", "input")
 #: causalities a connection or initial binding may read from
 READABLE_CAUSALITIES = ("output", "calculatedParameter")
-#: what an ``[[initial]]`` binding may read: an output, or a parameter (a value two FMUs need, kept in one of them)
-BINDING_SOURCES = READABLE_CAUSALITIES + ("parameter",)
 
 
 def find_fmu(scenario: Scenario, component: Component, candidates: Sequence[Path]) -> Path:
@@ -206,8 +204,7 @@ def resolve_system(scenario: Scenario, fmu_paths: Mapping[str, Path] | None = No
         if problem is not None:
             raise ScenarioError(f"connections[{i}].transformation", con.transformation.describe(), problem, src)
     for i, b in enumerate(scenario.initial):
-        out = _lookup(interfaces[b.source.component], b.source, f"initial[{i}].from", src, BINDING_SOURCES,
-                      "an output or parameter")
+        out = _lookup(interfaces[b.source.component], b.source, f"initial[{i}].from", src, READABLE_CAUSALITIES, "an output")
         var = _lookup(interfaces[b.target.component], b.target, f"initial[{i}].to", src, SETTABLE_CAUSALITIES, "a parameter or input")
         if var.variability == "constant":
             raise ScenarioError(f"initial[{i}].to", str(b.target), "a settable (fixed or tunable) parameter", src)

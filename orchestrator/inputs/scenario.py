@@ -390,10 +390,7 @@ class Scenario:
                 raise ScenarioError(f"initial[{i}].to", tgt, f"a variable set once (already by initial[{set_initially[tgt]}])", src)
             comp = next(c for c in self.components if c.name == b.target.component)
             if b.target.variable in comp.parameters:
-                raise ScenarioError(f"components.{comp.name}.parameters.{b.target.variable}",
-                                    comp.parameters[b.target.variable],
-                                    f"no value: initial[{i}] binds {tgt} to {b.source} (its one source; set that "
-                                    "instead, or remove the binding)", src)
+                raise ScenarioError(f"initial[{i}].to", tgt, f"a variable without a value in components.{comp.name}.parameters", src)
             set_initially[tgt] = i
         for i, pattern in enumerate(self.recorded):
             ref = VariableRef.parse(pattern, f"record.variables[{i}]", src)
