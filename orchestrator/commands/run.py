@@ -75,7 +75,6 @@ def _progress_bar(sim):
 
 def run(args: argparse.Namespace) -> int:
     """Run the scenario; write results; print a summary."""
-    from ..cosim.coupling_delays import FEEDTHROUGH
     from ..cosim.system import resolve_system
     from ..provision.project_fmus import ensure_fmus
     from ..provision.staleness import stale_project_fmus
@@ -97,9 +96,6 @@ def run(args: argparse.Namespace) -> int:
         print(f"{scenario.name}: valid ({len(scenario.components)} FMUs, {len(scenario.connections)} connections, "
               f"{len(system.recorded)} recorded variables, {len(system.events)} load event(s); stepping order {', '.join(system.order)}; "
               f"initialisation order {', '.join(system.init_order)})")
-        for delay in system.delays:
-            if delay.kind != FEEDTHROUGH:  # those are notes, printed above
-                print(f"  coupling: {delay.note}")
         return 0
     RunFolder.check(out_dir)  # a file or an unwritable folder: refused before anything is instantiated
     if out_note:

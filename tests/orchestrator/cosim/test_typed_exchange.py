@@ -131,10 +131,9 @@ def test_changing_values_of_every_type_travel_along_a_chain_in_the_python_loop(a
         n = outcome.column("src.n")
         stride = round(interval / 0.1)
         np.testing.assert_array_equal(n, stride * np.arange(len(n)))  # n counts the steps
-        # Gauss-Seidel steps the pass-throughs a, b in the data's order and before the source (receivers first):
-        # b passes what a passed in the same step, src's count arrives one step late; Jacobi delays every hop.
-        # The values arrive unchanged
-        delay = 1 if algorithm == "gauss-seidel" else 2
+        # Gauss-Seidel steps the receivers first (src, a, b are not in a loop): every hop is a step late,
+        # as with Jacobi; the values arrive unchanged
+        delay = 2
         steps = n.astype(int)
         expected_n = np.maximum(steps - delay, 0)
         np.testing.assert_array_equal(outcome.column("b.Int32_output"), expected_n)
