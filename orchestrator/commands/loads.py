@@ -14,7 +14,7 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
-from .cluster_options import add_cluster_arguments, check_cluster_arguments
+from .cluster_options import add_cluster_arguments, check_cluster_arguments, check_workers
 from .fmu_options import add_fmu_arguments
 
 
@@ -123,8 +123,7 @@ def run(args: argparse.Namespace) -> int:
     from ..study.sweep import pending_points, run_sweep
 
     quiet = args.quiet
-    if args.workers is not None and args.workers < 1:
-        raise LoadCaseError("--workers", args.workers, "an integer >= 1")
+    check_workers(args, LoadCaseError)
     lcs = load_load_cases(find_load_cases(args.set))
     changes = {}
     for option, attr in (("length", "length_s"), ("transient", "transient_s"), ("timeout", "timeout_s")):
@@ -189,9 +188,18 @@ def run(args: argparse.Namespace) -> int:
     finally:
         if "p" in bars:
             bars["p"].close()
-    files = write_lifetime_outputs(plc, out_dir, plots=not args.no_plots)
+    problems = list(report.problems)
+    try:
+        files = write_lifetime_outputs(plc, out_dir, plots=not args.no_plots)
+    except OSError as exc:  # a full disk: the runs are kept, the lifetime results can be written later
+        from ..atomic_files import describe_os_error
+
+        files = {}
+        problems.append(f"{describe_os_error(exc)}; the lifetime results are not all written; every finished run "
+                        f"is kept in {out_dir / JOURNAL_FILE} and {out_dir}/runs: free some space and run the same "
+                        "command with --report to write them")
     counts = status_counts(point_records(prepared, out_dir=out_dir))
-    if not quiet:
+    if not quiet and files:
         print((out_dir / "lifetime_report.txt").read_text(), end="")
         if report.submitted:
             finished_n = report.ok + report.failed + report.errors
@@ -204,8 +212,10 @@ def run(args: argparse.Namespace) -> int:
     if counts["failed"]:
         print(f"dtcosim loads: warning: {counts['failed']} runs failed (see {out_dir / 'results.csv'}); the lifetime "
               "figures leave them out", file=sys.stderr)
+    for problem in problems:
+        print(f"dtcosim loads: error: {problem}", file=sys.stderr)
     if report.interrupted:
         print(f"dtcosim loads: interrupted; finished runs kept in {out_dir / JOURNAL_FILE}; run the same command "
               "again to continue", file=sys.stderr)
         return 128 + (report.signal or 2)
-    return 1 if counts["error"] or counts["pending"] else 0
+    return 1 if counts["error"] or counts["pending"] or problems else 0

@@ -14,7 +14,7 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
-from .cluster_options import add_cluster_arguments, check_cluster_arguments
+from .cluster_options import add_cluster_arguments, check_cluster_arguments, check_workers
 from .fmu_options import add_fmu_arguments
 
 
@@ -79,8 +79,7 @@ def run(args: argparse.Namespace) -> int:
     from ..study.sweep import pending_points, run_sweep
 
     quiet = args.quiet
-    if args.workers is not None and args.workers < 1:
-        raise StudyError("--workers", args.workers, "an integer >= 1")
+    check_workers(args, StudyError)
     study = load_study(find_study(args.study))
     if args.timeout is not None:
         try:
@@ -146,8 +145,10 @@ def run(args: argparse.Namespace) -> int:
     if counts["failed"]:
         print(f"dtcosim sweep: warning: {counts['failed']} points failed (see the error column of "
               f"{out_dir / 'results.csv'})", file=sys.stderr)
+    for problem in report.problems:
+        print(f"dtcosim sweep: error: {problem}", file=sys.stderr)
     if report.interrupted:
         print(f"dtcosim sweep: interrupted; {report.ok + report.failed + report.errors} finished points kept in "
               f"{out_dir / JOURNAL_FILE}; run the same command again to continue", file=sys.stderr)
         return 128 + (report.signal or 2)
-    return 1 if counts["error"] or counts["pending"] else 0
+    return 1 if counts["error"] or counts["pending"] or report.problems else 0
