@@ -73,6 +73,7 @@ def run(args: argparse.Namespace) -> int:
     """Validate the study, run its pending points, write the results."""
     from ..inputs.study import StudyError
     from ..inputs.study_file import find_study, load_study
+    from ..output_folders import check_for_study
     from ..study.journal import JOURNAL_FILE, read_journal
     from ..study.prepare import prepare_study
     from ..study.report import point_records, status_counts, write_outputs
@@ -86,10 +87,11 @@ def run(args: argparse.Namespace) -> int:
             study = replace(study, timeout_s=args.timeout)
         except StudyError as exc:
             raise StudyError("--timeout", exc.value, exc.expected) from None
+    out_dir = args.out if args.out is not None else Path("results") / study.name
+    check_for_study(out_dir, study.name)  # a run's folder or another study's: refused before anything is prepared
     prepared = prepare_study(study, fmu_dir=args.fmu_dir, build=not args.no_build)
     for note in prepared.notes:
         print(f"dtcosim sweep: warning: {note}", file=sys.stderr)
-    out_dir = args.out if args.out is not None else Path("results") / study.name
     say = (lambda msg: None) if quiet else (lambda msg: print(msg, file=sys.stderr))
     if args.check:
         todo = pending_points(prepared, read_journal(out_dir / JOURNAL_FILE), args.retry_failed)

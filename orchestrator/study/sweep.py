@@ -38,6 +38,7 @@ from ..atomic_files import describe_os_error
 from ..cosim.stop_requests import STOP_SIGNALS
 from ..import_safe_signals import install, restore
 from ..inputs.study import StudyError
+from ..output_folders import check_for_study
 from .engine import FAILED, OK, PointTask, run_point
 from .journal import JOURNAL_FILE, Journal, latest_by_key, read_journal
 from .prepare import PreparedStudy
@@ -239,7 +240,8 @@ def run_sweep(
     prepared : PreparedStudy
     out_dir : path
         Output directory (created): ``journal.jsonl``, ``results.csv``,
-        ``study.json``, PNG plots.
+        ``study.json``, PNG plots. A folder that holds a run's results or another
+        study's is refused (:func:`orchestrator.output_folders.check_for_study`).
     workers : int, optional
         Workers of the LocalCluster (processes with one thread each; default: CPU count).
     scheduler : str, optional
@@ -273,6 +275,7 @@ def run_sweep(
 
     wall0 = time.perf_counter()
     out = Path(out_dir)
+    check_for_study(out, prepared.study.name)  # a run's folder or another study's: refused (folders never mix)
     out.mkdir(parents=True, exist_ok=True)
     report = SweepReport(total=len(prepared.points), out_dir=out)
     journal_path = out / JOURNAL_FILE
