@@ -7,12 +7,42 @@ without a binary for this platform cannot be loaded at all. :func:`archive_probl
 finds these from the archive's directory (nothing is extracted or loaded), so
 ``dtcosim run --check``, ``run``, ``sweep`` and ``validate`` refuse such a file
 with a message instead.
+
+Before any of that, :func:`layout_problems` checks what reading or extracting the
+archive would do, from its directory alone: a regular file (a FIFO or a device would
+block or never end), at most :data:`MAX_FMU_MEMBERS` members that expand to at most
+:data:`MAX_FMU_BYTES` together, no member expanding more than :data:`MAX_FMU_RATIO`
+times (a zip bomb: a 3 GiB member was extracted until the temporary folder was full),
+and member names that stay inside the folder they are extracted to (no absolute
+path, drive letter, backslash or ``..``). :func:`corrupt_member` reads every member
+once (a damaged member is found before a run, not as a ``zlib.error`` in the middle of
+one), and :func:`extract_fmu` extracts within the same bounds, whatever the
+directory says.
 """
 
 from __future__ import annotations
 
+import os
+import stat
 import zipfile
+import zlib
 from pathlib import Path
+
+from components.errors import DtcosimError
+
+#: the most members of an FMU archive
+MAX_FMU_MEMBERS = 10_000
+#: the most bytes an FMU archive's members expand to together (dtcosim's FMUs: about 5 MB)
+MAX_FMU_BYTES = 1 << 30
+#: the most a member above :data:`RATIO_FLOOR_BYTES` may expand (uncompressed / compressed size)
+MAX_FMU_RATIO = 200
+RATIO_FLOOR_BYTES = 1 << 20
+#: what reading a damaged member raises
+CORRUPT_ERRORS = (zipfile.BadZipFile, zlib.error, EOFError)
+
+
+class FmuArchiveError(DtcosimError, ValueError):
+    """An FMU archive that is unsafe to extract or damaged (names the file, the member and the bound)."""
 
 #: the file a PythonFMU binary reads at instantiation to find its slave module
 PYTHONFMU_MODULE_FILE = "resources/slavemodule.txt"
@@ -29,8 +59,113 @@ def _slave_module(path: Path | str) -> str | None:
     try:
         with zipfile.ZipFile(path) as archive:
             return archive.read(PYTHONFMU_MODULE_FILE).decode("utf-8").strip() or None
-    except (zipfile.BadZipFile, OSError, KeyError, UnicodeDecodeError):
+    except (OSError, KeyError, UnicodeDecodeError, *CORRUPT_ERRORS):
         return None
+
+
+def _illegal_name(name: str) -> bool:
+    """True for a member name that would be written outside the folder it is extracted to."""
+    return name.startswith("/") or "\\" in name or ":" in name or ".." in name.split("/")
+
+
+def _limit_problems(infos: list[zipfile.ZipInfo]) -> list[str]:
+    if len(infos) > MAX_FMU_MEMBERS:
+        return [f"{len(infos)} archive members, expected at most {MAX_FMU_MEMBERS} (a limit against zip bombs)"]
+    problems = []
+    total = sum(i.file_size for i in infos)
+    if total > MAX_FMU_BYTES:
+        problems.append(f"expands to {total / 2**20:.0f} MiB, expected at most {MAX_FMU_BYTES / 2**20:.0f} MiB (a "
+                        "limit against zip bombs)")
+    for info in infos:
+        ratio = info.file_size / max(info.compress_size, 1)
+        if info.file_size > RATIO_FLOOR_BYTES and ratio > MAX_FMU_RATIO:
+            problems.append(f"archive member {info.filename!r} expands {ratio:.0f} times ({info.compress_size} -> "
+                            f"{info.file_size} bytes), expected at most {MAX_FMU_RATIO} times (a limit against zip "
+                            "bombs)")
+            break
+    for info in infos:
+        if _illegal_name(info.filename):
+            problems.append(f"archive member {info.filename!r} would be extracted outside the FMU's folder (an "
+                            "absolute path, a drive letter, a backslash or '..'; FMI 2.0: relative names with '/')")
+            break
+    return problems
+
+
+def layout_problems(path: str | Path) -> list[str]:
+    """What makes the file at ``path`` unsafe to read or extract as an FMU (empty: nothing; nothing is decompressed)."""
+    try:
+        info = os.stat(path)
+    except OSError as exc:
+        return [f"cannot be read ({exc.strerror})"]
+    if not stat.S_ISREG(info.st_mode):
+        return ["not a regular file (a device, pipe or folder)"]
+    try:
+        with zipfile.ZipFile(path) as archive:
+            infos = archive.infolist()
+    except (zipfile.BadZipFile, OSError) as exc:
+        return [f"not a readable zip archive ({exc})"]
+    return _limit_problems(infos)
+
+
+def corrupt_member(path: str | Path) -> str | None:
+    """What is wrong with the first damaged member (its data does not decompress or match its CRC), or None."""
+    try:
+        with zipfile.ZipFile(path) as archive:
+            for info in archive.infolist():
+                try:
+                    with archive.open(info) as member:
+                        while member.read(1 << 20):
+                            pass
+                except CORRUPT_ERRORS as exc:
+                    return f"archive member {info.filename!r} is damaged ({exc or type(exc).__name__})"
+    except (zipfile.BadZipFile, OSError) as exc:
+        return f"not a readable zip archive ({exc})"
+    return None
+
+
+def extract_fmu(path: str | Path, target: str | Path) -> Path:
+    """Extract the FMU at ``path`` into the folder ``target`` within the limits of :func:`layout_problems`.
+
+    The bytes written are counted as they are written: the extraction stops at
+    :data:`MAX_FMU_BYTES` whatever the archive's directory declares.
+
+    Raises
+    ------
+    FmuArchiveError
+        The archive is beyond a limit, names a member outside ``target``, or a member is damaged.
+    OSError
+        ``target`` cannot take the files (a full disk, a file-size limit).
+    """
+    path, target = Path(path), Path(target)
+    try:
+        archive = zipfile.ZipFile(path)
+    except (zipfile.BadZipFile, OSError) as exc:
+        raise FmuArchiveError(f"{path}: not a readable zip archive ({exc})") from None
+    with archive:
+        infos = archive.infolist()
+        problems = _limit_problems(infos)
+        if problems:
+            raise FmuArchiveError(f"{path}: {problems[0]}")
+        left = MAX_FMU_BYTES
+        target.mkdir(parents=True, exist_ok=True)
+        for info in infos:
+            dest = target.joinpath(*info.filename.split("/"))
+            if info.is_dir():
+                dest.mkdir(parents=True, exist_ok=True)
+                continue
+            dest.parent.mkdir(parents=True, exist_ok=True)
+            try:
+                with archive.open(info) as member, open(dest, "wb") as out:
+                    while chunk := member.read(1 << 20):
+                        left -= len(chunk)
+                        if left < 0:
+                            raise FmuArchiveError(f"{path}: expands beyond {MAX_FMU_BYTES / 2**20:.0f} MiB (a limit "
+                                                  "against zip bombs)")
+                        out.write(chunk)
+            except CORRUPT_ERRORS as exc:
+                raise FmuArchiveError(f"{path}: archive member {info.filename!r} is damaged "
+                                      f"({exc or type(exc).__name__})") from None
+    return target
 
 
 def platform_binary(model_identifier: str) -> str:

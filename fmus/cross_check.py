@@ -22,7 +22,10 @@ host that runs the same binary with the same inputs should meet.
 
 from __future__ import annotations
 
+import errno
 import io
+import os
+import stat
 import zipfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -35,6 +38,8 @@ from .cross_check_case import CrossCheckCase, CrossCheckError, stated_inputs
 MEMBER_DIR = "documentation/cross-check"
 #: the RelTol written into ``<Model>_ref.opt``: the stricter comparison's default bound
 REL_TOL = 1e-4
+#: the largest result CSV read (a cross-check result of an FMU: kilobytes)
+MAX_RESULT_BYTES = 256 << 20
 
 
 def _csv_text(table: np.ndarray) -> str:
@@ -162,6 +167,10 @@ def compare(fmu: str | Path, result_csv: str | Path, rel_tol: float | None = Non
     fmu, result_csv = Path(fmu), Path(result_csv)
     model, ref, opts = read_reference(fmu)
     try:
+        if not stat.S_ISREG(os.stat(result_csv).st_mode):  # a pipe or a device would block or never end
+            raise OSError(errno.EINVAL, "not a regular file (a device, pipe or folder)")
+        if os.stat(result_csv).st_size > MAX_RESULT_BYTES:
+            raise OSError(errno.EFBIG, f"larger than {MAX_RESULT_BYTES >> 20} MiB")
         text = result_csv.read_text()
     except (OSError, UnicodeDecodeError) as exc:
         raise CrossCheckError(f"{result_csv}: cannot read it: {exc}") from None

@@ -6,6 +6,7 @@ truncated is one problem with a message, never a traceback.
 
 from __future__ import annotations
 
+import os
 import zipfile
 from pathlib import Path
 from typing import Iterable
@@ -13,7 +14,7 @@ from typing import Iterable
 from fmpy import read_model_description
 from fmpy.validation import validate_fmu
 
-from .archive_checks import RECORD_MEMBER, archive_problems
+from .archive_checks import RECORD_MEMBER, archive_problems, corrupt_member, layout_problems
 from .requirements import ARCHIVE_MEMBER, read_from_fmu
 from .runtime_guard import RequirementsFormatError
 
@@ -58,6 +59,8 @@ def runtime_declaration_problems(fmu_path: Path | str) -> list[str]:
 
 def _member_names(fmu_path: Path | str) -> tuple[set[str], str | None]:
     """The archive's member names, and why the file cannot be an FMU archive at all (or None)."""
+    if os.path.exists(fmu_path) and not os.path.isfile(fmu_path):  # a pipe or a device would block or never end
+        return set(), "not a regular file (a device, pipe or folder)"
     try:
         with zipfile.ZipFile(fmu_path) as archive:
             names = set(archive.namelist())
@@ -65,6 +68,12 @@ def _member_names(fmu_path: Path | str) -> tuple[set[str], str | None]:
         return set(), f"not a zip archive, so not an FMU ({exc})"
     except OSError as exc:
         return set(), f"cannot be read ({exc})"
+    problems = layout_problems(fmu_path)  # a zip bomb, members named outside the folder
+    if problems:
+        return names, "; ".join(problems)
+    damaged = corrupt_member(fmu_path)
+    if damaged:
+        return names, damaged
     if "modelDescription.xml" not in names:
         return names, "the archive has no modelDescription.xml"
     return names, None

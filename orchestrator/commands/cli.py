@@ -21,6 +21,9 @@ from components.errors import DtcosimError
 from ..cosim.stop_requests import STOP_SIGNALS
 from ..import_safe_signals import install, restore
 
+#: set (to anything) to see the traceback of an unexpected error instead of its one line
+DEBUG_VARIABLE = "DTCOSIM_DEBUG"
+
 #: modules providing subcommands, in help order
 COMMAND_MODULES = (
     "orchestrator.commands.run",
@@ -106,6 +109,9 @@ def main(argv: list[str] | None = None) -> int:
     SIGTERM and SIGHUP end a command like Ctrl-C does (the run command stops
     cleanly, see :mod:`orchestrator.cosim.stop_requests`): one line on stderr and
     the status ``128 + signal`` (130 for Ctrl-C), at any stage, start-up included.
+    No traceback reaches the user: an ``OSError`` no command explained (a full disk)
+    is one line naming the file, an unexpected exception one line saying it is a bug
+    (:data:`DEBUG_VARIABLE` shows its traceback); both exit 1.
     """
     with _command_signals():
         args = argparse.Namespace(command=None)
@@ -124,6 +130,16 @@ def main(argv: list[str] | None = None) -> int:
             text = str(exc) if getattr(exc, "signum", None) is not None else "interrupted by the user (Ctrl-C)"
             print(f"{_prog(args)}: {text}", file=sys.stderr)
             return 128 + int(signum)
+        except OSError as exc:  # a full disk, a file-size limit: where a command has nothing more to say about it
+            where = f"{exc.filename}: " if exc.filename is not None else ""
+            print(f"{_prog(args)}: error: {where}{exc.strerror or exc}", file=sys.stderr)
+            return 1
+        except Exception as exc:  # a bug: one line, the traceback only when asked for
+            if os.environ.get(DEBUG_VARIABLE):
+                raise
+            print(f"{_prog(args)}: internal error: {type(exc).__name__}: {exc} (a bug in dtcosim: please report it "
+                  f"with the command; {DEBUG_VARIABLE}=1 shows the traceback)", file=sys.stderr)
+            return 1
 
 
 def end_process(status: int) -> None:

@@ -8,19 +8,42 @@ credentials, no dashboard unless asked) and of the checks on an existing cluster
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 
 
 def add_cluster_arguments(p: argparse.ArgumentParser) -> None:
     """Add ``--workers``, ``--scheduler`` and ``--dashboard`` to a subcommand's parser."""
     p.add_argument("--workers", type=int, default=None, metavar="N",
-                   help="workers of the LocalCluster: processes with one thread each (default: CPU count)")
+                   help="workers of the LocalCluster: processes with one thread each (default: CPU count; at "
+                        f"most {WORKERS_PER_CPU} x the CPU count)")
     p.add_argument("--scheduler", default=None, metavar="ADDRESS",
                    help="use an existing Dask cluster through its scheduler, e.g. tls://10.0.0.5:8786 (left running; "
                         "TLS settings from the Dask configuration, see docs/studies.md)")
     p.add_argument("--dashboard", nargs="?", const="127.0.0.1:8787", default=None, metavar="HOST:PORT",
                    help="start the LocalCluster's Dask dashboard (default address 127.0.0.1:8787; without this "
                         "option nothing listens on it)")
+
+
+#: workers per CPU a LocalCluster may have: each is a process of its own (its interpreter, numpy and the
+#: FMUs it loads, 150-300 MB); beyond the cores they only take turns
+WORKERS_PER_CPU = 4
+
+
+def max_workers() -> int:
+    """The most ``--workers`` of a LocalCluster on this machine: :data:`WORKERS_PER_CPU` x its CPUs (at least 4)."""
+    return max(4, WORKERS_PER_CPU * (os.cpu_count() or 1))
+
+
+def check_workers(args: argparse.Namespace, error: type) -> None:
+    """Refuse ``--workers`` outside ``1..max_workers()`` (before anything is read or started), as ``error``."""
+    if args.workers is None:
+        return
+    limit = max_workers()
+    if not 1 <= args.workers <= limit:
+        raise error("--workers", args.workers, f"an integer from 1 to {limit} ({WORKERS_PER_CPU} x the "
+                    f"{os.cpu_count() or 1} CPUs of this machine: each worker is a process of 150-300 MB, and more "
+                    "than the cores only take turns; for more, start a cluster and give --scheduler)")
 
 
 def check_cluster_arguments(args: argparse.Namespace, command: str) -> None:

@@ -122,9 +122,10 @@ def _measured_step(path: Path, scenario_name: str, algorithm: str) -> tuple[floa
     import math
 
     from ..errors import ScenarioError
+    from ..inputs.files import read_regular_bytes
 
     try:
-        data = json.loads(Path(path).read_text(encoding="utf-8"))
+        data = json.loads(read_regular_bytes(path).decode("utf-8"))
     except (OSError, ValueError) as exc:
         raise ScenarioError("--tuning", str(path), f"a JSON file of benchmarks/coupling_study.py --json ({exc})") \
             from None

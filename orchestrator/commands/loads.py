@@ -14,7 +14,7 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
-from .cluster_options import add_cluster_arguments, check_cluster_arguments
+from .cluster_options import add_cluster_arguments, check_cluster_arguments, check_workers
 from .fmu_options import add_fmu_arguments
 
 
@@ -34,7 +34,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("set", metavar="SET", help="load-case set TOML file or packaged set name (e.g. paper-turbine)")
     add_cluster_arguments(p)
-    p.add_argument("--out", type=Path, default=None, help="output directory (default: results/<set name>)")
+    p.add_argument("--out", type=Path, default=None,
+                   help="output directory (default: results/loads/<set name>, apart from dtcosim run's folders)")
     add_fmu_arguments(p, "the base scenario's")
     p.add_argument("--length", type=_seconds_or("to_stop"), default=None, metavar="SECONDS",
                    help='override the analysed length of each run, or "to_stop" (runs.length; changes the run keys)')
@@ -96,6 +97,23 @@ class _Progress:
         self.total.close()
 
 
+def default_out_dir(name: str) -> Path:
+    """``results/loads/<set name>``: a run of a scenario of the same name writes ``results/<name>/``."""
+    from ..output_folders import LOADS_FOLDER
+
+    return Path("results") / LOADS_FOLDER / name
+
+
+def earlier_default_folder(name: str, out_dir: Path) -> Path | None:
+    """``results/<set name>`` when it holds this set's journal and ``out_dir`` none (the default before), else None."""
+    from ..output_folders import STUDY_JOURNAL, study_in
+
+    earlier = Path("results") / name
+    if (out_dir / STUDY_JOURNAL).exists() or not (earlier / STUDY_JOURNAL).is_file():
+        return None
+    return earlier if study_in(earlier) in (name, "") else None
+
+
 def _seconds_or(word: str):
     """An argparse type: a number of seconds, or ``word`` (given back as the string)."""
     def parse(text: str):
@@ -115,6 +133,7 @@ def run(args: argparse.Namespace) -> int:
 
     from ..inputs.load_case_file import find_load_cases, load_load_cases
     from ..inputs.load_cases import MAX_SEEDS, LoadCaseError
+    from ..output_folders import check_for_study
     from ..study.journal import JOURNAL_FILE, read_journal
     from ..study.lifetime_outputs import write_lifetime_outputs
     from ..study.lifetime_results import check_curves, mark_missing_run_files, store_run_data
@@ -123,8 +142,7 @@ def run(args: argparse.Namespace) -> int:
     from ..study.sweep import pending_points, run_sweep
 
     quiet = args.quiet
-    if args.workers is not None and args.workers < 1:
-        raise LoadCaseError("--workers", args.workers, "an integer >= 1")
+    check_workers(args, LoadCaseError)
     lcs = load_load_cases(find_load_cases(args.set))
     changes = {}
     for option, attr in (("length", "length_s"), ("transient", "transient_s"), ("timeout", "timeout_s")):
@@ -137,11 +155,18 @@ def run(args: argparse.Namespace) -> int:
         changes["seeds"] = tuple(range(1, args.seeds + 1))
     if changes:
         lcs = replace(lcs, **changes)
+    out_dir = args.out if args.out is not None else default_out_dir(lcs.name)
+    check_for_study(out_dir, lcs.name)  # a run's folder or another study's: refused before anything is prepared
     plc = prepare_load_cases(lcs, fmu_dir=args.fmu_dir, build=not args.no_build)
     check_curves(plc)
     for note in plc.notes:
         print(f"dtcosim loads: warning: {note}", file=sys.stderr)
-    out_dir = args.out if args.out is not None else Path("results") / lcs.name
+    if args.out is None:
+        earlier = earlier_default_folder(lcs.name, out_dir)
+        if earlier is not None:
+            print(f"dtcosim loads: note: {earlier} holds the runs of an earlier `dtcosim loads {args.set}` (load sets "
+                  f"wrote results/<set>/ before; now {out_dir}/, apart from `dtcosim run`'s folders): to continue "
+                  f"them, move it first: mv {earlier} {out_dir}", file=sys.stderr)
     say = (lambda msg: None) if quiet else (lambda msg: print(msg, file=sys.stderr))
     prepared = plc.prepared
     if args.check:
@@ -189,9 +214,18 @@ def run(args: argparse.Namespace) -> int:
     finally:
         if "p" in bars:
             bars["p"].close()
-    files = write_lifetime_outputs(plc, out_dir, plots=not args.no_plots)
+    problems = list(report.problems)
+    try:
+        files = write_lifetime_outputs(plc, out_dir, plots=not args.no_plots)
+    except OSError as exc:  # a full disk: the runs are kept, the lifetime results can be written later
+        from ..atomic_files import describe_os_error
+
+        files = {}
+        problems.append(f"{describe_os_error(exc)}; the lifetime results are not all written; every finished run "
+                        f"is kept in {out_dir / JOURNAL_FILE} and {out_dir}/runs: free some space and run the same "
+                        "command with --report to write them")
     counts = status_counts(point_records(prepared, out_dir=out_dir))
-    if not quiet:
+    if not quiet and files:
         print((out_dir / "lifetime_report.txt").read_text(), end="")
         if report.submitted:
             finished_n = report.ok + report.failed + report.errors
@@ -204,8 +238,10 @@ def run(args: argparse.Namespace) -> int:
     if counts["failed"]:
         print(f"dtcosim loads: warning: {counts['failed']} runs failed (see {out_dir / 'results.csv'}); the lifetime "
               "figures leave them out", file=sys.stderr)
+    for problem in problems:
+        print(f"dtcosim loads: error: {problem}", file=sys.stderr)
     if report.interrupted:
         print(f"dtcosim loads: interrupted; finished runs kept in {out_dir / JOURNAL_FILE}; run the same command "
               "again to continue", file=sys.stderr)
         return 128 + (report.signal or 2)
-    return 1 if counts["error"] or counts["pending"] else 0
+    return 1 if counts["error"] or counts["pending"] or problems else 0

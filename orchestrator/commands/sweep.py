@@ -14,7 +14,7 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
-from .cluster_options import add_cluster_arguments, check_cluster_arguments
+from .cluster_options import add_cluster_arguments, check_cluster_arguments, check_workers
 from .fmu_options import add_fmu_arguments
 
 
@@ -73,24 +73,25 @@ def run(args: argparse.Namespace) -> int:
     """Validate the study, run its pending points, write the results."""
     from ..inputs.study import StudyError
     from ..inputs.study_file import find_study, load_study
+    from ..output_folders import check_for_study
     from ..study.journal import JOURNAL_FILE, read_journal
     from ..study.prepare import prepare_study
     from ..study.report import point_records, status_counts, write_outputs
     from ..study.sweep import pending_points, run_sweep
 
     quiet = args.quiet
-    if args.workers is not None and args.workers < 1:
-        raise StudyError("--workers", args.workers, "an integer >= 1")
+    check_workers(args, StudyError)
     study = load_study(find_study(args.study))
     if args.timeout is not None:
         try:
             study = replace(study, timeout_s=args.timeout)
         except StudyError as exc:
             raise StudyError("--timeout", exc.value, exc.expected) from None
+    out_dir = args.out if args.out is not None else Path("results") / study.name
+    check_for_study(out_dir, study.name)  # a run's folder or another study's: refused before anything is prepared
     prepared = prepare_study(study, fmu_dir=args.fmu_dir, build=not args.no_build)
     for note in prepared.notes:
         print(f"dtcosim sweep: warning: {note}", file=sys.stderr)
-    out_dir = args.out if args.out is not None else Path("results") / study.name
     say = (lambda msg: None) if quiet else (lambda msg: print(msg, file=sys.stderr))
     if args.check:
         todo = pending_points(prepared, read_journal(out_dir / JOURNAL_FILE), args.retry_failed)
@@ -146,8 +147,10 @@ def run(args: argparse.Namespace) -> int:
     if counts["failed"]:
         print(f"dtcosim sweep: warning: {counts['failed']} points failed (see the error column of "
               f"{out_dir / 'results.csv'})", file=sys.stderr)
+    for problem in report.problems:
+        print(f"dtcosim sweep: error: {problem}", file=sys.stderr)
     if report.interrupted:
         print(f"dtcosim sweep: interrupted; {report.ok + report.failed + report.errors} finished points kept in "
               f"{out_dir / JOURNAL_FILE}; run the same command again to continue", file=sys.stderr)
         return 128 + (report.signal or 2)
-    return 1 if counts["error"] or counts["pending"] else 0
+    return 1 if counts["error"] or counts["pending"] or report.problems else 0

@@ -113,7 +113,7 @@ def run(args: argparse.Namespace) -> int:
     valid = []
     for path in files:
         if not path.is_file():
-            print(f"{path}: no such file")
+            print(f"{path}: {'not a regular file (a device, pipe or folder)' if path.exists() else 'no such file'}")
             failed += 1
             continue
         problems = check_fmu(path)

@@ -9,7 +9,8 @@ Every instance gets its own logger callback that keeps the FMU's last log
 messages, and is instantiated with logging on: pythonfmu slaves report a Python
 exception only through the logger, so this is how error messages reach the user.
 
-Each FMU file is extracted once per process (cached by SHA-256). Shared
+Each FMU file is extracted once per process (cached by SHA-256), within the archive
+limits of :func:`fmus.archive_checks.extract_fmu`. Shared
 libraries are never unloaded: pythonfmu's runtime does not survive being
 unloaded and loaded again in one process.
 """
@@ -79,7 +80,7 @@ _EXTRACT_ROOT: Path | None = None
 def _extract(iface: FmuInterface) -> Path:
     """Directory with the FMU's contents, extracted once per process."""
     global _EXTRACT_ROOT
-    from fmpy import extract
+    from fmus.archive_checks import FmuArchiveError, extract_fmu
 
     if iface.sha256 in _EXTRACTED:
         return _EXTRACTED[iface.sha256]
@@ -88,7 +89,10 @@ def _extract(iface: FmuInterface) -> Path:
         atexit.register(shutil.rmtree, _EXTRACT_ROOT, True)
     target = _EXTRACT_ROOT / iface.sha256[:16]
     try:
-        extract(str(iface.path), str(target))
+        extract_fmu(iface.path, target)  # bounded: the archive limits hold whatever its directory says
+    except FmuArchiveError as exc:  # a damaged member, a zip bomb, a member outside the folder
+        shutil.rmtree(target, ignore_errors=True)
+        raise InitializationError(f"cannot extract the FMU: {exc}") from None
     except OSError as exc:  # a full disk, a file-size limit, a read-only temporary folder
         shutil.rmtree(target, ignore_errors=True)
         reason = exc.strerror or str(exc) or type(exc).__name__

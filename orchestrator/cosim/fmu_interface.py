@@ -15,6 +15,7 @@ import hashlib
 import json
 import os
 import zipfile
+import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
@@ -193,7 +194,7 @@ def read_fmu_record(path: Path, key: str) -> dict[str, Any] | None:
             if member not in archive.namelist():
                 return None
             record = json.loads(archive.read(member))
-    except (OSError, zipfile.BadZipFile, ValueError) as exc:
+    except (OSError, zipfile.BadZipFile, zlib.error, EOFError, ValueError) as exc:
         raise ScenarioError(key, str(path), f"an FMU with a readable {member} ({exc})") from None
     if not isinstance(record, dict) or record.get("format") != RECORD_FORMAT or record.get("role") not in ROLES \
             or not isinstance(record.get("model"), dict) or not isinstance(record.get("signals"), dict):
@@ -224,7 +225,9 @@ def read_fmu_interface(path: str | Path, key: str = "fmu") -> FmuInterface:
     Raises
     ------
     ScenarioError
-        If the file is missing, unreadable, not FMI 2.0 or not co-simulation, or it
+        If the file is missing, unreadable, no regular file, beyond the archive limits, damaged
+        (:func:`fmus.archive_checks.layout_problems`, :func:`fmus.archive_checks.corrupt_member`),
+        not FMI 2.0 or not co-simulation, or it
         cannot be loaded here (no binary for this platform, a PythonFMU or dtcosim
         FMU without its resources: :func:`fmus.archive_checks.archive_problems`).
     """
@@ -238,6 +241,12 @@ def read_fmu_interface(path: str | Path, key: str = "fmu") -> FmuInterface:
     cache_key = (str(p), st.st_size, st.st_mtime_ns)
     if cache_key in _CACHE:
         return _CACHE[cache_key]
+    from fmus.archive_checks import corrupt_member, layout_problems
+
+    problems = layout_problems(p)  # before anything is decompressed: a pipe, a zip bomb, a zip-slip name
+    damaged = None if problems else corrupt_member(p)
+    if problems or damaged:
+        raise ScenarioError(key, str(path), f"a readable FMU ({'; '.join(problems) or damaged})")
     try:
         md = read_model_description(str(p), validate=False)
     except Exception as exc:  # fmpy raises plain Exceptions for broken archives/XML

@@ -8,6 +8,7 @@ subclass, raised before anything runs.
 
 from __future__ import annotations
 
+import errno
 import os
 import stat
 import sys
@@ -67,6 +68,23 @@ def read_toml(path: str | Path, error: type[EntryError]) -> dict[str, Any]:
     except ValueError:  # an integer beyond Python's int-from-string limit
         raise error("(syntax)", str(path), f"valid TOML with integers of at most {sys.get_int_max_str_digits()} "
                     "digits") from None
+
+
+def read_regular_bytes(path: str | Path, max_bytes: int = MAX_INPUT_BYTES) -> bytes:
+    """The content of the regular file ``path`` of at most ``max_bytes`` bytes.
+
+    Raises
+    ------
+    OSError
+        The file cannot be read, is a device, pipe or folder (``EINVAL``: reading it would block
+        or never end), or is larger (``EFBIG``); the message names the file.
+    """
+    info = os.stat(path)
+    if not stat.S_ISREG(info.st_mode):
+        raise OSError(errno.EINVAL, "not a regular file (a device, pipe or folder)", str(path))
+    if info.st_size > max_bytes:
+        raise OSError(errno.EFBIG, f"larger than {max_bytes} bytes ({info.st_size} bytes)", str(path))
+    return Path(path).read_bytes()
 
 
 def packaged_files(folder: str) -> dict[str, Path]:

@@ -18,12 +18,20 @@ MAX_STUDY_POINTS         1 000 000       points of one study (the product of its
 MAX_SSP_MEMBERS          10 000          files in an .ssp archive
 MAX_SSP_BYTES            1 GiB           uncompressed size of an .ssp archive's content
 MAX_SSP_RATIO            200             uncompressed / compressed size of one member
+MAX_SSP_XML_BYTES        64 MiB          one .ssd, .ssv or .ssm file (parsed whole)
+MAX_FMU_MEMBERS          10 000          files in an FMU archive (also one inside an .ssp)
+MAX_FMU_BYTES            1 GiB           uncompressed size of an FMU's content: checked
+                                         from its directory and counted while extracting
+MAX_FMU_RATIO            200             uncompressed / compressed size of one member
 MAX_RECORD_BYTES         256 MiB         a recorded series file (.outb, .out, .csv): read
                                          whole and decoded to float64 (an OpenFAST .outb
                                          grows 4x); 600 s of 100 channels at 80 Hz is 10 MB
 MAX_LOOP_ITERATIONS      10 000          fixed-point sweeps of an algebraic loop per
                                          communication point
 =======================  ==============  ==================================================
+
+The FMU limits are :data:`fmus.archive_checks.MAX_FMU_MEMBERS`, ``MAX_FMU_BYTES`` and
+``MAX_FMU_RATIO`` (the FMU layer checks them; :func:`fmus.archive_checks.layout_problems`).
 
 The number of harmonics of the wind (1 to 100 000) is a model limit:
 :data:`components.model.wind.MAX_HARMONICS`.
@@ -39,5 +47,6 @@ MAX_STUDY_POINTS = 1_000_000
 MAX_SSP_MEMBERS = 10_000
 MAX_SSP_BYTES = 1 << 30
 MAX_SSP_RATIO = 200
+MAX_SSP_XML_BYTES = 64 << 20
 MAX_RECORD_BYTES = 256 << 20
 MAX_LOOP_ITERATIONS = 10_000

@@ -30,6 +30,7 @@ from .load_cases import (
     DEFAULT_LEVELS,
     FOLDER,
     MAX_SEEDS,
+    MAX_RUNS,
     SETTLED,
     TO_STOP,
     CurveRule,
@@ -175,6 +176,9 @@ def _edges(tab: _BinsTable, src: str | None) -> tuple[float, ...]:
     if tab.edges is not None:
         if any(v is not None for v in regular):
             raise LoadCaseError("bins", tab.model_dump(exclude_none=True), "either edges = [...] or cut_in, cut_out and width", src)
+        if len(tab.edges) > MAX_RUNS + 1:  # every bin is run at least once
+            raise LoadCaseError("bins.edges", f"{len(tab.edges)} wind speeds", f"at most {MAX_RUNS + 1} edges "
+                                f"({MAX_RUNS} bins: a set runs at most {MAX_RUNS} runs)", src)
         edges = tuple(float(v) for v in tab.edges)
         if np.any(np.diff(edges) <= 0) or edges[0] < 0:
             raise LoadCaseError("bins.edges", list(edges), "increasing wind speeds >= 0 m/s", src)
@@ -185,6 +189,10 @@ def _edges(tab: _BinsTable, src: str | None) -> tuple[float, ...]:
     if not tab.cut_out > tab.cut_in:
         raise LoadCaseError("bins.cut_out", tab.cut_out, f"> cut_in = {tab.cut_in:g} m/s", src)
     n = (tab.cut_out - tab.cut_in) / tab.width
+    if n > MAX_RUNS:  # before a tuple of that many edges exists
+        raise LoadCaseError("bins.width", tab.width, f"a width of at least (cut_out - cut_in) / {MAX_RUNS} = "
+                            f"{(tab.cut_out - tab.cut_in) / MAX_RUNS:g} m/s (at most {MAX_RUNS} bins: a set runs at "
+                            f"most {MAX_RUNS} runs; this one has {n:.3g} bins)", src)
     if abs(n - round(n)) > 1e-9 * max(1.0, n):
         raise LoadCaseError("bins.width", tab.width, f"a width that divides cut_out - cut_in = {tab.cut_out - tab.cut_in:g} m/s", src)
     return tuple(float(tab.cut_in + i * tab.width) for i in range(int(round(n)) + 1))

@@ -23,6 +23,7 @@ from __future__ import annotations
 import csv
 import math
 import re
+import stat
 import struct
 import tempfile
 from dataclasses import dataclass
@@ -102,7 +103,10 @@ class Record:
 
 def _check_not_empty(path: Path) -> bytes:
     try:
-        size = path.stat().st_size
+        info = path.stat()
+        if not stat.S_ISREG(info.st_mode):  # a pipe or /dev/zero would block or never end
+            raise LoadRecordError("(file)", str(path), "a regular record file (this is a device, pipe or folder)")
+        size = info.st_size
         if size > MAX_RECORD_BYTES:  # refused before it is read
             raise LoadRecordError("(file)", str(path), f"a record of at most {MAX_RECORD_BYTES:,} bytes "
                               f"({MAX_RECORD_BYTES / 2**20:.3g} MiB); the file has {size:,} bytes")

@@ -8,6 +8,8 @@ naming the key, before anything runs.
 
 from __future__ import annotations
 
+import math
+
 from pathlib import Path
 from typing import Annotated, Any, Literal, Mapping
 
@@ -15,7 +17,7 @@ import numpy as np
 from pydantic import Field
 
 from .files import find_input_file, packaged_files, read_toml
-from .limits import MAX_AXIS_VALUES
+from .limits import MAX_AXIS_VALUES, MAX_STUDY_POINTS
 from .master_options import ALGORITHMS, EXTRAPOLATIONS
 from .measures import MeasureError, parse_measure
 from .overrides import SimulationOverrides
@@ -146,6 +148,27 @@ def _axis_values(tab: _AxisTable, key: str, source: str | None) -> tuple[Paramet
     return tuple(float(v) for v in grid)
 
 
+def _check_grid_size(doc: "StudyFile", source: str | None) -> None:
+    """Refuse a study of more than :data:`MAX_STUDY_POINTS` points from the axes' declared lengths.
+
+    Before any axis's values exist: each axis may hold up to :data:`MAX_AXIS_VALUES` values, so
+    many axes would allocate far beyond the point limit before the study could count its points.
+    """
+    lengths = [max(1, len(doc.points))]
+    lengths += [len(t.values) if t.values is not None else (t.num or 1) for t in doc.axes]
+    lengths.append(max(1, len(doc.seeds)))
+    n = 1
+    for length in lengths:
+        n *= length
+        if n > MAX_STUDY_POINTS:
+            if len(lengths) <= 8:
+                shown, count = " x ".join(map(str, lengths)), f"{math.prod(lengths):,}"
+            else:
+                shown, count = f"{len(doc.axes)} axes", f"more than {MAX_STUDY_POINTS:,}"
+            raise StudyError("axes", shown, f"a study of at most {MAX_STUDY_POINTS:,} points (explicit points x "
+                             f"axes x seeds); this one has {count}", source)
+
+
 def _axis(tab: _AxisTable, i: int, source: str | None) -> Axis:
     key = f"axes[{i}]"
     if (tab.parameter is None) == (tab.parameters is None):
@@ -228,6 +251,7 @@ def study_from_dict(data: Mapping[str, Any], name: str | None = None, base_dir: 
                          "its own solver parameters: set them as gearbox parameters)", source)
     solver = {_SOLVER_FIELDS[k]: v for k, v in solver.items()}
 
+    _check_grid_size(doc, source)
     axes = tuple(_axis(tab, i, source) for i, tab in enumerate(doc.axes))
     points = []
     for i, pt in enumerate(doc.points):

@@ -34,10 +34,13 @@ from __future__ import annotations
 
 import atexit
 import hashlib
+import os
 import re
 import shutil
+import stat
 import tempfile
 import zipfile
+import zlib
 from pathlib import Path
 from typing import Any, Callable
 
@@ -95,6 +98,12 @@ def _check_archive_size(path: Path, zf: zipfile.ZipFile) -> None:
 
 def _extract_ssp(path: Path) -> Path:
     """Directory with the archive's content (extracted once per process and content)."""
+    info = os.stat(path)
+    if not stat.S_ISREG(info.st_mode):
+        raise SspError(f"{path}: not a regular file (a device, pipe or folder); name the .ssp archive itself")
+    if info.st_size > MAX_SSP_BYTES:
+        raise SspError(f"{path}: {info.st_size / 2**20:.0f} MiB, expected at most {MAX_SSP_BYTES / 2**20:.0f} MiB "
+                       "(a limit against zip bombs); unpack it yourself and run the folder")
     digest = hashlib.sha256(path.read_bytes()).hexdigest()
     if digest not in _EXTRACTED:
         target = Path(tempfile.mkdtemp(prefix="dtcosim-ssp-"))
@@ -108,6 +117,11 @@ def _extract_ssp(path: Path) -> Path:
                         raise SspError(f"{path}: archive member {member!r} points outside the archive (refused: "
                                        "it would write elsewhere); repack the SSP with relative member names")
                 zf.extractall(target)
+        except (zlib.error, EOFError) as exc:  # a damaged member (zipfile reports a CRC mismatch as BadZipFile)
+            raise SspError(f"{path}: a damaged archive member ({exc or type(exc).__name__}); pack the SSP again") from None
+        except OSError as exc:  # a full disk, a file-size limit
+            reason = exc.strerror or str(exc)
+            raise SspError(f"{path}: cannot be extracted into {target} ({reason})") from None
         except zipfile.BadZipFile as exc:
             raise SspError(f"{path}: not a zip archive ({exc}; SSP 1.0: an .ssp file is a zip archive); pack the SSD "
                            "and its resources with zip, or name the SSP folder or its .ssd") from None

@@ -14,6 +14,8 @@ otherwise (SSP 1.0: tools ignore annotations they do not know).
 from __future__ import annotations
 
 import math
+import os
+import stat
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Mapping
@@ -21,6 +23,7 @@ from typing import Any, Mapping
 from lxml import etree
 
 from ..errors import SspError
+from ..inputs.limits import MAX_SSP_XML_BYTES
 from ..inputs.transformations import LinearTransformation, MappingTransformation, Transformation
 
 NS = {
@@ -100,7 +103,17 @@ def element_error(el, path: Path | str, problem: str, remedy: str) -> SspError:
 
 
 def parse(path: Path) -> Any:
-    """The root element of an SSP XML file (lxml, with line numbers)."""
+    """The root element of an SSP XML file (lxml, with line numbers); only a regular file of at most
+    :data:`~orchestrator.inputs.limits.MAX_SSP_XML_BYTES` is read."""
+    try:
+        info = os.stat(path)
+    except OSError as exc:
+        raise SspError(f"{path}: cannot be read ({exc.strerror})") from None
+    if not stat.S_ISREG(info.st_mode):
+        raise SspError(f"{path}: not a regular file (a device, pipe or folder); name the SSP file itself") from None
+    if info.st_size > MAX_SSP_XML_BYTES:
+        raise SspError(f"{path}: {info.st_size / 2**20:.0f} MiB, expected at most {MAX_SSP_XML_BYTES >> 20} MiB for "
+                       "one SSP XML file") from None
     try:
         return etree.parse(str(path), etree.XMLParser(remove_blank_text=False, resolve_entities=False)).getroot()
     except OSError as exc:

@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 import re
 import zipfile
+import zlib
 from pathlib import Path
 from typing import Mapping
 
@@ -27,14 +28,19 @@ def broken_fmu(path: Path) -> str | None:
     An interrupted or concurrent build of an older dtcosim could leave a truncated archive, or one without
     its slave module or record; in the folders dtcosim builds into such a file is rebuilt, not used.
     """
+    from fmus.archive_checks import corrupt_member, layout_problems
+
+    problems = layout_problems(path)  # a pipe, a zip bomb, names outside the folder: before anything is read
+    if problems:
+        return "; ".join(problems)
+    damaged = corrupt_member(path)  # zipfile's testzip lets a zlib.error of a damaged member through
+    if damaged is not None:
+        return damaged
     try:
         with zipfile.ZipFile(path) as zf:
             names = set(zf.namelist())
-            bad = zf.testzip()
     except (OSError, zipfile.BadZipFile) as exc:
         return f"not a readable zip archive ({exc})"
-    if bad is not None:
-        return f"the archive member {bad} is corrupt"
     missing = [m for m in ("resources/slavemodule.txt", f"resources/{RECORD_FILE}", "modelDescription.xml")
                if m not in names]
     return f"it lacks {', '.join(missing)}" if missing else None
@@ -55,7 +61,7 @@ def stale_project_fmus(paths: Mapping[str, Path]) -> list[str]:
                 module = zf.read("resources/slavemodule.txt").decode().strip()
                 record = json.loads(zf.read(f"resources/{RECORD_FILE}"))
             model = record["model"]
-        except (KeyError, OSError, ValueError, TypeError, zipfile.BadZipFile):
+        except (KeyError, OSError, ValueError, TypeError, zipfile.BadZipFile, zlib.error, EOFError):
             continue
         m = _BUILD_ID.match(module)
         name = record.get("fmu")

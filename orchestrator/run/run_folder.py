@@ -45,10 +45,11 @@ from typing import Any, Mapping
 
 from ..atomic_files import claims_for, describe_os_error
 from ..errors import EntryError, reason_of, signal_name
+from ..output_folders import RUN_SUMMARY, check_for_run
 from ..result_files import write_summary
 from .writers import PARTIAL_SUFFIX
 
-SUMMARY_FILE = "summary.json"
+SUMMARY_FILE = RUN_SUMMARY
 RUNNING, COMPLETE, STOPPED, FAILED = "running", "complete", "stopped", "failed"
 #: the probe file :meth:`RunFolder.check` writes and removes
 PROBE_PREFIX = ".dtcosim-write-test-"
@@ -119,7 +120,11 @@ class RunFolder:
     # ------------------------------------------------------------- checks
     @classmethod
     def check(cls, path: str | Path, key: str = "--out") -> Path:
-        """Raise :class:`OutputFolderError` unless ``path`` is (or can become) a writable folder."""
+        """Raise :class:`OutputFolderError` unless ``path`` is (or can become) a writable folder.
+
+        A folder that holds a sweep's or load set's results is refused too
+        (:class:`~orchestrator.output_folders.MixedFolderError`).
+        """
         path = Path(path)
         if path.exists() and not path.is_dir():
             raise OutputFolderError(key, str(path), "a folder for the results (this is a file)")
@@ -133,6 +138,7 @@ class RunFolder:
                     probe.unlink()
         except OSError as exc:
             raise OutputFolderError(key, str(path), f"a folder dtcosim can write ({exc.strerror or exc})") from None
+        check_for_run(path, key)  # a sweep's or load set's folder: refused (folders never mix)
         return path
 
     @classmethod

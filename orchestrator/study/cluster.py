@@ -10,6 +10,10 @@ started the workers. The LocalCluster of a sweep therefore
   machine (another user's, or a browser's page) can connect to the port but
   cannot run anything;
 * listens on 127.0.0.1 only;
+* keeps its scratch space (spilled data, worker files) in a private temporary
+  folder of this sweep (mode 0700, ``dtcosim-dask-*``), removed when the cluster is
+  closed or the process ends; not Dask's shared and predictable
+  ``/tmp/dask-scratch-space``, where another user could plant or read files;
 * starts no dashboard unless asked for (``dashboard_address``, ``dtcosim sweep
   --dashboard``). The scheduler and the workers always have an HTTP server for
   their health checks: it listens on a random 127.0.0.1 port and serves
@@ -28,8 +32,11 @@ from __future__ import annotations
 
 import logging
 import os
+import shutil
 import signal
+import tempfile
 import threading
+import weakref
 
 from ..inputs.study import StudyError
 
@@ -52,12 +59,15 @@ def locked_down_local_cluster(workers: int | None = None, dashboard_address: str
     Returns
     -------
     distributed.LocalCluster
-        ``cluster.security`` holds the credentials; ``Client(cluster)`` uses them.
+        ``cluster.security`` holds the credentials; ``Client(cluster)`` uses them;
+        ``cluster.remove_scratch()`` removes its scratch folder ``cluster.scratch`` (after
+        ``cluster.close()``; done at the process's end otherwise).
     """
     import dask
     from distributed import LocalCluster, Security
 
     n = workers if workers else (os.cpu_count() or 1)
+    scratch = tempfile.mkdtemp(prefix="dtcosim-dask-")  # mode 0700: this user's, and this sweep's only
     security = Security.temporary()
     config = {} if dashboard_address else {"distributed.scheduler.http.routes": HEALTH_ONLY,
                                            "distributed.worker.http.routes": HEALTH_ONLY}
@@ -67,17 +77,23 @@ def locked_down_local_cluster(workers: int | None = None, dashboard_address: str
     if threading.current_thread() is threading.main_thread():
         previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
-        with dask.config.set(config):
-            return LocalCluster(
+        with dask.config.set({**config, "temporary-directory": scratch}):
+            cluster = LocalCluster(
                 n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1", protocol="tls://",
-                security=security, dashboard_address=dashboard_address,
+                security=security, dashboard_address=dashboard_address, local_directory=scratch,
                 # without a dashboard the scheduler's health server goes to a random local port, never 8787
                 scheduler_kwargs={} if dashboard_address else {"dashboard_address": "127.0.0.1:0"},
                 silence_logs=logging.ERROR,
             )
+    except BaseException:
+        shutil.rmtree(scratch, ignore_errors=True)
+        raise
     finally:
         if previous is not None:
             signal.signal(signal.SIGINT, previous)
+    cluster.scratch = scratch
+    cluster.remove_scratch = weakref.finalize(cluster, shutil.rmtree, scratch, True)
+    return cluster
 
 
 #: seconds to wait for an existing scheduler to answer (Dask retries a refused connection until then)

@@ -25,7 +25,9 @@ from typing import Any, Iterable, Mapping
 
 from components.errors import DtcosimError
 
-JOURNAL_FILE = "journal.jsonl"
+from ..output_folders import STUDY_JOURNAL
+
+JOURNAL_FILE = STUDY_JOURNAL
 
 
 class JournalError(DtcosimError, RuntimeError):

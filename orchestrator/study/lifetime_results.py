@@ -5,7 +5,7 @@ Run files
 A worker returns each run's cycles and level histograms
 (:mod:`orchestrator.study.run_data`); the client writes them, before the run's
 journal line, to ``runs/<index>-<key>.npz`` (compressed NumPy arrays, written
-to a temporary name and renamed, so a file is complete or absent) and the
+through a temporary file and rename, so a file is complete or absent) and the
 journal line names the file. The journal line is the commit mark: a run is done
 when its line is in the journal (status ``ok``) and its file exists; a run whose
 file went missing is marked for a re-run (:func:`mark_missing_run_files`). The
@@ -28,7 +28,6 @@ The tables, the report and the plots written from these results are
 from __future__ import annotations
 
 import json
-import os
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Callable, Mapping
@@ -40,6 +39,7 @@ from components.analysis.lifetime import LifetimeDamage, lifetime_damage, lifeti
 from components.analysis.load_spectrum import LevelHistogram, merge_histograms
 from components.analysis.sn_curve import SNCurve
 
+from ..atomic_files import atomic_path
 from .engine import OK
 from .journal import JOURNAL_FILE, Journal, latest_by_key, read_journal
 from .load_cases import PreparedLoadCases
@@ -81,12 +81,9 @@ def store_run_data(plc: PreparedLoadCases, out_dir: str | Path) -> Callable[[int
         name = run_file_name(i, plc.keys[i])
         path = out / name
         path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(path.name + ".part")
-        with open(tmp, "wb") as fh:
-            np.savez_compressed(fh, **arrays)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
+        with atomic_path(path) as tmp:  # whole or not there, no temporary file left (a full disk left a .npz.part)
+            with open(tmp, "wb") as fh:
+                np.savez_compressed(fh, **arrays)
         return {"run_file": name, "analysed_time_s": data["analysed_time_s"], "loads": loads}
 
     return on_result

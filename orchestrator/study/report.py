@@ -25,10 +25,11 @@ import os
 from pathlib import Path
 from typing import Any, Mapping
 
+from ..output_folders import STUDY_SUMMARY
 from .journal import JOURNAL_FILE, latest_by_key, read_journal
 
 TABLE_FILE = "results.csv"
-SUMMARY_FILE = "study.json"
+SUMMARY_FILE = STUDY_SUMMARY
 PENDING = "pending"
 
 

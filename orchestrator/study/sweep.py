@@ -34,9 +34,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
 
+from ..atomic_files import describe_os_error
 from ..cosim.stop_requests import STOP_SIGNALS
 from ..import_safe_signals import install, restore
 from ..inputs.study import StudyError
+from ..output_folders import check_for_study
 from .engine import FAILED, OK, PointTask, run_point
 from .journal import JOURNAL_FILE, Journal, latest_by_key, read_journal
 from .prepare import PreparedStudy
@@ -75,6 +77,9 @@ class SweepReport:
     out_dir : pathlib.Path
     files : dict of str -> pathlib.Path
         Written files by role (``journal``, ``table``, ``summary``, ``plot:<name>``).
+    problems : list of str
+        Files that could not be written (a full disk), each with what is kept and what to do;
+        a run file or journal line that cannot be written stops the sweep.
     """
 
     total: int
@@ -90,6 +95,7 @@ class SweepReport:
     workers: int = 0
     out_dir: Path = Path(".")
     files: dict[str, Path] = field(default_factory=dict)
+    problems: list[str] = field(default_factory=list)
 
 
 def pending_points(prepared: PreparedStudy, records: list[dict], retry_failed: bool = False) -> list[int]:
@@ -129,6 +135,16 @@ class _Interrupts:
             self.pending = True
         else:
             raise KeyboardInterrupt
+
+    @contextlib.contextmanager
+    def shielded(self):
+        """Signals during the block are only noted (``pending``, ``signum``), never raised: the cluster's shutdown."""
+        was = self.critical
+        self.critical = True
+        try:
+            yield
+        finally:
+            self.critical = was
 
     @contextlib.contextmanager
     def critical_section(self):
@@ -174,12 +190,33 @@ def _worker_count(client) -> int:
 
 
 def _close(client, cluster) -> None:
-    """Close the client, then the cluster we started (never an external one)."""
+    """Close the client, then the cluster we started (never an external one) and remove its scratch folder."""
     with contextlib.suppress(Exception):
         client.close(timeout=10)
     if cluster is not None:
         with contextlib.suppress(Exception):
             cluster.close(timeout=20)
+        remove = getattr(cluster, "remove_scratch", None)
+        if remove is not None:
+            remove()
+
+
+@contextlib.contextmanager
+def _quiet_dask_logs():
+    """Dask's loggers in this process (the LocalCluster's scheduler) at CRITICAL for the block.
+
+    After a stop signal the scheduler logs the cancelled tasks it can no longer gather as
+    errors; the sweep says in one line what happened.
+    """
+    import logging
+
+    logger = logging.getLogger("distributed")
+    level = logger.level
+    logger.setLevel(logging.CRITICAL)
+    try:
+        yield
+    finally:
+        logger.setLevel(level)
 
 
 def run_sweep(
@@ -203,7 +240,8 @@ def run_sweep(
     prepared : PreparedStudy
     out_dir : path
         Output directory (created): ``journal.jsonl``, ``results.csv``,
-        ``study.json``, PNG plots.
+        ``study.json``, PNG plots. A folder that holds a run's results or another
+        study's is refused (:func:`orchestrator.output_folders.check_for_study`).
     workers : int, optional
         Workers of the LocalCluster (processes with one thread each; default: CPU count).
     scheduler : str, optional
@@ -237,6 +275,7 @@ def run_sweep(
 
     wall0 = time.perf_counter()
     out = Path(out_dir)
+    check_for_study(out, prepared.study.name)  # a run's folder or another study's: refused (folders never mix)
     out.mkdir(parents=True, exist_ok=True)
     report = SweepReport(total=len(prepared.points), out_dir=out)
     journal_path = out / JOURNAL_FILE
@@ -248,7 +287,12 @@ def run_sweep(
         if todo:
             _execute(prepared, todo, journal, report, workers, scheduler, progress, dashboard, on_result,
                      case_progress)
-    report.files = write_outputs(prepared, out, report, plots=plots)
+    try:
+        report.files = write_outputs(prepared, out, report, plots=plots)
+    except OSError as exc:  # a full disk while the table or the plots are drawn: the journal has every point
+        report.problems.append(f"{describe_os_error(exc)}; the table, plots and study.json are not all written; "
+                               f"every finished point is kept in {journal_path}: free some space and run the same "
+                               "command with --report to write them")
     report.wall_time_s = time.perf_counter() - wall0
     return report
 
@@ -264,8 +308,12 @@ def _execute(prepared: PreparedStudy, todo: list[int], journal: Journal, report:
     t0 = None
     with _Interrupts() as interrupts:
         client = cluster = None
+        quiet = contextlib.ExitStack()
         try:
-            client, cluster = _open_client(workers, scheduler, dashboard)
+            # a signal during the cluster's start-up is raised once it is up (and it is closed below): raised
+            # half-way, it left a cluster nobody closes (an atexit AssertionError, workers' heartbeat errors)
+            with interrupts.critical_section():
+                client, cluster = _open_client(workers, scheduler, dashboard)
             report.workers = _worker_count(client)
             if report.workers == 0:  # an existing cluster whose workers have not connected (yet)
                 try:
@@ -303,11 +351,19 @@ def _execute(prepared: PreparedStudy, todo: list[int], journal: Journal, report:
                     "error_type": result.get("error_type"), "worker": result.get("worker"),
                     "task_wall_time_s": result.get("task_wall_time_s"), "code_version": code, "finished_at": _now(),
                 }
-                # storing a run's data and journaling it is one step: a signal during it is raised after both
-                with interrupts.critical_section():
-                    if on_result is not None and record["status"] == OK:
-                        record.update(on_result(i, result))
-                    journal.append(record)
+                try:
+                    # storing a run's data and journaling it is one step: a signal during it is raised after both
+                    with interrupts.critical_section():
+                        if on_result is not None and record["status"] == OK:
+                            record.update(on_result(i, result))
+                        journal.append(record)
+                except OSError as exc:  # a full disk: nothing more can be kept, so nothing more is run
+                    report.problems.append(f"{describe_os_error(exc)}; the sweep stopped, the points finished "
+                                           f"before are kept in {journal.path}: free some space and run the same "
+                                           "command again to continue")
+                    with interrupts.shielded(), contextlib.suppress(Exception):
+                        client.cancel(list(futures))
+                    break
                 if record["status"] == OK:
                     report.ok += 1
                 elif record["status"] == FAILED:
@@ -319,11 +375,19 @@ def _execute(prepared: PreparedStudy, todo: list[int], journal: Journal, report:
         except KeyboardInterrupt:
             report.interrupted = True
             report.signal = interrupts.signum or signal.SIGINT
+            quiet.enter_context(_quiet_dask_logs())
             if client is not None:
-                with contextlib.suppress(Exception):
+                with interrupts.shielded(), contextlib.suppress(Exception):
                     client.cancel(list(futures))
         finally:
             if t0 is not None:
                 report.compute_time_s = time.perf_counter() - t0
-            if client is not None:
-                _close(client, cluster)
+            with interrupts.shielded(), quiet:  # a signal while the cluster closes is noted, never raised
+                if interrupts.pending:
+                    quiet.enter_context(_quiet_dask_logs())
+                if client is not None:
+                    _close(client, cluster)
+            if interrupts.pending:  # a signal during the shutdown
+                interrupts.pending = False
+                report.interrupted = True
+                report.signal = report.signal or interrupts.signum or signal.SIGINT

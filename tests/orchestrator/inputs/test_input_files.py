@@ -47,3 +47,43 @@ def test_a_device_is_refused_by_the_command_without_a_traceback(tmp_path):
     res = dtcosim("run", "/dev/zero", "--check", cwd=tmp_path, timeout=60)
     assert res.returncode != 0 and "Traceback" not in res.stderr
     assert "a regular scenario file" in res.stderr
+
+
+def _read_record(path):
+    from orchestrator.inputs.series_file import read_load_record
+
+    read_load_record(path)
+
+
+def _import_ssp(path):
+    from orchestrator.interop.ssp import import_ssp
+
+    import_ssp(path)
+
+
+def _tuning(path):
+    from orchestrator.commands.export_ssp import _measured_step
+
+    _measured_step(path, "paper-60s", "gauss-seidel")
+
+
+def _validate(path):
+    from fmus.validation import check_fmu
+
+    problems = check_fmu(path)
+    raise ValueError("; ".join(problems))
+
+
+@pytest.mark.parametrize("read, name, match", [
+    (_read_record, "record.csv", r"expected a regular record file \(this is a device, pipe or folder\)"),
+    (_import_ssp, "system.ssp", r"system.ssp: not a regular file \(a device, pipe or folder\)"),
+    (_import_ssp, "system.ssd", r"system.ssd: no SystemStructure.ssd"),
+    (_tuning, "tuning.json", r"--tuning = .*tuning.json': expected a JSON file of .*not a regular file"),
+    (_validate, "Gearbox.fmu", r"^not a regular file \(a device, pipe or folder\)$"),
+], ids=["record", "ssp", "ssd", "export-ssp-tuning", "validate"])
+def test_every_file_a_user_names_is_read_only_when_regular(tmp_path, read, name, match):
+    """A pipe named as any input would block the command until a writer came (issue 35.7)."""
+    path = tmp_path / name
+    os.mkfifo(path)
+    with pytest.raises(Exception, match=match):
+        read(path)

@@ -114,6 +114,13 @@ def test_a_seed_count_beyond_the_bound_is_refused_before_it_is_allocated(seeds, 
         load_cases_from_dict(_doc(runs={"length": 20.0, "transient": 5.0, "seeds": seeds}))
 
 
+def test_a_bin_count_beyond_the_bound_is_refused_before_the_edges_are_made():
+    # width 1e-9 between 3 and 25 m/s would make 2.2e10 edges (a hang); 1.1e-5 makes 2 million
+    with pytest.raises(LoadCaseError, match=r"bins\.width = 1\.1e-05: expected a width of at least \(cut_out - "
+                                            r"cut_in\) / 100000 = 0\.00022 m/s \(at most 100000 bins"):
+        load_cases_from_dict(_doc(bins={"cut_in": 3.0, "cut_out": 25.0, "width": 1.1e-5}))
+
+
 def test_the_command_refuses_a_huge_seed_count_at_once(tmp_path):
     res = dtcosim("loads", "paper-turbine", "--seeds", "2147483648", "--check", cwd=tmp_path, timeout=60)
     assert res.returncode == 1 and "--seeds = 2147483648: expected an integer from 1 to 1000" in res.stderr

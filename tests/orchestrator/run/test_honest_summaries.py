@@ -195,3 +195,46 @@ def test_a_signal_with_a_results_file_not_written_is_not_told_as_a_whole_run(toy
     assert err.strip().splitlines()[-1] == (f"dtcosim run: interrupted (SIGINT); the co-simulation completed but not "
                                             f"every result was written: {out} holds part of the run "
                                             f"({out / 'summary.json'} lists what it holds)")
+
+
+# a paper run killed (os._exit, as SIGKILL: no handler, no summary update) right after its first plot is in place
+KILLED_AFTER_A_PLOT = """
+import os, sys
+sys.path.insert(0, {root!r})
+real_replace = os.replace
+
+def replace_then_die(src, dst):
+    real_replace(src, dst)
+    if str(dst).endswith(".png"):
+        os._exit(137)
+
+os.replace = replace_then_die
+from orchestrator.commands import cli
+cli.end_process(cli.main(["run", "--fmu-dir", {fmus!r}, "--out", {out!r}, "--stop", "6", "-q",
+                          "--set", "wind.seed=1"]))
+"""
+
+
+@pytest.mark.slow
+def test_a_run_killed_after_writing_a_plot_leaves_nothing_for_the_next_run_to_mix(fmu_dir, tmp_path):
+    """Issue 35.6: a seed-1 rotor_speed.png survived beside the seed-7 results of the next run into the folder."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    from tests.helpers.scenarios import dtcosim
+
+    out = tmp_path / "out"
+    root = str(Path(__file__).resolve().parents[3])
+    killed = subprocess.run([sys.executable, "-c", KILLED_AFTER_A_PLOT.format(root=root, fmus=str(fmu_dir),
+                                                                              out=str(out))],
+                            capture_output=True, text=True, timeout=600, cwd=tmp_path)
+    assert killed.returncode == 137, killed.stderr
+    plots = [p.name for p in out.glob("*.png")]
+    assert plots and set(plots) <= set(summary_of(out)["files_being_written"])  # named before it appeared
+    again = dtcosim("run", "--fmu-dir", str(fmu_dir), "--out", str(out), "--stop", "0.5", "--no-plots", "-q",
+                    "--set", "wind.seed=7", cwd=tmp_path)
+    assert again.returncode == 0, again.stderr
+    summary = summary_of(out)
+    assert summary["status"] == "complete" and summary["fmus"]["wind"]["parameters"]["seed"] == 7
+    assert sorted(p.name for p in out.iterdir()) == sorted(summary["files"].values())  # nothing of seed 1 left

@@ -41,6 +41,24 @@ def test_study_sizes_are_bounded_before_any_point_is_made(write_study, axes, exp
     assert expected in str(info.value)
 
 
+def test_a_grid_of_many_axes_is_counted_before_any_axis_value_exists(write_study):
+    """Issue 35.7: 30 axes of 100 000 values each allocated 3 million values before the study counted its points."""
+    import tracemalloc
+
+    axes = "".join(f"[[axes]]\nparameter = \"gearbox.p{i}\"\nstart = 1.0\nstop = 2.0\nnum = 100000\n"
+                   for i in range(30))
+    path = write_study(SMALL_HEAD + SMALL_TABLES + axes)
+    tracemalloc.start()
+    try:
+        with pytest.raises(StudyError, match=r"axes = '30 axes': expected a study of at most 1,000,000 points "
+                                             r"\(explicit points x axes x seeds\); this one has more than 1,000,000"):
+            load_study(path)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 20e6, peak  # the values would take ~100 MB
+
+
 def test_seeds_beyond_an_fmi_integer_are_refused_at_check(fmu_dir, write_study, capsys):
     path = write_study(COSIM_SEEDS.format(seeds="[1, 4294967297, 8589934593]"))
     assert main(["sweep", str(path), "--check", "--fmu-dir", str(fmu_dir)]) == 1
