@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import Mapping
 
 from ..inputs.scenario import Scenario, VariableRef
+from .coupling_delays import CouplingDelay
 from .event_slots import AssignedEvent
 from .fmu_interface import FmuInterface, FmuVariable
 from .roles import ComponentRole
@@ -71,7 +72,11 @@ class ResolvedSystem:
         loop, which the master solves by iteration (:mod:`orchestrator.cosim.algebraic_loops`).
     notes : tuple of str
         What the checks accepted with a caveat (a loop through outputs that declare no
-        dependencies, run with Jacobi); printed by ``dtcosim run`` and kept in the summary.
+        dependencies, run with Jacobi; every one-step delay the stepping order puts on a
+        connection); printed by ``dtcosim run`` and kept in the summary.
+    delays : tuple of CouplingDelay
+        The connections that lag a communication step in this order, and why
+        (:mod:`orchestrator.cosim.coupling_delays`); ``coupling_delays`` in the summary.
     """
 
     scenario: Scenario
@@ -84,6 +89,7 @@ class ResolvedSystem:
     roles: Mapping[str, ComponentRole] = field(default_factory=dict)
     algebraic_loops: tuple[tuple[str, ...], ...] = ()
     notes: tuple[str, ...] = ()
+    delays: tuple[CouplingDelay, ...] = ()
 
     def with_role(self, role: str) -> list[ComponentRole]:
         """The components declared with ``role``, in scenario order."""

@@ -36,7 +36,8 @@ from ..inputs.limits import MAX_RESULT_VALUES
 from ..inputs.scenario import Component, Scenario, VariableRef
 from .event_slots import assign_events
 from .fmu_interface import FmuInterface, FmuVariable, read_fmu_interface
-from .graph import algebraic_loop_groups, find_algebraic_loop, initialization_order, stepping_order
+from .coupling_delays import coupling_delays
+from .graph import algebraic_loop_groups, dependency_order, find_algebraic_loop, initialization_order
 from .parameter_checks import model_problem, value_problem
 from .resolved import RecordedVariable, ResolvedSystem
 from .roles import declared_roles
@@ -215,6 +216,7 @@ def resolve_system(scenario: Scenario, fmu_paths: Mapping[str, Path] | None = No
     links = [(str(c.source), str(c.target)) for c in scenario.connections]
     loop = find_algebraic_loop(links, feedthrough)
     loops: tuple[tuple[str, ...], ...] = ()
+    solved: list[str] = []
     notes: list[str] = []
     if loop is not None and scenario.simulation.algebraic_loops != "iterate" \
             and scenario.simulation.algorithm == "jacobi" \
@@ -224,11 +226,19 @@ def resolve_system(scenario: Scenario, fmu_paths: Mapping[str, Path] | None = No
     if loop is not None:
         if scenario.simulation.algebraic_loops != "iterate":
             raise AlgebraicLoopError(loop, src, _loop_hint(loop, interfaces))
-        loops = _iterated_loops(scenario, interfaces, algebraic_loop_groups(links, feedthrough))
+        groups = algebraic_loop_groups(links, feedthrough)
+        loops = _iterated_loops(scenario, interfaces, groups)
+        solved = [v for group in groups for v in group]
 
     names = scenario.component_names
+    sim = scenario.simulation
+    default = tuple(dependency_order(names, links, feedthrough, solved))
+    order = tuple(sim.order) if sim.order else default
+    delays = coupling_delays(names, order, sim.algorithm, links, feedthrough,
+                             declared=_feedthrough(scenario, interfaces, declared_only=True), solved=solved,
+                             explicit=bool(sim.order), default_order=default)
+    notes += [d.note for d in delays]
     edges = [(c.source.component, c.target.component) for c in scenario.connections]
-    order = tuple(scenario.simulation.order) if scenario.simulation.order else tuple(stepping_order(names, edges))
     init_edges = edges + [(b.source.component, b.target.component) for b in scenario.initial]
     init_order = tuple(initialization_order(names, init_edges))
     system = ResolvedSystem(
@@ -242,6 +252,7 @@ def resolve_system(scenario: Scenario, fmu_paths: Mapping[str, Path] | None = No
         roles=FrozenMap(declared_roles(scenario, interfaces)),
         algebraic_loops=loops,
         notes=tuple(notes),
+        delays=delays,
     )
     problem = model_problem(system)
     if problem is not None:

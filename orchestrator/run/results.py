@@ -165,6 +165,8 @@ def build_summary(system: ResolvedSystem, outcome: RunOutcome, *, wall_time_s: f
         summary["import_notes"] = list(sc.import_notes)
     if system.notes:
         summary["notes"] = list(system.notes)
+    if system.delays:
+        summary["coupling_delays"] = [d.as_dict() for d in system.delays]
     summary["samples"] = int(outcome.time_s.size)
     summary.update({
         "window_s": list(sim.window_s),
