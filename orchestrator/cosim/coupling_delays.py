@@ -72,6 +72,8 @@ class CouplingDelay:
         The communication point the values belong to in step ``k`` (``"t_k"``, ``"t_{k-1}"``, ...).
     why : str
         The reason, in words.
+    undeclared : bool
+        Every output on these connections lacks declared dependencies (FMI 2: depends on every input).
     """
 
     kind: str
@@ -80,6 +82,7 @@ class CouplingDelay:
     connections: tuple[str, ...]
     received: str
     why: str
+    undeclared: bool = False
 
     @property
     def note(self) -> str:
@@ -177,7 +180,8 @@ def coupling_delays(components: Sequence[str], order: Sequence[str], algorithm: 
         undeclared = [o for o in outputs if o not in stated]
         depends = (f"{', '.join(outputs)} {'depends' if len(outputs) == 1 else 'depend'} directly on {src}'s "
                    f"{', '.join(on)}" + (f" ({', '.join(undeclared)} without declared dependencies: FMI 2 reads that "
-                                         "as depending on every input)" if undeclared else ""))
+                                         "as depending on every input; --no-feedthrough COMPONENT.OUTPUT says "
+                                         "one does not)" if undeclared else ""))
         if not gauss_seidel:
             why = (f"{depends}; Jacobi sets every input from the values of t_k before any FMU steps, so {src}'s "
                    "outputs still hold its inputs of the previous step (--algorithm gauss-seidel steps "
@@ -192,7 +196,8 @@ def coupling_delays(components: Sequence[str], order: Sequence[str], algorithm: 
                    "outputs that depend directly on their inputs, so one of them steps before a consumer of its "
                    "outputs")
         received = _point(min(points[c] for c in cons))
-        out.append(CouplingDelay(FEEDTHROUGH, src, dst, tuple(f"{o} -> {i}" for o, i in cons), received, why))
+        out.append(CouplingDelay(FEEDTHROUGH, src, dst, tuple(f"{o} -> {i}" for o, i in cons), received, why,
+                                 undeclared=len(undeclared) == len(outputs)))
 
     if gauss_seidel:
         out += _loop_delays(components, order, connections, direct, solved, explicit, points)

@@ -237,6 +237,8 @@ def resolve_system(scenario: Scenario, fmu_paths: Mapping[str, Path] | None = No
     delays = coupling_delays(names, order, sim.algorithm, links, feedthrough,
                              declared=_feedthrough(scenario, interfaces, declared_only=True), solved=solved,
                              explicit=bool(sim.order), default_order=default)
+    if notes:  # the Jacobi loop note already says that outputs without declared dependencies may lag a step
+        delays = tuple(d for d in delays if not d.undeclared)
     notes += [d.note for d in delays]
     edges = [(c.source.component, c.target.component) for c in scenario.connections]
     init_edges = edges + [(b.source.component, b.target.component) for b in scenario.initial]
