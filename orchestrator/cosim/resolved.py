@@ -108,8 +108,14 @@ class ResolvedSystem:
         return self.interfaces[ref.component].variables[ref.variable]
 
     def parameter_values(self, component: str) -> dict[str, object]:
-        """Effective parameter values of a component: FMU start values overridden by the scenario."""
+        """Effective parameter values of a component: FMU start values overridden by the scenario, and the bound
+        parameters' the values of their sources (``[[bindings]]``), as the FMU will have them in the run."""
         iface = self.interfaces[component]
         values = {n: v.start for n, v in iface.variables.items() if v.causality == "parameter"}
         values.update(self.scenario.component(component).parameters)
+        for b in self.scenario.bindings:
+            if b.target.component == component:
+                source = VariableRef.parse(self.scenario.bound_source(b.target), "bindings")
+                values[b.target.variable] = self.parameter_values(source.component).get(
+                    source.variable, self.variable(source).start)  # a calculatedParameter: its start value
         return values

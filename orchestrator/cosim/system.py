@@ -9,7 +9,8 @@ parameters, inputs and variables with ``initial="exact"`` or ``"approx"``) and h
 the right type; connections join an output to an input of the same type (Real,
 Integer, Boolean, String, or Enumeration of the same declared type; an Integer
 and an Enumeration connect); initial bindings join an output to a parameter or
-input of the same type; record patterns match variables (any type); no algebraic
+input of the same type; parameter bindings join a parameter to a settable parameter of another FMU of the same
+type; record patterns match variables (any type); no algebraic
 loop (with the scenario's ``no_feedthrough`` declarations for FMUs that omit their
 output dependencies, ``"*"`` for all of a component's; iterated with
 ``algebraic_loops = "iterate"``; with Jacobi, a loop that passes an output without
@@ -47,6 +48,8 @@ from .values import transformation_problem, type_mismatch
 SETTABLE_CAUSALITIES = ("parameter", "input")
 #: causalities a connection or initial binding may read from
 READABLE_CAUSALITIES = ("output", "calculatedParameter")
+#: causalities a parameter binding (``[[bindings]]``) may take its value from
+BINDING_SOURCES = ("parameter", "calculatedParameter")
 
 
 def find_fmu(scenario: Scenario, component: Component, candidates: Sequence[Path]) -> Path:
@@ -209,6 +212,15 @@ def resolve_system(scenario: Scenario, fmu_paths: Mapping[str, Path] | None = No
         if var.variability == "constant":
             raise ScenarioError(f"initial[{i}].to", str(b.target), "a settable (fixed or tunable) parameter", src)
         _same_type(out, var, f"initial[{i}]", str(b), src)
+
+    for i, b in enumerate(scenario.bindings):
+        value = _lookup(interfaces[b.source.component], b.source, f"bindings[{i}].from", src,
+                        BINDING_SOURCES, "a parameter")
+        var = _lookup(interfaces[b.target.component], b.target, f"bindings[{i}].to", src, ("parameter",),
+                      "a parameter")
+        if var.variability == "constant":
+            raise ScenarioError(f"bindings[{i}].to", str(b.target), "a settable (fixed or tunable) parameter", src)
+        _same_type(value, var, f"bindings[{i}]", str(b), src)
 
     recorded = _resolve_record(scenario, interfaces)
 
