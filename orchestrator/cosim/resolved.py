@@ -18,6 +18,11 @@ from .fmu_interface import FmuInterface, FmuVariable
 from .roles import ComponentRole
 
 
+#: a variable is a signal (a result the statistics describe) by these declarations
+SIGNAL_CAUSALITIES = ("output", "local")
+SIGNAL_VARIABILITIES = ("continuous", "discrete")
+
+
 @dataclass(frozen=True)
 class RecordedVariable:
     """A variable sampled into the results.
@@ -102,6 +107,12 @@ class ResolvedSystem:
         return numeric_transformation(con.transformation, self.variable(con.source), self.variable(con.target),
                                       self.interfaces[con.source.component].enumerations,
                                       self.interfaces[con.target.component].enumerations)
+
+    def is_signal(self, component: str, variable: str) -> bool:
+        """Whether a variable is a signal by its declaration: causality output or local, variability continuous
+        or discrete (not a parameter, a constant or an input; :data:`SIGNAL_CAUSALITIES`)."""
+        var = self.interfaces[component].variables[variable]
+        return var.causality in SIGNAL_CAUSALITIES and var.variability in SIGNAL_VARIABILITIES
 
     def variable(self, ref: VariableRef) -> FmuVariable:
         """Model-description entry of a ``component.variable`` reference."""

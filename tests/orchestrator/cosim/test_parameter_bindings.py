@@ -169,3 +169,30 @@ def test_the_exported_ssp_keeps_the_link(fmu_dir, tmp_path):
     assert system.parameter_values("generator")["inertia"] == 130.0
     assert system.parameter_values("gearbox")["generator_inertia"] == 130.0
     assert CoSimulation(system).initial_values()["gearbox.generator_inertia"] == 130.0
+
+
+STUDY = """
+name = "inertia"
+engine = "cosim"
+measures = ["wind.omega:std"]
+[base]
+scenario = "paper-60s"
+[simulation]
+stop = 0.1
+window = [0.0, 0.1]
+[[axes]]
+parameter = "{parameter}"
+values = [120.0, 151.0]
+"""
+
+
+def test_a_study_varies_the_source_and_refuses_the_bound_copy(fmu_dir, write_study, capsys):
+    assert cli.main(["sweep", str(write_study(STUDY.format(parameter="generator.inertia"))), "--check",
+                     "--fmu-dir", str(fmu_dir)]) == 0
+    capsys.readouterr()
+    path = write_study(STUDY.format(parameter="gearbox.generator_inertia"), "copy.toml")
+    assert cli.main(["sweep", str(path), "--check", "--fmu-dir", str(fmu_dir)]) == 1
+    assert capsys.readouterr().err.strip().endswith(
+        "axes[0].parameter = 'gearbox.generator_inertia': expected a parameter the scenario does not bind: "
+        "gearbox.generator_inertia takes its value from generator.inertia ([[bindings]]); vary generator.inertia "
+        "instead")
