@@ -230,7 +230,8 @@ def _loop_delays(components: Sequence[str], order: Sequence[str], connections: l
         first = ("simulation.order" if explicit else
                  "declaration order" if stepped == sorted(scc, key=rank.get) else "the declared dependencies")
         for (src, dst), cons in sorted(back.items(), key=lambda item: (slot[item[0][1]], slot[item[0][0]])):
-            why = (f"Gauss-Seidel breaks the feedback loop {' <-> '.join(stepped)} here: {dst} steps first ({first}) "
+            loop = " <-> ".join(stepped) if len(stepped) == 2 else "of " + ", ".join(stepped)
+            why = (f"Gauss-Seidel breaks the feedback loop {loop} here: {dst} steps before {src} ({first}) "
                    f"with {src}'s values of t_k, one step behind the t_{{k+1}} values {src} then receives; these "
                    "outputs depend on no input directly, so the loop is not algebraic and the delay is the loop's "
                    "explicit coupling (simulation.order chooses the direction that lags)")
