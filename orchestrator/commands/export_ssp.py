@@ -57,7 +57,7 @@ def run(args: argparse.Namespace) -> int:
     for warning in stale_project_fmus(paths):
         print(f"dtcosim export-ssp: warning: {warning}", file=sys.stderr)
     system = resolve_system(scenario, fmu_paths=paths)
-    initial = CoSimulation(system).initial_values() if scenario.initial else {}
+    initial = CoSimulation(system).initial_values() if scenario.initial or scenario.bindings else {}
     out = export_ssp(system, args.out, initial, tuning)
     for warning in stale_warnings(system, initial):
         print(f"dtcosim export-ssp: warning: {warning}", file=sys.stderr)

@@ -17,6 +17,23 @@ first would hand the gearbox the rotor motion at ``t_{k+1}`` next to the
 generator motion at ``t_k``; that inconsistency is a first-order coupling error
 (docs/orchestrator.md, coupling study).
 
+Direct feedthrough
+------------------
+An output that depends *directly* on an input (ModelStructure/Outputs
+``dependencies``) is computed from the value the input has when it is read: a
+pass-through FMU F between W and C (``W.z -> F.u``, ``F.y = g(F.u) -> C.v``) hands
+C what W gave F in the same communication step only if F is stepped before C;
+stepped after C, F's output still holds the previous step's input and C receives
+W's value one step late. :func:`dependency_order` therefore orders the system as
+if every such connection ran from F's own sources straight to C (so W and C keep
+the relative order they would have if connected directly, a loop through F is a
+loop of W and C) and then steps each pass-through FMU immediately before the
+first component that consumes its direct outputs (chains of them in the order the
+data flows). Without direct dependencies on connected inputs it is
+:func:`stepping_order`. What an order means for each connection (the value of
+which communication point it receives, where a one-step delay remains) is
+:mod:`orchestrator.cosim.coupling_delays`.
+
 Algebraic loops
 ---------------
 A loop is algebraic when every connection on it enters an input that the
@@ -137,6 +154,93 @@ def stepping_order(components: Sequence[str], edges: Iterable[tuple[str, str]]) 
             if pending[j] == 0:
                 ready.append(j)
         ready.sort(key=lambda k: first[k])
+    return order
+
+
+def _component(variable: str) -> str:
+    return variable.partition(".")[0]
+
+
+def direct_inputs(connections: Iterable[tuple[str, str]], feedthrough: Mapping[str, Iterable[str]],
+                  solved: Iterable[str] = ()) -> dict[str, list[str]]:
+    """``"comp.output" -> ["comp.input", ...]``: the *connected* inputs each output depends on directly.
+
+    Parameters
+    ----------
+    connections : iterable of (str, str)
+        ``("comp.output", "comp.input")`` pairs.
+    feedthrough : mapping of str -> iterable of str
+        For each ``"comp.input"``, the outputs of the same FMU that depend on it directly.
+    solved : iterable of str
+        Variables of algebraic loops the master iterates: their outputs are recomputed from
+        the converged inputs at every communication point, so they pass nothing late.
+    """
+    connected = {inp for _, inp in connections}
+    solved = set(solved)
+    out: dict[str, list[str]] = {}
+    for inp, outputs in feedthrough.items():
+        if inp not in connected:
+            continue  # a start value: constant over the run
+        for o in outputs:
+            if o not in solved:
+                out.setdefault(o, []).append(inp)
+    return out
+
+
+def dependency_order(components: Sequence[str], connections: Iterable[tuple[str, str]],
+                     feedthrough: Mapping[str, Iterable[str]], solved: Iterable[str] = ()) -> list[str]:
+    """Default Gauss-Seidel order that follows the declared direct dependencies (module docstring).
+
+    Parameters
+    ----------
+    components : sequence of str
+        Component names in declaration order.
+    connections : iterable of (str, str)
+        ``("comp.output", "comp.input")`` pairs.
+    feedthrough : mapping of str -> iterable of str
+        For each ``"comp.input"``, the outputs of the same FMU that depend on it directly.
+    solved : iterable of str
+        Variables of the algebraic loops the master iterates (see :func:`direct_inputs`).
+
+    Returns
+    -------
+    list of str
+        :func:`stepping_order` of the graph in which every connection from a direct output
+        runs from the sources of the inputs it depends on, with each pass-through component
+        moved to just before the first consumer of its direct outputs.
+    """
+    connections = list(connections)
+    producer = {inp: out for out, inp in connections}
+    direct = direct_inputs(connections, feedthrough, solved)
+
+    def origins(output: str, seen: frozenset) -> set[str]:
+        """Components whose non-direct outputs reach ``output`` within one step (through pass-throughs)."""
+        if output not in direct or output in seen:
+            return {_component(output)}
+        seen = seen | {output}
+        return {c for inp in direct[output] for c in origins(producer[inp], seen)}
+
+    edges: list[tuple[str, str]] = []
+    passes: dict[str, set[str]] = {}  # pass-through component -> components consuming its direct outputs
+    for out, inp in connections:
+        source, target = _component(out), _component(inp)
+        if out in direct:
+            if source != target:
+                passes.setdefault(source, set()).add(target)
+            edges += [(o, target) for o in sorted(origins(out, frozenset()))]
+        else:
+            edges.append((source, target))
+    order = stepping_order(components, edges)
+    if not passes:
+        return order
+    # consumers first: a chain F1 -> F2 -> C places F2 before C, then F1 before F2
+    rank = {c: i for i, c in enumerate(components)}
+    groups = strongly_connected(sorted(passes, key=rank.get),
+                                {f: sorted((c for c in cs if c in passes), key=rank.get) for f, cs in passes.items()})
+    for group in groups:  # Tarjan emits a component after every component it reaches
+        for f in sorted(group, key=order.index):
+            order.remove(f)
+            order.insert(min(order.index(c) for c in passes[f]), f)
     return order
 
 

@@ -9,6 +9,13 @@ gearbox ``omega_rotor`` -> gearbox ``omega_out`` -> generator initial speed.
 Sweeps repeat until no transferred value changes (a fixed point; feedback loops
 need one extra sweep; iterated algebraic loops converge within their tolerance),
 then every FMU exits initialisation mode.
+
+Before the first sweep the parameter bindings (``[[bindings]]``) are applied: each
+bound parameter is set to its source parameter's value, read with ``fmi2GetXXX`` once
+every FMU has its start values (FMI 2.0 allows reading only from initialisation mode
+on, and setting a parameter with ``initial="exact"`` there), chains in the order the
+value flows: the paper's ``gearbox.generator_inertia = generator.inertia``. Nothing
+has been computed from the target yet, so the FMU sees one value only.
 """
 
 from __future__ import annotations
@@ -36,8 +43,9 @@ def initialise(system: ResolvedSystem, instances: Mapping[str, FmuInstance],
     Returns
     -------
     dict of str -> float
-        ``{"component.parameter": value}`` for every ``[[initial]]`` binding (with
-        ``transferred``: also ``{"component.input": value}`` for every connected input).
+        ``{"component.parameter": value}`` for every ``[[bindings]]`` target and every
+        ``[[initial]]`` binding (with ``transferred``: also ``{"component.input": value}``
+        for every connected input).
 
     Raises
     ------
@@ -47,6 +55,7 @@ def initialise(system: ResolvedSystem, instances: Mapping[str, FmuInstance],
     sc = system.scenario
     sim = sc.simulation
     t0 = sim.start_s
+    bound = apply_bindings(system, instances)
     links = [(c.source, c.target, system.loop_transformation(c)) for c in sc.connections] \
         + [(b.source, b.target, None) for b in sc.initial]
     incoming: dict[str, list] = {name: [] for name in system.init_order}
@@ -93,10 +102,34 @@ def initialise(system: ResolvedSystem, instances: Mapping[str, FmuInstance],
         )
     for name in system.init_order:
         instances[name].exit_initialization(t0)
-    return dict(last) if transferred else bound_values(system, last)
+    return {**bound, **(dict(last) if transferred else bound_values(system, last))}
+
+
+def apply_bindings(system: ResolvedSystem, instances: Mapping[str, FmuInstance]) -> dict[str, object]:
+    """Set every ``[[bindings]]`` target from its source's value (FMUs in initialisation mode); returns them.
+
+    Raises
+    ------
+    InitializationError
+        A source value that is not a finite number.
+    """
+    t0 = system.scenario.simulation.start_s
+    pending = list(system.scenario.bindings)
+    targets = {str(b.target) for b in pending}
+    values: dict[str, object] = {}
+    while pending:  # a source that is itself bound waits for its own binding
+        ready = [b for b in pending if str(b.source) not in targets or str(b.source) in values]
+        for b in ready:
+            v = instances[b.source.component].get_values([b.source.variable], t0)[0]
+            if isinstance(v, float) and not math.isfinite(v):
+                raise InitializationError(f"initialisation: {b.source} = {v!r} (bound to {b.target})")
+            instances[b.target.component].set_values({b.target.variable: v}, t0)
+            values[str(b.target)] = v
+        pending = [b for b in pending if b not in ready]
+    return values
 
 
 def bound_values(system: ResolvedSystem, values: Mapping[str, float]) -> dict[str, float]:
-    """The ``[[initial]]`` bindings' values among ``values`` (``{"component.parameter": value}``)."""
-    bound = {str(b.target) for b in system.scenario.initial}
+    """The values of the ``[[initial]]`` and ``[[bindings]]`` targets among ``values`` (``{"component.parameter": value}``)."""
+    bound = {str(b.target) for b in (*system.scenario.initial, *system.scenario.bindings)}
     return {k: v for k, v in values.items() if k in bound}

@@ -18,10 +18,13 @@ Algorithms
 Gauss-Seidel (default) steps the components one after the other in the stepping
 order; an input whose source was already stepped in this communication step
 receives the source's new value (at ``t_{k+1}``), the others the value at
-``t_k``. The default order (:func:`orchestrator.cosim.graph.stepping_order`) steps
+``t_k``. The default order (:func:`orchestrator.cosim.graph.dependency_order`) steps
 receivers before their sources across feedback loops, so new values flow only
-inside loops (the paper's system: gearbox, generator, wind). Jacobi sets every
-input from the values at ``t_k`` and then steps all components.
+inside loops (the paper's system: gearbox, generator, wind), and an FMU whose
+outputs depend directly on its inputs just before the consumers of those outputs
+(a pass-through changes nothing). Jacobi sets every input from the values at
+``t_k`` and then steps all components. Where the order delays a connection by a
+step the run says so (:mod:`orchestrator.cosim.coupling_delays`).
 
 Input values
 ------------

@@ -12,9 +12,15 @@ from pathlib import Path
 from typing import Mapping
 
 from ..inputs.scenario import Scenario, VariableRef
+from .coupling_delays import CouplingDelay
 from .event_slots import AssignedEvent
 from .fmu_interface import FmuInterface, FmuVariable
 from .roles import ComponentRole
+
+
+#: a variable is a signal (a result the statistics describe) by these declarations
+SIGNAL_CAUSALITIES = ("output", "local")
+SIGNAL_VARIABILITIES = ("continuous", "discrete")
 
 
 @dataclass(frozen=True)
@@ -71,7 +77,11 @@ class ResolvedSystem:
         loop, which the master solves by iteration (:mod:`orchestrator.cosim.algebraic_loops`).
     notes : tuple of str
         What the checks accepted with a caveat (a loop through outputs that declare no
-        dependencies, run with Jacobi); printed by ``dtcosim run`` and kept in the summary.
+        dependencies, run with Jacobi; every one-step delay the stepping order puts on a
+        connection); printed by ``dtcosim run`` and kept in the summary.
+    delays : tuple of CouplingDelay
+        The connections that lag a communication step in this order, and why
+        (:mod:`orchestrator.cosim.coupling_delays`); ``coupling_delays`` in the summary.
     """
 
     scenario: Scenario
@@ -84,6 +94,7 @@ class ResolvedSystem:
     roles: Mapping[str, ComponentRole] = field(default_factory=dict)
     algebraic_loops: tuple[tuple[str, ...], ...] = ()
     notes: tuple[str, ...] = ()
+    delays: tuple[CouplingDelay, ...] = ()
 
     def with_role(self, role: str) -> list[ComponentRole]:
         """The components declared with ``role``, in scenario order."""
@@ -97,13 +108,25 @@ class ResolvedSystem:
                                       self.interfaces[con.source.component].enumerations,
                                       self.interfaces[con.target.component].enumerations)
 
+    def is_signal(self, component: str, variable: str) -> bool:
+        """Whether a variable is a signal by its declaration: causality output or local, variability continuous
+        or discrete (not a parameter, a constant or an input; :data:`SIGNAL_CAUSALITIES`)."""
+        var = self.interfaces[component].variables[variable]
+        return var.causality in SIGNAL_CAUSALITIES and var.variability in SIGNAL_VARIABILITIES
+
     def variable(self, ref: VariableRef) -> FmuVariable:
         """Model-description entry of a ``component.variable`` reference."""
         return self.interfaces[ref.component].variables[ref.variable]
 
     def parameter_values(self, component: str) -> dict[str, object]:
-        """Effective parameter values of a component: FMU start values overridden by the scenario."""
+        """Effective parameter values of a component: FMU start values overridden by the scenario, and the bound
+        parameters' the values of their sources (``[[bindings]]``), as the FMU will have them in the run."""
         iface = self.interfaces[component]
         values = {n: v.start for n, v in iface.variables.items() if v.causality == "parameter"}
         values.update(self.scenario.component(component).parameters)
+        for b in self.scenario.bindings:
+            if b.target.component == component:
+                source = VariableRef.parse(self.scenario.bound_source(b.target), "bindings")
+                values[b.target.variable] = self.parameter_values(source.component).get(
+                    source.variable, self.variable(source).start)  # a calculatedParameter: its start value
         return values

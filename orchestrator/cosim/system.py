@@ -9,7 +9,8 @@ parameters, inputs and variables with ``initial="exact"`` or ``"approx"``) and h
 the right type; connections join an output to an input of the same type (Real,
 Integer, Boolean, String, or Enumeration of the same declared type; an Integer
 and an Enumeration connect); initial bindings join an output to a parameter or
-input of the same type; record patterns match variables (any type); no algebraic
+input of the same type; parameter bindings join a parameter to a settable parameter of another FMU of the same
+type; record patterns match variables (any type); no algebraic
 loop (with the scenario's ``no_feedthrough`` declarations for FMUs that omit their
 output dependencies, ``"*"`` for all of a component's; iterated with
 ``algebraic_loops = "iterate"``; with Jacobi, a loop that passes an output without
@@ -36,7 +37,8 @@ from ..inputs.limits import MAX_RESULT_VALUES
 from ..inputs.scenario import Component, Scenario, VariableRef
 from .event_slots import assign_events
 from .fmu_interface import FmuInterface, FmuVariable, read_fmu_interface
-from .graph import algebraic_loop_groups, find_algebraic_loop, initialization_order, stepping_order
+from .coupling_delays import coupling_delays
+from .graph import algebraic_loop_groups, dependency_order, find_algebraic_loop, initialization_order
 from .parameter_checks import model_problem, value_problem
 from .resolved import RecordedVariable, ResolvedSystem
 from .roles import declared_roles
@@ -46,6 +48,8 @@ from .values import transformation_problem, type_mismatch
 SETTABLE_CAUSALITIES = ("parameter", "input")
 #: causalities a connection or initial binding may read from
 READABLE_CAUSALITIES = ("output", "calculatedParameter")
+#: causalities a parameter binding (``[[bindings]]``) may take its value from
+BINDING_SOURCES = ("parameter", "calculatedParameter")
 
 
 def find_fmu(scenario: Scenario, component: Component, candidates: Sequence[Path]) -> Path:
@@ -209,12 +213,22 @@ def resolve_system(scenario: Scenario, fmu_paths: Mapping[str, Path] | None = No
             raise ScenarioError(f"initial[{i}].to", str(b.target), "a settable (fixed or tunable) parameter", src)
         _same_type(out, var, f"initial[{i}]", str(b), src)
 
+    for i, b in enumerate(scenario.bindings):
+        value = _lookup(interfaces[b.source.component], b.source, f"bindings[{i}].from", src,
+                        BINDING_SOURCES, "a parameter")
+        var = _lookup(interfaces[b.target.component], b.target, f"bindings[{i}].to", src, ("parameter",),
+                      "a parameter")
+        if var.variability == "constant":
+            raise ScenarioError(f"bindings[{i}].to", str(b.target), "a settable (fixed or tunable) parameter", src)
+        _same_type(value, var, f"bindings[{i}]", str(b), src)
+
     recorded = _resolve_record(scenario, interfaces)
 
     feedthrough = _feedthrough(scenario, interfaces)
     links = [(str(c.source), str(c.target)) for c in scenario.connections]
     loop = find_algebraic_loop(links, feedthrough)
     loops: tuple[tuple[str, ...], ...] = ()
+    solved: list[str] = []
     notes: list[str] = []
     if loop is not None and scenario.simulation.algebraic_loops != "iterate" \
             and scenario.simulation.algorithm == "jacobi" \
@@ -224,11 +238,21 @@ def resolve_system(scenario: Scenario, fmu_paths: Mapping[str, Path] | None = No
     if loop is not None:
         if scenario.simulation.algebraic_loops != "iterate":
             raise AlgebraicLoopError(loop, src, _loop_hint(loop, interfaces))
-        loops = _iterated_loops(scenario, interfaces, algebraic_loop_groups(links, feedthrough))
+        groups = algebraic_loop_groups(links, feedthrough)
+        loops = _iterated_loops(scenario, interfaces, groups)
+        solved = [v for group in groups for v in group]
 
     names = scenario.component_names
+    sim = scenario.simulation
+    default = tuple(dependency_order(names, links, feedthrough, solved))
+    order = tuple(sim.order) if sim.order else default
+    delays = coupling_delays(names, order, sim.algorithm, links, feedthrough,
+                             declared=_feedthrough(scenario, interfaces, declared_only=True), solved=solved,
+                             explicit=bool(sim.order), default_order=default)
+    if notes:  # the Jacobi loop note already says that outputs without declared dependencies may lag a step
+        delays = tuple(d for d in delays if not d.undeclared)
+    notes += [d.note for d in delays]
     edges = [(c.source.component, c.target.component) for c in scenario.connections]
-    order = tuple(scenario.simulation.order) if scenario.simulation.order else tuple(stepping_order(names, edges))
     init_edges = edges + [(b.source.component, b.target.component) for b in scenario.initial]
     init_order = tuple(initialization_order(names, init_edges))
     system = ResolvedSystem(
@@ -242,6 +266,7 @@ def resolve_system(scenario: Scenario, fmu_paths: Mapping[str, Path] | None = No
         roles=FrozenMap(declared_roles(scenario, interfaces)),
         algebraic_loops=loops,
         notes=tuple(notes),
+        delays=delays,
     )
     problem = model_problem(system)
     if problem is not None:

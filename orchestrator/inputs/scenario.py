@@ -185,6 +185,24 @@ class InitialBinding:
 
 
 @dataclass(frozen=True)
+class ParameterBinding:
+    """Parameter ``target`` takes the value of parameter ``source`` of another FMU: one value, one source.
+
+    Example: the Gearbox's interface model needs the generator's inertia
+    (``gearbox.generator_inertia``), which is the GeneratorRotor's ``inertia``. The
+    master reads the source's value through FMI once the FMUs have their start values
+    and sets the target before anything is computed from it
+    (:mod:`orchestrator.cosim.initialisation`); the target takes no value of its own.
+    """
+
+    source: VariableRef
+    target: VariableRef
+
+    def __str__(self) -> str:
+        return f"{self.target} = {self.source}"
+
+
+@dataclass(frozen=True)
 class SimulationSettings:
     """Time grid and master algorithm.
 
@@ -317,6 +335,8 @@ class Scenario:
         Time grid and master options.
     initial : tuple of InitialBinding
         Output -> parameter assignments made during initialisation.
+    bindings : tuple of ParameterBinding
+        Parameters that take the value of another FMU's parameter (``[[bindings]]``).
     recorded : tuple of str
         The recorded variables (the ``[record]`` table's ``variables``): ``"component.name"`` or
         ``"component.pattern"`` with ``*``/``?`` wildcards; empty means every output of every component.
@@ -351,6 +371,7 @@ class Scenario:
     analysis: AnalysisSettings = field(default_factory=AnalysisSettings)
     results_format: str = "auto"
     import_notes: tuple[str, ...] = ()
+    bindings: tuple[ParameterBinding, ...] = ()
 
     def __post_init__(self) -> None:
         src = self.source
@@ -392,6 +413,8 @@ class Scenario:
             if b.target.variable in comp.parameters:
                 raise ScenarioError(f"initial[{i}].to", tgt, f"a variable without a value in components.{comp.name}.parameters", src)
             set_initially[tgt] = i
+        object.__setattr__(self, "bindings", tuple(self.bindings))
+        self._check_bindings(known, names, driven, set_initially)
         for i, pattern in enumerate(self.recorded):
             ref = VariableRef.parse(pattern, f"record.variables[{i}]", src)
             if ref.component not in known and not any(ch in ref.component for ch in "*?"):
@@ -413,6 +436,52 @@ class Scenario:
             raise ScenarioError("analysis", self.analysis, "an AnalysisSettings", src)
         if self.results_format not in RESULTS_FORMATS:
             raise ScenarioError("record.format", self.results_format, "one of " + ", ".join(RESULTS_FORMATS), src)
+
+    def _check_bindings(self, known: set[str], names: list[str], driven: Mapping[str, str],
+                        set_initially: Mapping[str, int]) -> None:
+        """Each binding joins declared components, sets its target once, from no cycle, with no value of its own."""
+        src = self.source
+        bound: dict[str, str] = {}
+        for i, b in enumerate(self.bindings):
+            for end, ref in (("from", b.source), ("to", b.target)):
+                if ref.component not in known:
+                    raise ScenarioError(f"bindings[{i}].{end}", str(ref), "a variable of a declared component: "
+                                        + ", ".join(names), src)
+            tgt = str(b.target)
+            if b.source.component == b.target.component:
+                raise ScenarioError(f"bindings[{i}].to", tgt, f"a parameter of another component than "
+                                    f"{b.source.component!r} (a binding joins two FMUs)", src)
+            if tgt in bound:
+                raise ScenarioError(f"bindings[{i}].to", tgt, f"a parameter bound once (already to {bound[tgt]})", src)
+            if tgt in driven or tgt in set_initially:
+                other = f"the connection from {driven[tgt]}" if tgt in driven else f"initial[{set_initially[tgt]}]"
+                raise ScenarioError(f"bindings[{i}].to", tgt, f"a parameter not also set by {other}", src)
+            bound[tgt] = str(b.source)
+        for b in self.bindings:  # a chain a -> b -> c is fine, a cycle has no source
+            seen, ref = [str(b.target)], str(b.source)
+            while ref in bound:
+                if ref in seen:
+                    raise ScenarioError("bindings", " = ".join(seen + [ref]), "bindings without a cycle (a bound "
+                                        "value needs one parameter that is set, not bound)", src)
+                seen.append(ref)
+                ref = bound[ref]
+        for comp in self.components:
+            for pname, value in comp.parameters.items():
+                key = f"{comp.name}.{pname}"
+                if key in bound:
+                    raise ScenarioError(
+                        f"components.{comp.name}.parameters.{pname}", value,
+                        f"no value: {key} takes its value from {bound[key]} ([[bindings]]: one source for a value "
+                        f"two FMUs need; a value here would break the link); set {bound[key]} instead (--set "
+                        f"{bound[key]}=...), or remove the binding", src)
+
+    def bound_source(self, ref: "VariableRef | str") -> str | None:
+        """``"component.parameter"`` whose value ``ref`` takes through the bindings (the chain's start), or None."""
+        bound = {str(b.target): str(b.source) for b in self.bindings}
+        key, found = str(ref), None
+        while key in bound:
+            key = found = bound[key]
+        return found
 
     # ------------------------------------------------------------------ access
     def component(self, name: str) -> Component:

@@ -35,6 +35,10 @@ TOML format (units SI; see ``docs/orchestrator.md`` for the full reference)::
     from = "gearbox.omega_out"
     to = "generator.omega_start"
 
+    [[bindings]]                          # a parameter takes another FMU's parameter value (one source)
+    from = "generator.inertia"
+    to = "gearbox.generator_inertia"
+
     [record]
     variables = ["wind.omega", "gearbox.stage*.F_sp[1]"]  # names or * / ? patterns
     format = "auto"                       # results file: "csv", "parquet" or "auto" (Parquet for long runs)
@@ -65,7 +69,15 @@ from .files import find_input_file, packaged_files, read_toml
 from .load_events import EventTable
 from .master_options import ALGEBRAIC_LOOPS, ALGORITHMS, EXTRAPOLATIONS
 from .results_format import RESULTS_FORMATS
-from .scenario import Component, Connection, InitialBinding, Scenario, SimulationSettings, VariableRef
+from .scenario import (
+    Component,
+    Connection,
+    InitialBinding,
+    ParameterBinding,
+    Scenario,
+    SimulationSettings,
+    VariableRef,
+)
 from .schema import Table, flatten_parameters, read_document
 from .series_spec import SeriesTable, series_from_table
 
@@ -116,6 +128,8 @@ class ScenarioFile(Table):
     connections: list[_LinkTable] = Field(default_factory=list,
                                          description="an array of tables [[connections]] with from/to")
     initial: list[_LinkTable] = Field(default_factory=list, description="an array of tables [[initial]] with from/to")
+    bindings: list[_LinkTable] = Field(default_factory=list,
+                                       description="an array of tables [[bindings]] with from/to (parameters)")
     record: _RecordTable | None = Field(None, description="a [record] table with variables = [...]")
     events: list[EventTable] = Field(default_factory=list,
                                      description="an array of tables [[events]] with kind, start, duration (, factor)")
@@ -207,6 +221,7 @@ def scenario_from_dict(data: Mapping[str, Any], name: str | None = None, base_di
         components=tuple(components),
         connections=links(doc.connections, "connections", Connection),
         initial=links(doc.initial, "initial", InitialBinding),
+        bindings=links(doc.bindings, "bindings", ParameterBinding),
         simulation=settings,
         recorded=tuple(doc.record.variables) if doc.record is not None else (),
         events=tuple(events),

@@ -21,6 +21,16 @@ of them at once), the ``ssd:Connections``, and an ``ssd:DefaultExperiment``
   they differ from the defaults. Load events (``[[events]]``) need no annotation:
   they are the generator FMU's event-slot parameters in the parameter set.
 
+A parameter binding (``[[bindings]]``: a parameter taking another FMU's parameter
+value) is SSP 1.0's own: the system's ``ssd:ParameterBinding`` holds the source's
+one value and its ``ssd:ParameterMapping`` applies it to the source and to every
+target (``generator.inertia`` -> ``generator.inertia``, ``gearbox.generator_inertia``),
+so a host that applies system-level bindings changes both with the one value
+(``dtc:Binding`` restores the link on dtcosim's import). libcosim and ecos read
+component-level values only: the components' parameter sets (and the archived
+dtcosim FMUs) carry the bound value too, equal at export, and ``dtcosim export-ssp``
+warns that those hosts must change both.
+
 An initial binding (a parameter set from another FMU's output during
 initialisation) cannot be an SSP/libcosim connection (targets must be inputs),
 so the exporter also writes the value the binding produced at initialisation
@@ -109,8 +119,11 @@ def computed_values(system: ResolvedSystem) -> dict[str, tuple[str, tuple[str, .
 
 
 def stale_warnings(system: ResolvedSystem, initial_values: Mapping[str, Any]) -> list[str]:
-    """What ``dtcosim export-ssp`` warns: which exported values are computed and what makes them stale in another host."""
-    out = []
+    """What ``dtcosim export-ssp`` warns: which exported values are computed or bound, and what makes them stale in
+    another host."""
+    out = [f"{b.target} is bound to {b.source} ([[bindings]]): the SSP's system-level parameter binding applies one "
+           f"value to both, but hosts that read component values only (libcosim, ecos) take the copy in "
+           f"{b.target.component}'s parameter set: change both there" for b in system.scenario.bindings]
     for target, (source, depends) in computed_values(system).items():
         if target in initial_values:
             out.append(f"{target} = {initial_values[target]:.10g} is computed by dtcosim's initialisation from "
@@ -138,6 +151,25 @@ def _parameter(parent: ET.Element, name: str, fmi_type: str, value: Any,
         annotations = ET.SubElement(p, _q("ssv:Annotations"))
         annotation = ET.SubElement(annotations, _q("ssc:Annotation"), type=COMPUTED_ANNOTATION)
         ET.SubElement(annotation, _q("dtc:Computed"), source=computed[0], dependsOn=" ".join(computed[1]))
+
+
+def _system_bindings(parent: ET.Element, system: ResolvedSystem) -> None:
+    """The system's binding of each ``[[bindings]]`` source: its value, mapped to itself and to its targets."""
+    sc = system.scenario
+    targets: dict[str, list[str]] = {}
+    for b in sc.bindings:
+        targets.setdefault(sc.bound_source(b.target), []).append(str(b.target))
+    binding = ET.SubElement(parent, _q("ssd:ParameterBinding"))
+    pvals = ET.SubElement(binding, _q("ssd:ParameterValues"))
+    pset = ET.SubElement(pvals, _q("ssv:ParameterSet"), version="1.0", name=PARAMETER_SET)
+    params = ET.SubElement(pset, _q("ssv:Parameters"))
+    mapping = ET.SubElement(ET.SubElement(binding, _q("ssd:ParameterMapping")), _q("ssm:ParameterMapping"),
+                            version="1.0")
+    for source, bound in targets.items():
+        ref = VariableRef.parse(source, "bindings")
+        _parameter(params, source, system.variable(ref).type, system.parameter_values(ref.component)[ref.variable])
+        for target in [source, *bound]:
+            ET.SubElement(mapping, _q("ssm:MappingEntry"), source=source, target=target)
 
 
 def _transformation(parent: ET.Element, transformation) -> None:
@@ -239,6 +271,8 @@ def system_structure(system: ResolvedSystem, initial_values: Mapping[str, float]
     sysel = ET.SubElement(root, _q("ssd:System"), name=sc.name)
     if sc.description:
         sysel.set("description", sc.description)
+    if sc.bindings:  # before ssd:Elements (SSP 1.0 schema order)
+        _system_bindings(ET.SubElement(sysel, _q("ssd:ParameterBindings")), system)
     elements = ET.SubElement(sysel, _q("ssd:Elements"))
     units: dict[str, Mapping[str, float]] = {}  # unit definitions of the connectors (SSP 1.0 ssd:Units)
     for comp in sc.components:
@@ -257,7 +291,7 @@ def system_structure(system: ResolvedSystem, initial_values: Mapping[str, float]
                 add(con.source.variable)
             if con.target.component == comp.name:
                 add(con.target.variable)
-        for b in sc.initial:
+        for b in (*sc.initial, *sc.bindings):
             if b.source.component == comp.name:
                 add(b.source.variable)
             if b.target.component == comp.name:
@@ -322,6 +356,8 @@ def system_structure(system: ResolvedSystem, initial_values: Mapping[str, float]
         settings.set("loopMaxIterations", str(sim.loop_max_iterations))
     for b in sc.initial:
         ET.SubElement(dtc, _q("dtc:Initial"), source=str(b.source), target=str(b.target))
+    for b in sc.bindings:
+        ET.SubElement(dtc, _q("dtc:Binding"), source=str(b.source), target=str(b.target))
     for pattern in sc.recorded:
         ET.SubElement(dtc, _q("dtc:Record"), variable=pattern)
     if sc.analysis != AnalysisSettings():

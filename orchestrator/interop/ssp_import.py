@@ -14,7 +14,7 @@ What is read
     ``https://`` and ``http://opensimulationplatform.com/SSP/OSPAnnotations``
     namespaces, as libcosim does;
   - ``org.dtcosim.scenario``: what dtcosim's own export adds (sampling interval,
-    window, algorithm, extrapolation, order, records, initial bindings, analysis).
+    window, algorithm, extrapolation, order, records, initial and parameter bindings, analysis).
 
 * without either annotation the step is ``--step`` (``step_s``), else the
   smallest DefaultExperiment ``stepSize`` of the FMUs, else a ScenarioError that
@@ -53,6 +53,7 @@ from ..inputs.scenario import (
     Component,
     Connection,
     InitialBinding,
+    ParameterBinding,
     Scenario,
     SimulationSettings,
     VariableRef,
@@ -170,10 +171,13 @@ def _osp_step(annotation, ssd: Path) -> float | None:
     return step
 
 
-def _dtcosim_settings(annotation, ssd: Path, source: str) -> tuple[dict, list, list, AnalysisSettings, float | None]:
-    """(simulation keyword arguments, initial bindings, record patterns, analysis settings, step) of dtcosim's annotation."""
+def _dtcosim_settings(annotation, ssd: Path, source: str) -> tuple[dict, list, list, AnalysisSettings, float | None,
+                                                                   list]:
+    """(simulation keyword arguments, initial bindings, record patterns, analysis settings, step, parameter bindings)
+    of dtcosim's annotation."""
     sim: dict[str, Any] = {}
     initial: list[InitialBinding] = []
+    bindings: list[ParameterBinding] = []
     record: list[str] = []
     analysis = AnalysisSettings()
     step = None
@@ -207,6 +211,10 @@ def _dtcosim_settings(annotation, ssd: Path, source: str) -> tuple[dict, list, l
             i = len(initial)
             initial.append(InitialBinding(VariableRef.parse(el.get("source"), f"initial[{i}].from", source),
                                           VariableRef.parse(el.get("target"), f"initial[{i}].to", source)))
+        elif name == "dtc:Binding":
+            i = len(bindings)
+            bindings.append(ParameterBinding(VariableRef.parse(el.get("source"), f"bindings[{i}].from", source),
+                                             VariableRef.parse(el.get("target"), f"bindings[{i}].to", source)))
         elif name == "dtc:Record":
             if el.get("variable"):
                 record.append(el.get("variable"))
@@ -214,8 +222,8 @@ def _dtcosim_settings(annotation, ssd: Path, source: str) -> tuple[dict, list, l
             analysis = _analysis_settings(el, ssd, source)
         else:
             raise element_error(el, ssd, "is not an element of dtcosim's annotation (dtc:Simulation, dtc:Initial, "
-                                "dtc:Record, dtc:Analysis)", "remove it or export the scenario again")
-    return sim, initial, record, analysis, step
+                                "dtc:Binding, dtc:Record, dtc:Analysis)", "remove it or export the scenario again")
+    return sim, initial, record, analysis, step, bindings
 
 
 def _analysis_settings(el, ssd: Path, source: str) -> AnalysisSettings:
@@ -324,6 +332,7 @@ def import_ssp(path: str | Path, step_s: float | None = None, stop_s: float | No
     step = None
     sim_kwargs: dict[str, Any] = {}
     initial: list[InitialBinding] = []
+    bindings: list[ParameterBinding] = []
     record: list[str] = []
     analysis = AnalysisSettings()
     annotations = child(exp, "ssd:Annotations") if exp is not None else None
@@ -331,7 +340,7 @@ def import_ssp(path: str | Path, step_s: float | None = None, stop_s: float | No
         if ann.get("type") == OSP_ANNOTATION:
             step = _osp_step(ann, ssd) if step is None else step
         elif ann.get("type") == DTCOSIM_ANNOTATION:
-            sim_kwargs, initial, record, analysis, dtc_step = _dtcosim_settings(ann, ssd, source)
+            sim_kwargs, initial, record, analysis, dtc_step, bindings = _dtcosim_settings(ann, ssd, source)
             step = dtc_step if dtc_step is not None else step
     if step is None or stop is None:
         fmu_step, fmu_stop = _fmu_defaults(interfaces)
@@ -352,7 +361,7 @@ def import_ssp(path: str | Path, step_s: float | None = None, stop_s: float | No
     except ScenarioError as exc:
         raise ScenarioError(exc.key, exc.value, exc.expected, source) from None
 
-    bound = {str(b.target) for b in initial}
+    bound = {str(b.target) for b in (*initial, *bindings)}  # set at initialisation, from their sources
     for (src, dst, origin) in flat.initial:
         initial.append(InitialBinding(VariableRef(*src), VariableRef(*dst)))
         bound.add(f"{dst[0]}.{dst[1]}")
@@ -369,7 +378,7 @@ def import_ssp(path: str | Path, step_s: float | None = None, stop_s: float | No
     return Scenario(
         name=name, description=system.get("description", ""), components=components, connections=connections,
         initial=tuple(initial), simulation=settings, recorded=tuple(record), analysis=analysis, base_dir=base,
-        source=source, import_notes=tuple(notes),
+        source=source, import_notes=tuple(notes), bindings=tuple(bindings),
     )
 
 

@@ -15,7 +15,8 @@
 
 ``summary.json``
     ``scenario``, ``complete``, ``statistics`` (``{"component.variable": {"mean",
-    "std", "min", "max"}}`` over the analysis window), ``window_s``,
+    "std", "min", "max"}}`` over the analysis window, of the recorded signals: outputs
+    and locals that vary by their declared variability, no parameters), ``window_s``,
     ``wall_time_s``, ``steps``, the time grid and master options, the generator
     speed against the ideal gearbox (``generator_vs_ideal``), ``versions``
     (dtcosim, python, numpy, scipy, fmpy, pythonfmu), ``fmus`` (file, SHA-256,
@@ -109,10 +110,13 @@ def write_timeseries(path: str | Path, outcome: RunOutcome, chunk_rows: int | No
     return writer.close()
 
 
-def statistics(outcome: RunOutcome, window: tuple[float, float]) -> dict[str, dict[str, float]]:
-    """Mean, std, min, max of every recorded variable over ``window`` [s]."""
+def statistics(outcome: RunOutcome, window: tuple[float, float],
+               system: ResolvedSystem | None = None) -> dict[str, dict[str, float]]:
+    """Mean, std, min, max over ``window`` [s] of every recorded signal (with ``system``: the variables it declares
+    signals, :meth:`~orchestrator.cosim.resolved.ResolvedSystem.is_signal`; a recorded parameter is none)."""
     return {c.column: window_statistics(outcome.time_s, outcome.values[:, i], window)
-            for i, c in enumerate(outcome.columns) if c.type != "String"}
+            for i, c in enumerate(outcome.columns)
+            if c.type != "String" and (system is None or system.is_signal(c.component, c.variable))}
 
 
 def run_status(outcome: RunOutcome, problems: list[str] | None = None) -> str:
@@ -165,10 +169,12 @@ def build_summary(system: ResolvedSystem, outcome: RunOutcome, *, wall_time_s: f
         summary["import_notes"] = list(sc.import_notes)
     if system.notes:
         summary["notes"] = list(system.notes)
+    if system.delays:
+        summary["coupling_delays"] = [d.as_dict() for d in system.delays]
     summary["samples"] = int(outcome.time_s.size)
     summary.update({
         "window_s": list(sim.window_s),
-        "statistics": statistics(outcome, sim.window_s),
+        "statistics": statistics(outcome, sim.window_s, system),
         "wall_time_s": wall_time_s,
         "cosimulation_wall_time_s": outcome.wall_time_s,
         "loop_time_s": outcome.loop_time_s,

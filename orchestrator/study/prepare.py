@@ -168,6 +168,10 @@ def _check_value(system, name: str, value: Any, key: str, source: str | None) ->
         raise StudyError(key, name, "a parameter, not an input a connection drives", source)
     if any(str(b.target) == name for b in system.scenario.initial):
         raise StudyError(key, name, "a parameter the scenario does not set at initialisation (an [[initial]] binding)", source)
+    bound = system.scenario.bound_source(name)
+    if bound is not None:
+        raise StudyError(key, name, f"a parameter the scenario does not bind: {name} takes its value from {bound} "
+                         f"([[bindings]]); vary {bound} instead", source)
     if not _value_matches(var, value):
         raise StudyError(key, value, f"a {var.type} value for {name}", source)
     problem = value_problem(iface, var, value)

@@ -11,6 +11,7 @@ Toys
 ToySine        no inputs; outputs y = amplitude sin(2 pi f t) and t_seen (last doStep start)
 ToyIntegrator  input u; outputs x (x' = u, exact for held u), u_seen, t_seen; parameter x0
 ToyGain        input u; output y = gain u (direct feedthrough: no dependencies attribute)
+ToyPass        input u; output y = u, read when asked (direct feedthrough declared: dependencies on u)
 ToyAdder       inputs u1, u2; output y = gain u1 + u2 (direct feedthrough: no dependencies attribute)
 ToyMassA       mass on a wall spring, input force F; outputs x, v (exact step for held F)
 ToyMassB       mass coupled to A by a spring-damper, inputs xa, va; outputs F (force on A), x, v
@@ -94,6 +95,16 @@ class ToyGain(Fmi2Slave):
         self.register_variable(Real("gain", causality=Fmi2Causality.parameter, variability=Fmi2Variability.tunable))
         self.register_variable(Real("u", causality=Fmi2Causality.input))
         self.register_variable(Real("y", causality=Fmi2Causality.output, getter=lambda: self.gain * self.u))
+    def do_step(self, t, h):
+        return True
+""",
+    "ToyPass": """
+class ToyPass(Fmi2Slave):
+    def __init__(self, **kw):
+        super().__init__(**kw)
+        self.u = 0.0
+        self.register_variable(Real("u", causality=Fmi2Causality.input))
+        self.register_variable(Real("y", causality=Fmi2Causality.output, getter=lambda: self.u))
     def do_step(self, t, h):
         return True
 """,
@@ -274,6 +285,8 @@ class ToyTyped(Fmi2Slave):
 
 #: toys whose outputs depend directly on their inputs (no dependencies attribute added)
 FEEDTHROUGH = {"ToyGain", "ToyAdder", "ToyInit"}
+#: toys that declare their outputs' direct dependencies: output -> the inputs it depends on
+DECLARED = {"ToyPass": {"y": ("u",)}}
 
 UNITS = {("ToyMassA", "x"): "m", ("ToyMassA", "v"): "m/s", ("ToyMassB", "F"): "N", ("ToyGearbox", "F_x"): "N.m",
          ("ToyGearbox", "shaft1.torque"): "N"}
@@ -287,7 +300,13 @@ def _patch_model_description(fmu: Path, model: str) -> None:
             data = zin.read(item.filename)
             if item.filename == "modelDescription.xml":
                 xml = data.decode("utf-8")
-                if model not in FEEDTHROUGH:
+                if model in DECLARED:
+                    index = {n: str(i + 1) for i, n in enumerate(re.findall(r'<ScalarVariable name="([^"]+)"', xml))}
+                    for out, inputs in DECLARED[model].items():
+                        deps = " ".join(index[i] for i in inputs)
+                        xml = xml.replace(f'<Unknown index="{index[out]}"/>',
+                                          f'<Unknown index="{index[out]}" dependencies="{deps}"/>')
+                elif model not in FEEDTHROUGH:
                     xml = re.sub(r'<Unknown index="(\d+)"\s*/>', r'<Unknown index="\1" dependencies=""/>', xml)
                 for (m, var), unit in UNITS.items():
                     if m == model:

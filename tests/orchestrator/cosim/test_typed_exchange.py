@@ -131,9 +131,11 @@ def test_changing_values_of_every_type_travel_along_a_chain_in_the_python_loop(a
         n = outcome.column("src.n")
         stride = round(interval / 0.1)
         np.testing.assert_array_equal(n, stride * np.arange(len(n)))  # n counts the steps
-        # Gauss-Seidel steps the receivers first (src, a, b are not in a loop): every hop is a step late,
-        # as with Jacobi; the values arrive unchanged
-        delay = 2
+        # src's state outputs reach a as the values of t_k (a is stepped before src). a and b pass their inputs
+        # through (declared dependencies): Gauss-Seidel steps a before b, so b passes on what src gave a in the
+        # same step (one step in all); Jacobi hands b a's outputs of the previous step (two); the values arrive
+        # unchanged
+        delay = 1 if algorithm == "gauss-seidel" else 2
         steps = n.astype(int)
         expected_n = np.maximum(steps - delay, 0)
         np.testing.assert_array_equal(outcome.column("b.Int32_output"), expected_n)
@@ -143,6 +145,9 @@ def test_changing_values_of_every_type_travel_along_a_chain_in_the_python_loop(a
         np.testing.assert_array_equal(outcome.column("b.Enumeration_output"), 1.0)
     np.testing.assert_array_equal(runs[0].values, runs[1].values)
     assert all(list(runs[0].text[k]) == list(runs[1].text[k]) for k in runs[0].text)
+    # the run says where the order delays (Jacobi: a -> b), and nowhere else
+    assert [(d.kind, d.source, d.target, d.received) for d in system.delays] == (
+        [] if algorithm == "gauss-seidel" else [("feedthrough", "a", "b", "t_{k-1}")])
 
 
 def test_a_connection_between_different_types_names_both(tmp_path):
