@@ -96,6 +96,9 @@ def run(args: argparse.Namespace) -> int:
         print(f"{scenario.name}: valid ({len(scenario.components)} FMUs, {len(scenario.connections)} connections, "
               f"{len(system.recorded)} recorded variables, {len(system.events)} load event(s); stepping order {', '.join(system.order)}; "
               f"initialisation order {', '.join(system.init_order)})")
+        for delay in system.delays:
+            if delay.note not in system.notes:  # the loops' explicit coupling (the notes are printed above)
+                print(f"  coupling: {delay.note}")
         return 0
     RunFolder.check(out_dir)  # a file or an unwritable folder: refused before anything is instantiated
     if out_note:

@@ -26,9 +26,11 @@ the counter torque of ``t_k``), but it is a one-step delay in one direction, so
 the run says where, once per loop.
 
 :func:`coupling_delays` lists both kinds for a resolved order, each with the
-connections and why; :mod:`orchestrator.cosim.system` puts their notes into
-``ResolvedSystem.notes`` (printed by ``dtcosim run``, kept in ``summary.json``,
-with the structured list as ``coupling_delays``). Iterated algebraic loops
+connections and why (``ResolvedSystem.delays``: ``coupling_delays`` in
+``summary.json``, printed by ``dtcosim run --check``); the delays of pass-through
+outputs are also ``ResolvedSystem.notes``, which every ``dtcosim run`` prints (a
+coupling error nobody chose), while a loop's lagging direction, its deliberate
+explicit coupling, is not repeated on every run. Iterated algebraic loops
 (``algebraic_loops = "iterate"``) are solved at every communication point and
 carry no delay inside the loop.
 """

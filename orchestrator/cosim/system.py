@@ -37,7 +37,7 @@ from ..inputs.limits import MAX_RESULT_VALUES
 from ..inputs.scenario import Component, Scenario, VariableRef
 from .event_slots import assign_events
 from .fmu_interface import FmuInterface, FmuVariable, read_fmu_interface
-from .coupling_delays import coupling_delays
+from .coupling_delays import FEEDTHROUGH, coupling_delays
 from .graph import algebraic_loop_groups, dependency_order, find_algebraic_loop, initialization_order
 from .parameter_checks import model_problem, value_problem
 from .resolved import RecordedVariable, ResolvedSystem
@@ -251,7 +251,9 @@ def resolve_system(scenario: Scenario, fmu_paths: Mapping[str, Path] | None = No
                              explicit=bool(sim.order), default_order=default)
     if notes:  # the Jacobi loop note already says that outputs without declared dependencies may lag a step
         delays = tuple(d for d in delays if not d.undeclared)
-    notes += [d.note for d in delays]
+    # a pass-through read late is a coupling error nobody chose: said on every run; the lagging direction of a
+    # feedback loop is the loop's deliberate explicit coupling: in summary.json (coupling_delays) and run --check
+    notes += [d.note for d in delays if d.kind == FEEDTHROUGH]
     edges = [(c.source.component, c.target.component) for c in scenario.connections]
     init_edges = edges + [(b.source.component, b.target.component) for b in scenario.initial]
     init_order = tuple(initialization_order(names, init_edges))

@@ -20,6 +20,11 @@ def test_a_run_with_overrides_writes_to_its_own_folder_and_says_so(fmu_dir, tmp_
     assert f"note: --stop 0.2 change the scenario: results go to results/{folders[0]}/ (results/paper-60s/ is for " \
            "the scenario as written" in err
     assert "warning: analysis window moved from [5, 60] s to [0, 0.2] s to fit the run [0, 0.2] s" in err
+    # the gearbox <-> generator loop's deliberate one-step delay is the summary's and --check's, not every run's
+    assert "one-step delay" not in err
+    assert main(["run", "--fmu-dir", str(fmu_dir), "--check"]) == 0
+    checked = capsys.readouterr()
+    assert "  coupling: one-step delay on generator.omega -> gearbox.omega_gen" in checked.out, checked
     # the same overrides again: the same folder, and the replacement is said
     assert main(["run", "--fmu-dir", str(fmu_dir), "--stop", "0.2", "--no-plots", "-q"]) == 0
     assert f"note: replacing the previous run in results/{folders[0]}/ (scenario paper-60s, complete, started" \

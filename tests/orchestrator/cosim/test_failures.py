@@ -73,8 +73,7 @@ def test_ctrl_c_stops_the_run_and_writes_partial_results(fmu_dir, tmp_path):
                             cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     note = proc.stderr.readline()  # the scenario's window [5, 60] s ended at its stop: it follows the new one
     assert "analysis window moved from [5, 60] s to [5, 600] s" in note, note
-    delay = proc.stderr.readline()  # the gearbox <-> generator loop's one-step delay, said once
-    assert delay.startswith("dtcosim run: note: one-step delay on generator.omega -> gearbox.omega_gen"), delay
+    # (the gearbox <-> generator loop's one-step delay is in summary.json and run --check, not on every run)
     header = proc.stderr.readline()  # printed before the FMUs are instantiated
     assert "3 FMUs" in header, header
     time.sleep(8.0)  # past instantiation (numba's cache load included) and initialisation, well before 600 s
