@@ -88,6 +88,11 @@ class Given:
     unit: str | None = None
 
     @property
+    def shown(self) -> float | str:
+        """For messages: the bare number as it was read, or the text with its unit."""
+        return self.magnitude if self.unit is None else self.text
+
+    @property
     def text(self) -> str:
         """As written: ``"0.56 mm"``, or the bare number."""
         return f"{self.magnitude:g}" if self.unit is None else f"{self.magnitude:g} {self.unit}"
@@ -97,8 +102,11 @@ class Given:
 
 
 def is_quantity_text(value: Any) -> bool:
-    """True for a string that starts with a number (``"0.56 mm"``, ``"16 rpm"``, ``"0.3"``)."""
-    return isinstance(value, str) and _NUMBER.match(value) is not None
+    """True for a string of a number and a unit (``"0.56 mm"``, ``"16 rpm"``; not ``"0.3"`` nor ``"abc"``)."""
+    if not isinstance(value, str):
+        return False
+    match = _NUMBER.match(value)
+    return match is not None and bool(match.group(2))
 
 
 def parse_given(value: Any) -> Given:
@@ -121,7 +129,7 @@ def parse_given(value: Any) -> Given:
         raise UnitError("a finite number with its unit")
     unit = match.group(2)
     if not unit:
-        return Given(magnitude)
+        raise UnitError("a number (not a string), or a quantity with its unit such as \"0.56 mm\"")
     _units(unit, 1.5)  # a known unit (the exponent of ^e does not matter here)
     return Given(magnitude, unit)
 
@@ -255,7 +263,7 @@ def to_declared(value: str, unit: str, definition: Mapping[str, float] | None = 
     Parameters
     ----------
     value : str
-        ``"<number> <unit>"`` (a bare number in a string is returned as it is).
+        ``"<number> <unit>"``.
     unit : str
         The variable's declared unit name (``"m"``, ``"N.m/rad"``, ``"N/m^e"``).
     definition : mapping, optional
