@@ -1,8 +1,12 @@
 """Conversions from the paper's units to SI.
 
 The paper's tables use millimetres, kg mm^2, N mm/deg and rpm. Inside dtcosim
-everything is SI; these helpers are the only place where the paper's units
-are turned into SI, so that presets read like the tables they come from.
+everything is SI. These helpers turn the paper's units into SI where the physics
+itself needs them (the presets read like the tables they come from, the FMUs carry
+them without any units library); the user's inputs are converted by the unit
+registry of :mod:`orchestrator.inputs.quantities` (pint). Both give the same
+numbers to the last bit: each helper multiplies by one factor, as pint does, and
+``tests/orchestrator/inputs/test_quantities.py`` checks every factor against pint.
 """
 
 from __future__ import annotations
@@ -12,6 +16,8 @@ import math
 MM_TO_M = 1.0e-3
 RPM_TO_RAD_PER_S = 2.0 * math.pi / 60.0
 DEG_TO_RAD = math.pi / 180.0
+#: [N mm/deg] -> [N m/rad] (and [N mm s/deg] -> [N m s/rad])
+NMM_PER_DEG_TO_NM_PER_RAD = MM_TO_M / DEG_TO_RAD
 
 
 def mm(value_mm: float) -> float:
@@ -56,9 +62,9 @@ def regularisation(lambda_per_mm: float) -> float:
 
 def torsional_stiffness(k_nmm_per_deg: float) -> float:
     """Shaft stiffness [N mm/deg] -> [N m/rad] (Table 6)."""
-    return k_nmm_per_deg * 1.0e-3 / DEG_TO_RAD
+    return k_nmm_per_deg * NMM_PER_DEG_TO_NM_PER_RAD
 
 
 def torsional_damping(c_nmms_per_deg: float) -> float:
     """Shaft damping [N mm s/deg] -> [N m s/rad] (Table 6)."""
-    return c_nmms_per_deg * 1.0e-3 / DEG_TO_RAD
+    return c_nmms_per_deg * NMM_PER_DEG_TO_NM_PER_RAD

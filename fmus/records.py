@@ -23,6 +23,9 @@ def full_record(name: str, role: str, model: Mapping[str, Any], source: str,
                 variables: Iterable[Variable] = (), bounds: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """The complete FMU record of FMU ``name`` (format :data:`~fmus.slaves.record.RECORD_FORMAT`).
 
+    ``variables`` give the record's ``signals`` and ``unit_exponents`` (variable -> the parameter
+    holding the exponent ``e`` of its unit, e.g. ``"stage1.k0": "stage1.exponent"`` for ``N/m^e``).
+
     ``bounds`` (parameter -> :class:`components.validation.Bounds`) become the record's
     ``bounds``: what a host checks a value against before it instantiates the FMU.
     """
@@ -35,6 +38,9 @@ def full_record(name: str, role: str, model: Mapping[str, Any], source: str,
         "model": dict(model),
         "signals": signals_of(variables),
     }
+    exponents = {v.name: v.unit_exponent for v in variables if v.unit_exponent}
+    if exponents:  # "stage1.k0": "stage1.exponent": the parameter holding the e of its unit N/m^e
+        record["unit_exponents"] = exponents
     if bounds:
         record["bounds"] = {var: b.as_dict() for var, b in bounds.items()}
     return record

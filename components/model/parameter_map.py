@@ -113,6 +113,17 @@ _PARALLEL_FIELDS = {
 }
 
 
+#: parameter field -> the field of the same prefix holding the exponent e of its unit (k0 [N/m^e])
+UNIT_EXPONENTS: dict[str, str] = {"k0": "exponent"}
+
+
+def unit_exponent_parameter(name: str) -> str:
+    """The flat parameter whose value is the ``e`` of ``name``'s unit (``stage1.k0`` -> ``stage1.exponent``), or ``""``."""
+    prefix, _, field = name.rpartition(".")
+    other = UNIT_EXPONENTS.get(field)
+    return "" if other is None else (f"{prefix}.{other}" if prefix else other)
+
+
 def unit_of_parameter(name: str) -> str:
     """Unit string of a flat parameter name (``"N/m^e"`` has the exponent e)."""
     return UNITS.get(name.rsplit(".", 1)[-1], "1")

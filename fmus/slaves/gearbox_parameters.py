@@ -21,6 +21,7 @@ from components.model.parameter_map import (
     description_of_parameter,
     flatten,
     unflatten,
+    unit_exponent_parameter,
     unit_of_parameter,
 )
 from components.model.stages import PlanetaryStage
@@ -81,7 +82,8 @@ def drivetrain_variables(template: Drivetrain) -> list[Variable]:
         if name.rsplit(".", 1)[-1] in _INTEGER_CODES:
             out.append(integer_parameter(name, int(values[name]), description))
         else:
-            out.append(real_parameter(name, values[name], unit_of_parameter(name), description))
+            out.append(real_parameter(name, values[name], unit_of_parameter(name), description,
+                                      unit_exponent_parameter(name)))
     return out
 
 

@@ -94,6 +94,10 @@ class Variable:
         analyses use.
     info : tuple of (str, str)
         Details of the signal (``("stage", "stage1"), ("mesh", "sun_planet"), ("planet", "1")``).
+    unit_exponent : str
+        For a unit with the exponent ``e`` (``"N/m^e"`` of a contact stiffness): the parameter whose value
+        is ``e``, declared in the FMU's record (``unit_exponents``) so a host can convert a quantity
+        such as ``"5e5 N/mm^1.5"`` to it; ``""`` otherwise.
     """
 
     name: str
@@ -104,6 +108,7 @@ class Variable:
     start: Value | None = None
     signal: str = ""
     info: tuple[tuple[str, str], ...] = ()
+    unit_exponent: str = ""
 
     def __post_init__(self) -> None:
         if self.type not in (REAL, INTEGER, BOOLEAN):
@@ -131,9 +136,9 @@ class Variable:
         return f"{self.description} [{unit}]"
 
 
-def real_parameter(name: str, start: float, unit: str, description: str) -> Variable:
-    """A fixed Real parameter."""
-    return Variable(name, REAL, PARAMETER, description, unit, float(start))
+def real_parameter(name: str, start: float, unit: str, description: str, unit_exponent: str = "") -> Variable:
+    """A fixed Real parameter (``unit_exponent``: the parameter holding the ``e`` of a unit such as ``N/m^e``)."""
+    return Variable(name, REAL, PARAMETER, description, unit, float(start), unit_exponent=unit_exponent)
 
 
 def integer_parameter(name: str, start: int, description: str) -> Variable:

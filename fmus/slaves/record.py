@@ -14,6 +14,9 @@ by hosts that want to know what the FMU is (:mod:`orchestrator.cosim.fmu_interfa
     The parameter set as plain data (:mod:`components.model.description`), plus
     operating-point defaults: WindSource ``{"wind"}``, Gearbox ``{"drivetrain",
     "rotor_speed_rad_s"}``, GeneratorRotor ``{"generator", "initial_speed_rad_s"}``.
+``unit_exponents`` (optional)
+    Variable -> the parameter whose value is the exponent ``e`` of its unit (``"stage1.k0":
+    "stage1.exponent"``: k0 is in N/m^e); hosts convert quantities such as ``"5e5 N/mm^1.5"`` with it.
 ``signals``
     Output variable -> ``{"signal": kind, ...}`` (:data:`SIGNALS` of the role),
     e.g. ``"stage1.F_sp[1]": {"signal": "contact_force", "stage": "stage1", "mesh":

@@ -16,7 +16,8 @@ output dependencies, ``"*"`` for all of a component's; iterated with
 ``algebraic_loops = "iterate"``; with Jacobi, a loop that passes an output without
 declared dependencies is run as libcosim runs it, with a note in
 ``ResolvedSystem.notes``);
-every value within what the FMU accepts (FMI Integer range, declared bounds, a
+values given with a unit (``"0.56 mm"``) converted to the unit the FMU declares
+(:mod:`orchestrator.cosim.declared_units`); every value within what the FMU accepts (FMI Integer range, declared bounds, a
 dtcosim model's own validation: :mod:`orchestrator.cosim.parameter_checks`); the
 results within the size limits (:func:`check_sizes`). The first problem raises
 :class:`~orchestrator.errors.ScenarioError` naming the scenario key. The result,
@@ -35,6 +36,7 @@ from ..errors import AlgebraicLoopError, ScenarioError, suggestion
 from ..frozen_map import FrozenMap
 from ..inputs.limits import MAX_RESULT_VALUES
 from ..inputs.scenario import Component, Scenario, VariableRef
+from .declared_units import quantities_as_values
 from .event_slots import assign_events
 from .fmu_interface import FmuInterface, FmuVariable, read_fmu_interface
 from .coupling_delays import FEEDTHROUGH, coupling_delays
@@ -181,6 +183,7 @@ def resolve_system(scenario: Scenario, fmu_paths: Mapping[str, Path] | None = No
     scenario, events = assign_events(scenario, interfaces)
 
     scenario = _enumeration_items_as_values(scenario, interfaces)
+    scenario = quantities_as_values(scenario, interfaces)  # "0.56 mm" -> the declared unit's number
     connected_inputs = {str(c.target) for c in scenario.connections}
     for comp in scenario.components:
         iface = interfaces[comp.name]

@@ -93,7 +93,7 @@ from components.model.gear_geometry import (
     ring_teeth_check,
 )
 from components.model.generator import GeneratorParameters
-from components.model.stages import ParallelStage, PlanetaryStage, Shaft
+from components.model.stages import STEEL_DENSITY_KG_M3, ParallelStage, PlanetaryStage, Shaft
 
 from .drivetrain_schema import (
     STAGE_TABLES,
@@ -187,36 +187,51 @@ _MESH_DEFAULTS = {"law": "cfs", "exponent": 1.5}
 _MESH_REQUIRED = ("k0", "c0", "lambda", "backlash")
 
 
+def _entries(table) -> dict[str, Any]:
+    """The given entries of a table by file key (values as read: :class:`~orchestrator.inputs.quantities.Given`)."""
+    return {info.alias or name: getattr(table, name) for name, info in type(table).model_fields.items()
+            if getattr(table, name) is not None}
+
+
 class _Reader:
     """Turns the validated tables into the model's dataclasses, naming file keys in every error."""
 
     def __init__(self, doc: DrivetrainFile, source: str | None) -> None:
         self.doc = doc
         self.source = source
-        self.u = FileUnits(doc.units)
+        self.u = FileUnits(doc.units, source)
+        self.density = self.u.si("density", doc.density, "density") if doc.density is not None \
+            else STEEL_DENSITY_KG_M3
 
     def error(self, key: str, value: Any, expected: str) -> DrivetrainFileError:
         return DrivetrainFileError(key, value, expected, self.source)
 
     # -- meshes
-    def mesh(self, key: str, pressure_angle_rad: float, *tables: MeshTable | None) -> MeshContact:
+    def mesh(self, key: str, pressure_angle_rad: float, tables: tuple[MeshTable | None, ...],
+             keys: tuple[str, ...]) -> MeshContact:
         merged: dict[str, Any] = dict(_MESH_DEFAULTS)
-        for table in (self.doc.mesh, *tables):
+        where: dict[str, str] = {}  # the file key each merged entry comes from
+        for table, tkey in zip((self.doc.mesh, *tables), ("mesh", *keys)):
             if table is not None:
-                merged.update(table.model_dump(by_alias=True, exclude_none=True))
+                entries = _entries(table)
+                merged.update(entries)
+                where.update({name: f"{tkey}.{name}" for name in entries})
         for name in _MESH_REQUIRED:
             if name not in merged:
                 raise self.error(f"{key}.{name}", None, f"a value for {name} (missing: give it in this mesh, the "
                                  "stage's mesh table or the file's [mesh] table)")
         e = merged["exponent"]
-        u = self.u
+
+        def si(name: str, dimension: str) -> float:
+            return self.u.si(where.get(name, f"{key}.{name}"), merged[name], dimension, e)
+
         try:
             return MeshContact(
-                stiffness=u.k0(merged["k0"], e), exponent=e, damping=u.c0(merged["c0"]),
-                regularisation=u.regularisation(merged["lambda"]), backlash_normal_m=u.length(merged["backlash"]),
+                stiffness=si("k0", "contact_stiffness"), exponent=e, damping=si("c0", "contact_damping"),
+                regularisation=si("lambda", "regularisation"), backlash_normal_m=si("backlash", "length"),
                 pressure_angle_rad=pressure_angle_rad, law=merged["law"],
-                **({"impact_depth_m": u.length(merged["impact_depth"])} if "impact_depth" in merged else {}),
-                **({"impact_damping": u.impact_damping(merged["impact_damping"])} if "impact_damping" in merged else {}),
+                **({"impact_depth_m": si("impact_depth", "length")} if "impact_depth" in merged else {}),
+                **({"impact_damping": si("impact_damping", "impact_damping")} if "impact_damping" in merged else {}),
                 **{k: merged[k] for k in ("contact_ratio", "stiffness_variation") if k in merged},
             )
         except ParameterError as exc:
@@ -238,16 +253,19 @@ class _Reader:
                 if getattr(table, name) is not None:
                     raise self.error(f"{key}.{name}", getattr(table, name), "no disc data when mass and inertia "
                                      "are given")
-            return BodyRow(body_name, table.mass, self.u.inertia(table.inertia), "given")
+            return BodyRow(body_name, self.u.si(f"{key}.mass", table.mass, "mass"),
+                           self.u.si(f"{key}.inertia", table.inertia, "inertia"), "given")
         if table.disc is None:
-            raise self.error(key, table.model_dump(exclude_none=True),
+            raise self.error(key, {k: str(v) for k, v in _entries(table).items()},
                              'mass and inertia, or disc = "solid" or "bored" (with bore_diameter) to derive them')
         if table.disc == "bored" and table.bore_diameter is None:
             raise self.error(f"{key}.bore_diameter", None, 'a bore diameter [length unit] for disc = "bored"')
         if table.disc == "solid" and table.bore_diameter is not None:
             raise self.error(f"{key}.bore_diameter", table.bore_diameter, 'no bore for disc = "solid"')
-        bore = 0.5 * self.u.length(table.bore_diameter) if table.bore_diameter is not None else 0.0
-        density = table.density if table.density is not None else self.doc.density
+        bore = 0.5 * self.u.si(f"{key}.bore_diameter", table.bore_diameter, "length") \
+            if table.bore_diameter is not None else 0.0
+        density = self.u.si(f"{key}.density", table.density, "density") if table.density is not None \
+            else self.density
         try:
             disc = disc_body(pitch_radius_m, width_m, density, bore)
         except ParameterError as exc:
@@ -278,25 +296,31 @@ class _Reader:
             return self.planetary(key, name, table)
         return self.parallel(key, name, table)
 
+    def common(self, key: str, t) -> tuple[float, float, float]:
+        """Module, pressure angle and face width of a stage, SI."""
+        u = self.u
+        module = u.si(f"{key}.module", t.module, "length")
+        alpha = u.si(f"{key}.pressure_angle", t.pressure_angle, "angle")
+        if not alpha < 0.5 * math.pi:
+            raise self.error(f"{key}.pressure_angle", t.pressure_angle.shown, "an angle below 90 deg")
+        return module, alpha, u.si(f"{key}.face_width", t.face_width, "length")
+
     def planetary(self, key: str, name: str, t: PlanetaryTable):
         u = self.u
-        module = u.length(t.module)
-        alpha = u.angle(t.pressure_angle)
-        if not alpha < 0.5 * math.pi:
-            raise self.error(f"{key}.pressure_angle", t.pressure_angle, f"an angle below 90 deg [{self.doc.units.angle}]")
-        width = u.length(t.face_width)
+        module, alpha, width = self.common(key, t)
         checks: list[GeometryCheck] = []
         angles = None
         if t.planet_angles is not None:
+            given = [a.shown for a in t.planet_angles]
             if len(t.planet_angles) != t.planets:
-                raise self.error(f"{key}.planet_angles", t.planet_angles, f"{t.planets} angles, one per planet")
-            angles = tuple(u.angle(a) for a in t.planet_angles)
+                raise self.error(f"{key}.planet_angles", given, f"{t.planets} angles, one per planet")
+            angles = tuple(u.si(f"{key}.planet_angles[{j}]", a, "angle") for j, a in enumerate(t.planet_angles))
             if not all(0.0 <= a < 2.0 * math.pi for a in angles) or any(b <= a for a, b in zip(angles, angles[1:])):
-                raise self.error(f"{key}.planet_angles", t.planet_angles,
+                raise self.error(f"{key}.planet_angles", given,
                                  "strictly increasing angles in [0, 360) deg ([0, 2 pi) rad)")
         if t.teeth is not None:
             z = t.teeth
-            r_s, r_p, r_r = (u.length(t.module * n / 2.0) for n in (z.sun, z.planet, z.ring))
+            r_s, r_p, r_r = (module * n / 2.0 for n in (z.sun, z.planet, z.ring))
             ring = ring_teeth_check(z.sun, z.planet, z.ring)
             if not ring.passed:
                 raise self.error(f"{key}.teeth.ring", z.ring, f"Z_sun + 2 Z_planet = {z.sun + 2 * z.planet} for "
@@ -304,17 +328,18 @@ class _Reader:
             assembly = assembly_check(z.sun, z.ring, t.planets, angles)
             if not assembly.passed:
                 where = "planet_angles" if angles is not None else "planets"
-                raise self.error(f"{key}.{where}", t.planet_angles if angles is not None else t.planets,
-                                 f"planets that can be assembled: {assembly.detail}")
+                raise self.error(f"{key}.{where}", [a.shown for a in t.planet_angles] if angles is not None
+                                 else t.planets, f"planets that can be assembled: {assembly.detail}")
             checks += [ring, assembly]
         else:
             r = t.radii
-            r_s, r_r = u.length(r.sun), u.length(r.ring)
+            r_s, r_r = u.si(f"{key}.radii.sun", r.sun, "length"), u.si(f"{key}.radii.ring", r.ring, "length")
             if not r_r > r_s:
-                raise self.error(f"{key}.radii.ring", r.ring, f"> the sun radius {r.sun:g}")
+                raise self.error(f"{key}.radii.ring", r.ring.shown, f"> the sun radius {r.sun.shown:g} ({r_s:g} m)" if r.sun.unit is None else f"> the sun radius {r.sun.text} ({r_s:g} m)")
             r_p = 0.5 * (r_r - r_s)
-            if r.planet is not None and not math.isclose(u.length(r.planet), r_p, rel_tol=1e-9):
-                raise self.error(f"{key}.radii.planet", r.planet, f"(ring - sun) / 2 = {0.5 * (r.ring - r.sun):g} "
+            if r.planet is not None and not math.isclose(u.si(f"{key}.radii.planet", r.planet, "length"), r_p,
+                                                         rel_tol=1e-9):
+                raise self.error(f"{key}.radii.planet", r.planet.shown, f"(ring - sun) / 2 = {r_p:g} m "
                                  "(coaxial sun, planet and ring)")
             checks.append(GeometryCheck("ring teeth", None, "radii given: no tooth counts to check"))
             checks.append(GeometryCheck("assembly", None, "radii given: no tooth counts to check"))
@@ -325,11 +350,11 @@ class _Reader:
         checks.append(clearance)
         sun = self.body(f"{key}.sun", f"{name}.sun", t.sun, r_s, width)
         planet = self.body(f"{key}.planet", f"{name}.planet", t.planet, r_p, width)
-        carrier = BodyRow(f"{name}.carrier", None, u.inertia(t.carrier_inertia),
+        carrier = BodyRow(f"{name}.carrier", None, u.si(f"{key}.carrier_inertia", t.carrier_inertia, "inertia"),
                           "given (extra carrier inertia; the planets' orbital inertia n m_p a^2 is added)")
         # precedence: the file's [mesh] < the stage's mesh < its sun_mesh / ring_mesh
-        sun_mesh = self.mesh(f"{key}.sun_mesh", alpha, t.mesh, t.sun_mesh)
-        ring_mesh = self.mesh(f"{key}.ring_mesh", alpha, t.mesh, t.ring_mesh)
+        sun_mesh = self.mesh(f"{key}.sun_mesh", alpha, (t.mesh, t.sun_mesh), (f"{key}.mesh", f"{key}.sun_mesh"))
+        ring_mesh = self.mesh(f"{key}.ring_mesh", alpha, (t.mesh, t.ring_mesh), (f"{key}.mesh", f"{key}.ring_mesh"))
         try:
             stage = PlanetaryStage(
                 name=name, sun_radius_m=r_s, ring_radius_m=r_r, n_planets=t.planets,
@@ -344,18 +369,15 @@ class _Reader:
 
     def parallel(self, key: str, name: str, t: ParallelTable):
         u = self.u
-        module = u.length(t.module)
-        alpha = u.angle(t.pressure_angle)
-        if not alpha < 0.5 * math.pi:
-            raise self.error(f"{key}.pressure_angle", t.pressure_angle, f"an angle below 90 deg [{self.doc.units.angle}]")
-        width = u.length(t.face_width)
+        module, alpha, width = self.common(key, t)
         if t.teeth is not None:
-            r1, r2 = (u.length(t.module * n / 2.0) for n in (t.teeth.drive, t.teeth.driven))
+            r1, r2 = (module * n / 2.0 for n in (t.teeth.drive, t.teeth.driven))
         else:
-            r1, r2 = u.length(t.radii.drive), u.length(t.radii.driven)
+            r1 = u.si(f"{key}.radii.drive", t.radii.drive, "length")
+            r2 = u.si(f"{key}.radii.driven", t.radii.driven, "length")
         drive = self.body(f"{key}.drive", f"{name}.drive", t.drive, r1, width)
         driven = self.body(f"{key}.driven", f"{name}.driven", t.driven, r2, width)
-        mesh = self.mesh(f"{key}.mesh", alpha, t.mesh)
+        mesh = self.mesh(f"{key}.mesh", alpha, (t.mesh,), (f"{key}.mesh",))
         try:
             stage = ParallelStage(
                 name=name, drive_radius_m=r1, driven_radius_m=r2, drive_mass_kg=drive.mass_kg,
@@ -395,14 +417,16 @@ class _Reader:
                 raise self.error(f"shafts[{k}].name", name, "a shaft name of letters, digits, '_' or '-', used by no "
                                  "other stage or shaft, not " + ", ".join(RESERVED_NAMES))
             taken.add(name)
-            shafts.append(Shaft(name, self.u.shaft_stiffness(t.stiffness), self.u.shaft_damping(t.damping)))
+            shafts.append(Shaft(name, self.u.si(f"shafts[{k}].stiffness", t.stiffness, "torsional_stiffness"),
+                                self.u.si(f"shafts[{k}].damping", t.damping, "torsional_damping")))
         try:
             if doc.generator is not None:
-                gen = GeneratorParameters(self.u.inertia(doc.generator.inertia),
-                                          self.u.torque(doc.generator.counter_torque))
+                gen = GeneratorParameters(self.u.si("generator.inertia", doc.generator.inertia, "inertia"),
+                                          self.u.si("generator.counter_torque", doc.generator.counter_torque,
+                                                    "torque"))
                 dt = Drivetrain(tuple(stages), tuple(shafts[:-1]), generator=gen, output_shaft=shafts[-1])
             else:
-                dt = Drivetrain(tuple(stages), tuple(shafts), output_torque_nm=self.u.torque(doc.output.torque))
+                dt = Drivetrain(tuple(stages), tuple(shafts), output_torque_nm=self.u.si("output.torque", doc.output.torque, "torque"))
         except ParameterError as exc:
             raise self.error(f"(drivetrain) {exc.name}", exc.value, exc.expected) from None
         return dt, bodies, checks
@@ -423,7 +447,8 @@ def drivetrain_from_dict(data: Mapping[str, Any], name: str | None = None, sourc
         raise DrivetrainFileError("name", dt_name, "a drivetrain name of letters, digits, '_' or '-'", source)
     reader = _Reader(doc, source)
     drivetrain, bodies, checks = reader.drivetrain()
-    speed = reader.u.speed(doc.operating_point.rotor_speed) if doc.operating_point else DEFAULT_ROTOR_SPEED_RAD_S
+    speed = reader.u.si("operating_point.rotor_speed", doc.operating_point.rotor_speed, "speed") \
+        if doc.operating_point else DEFAULT_ROTOR_SPEED_RAD_S
     return DrivetrainSpec(dt_name, doc.description, drivetrain, speed, bodies, checks, source, sha256, dict(data))
 
 

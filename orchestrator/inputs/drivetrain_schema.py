@@ -12,9 +12,9 @@ from typing import Any, Literal
 from pydantic import Field
 
 from components.model.contact import CONTACT_LAWS
-from components.model.stages import STEEL_DENSITY_KG_M3
 
 from ..errors import EntryError
+from .quantities import Given, amount
 from .schema import Table
 
 
@@ -25,33 +25,45 @@ class DrivetrainFileError(EntryError):
 
 
 class UnitsTable(Table):
-    """``[units]``: the unit of each quantity; SI unless named here."""
+    """``[units]``: the unit of the bare numbers of each dimension (any unit of it, e.g. ``length = "mm"``).
 
-    length: Literal["m", "mm"] = "m"
-    angle: Literal["rad", "deg"] = "rad"
-    inertia: Literal["kg.m2", "kg.mm2"] = "kg.m2"
-    contact_stiffness: Literal["N/m^e", "N/mm^e"] = "N/m^e"
-    contact_damping: Literal["N.s/m2", "N.s/mm2"] = "N.s/m2"
-    regularisation: Literal["1/m", "1/mm"] = "1/m"
-    impact_damping: Literal["N.s/m", "N.s/mm"] = "N.s/m"
-    torsional_stiffness: Literal["N.m/rad", "N.mm/deg"] = "N.m/rad"
-    torsional_damping: Literal["N.m.s/rad", "N.mm.s/deg"] = "N.m.s/rad"
-    torque: Literal["N.m", "N.mm"] = "N.m"
-    speed: Literal["rad/s", "rpm"] = "rad/s"
+    Named every dimension whose bare numbers the file uses, or none (then they are SI); a value
+    written with its unit (``backlash = "0.56 mm"``) needs no entry (:mod:`orchestrator.inputs.drivetrain_units`).
+    """
+
+    length: str | None = Field(None, description="a length unit such as \"mm\" or \"m\"")
+    angle: str | None = Field(None, description="an angle unit such as \"deg\" or \"rad\"")
+    mass: str | None = Field(None, description="a mass unit such as \"kg\"")
+    density: str | None = Field(None, description="a density unit such as \"kg/m3\"")
+    inertia: str | None = Field(None, description="an inertia unit such as \"kg.mm2\" or \"kg m^2\"")
+    contact_stiffness: str | None = Field(None, description="a unit of k0 such as \"N/mm^e\" (e: the force exponent)")
+    contact_damping: str | None = Field(None, description="a unit of c0 such as \"N.s/mm2\"")
+    regularisation: str | None = Field(None, description="a unit of lambda such as \"1/mm\"")
+    impact_damping: str | None = Field(None, description="a unit of c_max such as \"N.s/mm\"")
+    torsional_stiffness: str | None = Field(None, description="a unit such as \"N.mm/deg\" or \"N.m/rad\"")
+    torsional_damping: str | None = Field(None, description="a unit such as \"N.mm.s/deg\" or \"N.m.s/rad\"")
+    torque: str | None = Field(None, description="a torque unit such as \"N.mm\" or \"kN m\"")
+    speed: str | None = Field(None, description="a speed unit such as \"rpm\" or \"rad/s\"")
+
+
+class PlausibilityTable(Table):
+    """``[plausibility]``: the values a deliberate study keeps although physics calls them implausible."""
+
+    allow: list[str] = Field(default_factory=list, description='a list of parameter names such as "stage1.backlash"')
 
 
 class MeshTable(Table):
     """Contact law and parameters of a mesh; missing entries come from the file's ``[mesh]``."""
 
     law: Literal[CONTACT_LAWS] | None = None  # the laws of components.model.kernel.contact
-    k0: float | None = Field(None, gt=0, description="a number > 0: contact stiffness k0 [contact_stiffness unit]")
+    k0: amount(gt=0) | None = Field(None, description="a number > 0: contact stiffness k0 [contact_stiffness unit]")
     exponent: float | None = Field(None, ge=1, le=3, description="a number in [1, 3]: the force exponent e")
-    c0: float | None = Field(None, ge=0, description="a number >= 0: contact damping c0 [contact_damping unit]")
-    lambda_: float | None = Field(None, alias="lambda", gt=0,
+    c0: amount(ge=0) | None = Field(None, description="a number >= 0: contact damping c0 [contact_damping unit]")
+    lambda_: amount(gt=0) | None = Field(None, alias="lambda",
                                   description="a number > 0: backlash regularisation lambda [regularisation unit]")
-    backlash: float | None = Field(None, ge=0, description="a number >= 0: normal backlash j_n [length unit]")
-    impact_depth: float | None = Field(None, gt=0, description="a number > 0: impact penetration d_max [length unit]")
-    impact_damping: float | None = Field(None, ge=0, description="a number >= 0: impact damping c_max")
+    backlash: amount(ge=0) | None = Field(None, description="a number >= 0: normal backlash j_n [length unit]")
+    impact_depth: amount(gt=0) | None = Field(None, description="a number > 0: impact penetration d_max [length unit]")
+    impact_damping: amount(ge=0) | None = Field(None, description="a number >= 0: impact damping c_max")
     contact_ratio: float | None = Field(None, ge=1, le=10, description="a number in [1, 10]")
     stiffness_variation: float | None = Field(None, ge=0, le=0.9, description="a number in [0, 0.9]")
 
@@ -59,11 +71,11 @@ class MeshTable(Table):
 class GearTable(Table):
     """A gear body: ``mass`` and ``inertia`` given, or ``disc = "solid" | "bored"`` derived from the geometry."""
 
-    mass: float | None = Field(None, gt=0, description="a number > 0 [kg]")
-    inertia: float | None = Field(None, gt=0, description="a number > 0 [inertia unit]")
+    mass: amount(gt=0) | None = Field(None, description="a number > 0 [mass unit]")
+    inertia: amount(gt=0) | None = Field(None, description="a number > 0 [inertia unit]")
     disc: Literal["solid", "bored"] | None = None
-    bore_diameter: float | None = Field(None, gt=0, description="a number > 0 [length unit]")
-    density: float | None = Field(None, gt=0, description="a number > 0 [kg/m3]")
+    bore_diameter: amount(gt=0) | None = Field(None, description="a number > 0 [length unit]")
+    density: amount(gt=0) | None = Field(None, description="a number > 0 [density unit]")
 
 
 class PlanetaryTeeth(Table):
@@ -73,9 +85,9 @@ class PlanetaryTeeth(Table):
 
 
 class PlanetaryRadii(Table):
-    sun: float = Field(gt=0, description="a pitch radius > 0 [length unit]")
-    ring: float = Field(gt=0, description="a pitch radius > 0 [length unit]")
-    planet: float | None = Field(None, gt=0, description="a pitch radius > 0 [length unit]")
+    sun: amount(gt=0) = Field(description="a pitch radius > 0 [length unit]")
+    ring: amount(gt=0) = Field(description="a pitch radius > 0 [length unit]")
+    planet: amount(gt=0) | None = Field(None, description="a pitch radius > 0 [length unit]")
 
 
 class ParallelTeeth(Table):
@@ -84,15 +96,15 @@ class ParallelTeeth(Table):
 
 
 class ParallelRadii(Table):
-    drive: float = Field(gt=0, description="a pitch radius > 0 [length unit]")
-    driven: float = Field(gt=0, description="a pitch radius > 0 [length unit]")
+    drive: amount(gt=0) = Field(description="a pitch radius > 0 [length unit]")
+    driven: amount(gt=0) = Field(description="a pitch radius > 0 [length unit]")
 
 
 class _StageCommon(Table):
     name: str | None = Field(None, description="a stage name (letters, digits, '_', '-')")
-    module: float = Field(gt=0, description="a number > 0: the gear module [length unit]")
-    pressure_angle: float = Field(gt=0, description="a number > 0: the pressure angle [angle unit]")
-    face_width: float = Field(gt=0, description="a number > 0: the face width [length unit]")
+    module: amount(gt=0) = Field(description="a number > 0: the gear module [length unit]")
+    pressure_angle: amount(gt=0) = Field(description="a number > 0: the pressure angle [angle unit]")
+    face_width: amount(gt=0) = Field(description="a number > 0: the face width [length unit]")
 
 
 class PlanetaryTable(_StageCommon):
@@ -102,8 +114,8 @@ class PlanetaryTable(_StageCommon):
     teeth: PlanetaryTeeth | None = None
     radii: PlanetaryRadii | None = None
     planets: int = Field(ge=1, description="a whole number of planets >= 1")
-    planet_angles: list[float] | None = Field(None, description="a list of planet carrier angles [angle unit]")
-    carrier_inertia: float = Field(0.0, ge=0, description="a number >= 0: extra carrier inertia [inertia unit]")
+    planet_angles: list[amount()] | None = Field(None, description="a list of planet carrier angles [angle unit]")
+    carrier_inertia: amount(ge=0) = Field(Given(0.0), description="a number >= 0: extra carrier inertia [inertia unit]")
     sun: GearTable
     planet: GearTable
     mesh: MeshTable | None = None
@@ -124,21 +136,21 @@ class ParallelTable(_StageCommon):
 
 class ShaftTable(Table):
     name: str | None = Field(None, description="a shaft name (letters, digits, '_', '-')")
-    stiffness: float = Field(gt=0, description="a number > 0: torsional stiffness [torsional_stiffness unit]")
-    damping: float = Field(0.0, ge=0, description="a number >= 0: torsional damping [torsional_damping unit]")
+    stiffness: amount(gt=0) = Field(description="a number > 0: torsional stiffness [torsional_stiffness unit]")
+    damping: amount(ge=0) = Field(Given(0.0), description="a number >= 0: torsional damping [torsional_damping unit]")
 
 
 class GeneratorTable(Table):
-    inertia: float = Field(gt=0, description="a number > 0: generator rotor inertia [inertia unit]")
-    counter_torque: float = Field(description="a number: generator counter torque [torque unit]")
+    inertia: amount(gt=0) = Field(description="a number > 0: generator rotor inertia [inertia unit]")
+    counter_torque: amount() = Field(description="a number: generator counter torque [torque unit]")
 
 
 class OutputTable(Table):
-    torque: float = Field(description="a number: counter torque on the last stage's output member [torque unit]")
+    torque: amount() = Field(description="a number: counter torque on the last stage's output member [torque unit]")
 
 
 class OperatingPointTable(Table):
-    rotor_speed: float = Field(gt=0, description="a number > 0: rotor speed [speed unit]")
+    rotor_speed: amount(gt=0) = Field(description="a number > 0: rotor speed [speed unit]")
 
 
 class DrivetrainFile(Table):
@@ -146,8 +158,9 @@ class DrivetrainFile(Table):
 
     name: str | None = Field(None, description="a drivetrain name (letters, digits, '_', '-')")
     description: str = Field("", description="a string")
-    density: float = Field(STEEL_DENSITY_KG_M3, gt=0, description="a number > 0 [kg/m3]")
+    density: amount(gt=0) | None = Field(None, description="a number > 0 [density unit] (default: steel, 7800 kg/m3)")
     units: UnitsTable = Field(default_factory=UnitsTable, description="a [units] table")
+    plausibility: PlausibilityTable | None = Field(None, description="a [plausibility] table with allow = [...]")
     mesh: MeshTable = Field(default_factory=MeshTable, description="a [mesh] table of contact defaults")
     stages: list[dict[str, Any]] = Field(min_length=1, description="an array of tables [[stages]], at least one")
     shafts: list[ShaftTable] = Field(default_factory=list, description="an array of tables [[shafts]]")

@@ -1,50 +1,88 @@
-"""Unit conversions of a drivetrain file: its ``[units]`` table names the quantities not in SI."""
+"""The units of a drivetrain file's numbers: a value with its unit, or a bare number in the ``[units]`` one.
+
+Every dimensional entry of a drivetrain file may be written with its unit
+(``backlash = "0.56 mm"``, ``inertia = "1.51e8 kg mm^2"``, ``k0 = "5e5 N/mm^1.5"``), converted to SI
+by the registry of :mod:`orchestrator.inputs.quantities`. A bare number is in the unit the file's
+``[units]`` table names for its dimension (:data:`DIMENSIONS`), or SI when the file has no
+``[units]`` table. A ``[units]`` table names every dimension of the bare numbers the file uses, or
+none: a file that names ``length = "mm"`` but not ``inertia`` would otherwise read its inertias in
+kg m^2 without a word (and a table without ``length`` its module in metres). A contact stiffness's
+unit has the force exponent e (k0 of F = k0 d^e is in N/m^e): ``"N/mm^e"`` takes each mesh's
+exponent, ``"N/mm^1.5"`` fits only meshes with e = 1.5.
+"""
 
 from __future__ import annotations
 
-import math
+from typing import Any
 
-from components import units
+from .drivetrain_schema import DrivetrainFileError, UnitsTable
+from .quantities import Given, UnitError, convert
 
-from .drivetrain_schema import UnitsTable
+#: ``[units]`` key -> SI unit of that dimension (the unit of the model's numbers)
+DIMENSIONS: dict[str, str] = {
+    "length": "m", "angle": "rad", "mass": "kg", "density": "kg/m3", "inertia": "kg.m2",
+    "contact_stiffness": "N/m^e", "contact_damping": "N.s/m2", "regularisation": "1/m", "impact_damping": "N.s/m",
+    "torsional_stiffness": "N.m/rad", "torsional_damping": "N.m.s/rad", "torque": "N.m", "speed": "rad/s",
+}
 
 
 class FileUnits:
-    """Conversions of the file's numbers to SI, per the ``[units]`` table."""
+    """Conversions of a file's entries to SI, per its ``[units]`` table.
 
-    def __init__(self, table: UnitsTable) -> None:
-        self.t = table
+    Parameters
+    ----------
+    table : UnitsTable
+    source : str, optional
+        The file (error messages).
 
-    def length(self, v: float) -> float:
-        return units.mm(v) if self.t.length == "mm" else v
+    Raises
+    ------
+    DrivetrainFileError
+        A ``[units]`` entry that is no unit of its dimension (``units.<dimension>``).
+    """
 
-    def angle(self, v: float) -> float:
-        return math.radians(v) if self.t.angle == "deg" else v
+    def __init__(self, table: UnitsTable, source: str | None = None) -> None:
+        self.source = source
+        self.named = {k: v for k, v in table.model_dump().items() if v is not None}
+        for dim, unit in self.named.items():
+            if dim == "contact_stiffness":
+                continue  # its dimension depends on each mesh's exponent: checked where it is used
+            try:
+                convert(1.0, unit, DIMENSIONS[dim])
+            except UnitError as exc:
+                raise DrivetrainFileError(f"units.{dim}", unit, exc.expected, source) from None
 
-    def inertia(self, v: float) -> float:
-        return units.kgmm2(v) if self.t.inertia == "kg.mm2" else v
+    def si(self, key: str, value: Given | Any, dimension: str, exponent: float | None = None) -> float:
+        """The entry ``key`` (a :class:`Given` or a bare number) in SI.
 
-    def k0(self, v: float, exponent: float) -> float:
-        return units.contact_stiffness(v, exponent) if self.t.contact_stiffness == "N/mm^e" else v
+        Raises
+        ------
+        DrivetrainFileError
+            A unit of another dimension (naming ``key``), or a bare number of a dimension the
+            ``[units]`` table leaves out although it names others.
+        """
+        given = value if isinstance(value, Given) else Given(float(value))
+        target = DIMENSIONS[dimension]
+        if given.unit is not None:
+            try:
+                return convert(given.magnitude, given.unit, target, exponent)
+            except UnitError as exc:
+                raise DrivetrainFileError(key, given.shown, f"a {dimension.replace('_', ' ')}: {exc.expected}",
+                                          self.source) from None
+        if not self.named:
+            return given.magnitude  # no [units]: SI
+        unit = self.named.get(dimension)
+        if unit is None:
+            raise DrivetrainFileError(key, given.magnitude, (
+                f"a value with its unit (e.g. \"{given.magnitude:g} {target.replace('^e', '^1.5')}\"), or a "
+                f"[units] entry {dimension} = \"...\": this file's [units] names {', '.join(self.named)}, and it "
+                f"must name every dimension of the bare numbers the file uses, or none (then they are SI)"),
+                self.source)
+        try:
+            return convert(given.magnitude, unit, target, exponent)
+        except UnitError as exc:
+            raise DrivetrainFileError(f"units.{dimension}", unit, exc.expected, self.source) from None
 
-    def c0(self, v: float) -> float:
-        return units.contact_damping(v) if self.t.contact_damping == "N.s/mm2" else v
-
-    def regularisation(self, v: float) -> float:
-        return units.regularisation(v) if self.t.regularisation == "1/mm" else v
-
-    def impact_damping(self, v: float) -> float:
-        return v * 1e3 if self.t.impact_damping == "N.s/mm" else v
-
-    def shaft_stiffness(self, v: float) -> float:
-        return units.torsional_stiffness(v) if self.t.torsional_stiffness == "N.mm/deg" else v
-
-    def shaft_damping(self, v: float) -> float:
-        return units.torsional_damping(v) if self.t.torsional_damping == "N.mm.s/deg" else v
-
-    def torque(self, v: float) -> float:
-        return units.nmm(v) if self.t.torque == "N.mm" else v
-
-    def speed(self, v: float) -> float:
-        return units.rpm(v) if self.t.speed == "rpm" else v
-
+    def unit_of(self, dimension: str) -> str:
+        """The unit of a bare number of ``dimension`` (messages)."""
+        return self.named.get(dimension, DIMENSIONS[dimension])

@@ -142,6 +142,9 @@ def entry_error(exc: ValidationError, root: type[BaseModel], error: type[EntryEr
     if kind == "literal_error":
         expected = first.get("ctx", {}).get("expected", "")
         return error(key, value, f"one of {expected}" if expected else (described or _GENERIC[kind]), source)
+    if kind == "quantity":  # a unit of the wrong dimension (orchestrator.inputs.quantities): say which
+        expected = first["ctx"]["expected"]
+        return error(key, value, f"{described}: {expected}" if described else expected, source)
     if described is not None and not isinstance(loc[-1], int):
         return error(key, value, described, source)
     if kind == "value_error":  # a validator's own message

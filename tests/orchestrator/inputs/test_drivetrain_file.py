@@ -18,12 +18,20 @@ from orchestrator.inputs.drivetrain_file import (
     load_drivetrain_file,
 )
 
-#: a valid two-stage file (paper units for lengths and angles, SI otherwise)
+#: a valid two-stage file (paper units for lengths and angles, SI otherwise: [units] names every dimension it uses)
 BASE = """
 name = "two-stage"
 [units]
 length = "mm"
 angle = "deg"
+mass = "kg"
+inertia = "kg.m2"
+contact_stiffness = "N/m^e"
+contact_damping = "N.s/m2"
+regularisation = "1/m"
+torsional_stiffness = "N.m/rad"
+torsional_damping = "N.m.s/rad"
+torque = "N.m"
 
 [mesh]
 k0 = 1.58e10
@@ -80,7 +88,7 @@ def test_the_base_file_reads_in_si():
     assert sp.planet_radius_m == pytest.approx(0.195)
     assert sp.sun_mesh.pressure_angle_rad == pytest.approx(math.radians(20.0))
     assert sp.sun_mesh.backlash_normal_m == pytest.approx(5e-4)  # length unit mm
-    assert sp.sun_mesh.stiffness == 1.58e10  # contact stiffness stays SI: [units] does not name it
+    assert sp.sun_mesh.stiffness == 1.58e10  # contact stiffness in N/m^e, as [units] names it
     # derived sun: solid steel disc of the pitch diameter and face width, by hand
     mass = 7800.0 * math.pi * 0.105**2 * 0.05
     assert sp.sun_mass_kg == pytest.approx(mass, rel=1e-12)
@@ -218,7 +226,18 @@ BAD_FILES = [
      r"stages\[0\]\.planet_angles = \[0\.0, 100\.0, 240\.0\]: expected planets that can be assembled: .*planet\(s\) 2 fail"),
     ("contact parameter given nowhere", _delete(["mesh", "k0"]),
      r"stages\[0\]\.sun_mesh\.k0 = None: expected a value for k0 \(missing: give it in this mesh"),
-    ("unknown unit", _set(["units", "length"], "cm"), r"units\.length = 'cm': expected one of 'm' or 'mm'"),
+    ("unknown unit", _set(["units", "length"], "blorps"), r"units\.length = 'blorps': expected a unit dtcosim knows"),
+    ("[units] entry of another dimension", _set(["units", "length"], "kg"),
+     r"units\.length = 'kg': expected a quantity of dimension \[length\] \(SI unit m\); the unit 'kg' is \[mass\]"),
+    ("value with a unit of another dimension", _set(["mesh", "backlash"], "0.56 N"),
+     r"mesh\.backlash = '0\.56 N': expected a length: a quantity of dimension \[length\] \(SI unit m\); the unit 'N' is"),
+    ("torque given for a shaft stiffness", _set(["shafts", 0, "stiffness"], "1e7 N m"),
+     r"shafts\[0\]\.stiffness = '1e\+07 N m': expected a torsional stiffness: .*\[angle\]\^-1 \(SI unit N\.m/rad\)"),
+    ("[units] that leaves out a dimension the file uses", _delete(["units", "inertia"]),
+     r"stages\[0\]\.planet\.inertia = 2\.0: expected a value with its unit \(e\.g\. \"2 kg\.m2\"\), or a \[units\] "
+     r"entry inertia = \"\.\.\.\": this file's \[units\] names length, angle, mass, contact_stiffness, .* or none"),
+    ("[units] without length reads no module in metres", _delete(["units", "length"]),
+     r"stages\[0\]\.module = 10\.0: expected a value with its unit .*\[units\] entry length"),
     ("reserved stage name", _set(["stages", 1, "name"], "generator"), r"stages\[1\]\.name = 'generator': expected a stage name"),
     ("pressure angle of 90 deg or more", _set(["stages", 1, "pressure_angle"], 90.0),
      r"stages\[1\]\.pressure_angle = 90\.0: expected an angle below 90 deg"),
