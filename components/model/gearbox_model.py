@@ -203,18 +203,22 @@ class GearboxModel:
         a = self.assembly
         n, m, n2 = a.n_dof, a.n_mesh, 2 * a.n_dof
         width = a.nz_index.shape[1]
-        n_linear = 3 + m + a.n_shaft + len(self.gearbox_dofs)
+        n_ext = a.load_matrix.shape[0]
+        n_linear, n_mag = self._output_matrix.shape[1], self._magnitudes.shape[0]
         shapes = {
-            "a_t": (n, m), "a_port": (m,), "fast": (m + n2 + 3, n), "contact": a.law.table.shape, "stks": (n, n),
-            "stcs": (n, n), "stks_port": (n,), "stcs_port": (n,), "inv_m": (n,), "phasing": a.phasing_table.shape,
-            "kappa": (n,), "force_rows": (m, n), "nz_index": (m, width), "nz_value": (m, width), "cos_alpha": (m,),
-            "control": (L.N_CONTROL,), "twist_q": (n2,), "output_matrix": (m + n2 + 4, n_linear),
-            "z": (m + n2 + 4,), "defl": (2, m), "acc": (n,), "fd": (m,), "fv": (m,), "factor": (m,), "slope": (m,),
-            "sens": (m,), **{name: (n2,) for name in ("f0", "f1", "fn", "k1", "k2", "k3", "y1", "yn", "rhs", "w_hdt")},
+            "a_t": (n, m), "a_port": (m,), "fast": (m + n2 + 3 + n_ext, n), "contact": a.law.table.shape,
+            "stks": (n, n), "stcs": (n, n), "stks_port": (n,), "stcs_port": (n,), "inv_m": (n,),
+            "phasing": a.phasing_table.shape, "kappa": (n,), "force_rows": (m, n), "nz_index": (m, width),
+            "nz_value": (m, width), "cos_alpha": (m,), "control": (L.N_CONTROL,), "twist_q": (n2,),
+            "output_matrix": (m + n2 + 4, n_linear), "offset": (m,), "load_rates": a.load_rates.shape,
+            "magnitudes": (n_mag, 2),
+            "z": (m + n2 + 4 + n_ext,), "defl": (2, m), "acc": (n,), "fd": (m,), "fv": (m,), "factor": (m,),
+            "slope": (m,), "sens": (m,),
+            **{name: (n2,) for name in ("f0", "f1", "fn", "k1", "k2", "k3", "y1", "yn", "rhs", "w_hdt", "w_ext")},
             "da": (n,), "istate": (L.N_ISTATE,), "dq": (n, n), "dv": (n, n),
             "winvs": (2, n2, n2), "w_bases": (2, 3, n2),  # the active W^-1 and the one kept (istate[ACTIVE])
             "port_jac": (2, n), "last_acc": (n,), "last_force": (m,), "last_defl": (2, m), "y": (n2,),
-            "driver": (4,), "port": (4,), "scalars": (len(L.SCALAR_NAMES),), "outputs": (n_linear + 4,),
+            "driver": (4,), "port": (4,), "scalars": (len(L.SCALAR_NAMES),), "outputs": (n_linear + n_mag + 4,),
             "anchor": (n + 1,),
         }
         shapes["backup"] = (sum(int(np.prod(shapes[name])) for name in L.STATE_SLOTS),)
@@ -223,6 +227,7 @@ class GearboxModel:
     def _allocate(self) -> None:
         """The buffer with its views, constants and sizes."""
         a = self.assembly
+        self._output_matrix, self._magnitudes, self._output_names = self._build_outputs()
         shapes = self._slot_shapes()
         sizes = [int(np.prod(shapes[name])) for name in L.SLOTS]
         self._offsets = np.concatenate(([0], np.cumsum(sizes))).astype(np.int64)
@@ -247,13 +252,16 @@ class GearboxModel:
         v["force_rows"][:] = a.force_rows
         v["nz_index"][:], v["nz_value"][:] = a.nz_index, a.nz_value
         v["cos_alpha"][:] = a.cos_alpha
+        v["offset"][:] = a.mesh_offset
+        v["load_rates"][:] = a.load_rates
+        v["magnitudes"][:] = self._magnitudes
         c = self.control
         v["control"][:] = (c.rtol, c.atol_q, c.atol_v, c.h_min, float(c.max_steps), float(c.jacobian_max_age),
                            self._out_kinematic, float(self._out_rate_index))
         # output-shaft twist = twist_q . q + twist_port * port angle (its rate: the same weights on v)
         self._twist_q = np.concatenate((a.S[-1], np.zeros(a.n_dof)))
         v["twist_q"][:] = self._twist_q
-        v["output_matrix"][:] = self._build_output_matrix()
+        v["output_matrix"][:] = self._output_matrix
         sc = self._scalars
         sc[L.S_KX] = self._kx
         sc[L.S_TWIST_PORT] = float(a.port_twist[-1])
@@ -268,32 +276,73 @@ class GearboxModel:
         dims[L.D_END_TORQUE] = int(self.shaft_torque_mode == "end")
         dims[L.D_GEN_DOF] = -1 if self.generator_dof is None else self.generator_dof
         dims[L.D_ROTOR_DERIVATIVES] = int(self.rotor_derivatives)
+        dims[L.D_EXT] = a.load_matrix.shape[0]
+        dims[L.D_MAGNITUDES] = self._magnitudes.shape[0]
 
-    def _build_output_matrix(self) -> np.ndarray:
-        """Linear map ``z -> [shaft_torque_end, omega_out, torque_rotor, forces, shaft torques, speeds]``.
+    def _build_outputs(self) -> tuple[np.ndarray, np.ndarray, list[str]]:
+        """The linear map of the outputs, the index pairs of the magnitudes and every output's name.
 
-        ``z = [contact forces (n_mesh), q, v (n_dof each), port angle, port speed,
-        driver speed, driver acceleration]``: every output except the step-averaged
-        shaft torque is linear in ``z``.
+        ``z = [contact forces (n_mesh), q, v (n_dof each), port angle, port speed, driver speed, driver
+        acceleration]``: every output except the step-averaged shaft torque and the bearing-force magnitudes is
+        linear in ``z``: ``[shaft_torque_end, omega_out, torque_rotor, forces, shaft torques, speeds of the
+        rotations, displacements of the translations, bearing force components and bearing speeds]``; the
+        magnitudes are ``hypot`` of a bearing's two components (:func:`components.model.kernel.step.outputs`).
         """
         a = self.assembly
-        n, m, ns = a.n_dof, a.n_mesh, a.n_shaft
+        n, m = a.n_dof, a.n_mesh
         rows = m + 2 * n + 4
-        shafts = np.zeros((rows, ns))
+        shafts = np.zeros((rows, a.n_shaft))
         shafts[m : m + n] = (a.shaft_k[:, None] * a.S).T
         shafts[m + n : m + 2 * n] = (a.shaft_c[:, None] * a.S).T
         shafts[m + 2 * n] = a.shaft_k * a.port_twist
         shafts[m + 2 * n + 1] = a.shaft_c * a.port_twist
+        bearings = np.zeros((rows, a.n_spring))
+        bearings[m : m + n] = (a.bearing_k[:, None] * a.B).T
+        bearings[m + n : m + 2 * n] = (a.bearing_c[:, None] * a.B).T
         speeds = np.zeros((rows, n))
         speeds[m + n : m + 2 * n] = np.eye(n)
         speeds[m + 2 * n + 2] = a.kinematic_ratio
         forces = np.zeros((rows, m))
         forces[:m] = np.eye(m)
-        rotor = shafts @ a.s_driver  # shaft reactions on the driven carrier
+        rotor = shafts @ a.s_driver + bearings @ a.b_driver  # shaft and bearing reactions on the driven carrier
         rotor[:m] += a.BT_driver  # mesh reactions
         rotor[m + 2 * n + 3] += a.driver_inertia_kgm2  # carrier (and orbital planet) inertia
-        return np.column_stack((shafts[:, -1], speeds[:, self._out_member], rotor, forces, shafts,
-                                speeds[:, self.gearbox_dofs]))
+        rotations = [j for j in self.gearbox_dofs if a.bodies[a.free[j]].rotation]
+        translations = [j for j in self.gearbox_dofs if not a.bodies[a.free[j]].rotation]
+        positions = np.zeros((rows, len(translations)))
+        positions[m + np.array(translations, dtype=int), np.arange(len(translations))] = 1.0
+        columns = [shafts[:, -1:], speeds[:, [self._out_member]], rotor[:, None], forces, shafts,
+                   speeds[:, rotations], positions]
+        names = (["shaft_torque_end", "omega_out", "torque_rotor"] + a.mesh_names + [f"{s}.torque" for s in a.shaft_names]
+                 + [f"{a.dof_names[j]}.omega" for j in rotations] + [a.dof_names[j] for j in translations])
+        pairs = []
+        for element in a.elements:
+            first = len(names)
+            columns.append(bearings[:, list(element.rows)])
+            names += [f"{element.name}.{'torque' if c == 'torque' else 'F_' + c}" for c in element.components]
+            if element.kind != "torsion":
+                pairs.append((first, first + 1 if len(element.rows) > 1 else -1))
+            if element.speed:
+                column = self._speed_column(element.speed[0], rows)
+                if len(element.speed) > 1:
+                    column = column - self._speed_column(element.speed[1], rows)
+                columns.append(column[:, None])
+                names.append(f"{element.name}.omega")
+        magnitudes = [f"{e.name}.F" for e in a.elements if e.kind != "torsion"]
+        output_names = (["shaft_torque", "shaft_torque_avg"] + names + magnitudes + ["alpha_out", "alpha_out_max"])
+        return np.column_stack(columns), np.array(pairs, dtype=float).reshape(-1, 2), output_names
+
+    def _speed_column(self, body: str, rows: int) -> np.ndarray:
+        """The output column of a body's absolute speed ``kappa omega_in + v`` (the driver: ``omega_in``)."""
+        a = self.assembly
+        n, m = a.n_dof, a.n_mesh
+        j = [b.name for b in a.bodies].index(body)
+        column = np.zeros(rows)
+        column[m + 2 * n + 2] = a.kinematic_ratio_all[j]
+        free = np.flatnonzero(a.free == j)
+        if free.size:
+            column[m + n + int(free[0])] = 1.0
+        return column
 
     # the scalar state lives in the buffer
     time_s = _buffer_scalar(L.S_TIME, "Current time [s].")
@@ -397,23 +446,18 @@ class GearboxModel:
     def rotor_torque_from(self, shaft_torques_nm: np.ndarray) -> float:
         """Rotor torque [N m] given the current shaft torques [N m], shape (n_shaft,)."""
         a = self.assembly
+        bearing = self.y.reshape(2, a.n_dof) @ a.B.T
         return float(
             a.driver_inertia_kgm2 * self.driver_accel_rad_s2
             + self.contact_force_n @ a.BT_driver
             + shaft_torques_nm @ a.s_driver
+            + (a.bearing_k * bearing[0] + a.bearing_c * bearing[1]) @ a.b_driver
         )
 
     @property
     def output_names(self) -> list[str]:
         """Names of the entries of :meth:`output_vector`, in order (FMU variable names)."""
-        a = self.assembly
-        return (
-            ["shaft_torque", "shaft_torque_avg", "shaft_torque_end", "omega_out", "torque_rotor"]
-            + a.mesh_names
-            + [f"{s}.torque" for s in a.shaft_names]
-            + [f"{a.dof_names[j]}.omega" for j in self.gearbox_dofs]
-            + ["alpha_out", "alpha_out_max"]
-        )
+        return list(self._output_names)
 
     def output_vector(self) -> np.ndarray:
         """Every output at the current time, ordered as :attr:`output_names` (a copy).

@@ -38,7 +38,7 @@ import math
 
 import numpy as np
 
-from .dynamics import acceleration, jacobian, stiffness_rate
+from .dynamics import acceleration, external_rate, external_terms, jacobian, stiffness_rate
 from .layout import (
     ACCEPTED, ACTIVE, AGE, ALPHA_OUT_MAX, ATOL_Q, ATOL_V, BASIS_PREV_VALID, BASIS_VALID, H_MIN, H_NEXT, HD, HD_PREV,
     JAC_MAX_AGE, JACOBIANS, MAX_STEPS, OK, OUT_KINEMATIC, OUT_RATE_INDEX, REJECTED, RTOL, STEP_TOO_SMALL,
@@ -129,8 +129,9 @@ def refresh_jacobian(k, y, t, angle0, driver, port):
     """Evaluate the Jacobian at local time ``t`` and state ``y``; every kept factorisation is void."""
     if k.tvs:
         stiffness_factors(angle0 + value(driver, t), k.phasing, k.factor, k.slope)
-    jacobian(y, value(port, t), rate(port, t), k.factor, k.a_t, k.a_port, k.contact, k.defl, k.nz_index, k.nz_value,
-             k.cos_alpha, k.stks, k.stcs, k.stks_port, k.stcs_port, k.inv_m, k.fd, k.fv, k.dq, k.dv, k.port_jac)
+    jacobian(y, value(port, t), rate(port, t), k.factor, k.a_t, k.a_port, k.offset, k.contact, k.defl, k.nz_index,
+             k.nz_value, k.cos_alpha, k.stks, k.stcs, k.stks_port, k.stcs_port, k.inv_m, k.fd, k.fv, k.dq, k.dv,
+             k.port_jac)
     ist = k.istate
     ist[AGE] = 0.0
     ist[HD] = -1.0
@@ -139,10 +140,12 @@ def refresh_jacobian(k, y, t, angle0, driver, port):
 
 
 def time_derivative_term(k, y, t, h, hd, angle0, driver, port, winv, w_basis):
-    """``h d W^-1 [0, f_t]`` into ``k.w_hdt``: the prescribed motions' part of the stages at local time ``t``."""
+    """``h d W^-1 [0, f_t]`` into ``k.w_hdt``: the prescribed motions' part of the stages at local time ``t``
+    (and the external loads', which move with the driver angle and speed)."""
     n = k.dq.shape[0]
     n2 = 2 * n
     w_hdt = k.w_hdt
+    ext = k.fast[k.fast.shape[0] - k.n_ext:]  # the external rows (none without external loads)
     if not k.tvs:  # f_t = [port speed, port accel, driver jerk] @ [pj0; pj1; -kappa]: W^-1 of the rows once
         ist = k.istate
         if ist[BASIS_VALID] == 0.0:
@@ -157,6 +160,14 @@ def time_derivative_term(k, y, t, h, hd, angle0, driver, port, winv, w_basis):
         c2 = hd * jerk(driver)
         for i in range(n2):
             w_hdt[i] = w_basis[0, i] * c0 + w_basis[1, i] * c1 + w_basis[2, i] * c2
+        if k.n_ext:
+            da = k.da
+            for j in range(n):
+                da[j] = 0.0
+            external_rate(angle0 + value(driver, t), rate(driver, t), accel(driver, t), k.load_rates, ext, da)
+            matvec(winv[:, n:], da, k.w_ext)
+            for i in range(n2):
+                w_hdt[i] += hd * k.w_ext[i]
         return
     pr = rate(port, t)
     pa = accel(port, t)
@@ -164,8 +175,9 @@ def time_derivative_term(k, y, t, h, hd, angle0, driver, port, winv, w_basis):
     da = k.da
     for j in range(n):
         da[j] = k.port_jac[0, j] * pr + k.port_jac[1, j] * pa - k.kappa[j] * jk
-    stiffness_rate(y, n, angle0 + value(driver, t), rate(driver, t), value(port, t), pr, k.a_t, k.a_port, k.contact,
-                   k.phasing, k.force_rows, k.factor, k.slope, k.defl, k.sens, da)
+    stiffness_rate(y, n, angle0 + value(driver, t), rate(driver, t), value(port, t), pr, k.a_t, k.a_port, k.offset,
+                   k.contact, k.phasing, k.force_rows, k.factor, k.slope, k.defl, k.sens, da)
+    external_rate(angle0 + value(driver, t), rate(driver, t), accel(driver, t), k.load_rates, ext, da)
     da *= hd
     matvec(winv[:, n:], da, w_hdt)
 
@@ -175,8 +187,11 @@ def evaluate(k, y, t, angle0, driver, port, out):
     n = k.dq.shape[0]
     if k.tvs:
         stiffness_factors(angle0 + value(driver, t), k.phasing, k.factor, k.slope)
-    acceleration(y, value(port, t), rate(port, t), accel(driver, t), k.factor, k.a_t, k.a_port, k.fast, k.contact,
-                 k.z, k.defl, k.acc)
+    if k.n_ext:
+        first = k.fast.shape[0] - k.n_ext
+        external_terms(angle0 + value(driver, t), rate(driver, t), k.load_rates, k.z[first:first + k.n_ext])
+    acceleration(y, value(port, t), rate(port, t), accel(driver, t), k.factor, k.a_t, k.a_port, k.offset, k.fast,
+                 k.contact, k.z, k.defl, k.acc)
     copy(y[n:], out[:n])
     copy(k.acc, out[n:])
 

@@ -24,9 +24,10 @@ OK, STEP_TOO_SMALL, TOO_MANY_STEPS, NON_FINITE_INPUT = range(4)
 
 # slots of the buffer, in this order (GearboxModel gives their shapes)
 CONSTANT_SLOTS = ("a_t", "a_port", "fast", "contact", "stks", "stcs", "stks_port", "stcs_port", "inv_m", "phasing",
-                  "kappa", "force_rows", "nz_index", "nz_value", "cos_alpha", "control", "twist_q", "output_matrix")
+                  "kappa", "force_rows", "nz_index", "nz_value", "cos_alpha", "control", "twist_q", "output_matrix",
+                  "offset", "load_rates", "magnitudes")
 WORK_SLOTS = ("z", "defl", "acc", "fd", "fv", "factor", "slope", "sens", "f0", "f1", "fn", "k1", "k2", "k3", "y1",
-              "yn", "rhs", "w_hdt", "da")
+              "yn", "rhs", "w_hdt", "da", "w_ext")
 #: the state a failed step restores: contiguous, so that saving it is one copy into "backup"
 STATE_SLOTS = ("istate", "dq", "dv", "winvs", "w_bases", "port_jac", "last_acc", "last_force", "last_defl", "y")
 #: the inputs' curves, scalars, outputs, and the generator speed and loads before the inertia interface's
@@ -34,8 +35,8 @@ STATE_SLOTS = ("istate", "dq", "dv", "winvs", "w_bases", "port_jac", "last_acc",
 STEP_SLOTS = ("backup", "driver", "port", "scalars", "outputs", "anchor")
 SLOTS = CONSTANT_SLOTS + WORK_SLOTS + STATE_SLOTS + STEP_SLOTS
 (A_T, A_PORT, FAST, CONTACT, STKS, STCS, STKS_PORT, STCS_PORT, INV_M, PHASING, KAPPA, FORCE_ROWS, NZ_INDEX, NZ_VALUE,
- COS_ALPHA, CONTROL, TWIST_Q, OUTPUT_MATRIX,
- Z, DEFL, ACC, FD, FV, FACTOR, SLOPE, SENS, F0, F1, FN, K1, K2, K3, Y1, YN, RHS, W_HDT, DA,
+ COS_ALPHA, CONTROL, TWIST_Q, OUTPUT_MATRIX, OFFSET, LOAD_RATES, MAGNITUDES,
+ Z, DEFL, ACC, FD, FV, FACTOR, SLOPE, SENS, F0, F1, FN, K1, K2, K3, Y1, YN, RHS, W_HDT, DA, W_EXT,
  ISTATE, DQ, DV, WINVS, W_BASES, PORT_JAC, LAST_ACC, LAST_FORCE, LAST_DEFL, Y,
  BACKUP, DRIVER, PORT, SCALARS, OUTPUTS, ANCHOR) = range(len(SLOTS))
 #: first and last slot of the restorable state
@@ -53,6 +54,7 @@ SCALAR_NAMES = (
  S_SHAFT_K, S_SHAFT_C, S_PORT_OFFSET) = range(len(SCALAR_NAMES))
 
 # entries of the integer vector ``dims``: sizes, flags, the generator's degree of freedom (-1: the motion
-# interface, the generator is the port) and whether the rotor motion is extrapolated from its derivative inputs
-D_N, D_M, D_WIDTH, D_TVS, D_EXTRAPOLATE, D_END_TORQUE, D_GEN_DOF, D_ROTOR_DERIVATIVES = range(8)
-N_DIMS = 8
+# interface, the generator is the port), whether the rotor motion is extrapolated from its derivative inputs, the
+# number of external terms (0: no external loads) and of output magnitudes (bearing forces)
+D_N, D_M, D_WIDTH, D_TVS, D_EXTRAPOLATE, D_END_TORQUE, D_GEN_DOF, D_ROTOR_DERIVATIVES, D_EXT, D_MAGNITUDES = range(10)
+N_DIMS = 10
