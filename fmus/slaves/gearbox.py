@@ -65,6 +65,44 @@ def _planet_of(force_name: str) -> dict[str, str]:
     return {"planet": inside} if inside else {}
 
 
+def _lateral_outputs(assembly: Assembly) -> list[Variable]:
+    """The body speeds, then what the lateral-torsional stages add: displacements, bearing forces and speeds.
+
+    In :class:`GearboxModel`'s order (:attr:`GearboxModel.output_names`): the speeds of the rotations, the
+    displacements of the translations, per bearing or support its force components (and a rolling bearing's
+    speed), then every bearing's and support's force magnitude.
+    """
+    out = []
+    bodies = [assembly.bodies[j] for j in assembly.free if assembly.bodies[j].role != "generator"]
+    for body in bodies:
+        if body.rotation:
+            out.append(real_output(f"{body.name}.omega", "rad/s", f"absolute speed of {body.name}", "body_speed",
+                                   body=body.name))
+    for body in bodies:
+        if not body.rotation:
+            out.append(real_output(body.name, "m", f"{body.coordinate} displacement of {body.name.rpartition('.')[0]} "
+                                   "(a planetary stage's carrier frame, a parallel stage's housing)",
+                                   "body_displacement", body=body.name))
+    for e in assembly.elements:
+        what = {"bearing": "bearing", "support": "support", "torsion": "torsional support"}[e.kind]
+        for c in e.components:
+            if c == "torque":
+                out.append(real_output(f"{e.name}.torque", "N.m", f"torque of the {what} {e.name} on {e.body}",
+                                       "support_torque", bearing=e.name, stage=e.stage, body=e.body))
+            else:
+                out.append(real_output(f"{e.name}.F_{c}", "N", f"{c} force of the {what} {e.name} on {e.body}"))
+        if e.speed:
+            relative = f" relative to {e.speed[1]}" if len(e.speed) > 1 else ""
+            out.append(real_output(f"{e.name}.omega", "rad/s", f"speed of {e.speed[0]}{relative} (turns the bearing "
+                                   f"{e.name})", "bearing_speed", bearing=e.name, stage=e.stage, body=e.body))
+    for e in assembly.elements:
+        if e.kind != "torsion":
+            out.append(real_output(f"{e.name}.F", "N", f"radial force magnitude of the {e.kind} {e.name} on {e.body}",
+                                   "bearing_force" if e.kind == "bearing" else "support_force", bearing=e.name,
+                                   stage=e.stage, body=e.body))
+    return out
+
+
 def template_of(model: Mapping[str, Any]) -> Drivetrain:
     """The drivetrain of a Gearbox record's model (structure and default values)."""
     return build(model["drivetrain"], "model.drivetrain")
@@ -137,8 +175,7 @@ class Gearbox(DtcosimSlave):
                                          f"torque of {shaft.name} ({shaft.upstream} -> {shaft.downstream})",
                                          "shaft_torque", shaft=shaft.name, upstream=shaft.upstream,
                                          downstream=shaft.downstream))
-        for body in assembly.dof_names:
-            variables.append(real_output(f"{body}.omega", "rad/s", f"absolute speed of {body}", "body_speed", body=body))
+        variables += _lateral_outputs(assembly)
         out_member = assembly.stage_members[template.stages[-1].name]["output"]
         variables += [  # after the body speeds: the same order as GearboxModel.output_names
             real_output("alpha_out", "rad/s2",
