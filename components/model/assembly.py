@@ -131,6 +131,25 @@ class InternalLoads:
     bearing_force_n: np.ndarray | None = None
 
 
+def column_sparsity(w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The nonzero rows of every column of ``w`` and their entries, ascending, padded with -1 / 0.
+
+    Returns
+    -------
+    index, value : ndarray, shape (n_columns, width)
+        ``width`` is the most nonzeros of one column (at least 1); the kernel's sparse products
+        (:func:`components.model.kernel.linalg.sparse_vecmat`) stop at the first negative index.
+    """
+    columns = [np.flatnonzero(w[:, j]) for j in range(w.shape[1])]
+    width = max([1] + [c.size for c in columns])
+    index = np.full((w.shape[1], width), -1.0)
+    value = np.zeros((w.shape[1], width))
+    for j, rows in enumerate(columns):
+        index[j, : rows.size] = rows
+        value[j, : rows.size] = w[rows, j]
+    return index, value
+
+
 def _matrix(rows: list[dict[int, float]], n_bodies: int) -> np.ndarray:
     """The dense matrix of sparse rows (body index -> coefficient)."""
     out = np.zeros((len(rows), n_bodies))
@@ -185,7 +204,7 @@ class Assembly:
         stage_members: dict[str, dict[str, int]] = {}
         for k, st in enumerate(drivetrain.stages):
             build = planetary_rows if isinstance(st, PlanetaryStage) else parallel_rows
-            members = build(rows, st, gravity)
+            members = build(rows, st, gravity, k == 0)
             stage_members[st.name] = members
             if k > 0:
                 shaft(drivetrain.shafts[k - 1], previous_output, members["input"])
@@ -314,7 +333,17 @@ class Assembly:
         self.phasing_table = self.phasing.table if self.phasing is not None else np.zeros((N_PHASING_ROWS, self.n_mesh))
         #: d q_ddot / d F, shape (n_mesh, n_dof): the force rows of the folded matrix
         self.force_rows = np.ascontiguousarray(self.fast_matrix[: self.n_mesh])
-        self.nz_index, self.nz_value = self._mesh_sparsity()
+        #: the nonzero columns of every mesh row of ``A`` (free bodies) and their entries: the kernel's Jacobian
+        #: sums over these only
+        self.nz_index, self.nz_value = column_sparsity(self.A.T)
+        #: the folded matrix by columns, its nonzero rows only: what the kernel's accelerations sum
+        self.fast_index, self.fast_value = column_sparsity(self.fast_matrix)
+        #: the columns each row of the Jacobian blocks dq/dv can hold (shafts, bearings and the bodies of one mesh)
+        pattern = (self.STkS != 0.0) | (self.STcS != 0.0) | np.eye(self.n_dof, dtype=bool)
+        for row in self.A:
+            cols = np.flatnonzero(row)
+            pattern[np.ix_(cols, cols)] = True
+        self.jacobian_index = column_sparsity(pattern.T.astype(float))[0]
 
     def _external_loads(self, rows: Rows, kappa_all: np.ndarray, free: list[int]) -> None:
         """:attr:`load_rates` and :attr:`load_matrix` from the stages' loads (none without a lateral stage).
@@ -340,24 +369,6 @@ class Assembly:
                 matrix[2 + 2 * frames.index(frame) + (term == SIN), where[body]] += coefficient
         #: external generalised forces per external term, shape (n_terms, n_dof) (0 rows: no lateral stage)
         self.load_matrix = matrix
-
-    def _mesh_sparsity(self) -> tuple[np.ndarray, np.ndarray]:
-        """Nonzero columns of every mesh row of ``A`` (free bodies) and their entries, padded with -1 / 0.
-
-        Returns
-        -------
-        index, value : ndarray, shape (n_mesh, width)
-            ``width`` is the largest number of free bodies one mesh touches (at least 1); the kernel's
-            Jacobian sums over these only.
-        """
-        rows = [np.flatnonzero(row) for row in self.A]
-        width = max([1] + [r.size for r in rows])
-        index = np.full((self.n_mesh, width), -1.0)
-        value = np.zeros((self.n_mesh, width))
-        for i, cols in enumerate(rows):
-            index[i, : cols.size] = cols
-            value[i, : cols.size] = self.A[i, cols]
-        return index, value
 
     # ------------------------------------------------------------------ names
     @property
@@ -533,7 +544,7 @@ class Assembly:
         stks_port = self.STkS_port[:, 0].copy() if self.ports.size else np.zeros(n)
         stcs_port = self.STcS_port[:, 0].copy() if self.ports.size else np.zeros(n)
         model_kernel.monolithic(kernel)[0].jacobian(
-            y, port, port_rate, factor, self.A_T, self.port_deflection, self.mesh_offset, self.law.table,
+            y, port, port_rate, factor, self.port_deflection, self.mesh_offset, self.law.table,
             np.zeros((2, m)), self.nz_index, self.nz_value, self.cos_alpha, self.STkS, self.STcS, stks_port, stcs_port, self.inv_inertia, np.zeros(m),
             np.zeros(m), dq, dv, port_jac)
         if not self.ports.size:
@@ -590,7 +601,7 @@ class Assembly:
         z[m + 2 * n + 3:m + 2 * n + 3 + n_ext] = self.external_terms(driver_angle_rad, driver_speed_rad_s)
         status, iterations, imbalance = model_kernel.monolithic(kernel)[0].static_deflection(
             y, n, float(load_nm), factor, math.copysign(1.0, load_nm), self.A_T, self.port_deflection, self.mesh_offset,
-            self.fast_matrix, self.law.table, self.nz_index, self.nz_value, self.cos_alpha, self.STkS, self.STcS,
+            self.fast_matrix, self.fast_index, self.fast_value, self.law.table, self.nz_index, self.nz_value, self.cos_alpha, self.STkS, self.STcS,
             np.zeros(n), np.zeros(n), self.inv_inertia, z, np.zeros((2, m)), np.zeros(n),
             np.zeros(m), np.zeros(m), np.zeros((n, n)), np.zeros((n, n)), np.zeros((2, n)), np.zeros((n, n)),
             np.zeros((n, n)), np.zeros(n), np.zeros(n), np.zeros(m), np.zeros(2 * n), rtol, max_iterations)

@@ -31,7 +31,7 @@ from ..compile.jit import entry_point
 from ..errors import ParameterError, SolverError
 from ..validation import finite, one_of
 from . import kernel as model_kernel
-from .assembly import Assembly
+from .assembly import Assembly, column_sparsity
 from .drivetrain import Drivetrain
 from .integrators import StepControl
 from .kernel import layout as L
@@ -204,19 +204,22 @@ class GearboxModel:
         n, m, n2 = a.n_dof, a.n_mesh, 2 * a.n_dof
         width = a.nz_index.shape[1]
         n_ext = a.load_matrix.shape[0]
-        n_linear, n_mag = self._output_matrix.shape[1], self._magnitudes.shape[0]
+        n_linear, n_mag = self._out_index.shape[0], self._magnitudes.shape[0]
         shapes = {
             "a_t": (n, m), "a_port": (m,), "fast": (m + n2 + 3 + n_ext, n), "contact": a.law.table.shape,
             "stks": (n, n), "stcs": (n, n), "stks_port": (n,), "stcs_port": (n,), "inv_m": (n,),
             "phasing": a.phasing_table.shape, "kappa": (n,), "force_rows": (m, n), "nz_index": (m, width),
             "nz_value": (m, width), "cos_alpha": (m,), "control": (L.N_CONTROL,), "twist_q": (n2,),
-            "output_matrix": (m + n2 + 4, n_linear), "offset": (m,), "load_rates": a.load_rates.shape,
-            "magnitudes": (n_mag, 2),
+            "offset": (m,), "load_rates": a.load_rates.shape, "magnitudes": (n_mag, 2),
+            "fast_index": a.fast_index.shape, "fast_value": a.fast_value.shape, "jac_index": a.jacobian_index.shape,
+            "out_index": self._out_index.shape, "out_value": self._out_index.shape,
             "z": (m + n2 + 4 + n_ext,), "defl": (2, m), "acc": (n,), "fd": (m,), "fv": (m,), "factor": (m,),
             "slope": (m,), "sens": (m,),
-            **{name: (n2,) for name in ("f0", "f1", "fn", "k1", "k2", "k3", "y1", "yn", "rhs", "w_hdt", "w_ext")},
-            "da": (n,), "istate": (L.N_ISTATE,), "dq": (n, n), "dv": (n, n),
-            "winvs": (2, n2, n2), "w_bases": (2, 3, n2),  # the active W^-1 and the one kept (istate[ACTIVE])
+            **{name: (n2,) for name in ("f0", "f1", "fn", "k1", "k2", "k3", "y1", "yn", "rhs", "w_hdt")},
+            "w_ext": (max(n_ext, 1),),
+            "da": (n,), "sol": (n,), "istate": (L.N_ISTATE,), "dq": (n, n), "dv": (n, n),
+            # G^-1 (or its LU factors, pivots and pattern) and the time-derivative basis of every kept factorisation
+            "winvs": (L.N_SLOTS, n, n), "pivots": (L.N_SLOTS, 2 * n + 1, n), "w_bases": (L.N_SLOTS, 3 + n_ext, n2),
             "port_jac": (2, n), "last_acc": (n,), "last_force": (m,), "last_defl": (2, m), "y": (n2,),
             "driver": (4,), "port": (4,), "scalars": (len(L.SCALAR_NAMES),), "outputs": (n_linear + n_mag + 4,),
             "anchor": (n + 1,),
@@ -227,7 +230,8 @@ class GearboxModel:
     def _allocate(self) -> None:
         """The buffer with its views, constants and sizes."""
         a = self.assembly
-        self._output_matrix, self._magnitudes, self._output_names = self._build_outputs()
+        output_matrix, self._magnitudes, self._output_names = self._build_outputs()
+        self._out_index, self._out_value = column_sparsity(output_matrix)
         shapes = self._slot_shapes()
         sizes = [int(np.prod(shapes[name])) for name in L.SLOTS]
         self._offsets = np.concatenate(([0], np.cumsum(sizes))).astype(np.int64)
@@ -261,7 +265,9 @@ class GearboxModel:
         # output-shaft twist = twist_q . q + twist_port * port angle (its rate: the same weights on v)
         self._twist_q = np.concatenate((a.S[-1], np.zeros(a.n_dof)))
         v["twist_q"][:] = self._twist_q
-        v["output_matrix"][:] = self._output_matrix
+        v["out_index"][:], v["out_value"][:] = self._out_index, self._out_value
+        v["fast_index"][:], v["fast_value"][:] = a.fast_index, a.fast_value
+        v["jac_index"][:] = a.jacobian_index
         sc = self._scalars
         sc[L.S_KX] = self._kx
         sc[L.S_TWIST_PORT] = float(a.port_twist[-1])
@@ -508,7 +514,8 @@ class GearboxModel:
         self._state[:] = 0.0
         ist = self._istate
         ist[L.AGE] = -1.0  # no Jacobian yet
-        ist[L.HD] = ist[L.HD_PREV] = -1.0  # no factorisation
+        ist[L.HD] = -1.0  # no factorisation
+        ist[L.SLOT_HD:L.SLOT_HD + L.N_SLOTS] = -1.0
         sc = self._scalars
         sc[[L.S_LAST_STEP, L.S_SHAFT_TORQUE_AVG, L.S_OUTPUT_TWIST, L.S_ALPHA_OUT_AVG, L.S_DRIVER_ACCEL,
             L.S_LAST_ALPHA]] = 0.0

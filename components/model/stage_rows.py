@@ -176,10 +176,11 @@ def _gravity_xy(rows: Rows, xy: tuple[int, int], mass: float, g: float, frame: i
         rows.load(xy[1], COS, -mass * g, frame)
 
 
-def planetary_rows(rows: Rows, st: PlanetaryStage, gravity: float) -> dict[str, int]:
+def planetary_rows(rows: Rows, st: PlanetaryStage, gravity: float, driven: bool = False) -> dict[str, int]:
     """Add a planetary stage (torsional, or lateral-torsional with ``st.lateral``); its input and output bodies.
 
-    ``gravity`` is the in-plane gravity [m/s^2] (0: none).
+    ``gravity`` is the in-plane gravity [m/s^2] (0: none); ``driven``: the carrier's rotation is the kinematic
+    driver's (no inertia of its own needed).
     """
     n = st.name
     r_s, r_p, r_r = st.sun_radius_m, st.planet_radius_m, st.ring_radius_m
@@ -203,7 +204,7 @@ def planetary_rows(rows: Rows, st: PlanetaryStage, gravity: float) -> dict[str, 
             rows.mesh({p: r_p, c: r_r - r_p}, f"{n}.F_rp[{i + 1}]", n, "ring_planet", st.ring_mesh, c, z_r,
                       z_r * positions[i], e_t + t_r * e_r)
         return {"input": c, "output": s}
-    if not st.carrier_inertia_kgm2 > 0.0:
+    if not (driven or st.carrier_inertia_kgm2 > 0.0):
         raise ParameterError(f"{n}.carrier_inertia", st.carrier_inertia_kgm2, "> 0 in the lateral-torsional model "
                              "(the planets' masses are bodies of their own there, not part of the carrier's inertia)")
     c = rows.body(f"{n}.carrier", st.carrier_inertia_kgm2, n, "carrier")
@@ -251,7 +252,7 @@ def planetary_rows(rows: Rows, st: PlanetaryStage, gravity: float) -> dict[str, 
     return {"input": c, "output": s}
 
 
-def parallel_rows(rows: Rows, st: ParallelStage, gravity: float) -> dict[str, int]:
+def parallel_rows(rows: Rows, st: ParallelStage, gravity: float, driven: bool = False) -> dict[str, int]:
     """Add a parallel stage (torsional, or lateral-torsional with ``st.lateral``); its input and output bodies."""
     n = st.name
     d1 = rows.body(f"{n}.drive", st.drive_inertia_kgm2, n, "drive")

@@ -126,14 +126,15 @@ class MonolithicSystem:
         self._ones = np.ones(m)
         self._rhs_out = np.zeros(2 * n + 3)
         rhs_args = (
-            self._out, self._kappa_out, float(a.driver_inertia_kgm2), c(a.A_T), np.zeros(m), c(a.mesh_offset),
+            self._out, self._kappa_out, float(a.driver_inertia_kgm2), a.nz_index, a.nz_value, np.zeros(m),
+            c(a.mesh_offset),
             c(a.fast_matrix), a.law.table, c(a.load_rates), c(a.springs), c(a.springs_k, dtype=float),
             c(a.springs_c, dtype=float), c(a.BT_driver), c(a.springs_driver), c(a.cos_alpha), c(a.inv_inertia),
             np.zeros(m), np.zeros(m), np.zeros((2, m)), np.zeros(m + 2 * n + 4 + a.load_matrix.shape[0]), np.zeros(n),
             self._rhs_out,
         )
         jac_args = (
-            c(a.A_T), np.zeros(m), c(a.mesh_offset), a.law.table, np.zeros((2, m)), a.nz_index, a.nz_value,
+            np.zeros(m), c(a.mesh_offset), a.law.table, np.zeros((2, m)), a.nz_index, a.nz_value,
             c(a.cos_alpha), c(a.STkS), c(a.STcS), np.zeros(n), np.zeros(n), c(a.inv_inertia), np.zeros(m), np.zeros(m),
             np.zeros((n, n)), np.zeros((n, n)), np.zeros((2, n)), self._jac,
         )

@@ -20,8 +20,8 @@ from .statics import static_deflection  # noqa: F401 - an entry of this module (
 from .stiffness import stiffness_factors
 
 
-def monolithic_rhs(y, omega, alpha, angle, factor, load, out_dof, kappa_out, inertia_in, a_t, a_port, offset, fast,
-                   contact, load_rates, s_mat, shaft_k, shaft_c, bt_driver, s_driver, cos_alpha, inv_m, force, elastic,
+def monolithic_rhs(y, omega, alpha, angle, factor, load, out_dof, kappa_out, inertia_in, nz_index, nz_value, a_port,
+                   offset, fast, contact, load_rates, s_mat, shaft_k, shaft_c, bt_driver, s_driver, cos_alpha, inv_m, force, elastic,
                    defl, z, acc, out):
     """``[v, q_ddot, rotor power, output power, dissipated power]`` into ``out``.
 
@@ -33,7 +33,7 @@ def monolithic_rhs(y, omega, alpha, angle, factor, load, out_dof, kappa_out, ine
     n = inv_m.shape[0]
     m = force.shape[0]
     n2 = 2 * n
-    deflections(y, n, a_t, a_port, offset, 0.0, 0.0, defl)
+    deflections(y, n, nz_index, nz_value, a_port, offset, 0.0, 0.0, defl)
     mesh_forces(defl, factor, contact, force, elastic)
     copy(force, z[:m])
     copy(y[:n2], z[m:m + n2])
@@ -63,11 +63,11 @@ def monolithic_rhs(y, omega, alpha, angle, factor, load, out_dof, kappa_out, ine
     out[n2 + 2] = dissipation
 
 
-def monolithic_jacobian(y, factor, a_t, a_port, offset, contact, defl, nz_index, nz_value, cos_alpha, stks, stcs,
+def monolithic_jacobian(y, factor, a_port, offset, contact, defl, nz_index, nz_value, cos_alpha, stks, stcs,
                         stks_port, stcs_port, inv_m, fd, fv, dq, dv, port_jac, jac):
     """The acceleration rows of the monolithic Jacobian ``jac`` (the rest is fixed)."""
     n = inv_m.shape[0]
-    jacobian(y, 0.0, 0.0, factor, a_t, a_port, offset, contact, defl, nz_index, nz_value, cos_alpha, stks, stcs,
+    jacobian(y, 0.0, 0.0, factor, a_port, offset, contact, defl, nz_index, nz_value, cos_alpha, stks, stcs,
              stks_port, stcs_port, inv_m, fd, fv, dq, dv, port_jac)
     jac[n:2 * n, :n] = dq
     jac[n:2 * n, n:2 * n] = dv

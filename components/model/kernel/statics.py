@@ -44,10 +44,12 @@ def _linear_guess(y, n, port, flank, stiffness, a_t, a_port, offset, fast, conta
         y[j] = -y[j]
 
 
-def _imbalance(y, n, port, factor, a_t, a_port, offset, fast, contact, z, defl, acc, inv_m):
+def _imbalance(y, n, port, factor, nz_index, nz_value, a_port, offset, fast, fast_index, fast_value, contact, z, defl,
+               acc, inv_m):
     """``(max |M a|, max over bodies of the sum of the magnitudes of its generalised forces)`` at ``y`` [N m]."""
     m = contact.shape[0]
-    acceleration(y, port, 0.0, 0.0, factor, a_t, a_port, offset, fast, contact, z, defl, acc)
+    acceleration(y, port, 0.0, 0.0, factor, nz_index, nz_value, a_port, offset, fast_index, fast_value, contact, z, defl,
+                 acc)
     worst = 0.0
     scale = 0.0
     for j in range(n):
@@ -63,7 +65,8 @@ def _imbalance(y, n, port, factor, a_t, a_port, offset, fast, contact, z, defl, 
     return worst, scale
 
 
-def static_deflection(y, n, port, factor, flank, a_t, a_port, offset, fast, contact, nz_index, nz_value, cos_alpha,
+def static_deflection(y, n, port, factor, flank, a_t, a_port, offset, fast, fast_index, fast_value, contact, nz_index,
+                      nz_value, cos_alpha,
                       stks, stcs, stks_port, stcs_port, inv_m, z, defl, acc, fd, fv, dq, dv, port_jac, g, ginv, c, step,
                       stiffness, trial, rtol, max_iterations):
     """Solve ``a(q, v, u) = 0`` for ``q = y[:n]`` at the port input ``u = port`` (``v = y[n:]`` kept, normally 0).
@@ -78,6 +81,8 @@ def static_deflection(y, n, port, factor, flank, a_t, a_port, offset, fast, cont
     rtol : float
         Converged when the largest generalised-force imbalance is below ``rtol`` times the largest
         sum of generalised-force magnitudes on one body.
+    fast, fast_index, fast_value : ndarray
+        The folded matrix, and by columns (:func:`.dynamics.acceleration`).
     g, ginv, dq, dv : ndarray (n, n); c, step, acc : ndarray (n,); stiffness : ndarray (n_mesh,);
     trial : ndarray like ``y``; the others as :func:`.dynamics.jacobian`
         Work arrays.
@@ -102,19 +107,21 @@ def static_deflection(y, n, port, factor, flank, a_t, a_port, offset, fast, cont
         penetration = max((force / k0) ** (1.0 / e), 1e-9)
         stiffness[i] = k0 * penetration ** (e - 1.0)
     _linear_guess(y, n, port, flank, stiffness, a_t, a_port, offset, fast, contact, z, g, ginv, c)
-    worst, scale = _imbalance(y, n, port, factor, a_t, a_port, offset, fast, contact, z, defl, acc, inv_m)
+    worst, scale = _imbalance(y, n, port, factor, nz_index, nz_value, a_port, offset, fast, fast_index, fast_value,
+                              contact, z, defl, acc, inv_m)
     iterations = 0
     while worst > rtol * scale:
         if iterations >= max_iterations:
             return NOT_CONVERGED, iterations, worst / scale
         iterations += 1
-        jacobian(y, port, 0.0, factor, a_t, a_port, offset, contact, defl, nz_index, nz_value, cos_alpha, stks, stcs,
+        jacobian(y, port, 0.0, factor, a_port, offset, contact, defl, nz_index, nz_value, cos_alpha, stks, stcs,
                  stks_port, stcs_port, inv_m, fd, fv, dq, dv, port_jac)
         for j in range(n):
             for k in range(n):
                 g[j, k] = dq[j, k]
         invert(g, ginv)
-        acceleration(y, port, 0.0, 0.0, factor, a_t, a_port, offset, fast, contact, z, defl, acc)
+        acceleration(y, port, 0.0, 0.0, factor, nz_index, nz_value, a_port, offset, fast_index, fast_value, contact, z,
+                     defl, acc)
         matvec(ginv, acc, step)
         for j in range(n):
             if not math.isfinite(step[j]):
@@ -125,8 +132,8 @@ def static_deflection(y, n, port, factor, flank, a_t, a_port, offset, fast, cont
                 trial[j] = y[j]
             for j in range(n):
                 trial[j] = y[j] - alpha * step[j]
-            new_worst, new_scale = _imbalance(trial, n, port, factor, a_t, a_port, offset, fast, contact, z, defl, acc,
-                                              inv_m)
+            new_worst, new_scale = _imbalance(trial, n, port, factor, nz_index, nz_value, a_port, offset, fast,
+                                              fast_index, fast_value, contact, z, defl, acc, inv_m)
             if new_worst < worst or alpha < 1e-6:
                 break
             alpha *= 0.5
