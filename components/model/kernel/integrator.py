@@ -20,13 +20,15 @@ and ``W^-1 = (I - h d J)^-1``, ``d = 1 / (2 + sqrt 2)``::
   refreshed only when older than ``jacobian_max_age`` accepted steps or after a rejected step;
   a stale Jacobian that hurts accuracy causes a rejection, which forces a refresh.
 * **Step control**: ``h_new = h min(5, 0.9 err^(-1/3))``, kept unchanged for factors in [1, 2]
-  (the factorisation is reused); the rest of a communication step is divided into equal steps of at
-  most that size (the same sizes recur from one communication step to the next, with their
-  factorisations, and no short last step is needed). New inputs start a transient at a communication point, where the
-  proposal from the smooth end of the last step may be rejected: once the first internal step of a
-  communication step was rejected, the next ones start with at most the step their predecessor's
-  first step proposed, while that is smaller than the proposal (in a lateral-torsional gearbox this
-  saves two or three rejections per communication step). After a second rejection at the same time with a fresh Jacobian
+  (the factorisation is reused).
+* **Large models** (more than :data:`LU_ABOVE` degrees of freedom: the lateral-torsional gearboxes),
+  where factorising costs most: ``G`` is kept as LU factors, four factorisations are kept (least
+  recently used replaced), and the step sizes are made to recur: the rest of a communication step
+  is divided into equal steps of at most the proposed size, and once the first internal step of a
+  communication step was rejected (new inputs start a transient there, where the proposal from the
+  smooth end of the last step fails two or three times in a lateral-torsional gearbox), the next
+  ones start with at most the step their predecessor's first step proposed, while that is smaller
+  than the proposal. Smaller models keep the plain policy (their factorisations cost little). After a second rejection at the same time with a fresh Jacobian
   the controller uses the order observed between the two attempts, ``p = log(err1 / err2) /
   log(h1 / h2)`` clipped to [0.2, 3], and proposes ``h (0.9 / err)^(1/p)`` (at least a tenth of
   ``h``): at a communication point the inputs change their acceleration, which starts a fast,
@@ -56,7 +58,9 @@ from .motion import accel, jerk, rate, value
 from .stiffness import stiffness_factors
 
 D = 1.0 / (2.0 + math.sqrt(2.0))
-#: above this many degrees of freedom ``G`` is kept as its LU factors (n^3/3 operations), below as its inverse
+#: above this many degrees of freedom (a lateral-torsional gearbox) a factorisation is what a step costs most: ``G`` is
+#: kept as its LU factors (n^3/3 operations, not an inverse's n^3), and the step sizes are made to recur so that
+#: the kept factorisations are used again (equal internal steps, the first-step cap; module docstring)
 LU_ABOVE = 24
 E32 = 6.0 + math.sqrt(2.0)
 #: bounds of the error order observed between two rejected attempts
@@ -286,8 +290,9 @@ def advance(k, y, t_end, alpha_shift, driver, port, angle0, twist_q, twist_port)
     w_basis = k.w_bases[active]
     t = 0.0
     h = ist[H_NEXT] if ist[H_NEXT] > 0.0 else t_end - t
-    if 0.0 < ist[H_FIRST] < h:  # the transient the new inputs start at a communication point: the first step the
-        h = ist[H_FIRST]  # last one allowed (without it, the proposal from the smooth end of the step is rejected)
+    large = n > LU_ABOVE
+    if large and 0.0 < ist[H_FIRST] < h:  # the transient the new inputs start at a communication point: the first
+        h = ist[H_FIRST]  # step the last one allowed (else the proposal from the smooth end of the step is rejected)
     first_rejected = False
     for i in range(n):
         f0[i] = y[n + i]
@@ -304,7 +309,7 @@ def advance(k, y, t_end, alpha_shift, driver, port, angle0, twist_q, twist_port)
         last = h >= remaining * (1.0 - 1e-12)
         if last:
             h = remaining
-        else:  # equal steps to the communication point: their sizes repeat, and so do their factorisations
+        elif large:  # equal steps to the communication point: their sizes recur, and so do their factorisations
             pieces = math.ceil(remaining / h * (1.0 - 1e-12))
             h = remaining / pieces
         if ist[AGE] < 0.0 or ist[AGE] >= max_age:
