@@ -47,10 +47,11 @@ from .contact import ContactLaw, MeshContact
 from .drivetrain import Drivetrain
 from .kernel.stiffness import N_PHASING_ROWS
 from .mesh_stiffness import MeshPhasing
+from .sparse import column_sparsity, dense_rows
 from .stage_rows import CONSTANT, COS, OMEGA2, SIN, Body, Rows, SpringElement, parallel_rows, planetary_rows
 from .stages import PlanetaryStage
 
-__all__ = ["Assembly", "Body", "InternalLoads", "Mesh", "ShaftElement", "SpringElement"]
+__all__ = ["Assembly", "Body", "InternalLoads", "Mesh", "ShaftElement", "SpringElement", "column_sparsity"]
 
 
 @dataclass(frozen=True)
@@ -131,34 +132,6 @@ class InternalLoads:
     bearing_force_n: np.ndarray | None = None
 
 
-def column_sparsity(w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The nonzero rows of every column of ``w`` and their entries, ascending, padded with -1 / 0.
-
-    Returns
-    -------
-    index, value : ndarray, shape (n_columns, width)
-        ``width`` is the most nonzeros of one column (at least 1); the kernel's sparse products
-        (:func:`components.model.kernel.linalg.sparse_vecmat`) stop at the first negative index.
-    """
-    columns = [np.flatnonzero(w[:, j]) for j in range(w.shape[1])]
-    width = max([1] + [c.size for c in columns])
-    index = np.full((w.shape[1], width), -1.0)
-    value = np.zeros((w.shape[1], width))
-    for j, rows in enumerate(columns):
-        index[j, : rows.size] = rows
-        value[j, : rows.size] = w[rows, j]
-    return index, value
-
-
-def _matrix(rows: list[dict[int, float]], n_bodies: int) -> np.ndarray:
-    """The dense matrix of sparse rows (body index -> coefficient)."""
-    out = np.zeros((len(rows), n_bodies))
-    for i, row in enumerate(rows):
-        for j, coef in row.items():
-            out[i, j] = coef
-    return out
-
-
 class Assembly:
     """The matrices of a drivetrain (the kernel's constants) and their evaluation over arrays of states.
 
@@ -216,12 +189,12 @@ class Assembly:
         output_index = generator_index if generator_index is not None else previous_output
 
         nb = len(bodies)
-        A = _matrix(rows.mesh_rows, nb)
+        A = dense_rows(rows.mesh_rows, nb)
         S = np.zeros((len(shaft_rows), nb))
         for i, (a, b) in enumerate(shaft_rows):
             S[i, a] = 1.0
             S[i, b] = -1.0
-        B = _matrix(rows.spring_rows, nb)
+        B = dense_rows(rows.spring_rows, nb)
 
         driver = 0
         ports = [generator_index] if cut_at_generator else []

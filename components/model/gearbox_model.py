@@ -32,6 +32,7 @@ from ..errors import ParameterError, SolverError
 from ..validation import finite, one_of
 from . import kernel as model_kernel
 from .assembly import Assembly, column_sparsity
+from .gearbox_outputs import gearbox_outputs
 from .drivetrain import Drivetrain
 from .integrators import StepControl
 from .kernel import layout as L
@@ -230,7 +231,7 @@ class GearboxModel:
     def _allocate(self) -> None:
         """The buffer with its views, constants and sizes."""
         a = self.assembly
-        output_matrix, self._magnitudes, self._output_names = self._build_outputs()
+        output_matrix, self._magnitudes, self._output_names = gearbox_outputs(a, self.gearbox_dofs, self._out_member)
         self._out_index, self._out_value = column_sparsity(output_matrix)
         shapes = self._slot_shapes()
         sizes = [int(np.prod(shapes[name])) for name in L.SLOTS]
@@ -284,71 +285,6 @@ class GearboxModel:
         dims[L.D_ROTOR_DERIVATIVES] = int(self.rotor_derivatives)
         dims[L.D_EXT] = a.load_matrix.shape[0]
         dims[L.D_MAGNITUDES] = self._magnitudes.shape[0]
-
-    def _build_outputs(self) -> tuple[np.ndarray, np.ndarray, list[str]]:
-        """The linear map of the outputs, the index pairs of the magnitudes and every output's name.
-
-        ``z = [contact forces (n_mesh), q, v (n_dof each), port angle, port speed, driver speed, driver
-        acceleration]``: every output except the step-averaged shaft torque and the bearing-force magnitudes is
-        linear in ``z``: ``[shaft_torque_end, omega_out, torque_rotor, forces, shaft torques, speeds of the
-        rotations, displacements of the translations, bearing force components and bearing speeds]``; the
-        magnitudes are ``hypot`` of a bearing's two components (:func:`components.model.kernel.step.outputs`).
-        """
-        a = self.assembly
-        n, m = a.n_dof, a.n_mesh
-        rows = m + 2 * n + 4
-        shafts = np.zeros((rows, a.n_shaft))
-        shafts[m : m + n] = (a.shaft_k[:, None] * a.S).T
-        shafts[m + n : m + 2 * n] = (a.shaft_c[:, None] * a.S).T
-        shafts[m + 2 * n] = a.shaft_k * a.port_twist
-        shafts[m + 2 * n + 1] = a.shaft_c * a.port_twist
-        bearings = np.zeros((rows, a.n_spring))
-        bearings[m : m + n] = (a.bearing_k[:, None] * a.B).T
-        bearings[m + n : m + 2 * n] = (a.bearing_c[:, None] * a.B).T
-        speeds = np.zeros((rows, n))
-        speeds[m + n : m + 2 * n] = np.eye(n)
-        speeds[m + 2 * n + 2] = a.kinematic_ratio
-        forces = np.zeros((rows, m))
-        forces[:m] = np.eye(m)
-        rotor = shafts @ a.s_driver + bearings @ a.b_driver  # shaft and bearing reactions on the driven carrier
-        rotor[:m] += a.BT_driver  # mesh reactions
-        rotor[m + 2 * n + 3] += a.driver_inertia_kgm2  # carrier (and orbital planet) inertia
-        rotations = [j for j in self.gearbox_dofs if a.bodies[a.free[j]].rotation]
-        translations = [j for j in self.gearbox_dofs if not a.bodies[a.free[j]].rotation]
-        positions = np.zeros((rows, len(translations)))
-        positions[m + np.array(translations, dtype=int), np.arange(len(translations))] = 1.0
-        columns = [shafts[:, -1:], speeds[:, [self._out_member]], rotor[:, None], forces, shafts,
-                   speeds[:, rotations], positions]
-        names = (["shaft_torque_end", "omega_out", "torque_rotor"] + a.mesh_names + [f"{s}.torque" for s in a.shaft_names]
-                 + [f"{a.dof_names[j]}.omega" for j in rotations] + [a.dof_names[j] for j in translations])
-        pairs = []
-        for element in a.elements:
-            first = len(names)
-            columns.append(bearings[:, list(element.rows)])
-            names += [f"{element.name}.{'torque' if c == 'torque' else 'F_' + c}" for c in element.components]
-            if element.kind != "torsion":
-                pairs.append((first, first + 1 if len(element.rows) > 1 else -1))
-            if element.speed:
-                column = self._speed_column(element.speed[0], rows)
-                if len(element.speed) > 1:
-                    column = column - self._speed_column(element.speed[1], rows)
-                columns.append(column[:, None])
-                names.append(f"{element.name}.omega")
-        magnitudes = [f"{e.name}.F" for e in a.elements if e.kind != "torsion"]
-        output_names = (["shaft_torque", "shaft_torque_avg"] + names + magnitudes + ["alpha_out", "alpha_out_max"])
-        return np.column_stack(columns), np.array(pairs, dtype=float).reshape(-1, 2), output_names
-
-    def _speed_column(self, body: str, rows: int) -> np.ndarray:
-        """The output column of a body's absolute speed ``kappa omega_in + v`` (the driver: ``omega_in``)."""
-        a = self.assembly
-        n, m = a.n_dof, a.n_mesh
-        j = [b.name for b in a.bodies].index(body)
-        column = np.zeros(rows)
-        column[m + 2 * n + 2] = a.kinematic_ratio_all[j]
-        free = np.flatnonzero(a.free == j)
-        if free.size:
-            column[m + n + int(free[0])] = 1.0
-        return column
 
     # the scalar state lives in the buffer
     time_s = _buffer_scalar(L.S_TIME, "Current time [s].")
