@@ -459,6 +459,11 @@ class _Reader:
             stage, rows, stage_checks = self.stage(i, data)
             if stage.name in bodies:
                 raise self.error(f"stages[{i}].name", stage.name, "a stage name not used by another stage")
+            if i > 0 and isinstance(stage, PlanetaryStage) and stage.lateral is not None \
+                    and not stage.carrier_inertia_kgm2 > 0.0:
+                raise self.error(f"stages[{i}].carrier_inertia", 0.0, '> 0 with model = "lateral" (the planets\' '
+                                 "masses are bodies of their own there, not part of the carrier's inertia; only the "
+                                 "first stage's carrier turns with the rotor and needs none)")
             stages.append(stage)
             bodies[stage.name] = rows
             checks[stage.name] = stage_checks
