@@ -22,8 +22,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import subprocess
-import sys
 import tempfile
 from dataclasses import replace
 from pathlib import Path
@@ -70,13 +68,15 @@ def stiff_centre(drivetrain):
     return replace(drivetrain, stages=(replace(st, lateral=lat),) + drivetrain.stages[1:])
 
 
-def cosimulated(fmu_dir: str | None) -> float | None:
-    """The stage-1 factor of `dtcosim run paper-60s-pin-error` (its summary.json), or None if it failed."""
+def cosimulated(fmu_dir: str | None) -> float:
+    """The stage-1 factor of `dtcosim run paper-60s-pin-error` (its summary.json)."""
+    from orchestrator.commands.cli import main as dtcosim
+
     with tempfile.TemporaryDirectory(prefix="dtcosim-ls-") as tmp:
-        cmd = [sys.executable, "-m", "orchestrator.commands.cli", "run", "paper-60s-pin-error", "--out", tmp,
-               "--no-plots", "-q"] + (["--fmu-dir", fmu_dir] if fmu_dir else [])
-        if subprocess.run(cmd, capture_output=True, text=True).returncode != 0:
-            return None
+        code = dtcosim(["run", "paper-60s-pin-error", "--out", tmp, "--no-plots", "-q"]
+                       + (["--fmu-dir", fmu_dir] if fmu_dir else []))
+        if code != 0:
+            raise SystemExit(f"dtcosim run paper-60s-pin-error failed ({code})")
         summary = json.loads((Path(tmp) / "summary.json").read_text())
     return summary["load_sharing"]["stages"]["gearbox.stage1"]["factor"]
 

@@ -14,6 +14,13 @@ from .assembly import Assembly
 def gearbox_outputs(a: Assembly, gearbox_dofs: np.ndarray, out_member: int) -> tuple[np.ndarray, np.ndarray, list[str]]:
     """The linear map of the outputs, the index pairs of the magnitudes and every output's name.
 
+    Every output but the step-averaged shaft torque and the bearing-force magnitudes is linear in the
+    kernel's ``z`` (contact forces, ``q``, ``v``, port angle and speed, driver speed and acceleration):
+    the end-of-step shaft torque, ``omega_out``, the rotor torque, the contact forces, the shaft torques,
+    the speeds of the rotations, the displacements of the translations, and per bearing its force
+    components and speed; a magnitude is ``hypot`` of a bearing's two components
+    (:func:`components.model.kernel.step.outputs`).
+
     Parameters
     ----------
     a : Assembly
@@ -23,11 +30,14 @@ def gearbox_outputs(a: Assembly, gearbox_dofs: np.ndarray, out_member: int) -> t
     out_member : int
         The degree of freedom of the last stage's output member (``omega_out``).
 
-    ``z = [contact forces (n_mesh), q, v (n_dof each), port angle, port speed, driver speed, driver
-    acceleration]``: every output except the step-averaged shaft torque and the bearing-force magnitudes is
-    linear in ``z``: ``[shaft_torque_end, omega_out, torque_rotor, forces, shaft torques, speeds of the
-    rotations, displacements of the translations, bearing force components and bearing speeds]``; the
-    magnitudes are ``hypot`` of a bearing's two components (:func:`components.model.kernel.step.outputs`).
+    Returns
+    -------
+    matrix : ndarray, shape (n_z, n_linear)
+        The linear outputs ``z @ matrix``.
+    pairs : ndarray, shape (n_magnitudes, 2)
+        The linear outputs whose ``hypot`` each magnitude is (-1: none).
+    names : list of str
+        Every output's name, in the kernel's order.
     """
     n, m = a.n_dof, a.n_mesh
     rows = m + 2 * n + 4
