@@ -8,6 +8,7 @@ import json
 from typing import Any, Mapping
 
 from .drivetrain_file import DrivetrainSpec, drivetrain_from_dict
+from .drivetrain_plausibility import split_path
 from .drivetrain_schema import DrivetrainFileError
 
 
@@ -29,23 +30,10 @@ def with_entries(spec: DrivetrainSpec, entries: Mapping[str, Any]) -> Drivetrain
     return drivetrain_from_dict(data, name=spec.name, source=spec.source, sha256=sha)
 
 
-def _split_path(path: str) -> list[str | int]:
-    parts: list[str | int] = []
-    for piece in path.split("."):
-        name, _, rest = piece.partition("[")
-        if name:
-            parts.append(name)
-        while rest:
-            index, _, rest = rest.partition("]")
-            parts.append(int(index))
-            rest = rest.lstrip("[")
-    return parts
-
-
 def set_entry(data: dict, path: str, value: Any, source: str | None = None) -> None:
     """Set the entry at a key path (``stages[1].teeth.ring``) of a parsed document; the entry must exist."""
     try:
-        parts = _split_path(path)
+        parts = split_path(path)
     except ValueError:
         raise DrivetrainFileError(path, value, "a key path such as stages[0].planets", source) from None
     node: Any = data
