@@ -319,20 +319,38 @@ def judge(drivetrain: Drivetrain, rating: Rating) -> tuple[Judgement, ...]:
 
 
 def judge_operation(rating: Rating, speeds: Mapping[str, float] | None = None,
-                    torques: Mapping[str, float] | None = None) -> tuple[Judgement, ...]:
-    """Rotor speeds and generator-side torques (by key) against the rating (module docstring)."""
+                    torques: Mapping[str, float] | None = None,
+                    torque_factors: Mapping[str, tuple[float, float]] | None = None) -> tuple[Judgement, ...]:
+    """Rotor speeds and generator-side torques (by key) against the rating (module docstring).
+
+    Parameters
+    ----------
+    rating : Rating
+    speeds : mapping of str -> float
+        Rotor speeds [rad/s] by key (a wind source's mean speed).
+    torques : mapping of str -> float
+        Torques on the generator side [N m] by key (a counter torque, a controller's rated torque).
+    torque_factors : mapping of str -> (float, float)
+        ``(factor, base torque [N m])`` by key: a load event's torque ``factor x base``, judged as the factor.
+    """
     out = []
     w = MAX_SPEED_FACTOR * abs(rating.rotor_speed_rad_s)
+    rated_speed = f"{rating.rotor_speed_rad_s * 30.0 / math.pi:.4g} rpm"
     for key, value in (speeds or {}).items():
         out.append(Judgement("speed", key, float(value), -w, w, "rad/s",
-                             f"at most {MAX_SPEED_FACTOR:g} x the drivetrain's rated rotor speed "
-                             f"{rating.rotor_speed_rad_s * 30.0 / math.pi:.4g} rpm: overspeed protection trips at "
-                             "1.1-1.3 x rated"))
+                             f"at most {MAX_SPEED_FACTOR:g} x the drivetrain's rated rotor speed {rated_speed}: "
+                             "overspeed protection trips at 1.1-1.3 x rated"))
     t = MAX_TORQUE_FACTOR * abs(rating.torque_nm)
-    for key, value in (torques or {}).items() if t > 0.0 else ():
-        out.append(Judgement("torque", key, float(value), -t, t, "N m",
-                             f"at most {MAX_TORQUE_FACTOR:g} x the drivetrain's rated torque {rating.torque_nm:.4g} N m: "
-                             "a generator's breakdown torque is 2-3 x rated"))
+    if t == 0.0:
+        return tuple(out)  # no rated torque to judge a torque by
+    why = (f"at most {MAX_TORQUE_FACTOR:g} x the drivetrain's rated torque {rating.torque_nm:.4g} N m: a generator's "
+           "breakdown torque is 2-3 x rated")
+    for key, value in (torques or {}).items():
+        out.append(Judgement("torque", key, float(value), -t, t, "N m", why))
+    for key, (factor, base) in (torque_factors or {}).items():
+        if base != 0.0:
+            out.append(Judgement("torque", key, float(factor), -t / abs(base), t / abs(base), "",
+                                 f"a torque factor x {base:.4g} N m {why}"))
     return tuple(out)
 
 

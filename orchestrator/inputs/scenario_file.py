@@ -50,6 +50,9 @@ TOML format (units SI; see ``docs/orchestrator.md`` for the full reference)::
 
     [analysis]                            # result analyses (orchestrator.inputs.analysis_settings)
     woehler_exponents = [3, 5, 8, 10]
+
+    [plausibility]                        # values kept although implausible by physics (a deliberate study)
+    allow = ["gearbox.stage1.backlash"]
 """
 
 from __future__ import annotations
@@ -78,7 +81,7 @@ from .scenario import (
     SimulationSettings,
     VariableRef,
 )
-from .schema import Table, flatten_parameters, read_document
+from .schema import PlausibilityTable, Table, flatten_parameters, read_document
 from .series_spec import SeriesTable, series_from_table
 
 
@@ -134,6 +137,7 @@ class ScenarioFile(Table):
     events: list[EventTable] = Field(default_factory=list,
                                      description="an array of tables [[events]] with kind, start, duration (, factor)")
     analysis: AnalysisTable | None = Field(None, description="an [analysis] table")
+    plausibility: PlausibilityTable | None = Field(None, description="a [plausibility] table with allow = [...]")
 
 
 _SIM_FIELDS = {"start": "start_s", "stop": "stop_s", "step": "step_s", "output_interval": "output_interval_s",
@@ -229,6 +233,7 @@ def scenario_from_dict(data: Mapping[str, Any], name: str | None = None, base_di
         results_format=doc.record.format if doc.record is not None else "auto",
         base_dir=base_dir,
         source=source,
+        allow_implausible=tuple(doc.plausibility.allow) if doc.plausibility is not None else (),
     )
 
 
