@@ -29,9 +29,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--extrapolation", choices=EXTRAPOLATIONS, default=None, help="override the input extrapolation")
     p.add_argument("--set", action="append", default=[], metavar="COMPONENT.PARAMETER=VALUE",
                    help="override a parameter value, e.g. --set wind.seed=7 (repeatable)")
-    p.add_argument("--allow-implausible", action="append", default=[], metavar="COMPONENT.PARAMETER",
-                   help="keep a value physics calls implausible (a deliberate study), e.g. --allow-implausible "
-                        "gearbox.stage1.backlash (repeatable; [plausibility] allow in the scenario)")
+    add_allow_argument(p, "the scenario")
     p.add_argument("--algebraic-loops", choices=ALGEBRAIC_LOOPS, default=None,
                    help="override what the master does with an algebraic loop: refuse it, or iterate it at every "
                         "communication point ([simulation] algebraic_loops)")
@@ -39,6 +37,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="an output (or, with COMPONENT alone, every output without declared dependencies) that "
                         "does not depend directly on the FMU's inputs, for FMUs whose model description does not "
                         "say (repeatable; [components.X] no_feedthrough)")
+
+
+def add_allow_argument(p: argparse.ArgumentParser, where: str) -> None:
+    """``--allow-implausible COMPONENT.PARAMETER`` (repeatable): what ``[plausibility] allow`` in ``where`` keeps."""
+    p.add_argument("--allow-implausible", action="append", default=[], metavar="COMPONENT.PARAMETER",
+                   help="keep a value physics calls implausible (a deliberate study), e.g. --allow-implausible "
+                        f"gearbox.stage1.backlash (repeatable; [plausibility] allow in {where})")
 
 
 def load(spec, args: argparse.Namespace, command: str):

@@ -78,7 +78,7 @@ import hashlib
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Mapping, Sequence
 
 from components import units
 from components.analysis.plausibility import Judgement
@@ -459,8 +459,10 @@ class _Reader:
 
 
 def drivetrain_from_dict(data: Mapping[str, Any], name: str | None = None, source: str | None = None,
-                         sha256: str = "") -> DrivetrainSpec:
+                         sha256: str = "", allow: Sequence[str] = ()) -> DrivetrainSpec:
     """Read a parsed drivetrain document.
+
+    ``allow`` adds flat parameter names to the file's ``[plausibility] allow`` (a study's).
 
     Raises
     ------
@@ -475,7 +477,7 @@ def drivetrain_from_dict(data: Mapping[str, Any], name: str | None = None, sourc
     drivetrain, bodies, checks = reader.drivetrain()
     speed = reader.u.si("operating_point.rotor_speed", doc.operating_point.rotor_speed, "speed") \
         if doc.operating_point else DEFAULT_ROTOR_SPEED_RAD_S
-    allow = doc.plausibility.allow if doc.plausibility is not None else []
+    allow = [*(doc.plausibility.allow if doc.plausibility is not None else ()), *allow]
     judgements = check_file(drivetrain, speed, allow, reader.file_keys, data, source)
     for stage, rows in plausibility_checks(judgements, allow).items():
         checks[stage] = tuple(checks.get(stage, ())) + rows

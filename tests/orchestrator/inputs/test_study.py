@@ -148,7 +148,7 @@ def test_point_timeout_fails_the_point_and_leaves_the_keys_alone(write_study):
     """A point past the study's timeout fails with the limit and the time reached; keys ignore the limit."""
     from orchestrator.study.engine import PointTask, run_point
 
-    text = MODEL_BASE.replace("stop = 0.01", "stop = 1.0") + '[[axes]]\nparameter = "gearbox.R1"\nvalues = [6.0]\n'
+    text = MODEL_BASE.replace("stop = 0.01", "stop = 1.0") + '[[axes]]\nparameter = "gearbox.R1"\nvalues = [8.0]\n'
     free = prepare_study(load_study(write_study(text, "free.toml")))
     limited = prepare_study(load_study(write_study("timeout = 0.001\n" + text, "limited.toml")))
     assert limited.payload.timeout_s == 0.001 and free.payload.timeout_s is None
