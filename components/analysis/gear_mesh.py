@@ -19,8 +19,8 @@ The rating that uses these is :mod:`components.analysis.gear_rating` (formulas t
   :meth:`MeshGeometry.mesh_stiffness`): the theoretical single stiffness ``c'_th = 1 / q'`` of a solid
   steel pair, ``q' = C1 + C2 / z_1 + C3 / z_2 + C4 x_1 + C5 x_1 / z_1 + C6 x_2 + C7 x_2 / z_2 + C8 x_1^2
   + C9 x_2^2`` [mm um / N] (an internal wheel counts as ``z_2 = infinity``), the single stiffness ``c' =
-  c'_th C_M C_R C_B`` (spur: ``cos(beta) = 1``; ``C_M = 0.8``; ``C_R = 1``, a solid blank; ``C_B = [1 +
-  0.5 (1.2 - h_fP / m)] [1 - 0.02 (20 deg - alpha)]`` of the basic rack), times ``(w / 100 N/mm)^0.25``
+  c'_th C_M C_R C_B`` (spur: ``cos(beta) = 1``; ``C_M = 0.8``; ``C_R = 1``, a solid blank; ``C_B = (1 +
+  0.5 (1.2 - h_fP / m)) (1 - 0.02 (20 deg - alpha))`` of the basic rack), times ``(w / 100 N/mm)^0.25``
   below a line load ``w`` of 100 N/mm, and the mesh stiffness ``c_gamma_alpha = c' (0.75 eps_alpha +
   0.25)``; all per unit face width [N/m^2 in SI; 1 N/(mm um) = 1e9 N/m^2].
 """

@@ -7,12 +7,13 @@ import math
 import pytest
 
 from components import units
-from orchestrator.inputs.load_case_file import load_cases_from_dict
+from orchestrator.inputs.load_case_file import find_load_cases, load_cases_from_dict, load_load_cases, packaged_load_cases
 from orchestrator.inputs.load_cases import LoadCaseError
 from orchestrator.inputs.study import StudyError
 from orchestrator.inputs.study_file import load_study
 from orchestrator.study.load_cases import prepare_load_cases
 from orchestrator.study.prepare import prepare_study
+from tests.helpers.openfast_data import openfast_file
 
 MODEL = """
 name = "units"
@@ -134,3 +135,13 @@ def test_a_load_case_set_takes_quantities_and_judges_every_run(fmu_dir):
     allowed = _set(operating_points=[{"wind_speed": 10.0, "generator_torque": "100 kN m"}],
                    plausibility={"allow": ["generator.counter_torque"]})
     assert prepare_load_cases(allowed, fmu_dir=fmu_dir).cases[0].parameters["generator.counter_torque"] == 1.0e5
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", sorted(packaged_load_cases()))
+def test_every_run_of_every_packaged_load_case_set_is_plausible(name, tmp_path_factory):
+    if name.startswith("openfast"):
+        openfast_file("DLC1.1_0_NREL5MW_OC3_spar_0.outb")  # skips without the shared data
+    plc = prepare_load_cases(load_load_cases(find_load_cases(name)),
+                             fmu_dir=tmp_path_factory.getbasetemp() / "plausible-fmus")
+    assert plc.cases and len(set(plc.keys)) == len(plc.cases)
