@@ -141,16 +141,10 @@ def check_points(study: Study, points: list[Point], problem: Callable[[Mapping[s
 def scenario_problem(system, study: Study) -> Callable[[Mapping[str, Any]], tuple | None]:
     """``problem(point values)`` of :func:`check_points` for a scenario base: the run's own plausibility check."""
     from ..cosim.plausibility_checks import plausibility_problem
+    from ..inputs.overrides import apply_parameters
 
     def problem(values: Mapping[str, Any]) -> tuple | None:
-        scenario = system.scenario
-        by_comp: dict[str, dict[str, Any]] = {}
-        for name, value in values.items():
-            comp, param = split_parameter(name)
-            by_comp.setdefault(comp, {})[param] = value
-        for comp, vals in by_comp.items():
-            scenario = scenario.with_parameters(comp, **vals)
-        found = plausibility_problem(replace(system, scenario=scenario))
+        found = plausibility_problem(replace(system, scenario=apply_parameters(system.scenario, values)))
         if found is None:
             return None
         key, value, expected = found  # components.<comp>.parameters.<param>

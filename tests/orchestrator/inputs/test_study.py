@@ -11,17 +11,7 @@ from components.errors import DtcosimError
 from orchestrator.inputs.study import StudyError
 from orchestrator.inputs.study_file import find_study, load_study, study_from_dict
 from orchestrator.study.prepare import prepare_study
-from tests.helpers.studies import SMALL_STUDY, run_cli
-
-MODEL_BASE = """
-name = "t"
-engine = "monolithic"
-measures = ["I_max_acc"]
-[base]
-model = "sensitivity-variant"
-[simulation]
-stop = 0.01
-"""
+from tests.helpers.studies import MODEL_BASE, SMALL_STUDY, run_cli
 
 
 def test_paper_sensitivity_is_the_sec41_grid():

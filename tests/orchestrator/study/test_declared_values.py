@@ -14,16 +14,7 @@ from orchestrator.inputs.study_file import load_study
 from orchestrator.study.load_cases import prepare_load_cases
 from orchestrator.study.prepare import prepare_study
 from tests.helpers.openfast_data import openfast_file
-
-MODEL = """
-name = "units"
-engine = "monolithic"
-measures = ["I_max_acc"]
-[base]
-model = "sensitivity-variant"
-[simulation]
-stop = 0.01
-"""
+from tests.helpers.studies import MODEL_BASE as MODEL
 
 COSIM = """
 name = "units"
