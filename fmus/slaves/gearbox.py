@@ -97,7 +97,9 @@ class Gearbox(DtcosimSlave):
                               f"{enumeration_text(GENERATOR_INTERFACES)} (motion: along the generator-motion "
                               "inputs; inertia: an interface model, the generator inertia generator_inertia "
                               "integrated in the step against the input counter_torque, its speed set to "
-                              "omega_gen at every communication point)"),
+                              "omega_gen at every communication point; inertia_own: the same, its speed set to "
+                              "its own impulse balance instead (omega_gen unused), for hosts that step with "
+                              "Jacobi, with a generator that follows omega_generator)"),
             real_parameter("generator_inertia", template.generator.inertia_kgm2, "kg.m2",
                            "generator rotor inertia of the inertia interface (the generator component's)"),
             boolean_parameter("rotor_derivatives", False,
@@ -147,6 +149,10 @@ class Gearbox(DtcosimSlave):
                         "largest |d omega_out/dt| since initialisation over every internal solver step "
                         "(paper eq. 11; resolves tooth impacts shorter than the communication step)",
                         "output_acceleration_peak"),
+            real_output("omega_generator", "rad/s",
+                        "generator speed of the interface model: the speed the next step starts from "
+                        "(inertia_own), the generator's impulse balance over the last step (inertia), the "
+                        "extrapolated omega_gen (motion)"),
         ]
         return variables
 

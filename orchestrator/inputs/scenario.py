@@ -203,6 +203,40 @@ class ParameterBinding:
 
 
 @dataclass(frozen=True)
+class JacobiCoupling:
+    """How the system is coupled when it is stepped with Jacobi (the ``[jacobi]`` table).
+
+    A host that exchanges values after every component stepped (Jacobi: libcosim, ecos) gives
+    each component its partners' values of the last communication point; a cut designed for
+    Gauss-Seidel may then need other interface settings and connections (the paper scenario:
+    the Gearbox's ``inertia_own`` interface and a generator that follows it) and another step.
+    :meth:`Scenario.for_algorithm` applies them; ``dtcosim export-ssp --target libcosim|ecos``
+    and ``--algorithm jacobi`` use it.
+
+    Attributes
+    ----------
+    step_s : float or None
+        Communication step under Jacobi [s] (None: the scenario's).
+    step_criteria : str
+        What the step was chosen by (written into an exported SSD and printed).
+    parameters : mapping of str -> mapping of str -> value
+        Component -> parameter values that replace the scenario's.
+    connections : tuple of Connection
+        Connections added to the scenario's.
+    """
+
+    step_s: float | None = None
+    step_criteria: str = ""
+    parameters: Mapping[str, Mapping[str, ParameterValue]] = field(default_factory=dict)
+    connections: tuple[Connection, ...] = ()
+
+    def describe(self) -> str:
+        """``"gearbox.generator_interface = 2, ..., gearbox.omega_generator -> generator.omega_gearbox"``."""
+        items = [f"{comp}.{name} = {value}" for comp, values in self.parameters.items() for name, value in values.items()]
+        return ", ".join(items + [str(c) for c in self.connections])
+
+
+@dataclass(frozen=True)
 class SimulationSettings:
     """Time grid and master algorithm.
 
@@ -359,6 +393,9 @@ class Scenario:
     allow_implausible : tuple of str
         ``"component.parameter"`` values kept although implausible by physics (``[plausibility] allow``,
         ``--allow-implausible``; :mod:`orchestrator.cosim.plausibility_checks`).
+    jacobi : JacobiCoupling or None
+        How the system is coupled when stepped with Jacobi (``[jacobi]``; applied by
+        :meth:`for_algorithm`).
     """
 
     name: str
@@ -376,6 +413,7 @@ class Scenario:
     import_notes: tuple[str, ...] = ()
     bindings: tuple[ParameterBinding, ...] = ()
     allow_implausible: tuple[str, ...] = ()
+    jacobi: JacobiCoupling | None = None
 
     def __post_init__(self) -> None:
         src = self.source
@@ -509,6 +547,23 @@ class Scenario:
     def with_simulation(self, **changes) -> "Scenario":
         """Copy with some :class:`SimulationSettings` fields replaced (validated again)."""
         return replace(self, simulation=replace(self.simulation, **changes))
+
+    def for_algorithm(self, algorithm: str, **changes) -> "Scenario":
+        """The scenario stepped with ``algorithm``: with Jacobi, its :class:`JacobiCoupling` applied.
+
+        The coupling's parameter values replace the scenario's, its connections are added and
+        its step (if any) becomes the scenario's; the result declares no coupling of its own.
+        ``changes`` are :class:`SimulationSettings` fields set at the same time (they win over
+        the coupling's step).
+        """
+        if algorithm != "jacobi" or self.jacobi is None:
+            return self.with_simulation(algorithm=algorithm, **changes)
+        coupling, scenario = self.jacobi, self
+        for comp, values in coupling.parameters.items():
+            scenario = scenario.with_parameters(comp, **values)
+        step = {} if coupling.step_s is None else {"step_s": coupling.step_s}
+        return replace(scenario, connections=scenario.connections + coupling.connections, jacobi=None,
+                       simulation=replace(scenario.simulation, algorithm="jacobi", **{**step, **changes}))
 
     def with_parameters(self, component: str, **values: ParameterValue) -> "Scenario":
         """Copy with parameter values of one component added or replaced."""
