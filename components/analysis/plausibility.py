@@ -169,13 +169,6 @@ def _radii(stage) -> dict[str, float]:
     return {"drive": stage.drive_radius_m, "driven": stage.driven_radius_m}
 
 
-def _meshes(stage) -> dict[str, object]:
-    """Mesh field -> MeshContact of a stage."""
-    if isinstance(stage, PlanetaryStage):
-        return {"sun_mesh": stage.sun_mesh, "ring_mesh": stage.ring_mesh}
-    return {"mesh": stage.mesh}
-
-
 def _module(stage, forces: Mapping[str, float]) -> Iterable[Judgement]:
     m, radii = stage.module_m, _radii(stage)
     small, large = min(radii, key=radii.get), max(radii, key=radii.get)

@@ -138,7 +138,7 @@ def check_points(study: Study, points: list[Point], problem: Callable[[Mapping[s
             raise StudyError(point_key(study, point, name), value, f"{expected} (point {point.index})", study.source)
 
 
-def scenario_problem(system, study: Study) -> Callable[[Mapping[str, Any]], tuple | None]:
+def scenario_problem(system) -> Callable[[Mapping[str, Any]], tuple | None]:
     """``problem(point values)`` of :func:`check_points` for a scenario base: the run's own plausibility check."""
     from ..cosim.plausibility_checks import plausibility_problem
     from ..inputs.overrides import apply_parameters

@@ -303,8 +303,9 @@ def _prepare_scenario(study: Study, fmu_dir,
         for value in values if not is_file_entry(name) else ():
             _check_value(system, name, value, key, src)
     seed = study.seed_parameter if study.seeds else None  # a seed changes no value physics bounds
-    check_points(study, [p for p in study.expand() if not any(is_file_entry(n) for n in p.parameters)],
-                 scenario_problem(system, study), skip=lambda name: name == seed)
+    # drivetrain file entries are judged when each point's file is read again (drivetrain_variants)
+    check_points(study, study.expand(), scenario_problem(system),
+                 skip=lambda name: name == seed or is_file_entry(name))
     _check_measure_engines(study)
 
     series_names: dict[str, str] = {}
