@@ -107,9 +107,8 @@ def plausibility_checks(judgements: Sequence[Judgement], allow: Sequence[str]) -
             if not mine:
                 continue
             failed = [j for j in mine if not j.passed]
-            shown = failed or mine
             detail = "; ".join(dict.fromkeys(f"{j.key.split('.', 1)[1]} {j.value:.4g} {j.unit}, plausible {j.bound}"
-                                             for j in shown))
+                                             + (f" ({j.reason})" if failed else "") for j in failed or mine))
             if failed:
                 detail = "allowed by [plausibility]: " + detail
             out.setdefault(stage, []).append(GeometryCheck(f"plausible {rule.title}", not failed, detail))

@@ -91,5 +91,5 @@ def test_the_design_table_lists_every_rule_and_the_allowed_values():
     assert "check plausible backlash against module and tooth thickness: ok (backlash 0.00056 m, plausible within " \
            "[0, 0.002952] m)" in text
     assert "check plausible face width against module and gear size: not met (allowed by [plausibility]: " \
-           "width 0.005 m, plausible within [0.0225, 0.4] m)" in text
+           "width 0.005 m, plausible within [0.0225, 0.4] m (at least the tooth height 2.25 m = 22.5 mm" in text
     assert text.count("check plausible") == 15  # 5 rules x 3 stages
