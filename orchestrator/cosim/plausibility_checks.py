@@ -53,6 +53,9 @@ def check_allowed(system) -> None:
     scenario = system.scenario
     for i, key in enumerate(scenario.allow_implausible):
         comp, _, param = key.partition(".")
+        if comp not in system.interfaces:
+            raise ScenarioError(f"plausibility.allow[{i}]", key, "a parameter of a declared component: "
+                                + ", ".join(system.interfaces), scenario.source)
         variables = system.interfaces[comp].variables
         if param not in variables or variables[param].causality != "parameter":
             names = [n for n, v in variables.items() if v.causality == "parameter"]

@@ -479,11 +479,6 @@ class Scenario:
         if self.results_format not in RESULTS_FORMATS:
             raise ScenarioError("record.format", self.results_format, "one of " + ", ".join(RESULTS_FORMATS), src)
         object.__setattr__(self, "allow_implausible", tuple(dict.fromkeys(self.allow_implausible)))
-        for i, key in enumerate(self.allow_implausible):
-            ref = VariableRef.parse(key, f"plausibility.allow[{i}]", src)
-            if ref.component not in known:
-                raise ScenarioError(f"plausibility.allow[{i}]", key, "a parameter of a declared component: "
-                                    + ", ".join(names), src)
 
     def _check_bindings(self, known: set[str], names: list[str], driven: Mapping[str, str],
                         set_initially: Mapping[str, int]) -> None:
