@@ -16,6 +16,7 @@ from pathlib import Path
 
 from .cluster_options import add_cluster_arguments, check_cluster_arguments, check_workers
 from .fmu_options import add_fmu_arguments
+from .scenario_options import add_allow_argument, allow_implausible
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -53,6 +54,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--quiet", "-q", action="store_true", help="no progress bars and no report on the terminal")
     p.add_argument("--timeout", type=float, default=None, metavar="SECONDS",
                    help="wall-clock time one run may take (overrides the set's timeout)")
+    add_allow_argument(p, "the load-case set")
     p.set_defaults(func=run)
 
 
@@ -155,6 +157,7 @@ def run(args: argparse.Namespace) -> int:
         changes["seeds"] = tuple(range(1, args.seeds + 1))
     if changes:
         lcs = replace(lcs, **changes)
+    lcs = allow_implausible(lcs, args.allow_implausible)
     out_dir = args.out if args.out is not None else default_out_dir(lcs.name)
     check_for_study(out_dir, lcs.name)  # a run's folder or another study's: refused before anything is prepared
     plc = prepare_load_cases(lcs, fmu_dir=args.fmu_dir, build=not args.no_build)

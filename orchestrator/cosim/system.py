@@ -18,7 +18,8 @@ declared dependencies is run as libcosim runs it, with a note in
 ``ResolvedSystem.notes``);
 values given with a unit (``"0.56 mm"``) converted to the unit the FMU declares
 (:mod:`orchestrator.cosim.declared_units`); every value within what the FMU accepts (FMI Integer range, declared bounds, a
-dtcosim model's own validation: :mod:`orchestrator.cosim.parameter_checks`); the
+dtcosim model's own validation: :mod:`orchestrator.cosim.parameter_checks`); values plausible by physics
+(:mod:`orchestrator.cosim.plausibility_checks`); the
 results within the size limits (:func:`check_sizes`). The first problem raises
 :class:`~orchestrator.errors.ScenarioError` naming the scenario key. The result,
 a :class:`~orchestrator.cosim.resolved.ResolvedSystem`, is what the master runs.
@@ -42,6 +43,7 @@ from .fmu_interface import FmuInterface, FmuVariable, read_fmu_interface
 from .coupling_delays import FEEDTHROUGH, coupling_delays
 from .graph import algebraic_loop_groups, dependency_order, find_algebraic_loop, initialization_order
 from .parameter_checks import model_problem, value_problem
+from .plausibility_checks import plausibility_problem
 from .resolved import RecordedVariable, ResolvedSystem
 from .roles import declared_roles
 from .values import transformation_problem, type_mismatch
@@ -273,7 +275,7 @@ def resolve_system(scenario: Scenario, fmu_paths: Mapping[str, Path] | None = No
         notes=tuple(notes),
         delays=delays,
     )
-    problem = model_problem(system)
+    problem = model_problem(system) or plausibility_problem(system)
     if problem is not None:
         raise ScenarioError(*problem, src)
     check_sizes(system)

@@ -15,7 +15,7 @@ from components.model.contact import CONTACT_LAWS
 
 from ..errors import EntryError
 from .quantities import Given, amount
-from .schema import Table
+from .schema import PlausibilityTable, Table
 
 
 class DrivetrainFileError(EntryError):
@@ -44,12 +44,6 @@ class UnitsTable(Table):
     torsional_damping: str | None = Field(None, description="a unit such as \"N.mm.s/deg\" or \"N.m.s/rad\"")
     torque: str | None = Field(None, description="a torque unit such as \"N.mm\" or \"kN m\"")
     speed: str | None = Field(None, description="a speed unit such as \"rpm\" or \"rad/s\"")
-
-
-class PlausibilityTable(Table):
-    """``[plausibility]``: the values a deliberate study keeps although physics calls them implausible."""
-
-    allow: list[str] = Field(default_factory=list, description='a list of parameter names such as "stage1.backlash"')
 
 
 class MeshTable(Table):

@@ -390,6 +390,9 @@ class Scenario:
     import_notes : tuple of str
         What the SSP import passed over (other tools' annotations, skipped mapping
         entries, parameter values not applied); listed in the run's summary.
+    allow_implausible : tuple of str
+        ``"component.parameter"`` values kept although implausible by physics (``[plausibility] allow``,
+        ``--allow-implausible``; :mod:`orchestrator.cosim.plausibility_checks`).
     jacobi : JacobiCoupling or None
         How the system is coupled when stepped with Jacobi (``[jacobi]``; applied by
         :meth:`for_algorithm`).
@@ -409,6 +412,7 @@ class Scenario:
     results_format: str = "auto"
     import_notes: tuple[str, ...] = ()
     bindings: tuple[ParameterBinding, ...] = ()
+    allow_implausible: tuple[str, ...] = ()
     jacobi: JacobiCoupling | None = None
 
     def __post_init__(self) -> None:
@@ -474,6 +478,7 @@ class Scenario:
             raise ScenarioError("analysis", self.analysis, "an AnalysisSettings", src)
         if self.results_format not in RESULTS_FORMATS:
             raise ScenarioError("record.format", self.results_format, "one of " + ", ".join(RESULTS_FORMATS), src)
+        object.__setattr__(self, "allow_implausible", tuple(dict.fromkeys(self.allow_implausible)))
 
     def _check_bindings(self, known: set[str], names: list[str], driven: Mapping[str, str],
                         set_initially: Mapping[str, int]) -> None:
@@ -563,6 +568,10 @@ class Scenario:
         if component not in self.component_names:
             raise ScenarioError("components", component, "a declared component: " + ", ".join(self.component_names), self.source)
         return replace(self, components=comps)
+
+    def with_allowed(self, *keys: str) -> "Scenario":
+        """Copy that keeps these ``"component.parameter"`` values although implausible (``--allow-implausible``)."""
+        return replace(self, allow_implausible=self.allow_implausible + tuple(keys))
 
     def with_no_feedthrough(self, item: str) -> "Scenario":
         """Copy where ``"component.output"`` (or ``"component"``: all its undeclared outputs) does not feed through.

@@ -51,6 +51,9 @@ TOML format (units SI; see ``docs/orchestrator.md`` for the full reference)::
     [analysis]                            # result analyses (orchestrator.inputs.analysis_settings)
     woehler_exponents = [3, 5, 8, 10]
 
+    [plausibility]                        # values kept although implausible by physics (a deliberate study)
+    allow = ["gearbox.stage1.backlash"]
+
     [jacobi]                              # the coupling when stepped with Jacobi (libcosim, ecos, --algorithm jacobi)
     step = 2e-2                           # s, optional: the step under Jacobi
     step_criteria = "..."                 # optional: what the step was chosen by
@@ -88,7 +91,7 @@ from .scenario import (
     SimulationSettings,
     VariableRef,
 )
-from .schema import Table, flatten_parameters, read_document
+from .schema import PlausibilityTable, Table, flatten_parameters, read_document
 from .series_spec import SeriesTable, series_from_table
 
 
@@ -153,6 +156,7 @@ class ScenarioFile(Table):
     events: list[EventTable] = Field(default_factory=list,
                                      description="an array of tables [[events]] with kind, start, duration (, factor)")
     analysis: AnalysisTable | None = Field(None, description="an [analysis] table")
+    plausibility: PlausibilityTable | None = Field(None, description="a [plausibility] table with allow = [...]")
     jacobi: _JacobiTable | None = Field(None, description="a [jacobi] table (the coupling under Jacobi)")
 
 
@@ -256,6 +260,7 @@ def scenario_from_dict(data: Mapping[str, Any], name: str | None = None, base_di
         results_format=doc.record.format if doc.record is not None else "auto",
         base_dir=base_dir,
         source=source,
+        allow_implausible=tuple(doc.plausibility.allow) if doc.plausibility is not None else (),
         jacobi=jacobi,
     )
     if jacobi is not None:  # checked as applied; a scenario stepped with Jacobi is coupled so from the start

@@ -203,9 +203,10 @@ def _check_measure_engines(study: Study) -> None:
                              f"({m.name} needs the {' or '.join(m.engines)} engine)", study.source)
 
 
-def _prepare_model(study: Study) -> tuple[StudyPayload, dict[str, Any]]:
+def _prepare_model(study: Study) -> tuple[Study, StudyPayload, dict[str, Any]]:
     from components.errors import ParameterError
 
+    from .declared_values import check_points, in_declared_units, model_converter
     from .models import MODEL_COMPONENT, MODELS
 
     src = study.source
@@ -213,6 +214,7 @@ def _prepare_model(study: Study) -> tuple[StudyPayload, dict[str, Any]]:
         raise StudyError("base.model", study.base.name, "one of the built-in models: " + ", ".join(MODELS), src)
     model = MODELS[study.base.name]
     defaults = model.defaults()
+    study = in_declared_units(study, model_converter(model.units(), model.exponent), base_too=True)
     checks = [(f"base.parameters.{p}", p, [v]) for p, v in study.base.parameters.items()] + _origins(study)
     for key, name, values in checks:
         if name not in defaults:
@@ -224,6 +226,7 @@ def _prepare_model(study: Study) -> tuple[StudyPayload, dict[str, Any]]:
         drivetrain, driver = model.build(dict(study.base.parameters))
     except ParameterError as exc:
         raise StudyError(f"base.parameters ({exc.name})", exc.value, exc.expected, src) from None
+    check_points(study, study.expand(), model.plausibility(dict(study.base.parameters), study.allow_implausible))
     sim = study.simulation
     start = 0.0 if sim.start_s is None else float(sim.start_s)
     stop = float(sim.stop_s)
@@ -255,11 +258,11 @@ def _prepare_model(study: Study) -> tuple[StudyPayload, dict[str, Any]]:
         solver={k: getattr(settings, k) for k in ("rtol", "atol_angle_rad", "atol_speed_rad_s", "max_step_s", "max_steps")},
         series_names=series_names,
     )
-    return payload, {"model": model.name}
+    return study, payload, {"model": model.name}
 
 
 def _prepare_scenario(study: Study, fmu_dir,
-                      build: bool) -> tuple[StudyPayload, dict[str, Any], dict[str, Path], tuple[str, ...]]:
+                      build: bool) -> tuple[Study, StudyPayload, dict[str, Any], dict[str, Path], tuple[str, ...]]:
     from ..cosim.roles import GEARBOX
     from ..cosim.system import resolve_system
     from ..provision.project_fmus import ensure_fmus
@@ -279,6 +282,7 @@ def _prepare_scenario(study: Study, fmu_dir,
         paths = ensure_fmus(scenario, fmu_dir, build=build)
     except ScenarioError as exc:
         raise StudyError("base.scenario", study.base.name, f"FMUs that exist or can be built ({exc})", src) from None
+    from .declared_values import check_points, in_declared_units, scenario_converter, scenario_problem
     from .drivetrain_variants import is_file_entry
 
     by_comp: dict[str, dict[str, Any]] = {}
@@ -290,12 +294,18 @@ def _prepare_scenario(study: Study, fmu_dir,
     try:
         for comp, values in by_comp.items():
             scenario = scenario.with_parameters(comp, **values)
+        scenario = scenario.with_allowed(*study.allow_implausible)
         system = resolve_system(scenario, fmu_paths=paths)
     except ScenarioError as exc:
         raise StudyError(_study_key_of(exc), exc.value, exc.expected, src) from None
+    study = in_declared_units(study, scenario_converter(system, is_file_entry))
     for key, name, values in _origins(study):
         for value in values if not is_file_entry(name) else ():
             _check_value(system, name, value, key, src)
+    seed = study.seed_parameter if study.seeds else None  # a seed changes no value physics bounds
+    # drivetrain file entries are judged when each point's file is read again (drivetrain_variants)
+    check_points(study, study.expand(), scenario_problem(system),
+                 skip=lambda name: name == seed or is_file_entry(name))
     _check_measure_engines(study)
 
     series_names: dict[str, str] = {}
@@ -382,7 +392,7 @@ def _prepare_scenario(study: Study, fmu_dir,
         identity["structures"] = {sid: {c: i.sha256 for c, i in s.interfaces.items()}
                                   for sid, s in variants.systems.items()}
         payload = replace(payload, structures=dict(variants.systems), variants=dict(variants.points))
-    return payload, identity, dict(system.fmu_paths), tuple(notes)
+    return study, payload, identity, dict(system.fmu_paths), tuple(notes)
 
 
 def _variants(study: Study, scenario, fmu_dir, build: bool):
@@ -434,11 +444,11 @@ def prepare_study(study: Study, fmu_dir: str | Path | None = None, build: bool =
         Naming the study key of the first problem.
     """
     if study.base.kind == "model":
-        payload, base_identity = _prepare_model(study)
+        study, payload, base_identity = _prepare_model(study)
         fmu_paths: dict[str, Path] = {}
         notes: tuple[str, ...] = ()
     else:
-        payload, base_identity, fmu_paths, notes = _prepare_scenario(study, fmu_dir, build)
+        study, payload, base_identity, fmu_paths, notes = _prepare_scenario(study, fmu_dir, build)
     identity = {
         "engine": study.engine,
         "base": {"kind": study.base.kind, **base_identity},

@@ -3,8 +3,8 @@
 ``results.csv``
     One row per point of the study, in point order: ``index``, ``status``
     (``ok``, ``failed``, ``error`` or ``pending`` = not run yet), one column per
-    varied parameter (``component.parameter``, SI, full precision), for axes with
-    a display scale also ``label [unit]`` (e.g. ``lambda [1/mm]``), one column
+    varied parameter (``component.parameter``, in its declared unit, full precision), for axes
+    written in another unit also ``label [unit]`` as written (e.g. ``lambda [1/mm]``), one column
     per measure (``name [unit]``), ``error`` (the message of a failed point),
     ``worker``, ``task_wall_time [s]`` and ``key``.
 ``study.json``
@@ -68,7 +68,7 @@ def table_text(prepared, recs: list[dict | None]) -> str:
     """The CSV table (see the module docstring) as text."""
     study = prepared.study
     params = study.varied_parameters
-    display = [(a, a.parameters[0]) for a in study.axes if a.scale != 1.0]
+    display = [(a, a.parameters[0]) for a in study.axes if a.shown is not None]
     header = ["index", "status", *params, *(a.axis_label for a, _ in display), *(m.column for m in study.measures),
               "error", "worker", "task_wall_time [s]", "key"]
     buf = io.StringIO()
@@ -115,8 +115,8 @@ def summary(prepared, recs: list[dict | None], report=None, files: Mapping[str, 
                  "parameters": dict(study.base.parameters)},
         "points": len(prepared.points),
         "status": status_counts(recs),
-        "axes": [{"label": a.label, "unit": a.unit, "scale": a.scale, "parameters": list(a.parameters),
-                  "values": list(a.values)} for a in study.axes],
+        "axes": [{"label": a.label, "unit": a.unit, "parameters": list(a.parameters), "values": list(a.values),
+                  "shown": list(a.shown) if a.shown is not None else None} for a in study.axes],
         "seeds": list(study.seeds),
         "measures": [{"name": m.name, "unit": m.unit, "description": m.description} for m in study.measures],
         "code_version": prepared.identity["code"],
