@@ -54,6 +54,7 @@ from components.model.drivetrain import Drivetrain
 from components.model.wind import WindParameters
 
 from . import binary, model_description, registry, runtime_files
+from .build_lock import build_lock, building_prefix
 from .parameter_ranges import parameter_bounds
 from .records import full_record
 from .slaves import base as slave_base
@@ -358,10 +359,9 @@ def build_fmu(name: str, out_dir: Path | str, preset: str = "table6", source: So
     if model is None:
         model = kind.model(drivetrain, wind)
     out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
     # written, completed and checked under a temporary name in the same folder, then renamed: an interrupted
-    # build leaves no FMU under the final name, and two builds into one folder each rename a whole archive
-    with tempfile.TemporaryDirectory(prefix=f".{name}-building-", dir=out_dir) as part:
+    # build leaves no FMU under the final name; one build at a time per folder (fmus.build_lock)
+    with build_lock(out_dir), tempfile.TemporaryDirectory(prefix=building_prefix(name), dir=out_dir) as part:
         built = _build_archive(name, kind, model, origin, source, Path(part), resources, validate)
         final = out_dir / f"{name}.fmu"
         os.replace(built.path, final)
