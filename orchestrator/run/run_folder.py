@@ -55,8 +55,8 @@ RUNNING, COMPLETE, STOPPED, FAILED = "running", "complete", "stopped", "failed"
 PROBE_PREFIX = ".dtcosim-write-test-"
 #: what a summary shortened for a full disk keeps (:meth:`RunFolder.finish`)
 BRIEF_KEYS = ("scenario", "description", "scenario_file", "results_format", "started_at", "pid", "status",
-              "complete", "stage", "stopped_at", "error", "interrupted", "signal", "problems", "samples", "files",
-              "files_incomplete")
+              "complete", "stage", "stopped_at", "error", "interrupted", "signal", "problems", "post_processing",
+              "samples", "files", "files_incomplete")
 
 
 class OutputFolderError(EntryError):

@@ -130,6 +130,39 @@ def test_no_room_even_for_the_short_summary_leaves_none(tmp_path, monkeypatch):
     assert list((tmp_path / "out").iterdir()) == []  # the running summary would lie: removed
 
 
+@pytest.mark.parametrize("full_at, kept, not_done", [
+    ("load_duration.png", ["contact_loss", "fatigue_del", "fatigue_ldd"], ["the rest of analyses", "plots"]),
+    ("generator_speed.png", ["contact_loss", "fatigue_del", "fatigue_ldd", "plot:load_duration", "plot:rotor_speed"],
+     ["the rest of plots"]),
+])
+def test_a_full_disk_during_the_analyses_or_plots_keeps_what_was_written_and_says_what_was_not(
+        fmu_dir, tmp_path, monkeypatch, capsys, full_at, kept, not_done):
+    """A disk that filled at a plot: the whole CSVs written before it were removed as never listed, the analyses'
+    results left the summary, and the run said "not done: " with nothing after it (seen on a 100 kB tmpfs)."""
+    import errno
+    from pathlib import Path
+
+    real_replace = os.replace
+
+    def replace(src, dst):
+        if Path(dst).name == full_at:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        real_replace(src, dst)
+
+    monkeypatch.setattr(os, "replace", replace)
+    out = tmp_path / "out"
+    assert cli.main(["run", "--fmu-dir", str(fmu_dir), "--no-build", "--stop", "0.5", "--out", str(out), "-q"]) == 1
+    summary = summary_of(out)
+    assert sorted(summary["files"]) == sorted(["timeseries", *kept, "summary"])
+    assert sorted(p.name for p in out.iterdir()) == sorted(summary["files"].values())
+    assert "contact_loss" in summary and "fatigue" in summary  # what the analyses computed
+    problem = f"cannot write {out / full_at}: No space left on device"
+    assert summary["post_processing"] == {"stopped": f"stopped: {problem}", "not_done": not_done, "error": problem}
+    assert summary["problems"] == [problem] and summary["status"] == "failed"
+    errors = [line for line in capsys.readouterr().err.splitlines() if "error" in line]
+    assert errors == [f"dtcosim run: error: {problem}; not done: {', '.join(not_done)}"]
+
+
 def test_a_file_written_into_the_folder_is_named_in_the_summary_before_it_appears(tmp_path, monkeypatch):
     """Issue 35.6: killed between writing a plot and listing it, the next run still knows the plot is a run's."""
     from orchestrator.atomic_files import write_bytes_atomic
