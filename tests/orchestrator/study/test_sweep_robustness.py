@@ -69,6 +69,53 @@ def test_a_full_disk_while_the_plots_are_drawn_is_one_line(write_study, tmp_path
     assert sorted(p.name for p in out.iterdir() if p.name.startswith(".")) == []  # no temporary file left
 
 
+@pytest.mark.parametrize("full_at", ["results.csv", "study.json"])
+def test_a_full_disk_at_the_table_or_summary_names_the_file_and_leaves_no_temporary_file(
+        write_study, tmp_path, monkeypatch, capsys, full_at):
+    """The table and study.json went through a writer of their own: 'error: No space left on device' naming no
+    file, and results.csv.tmp left behind (seen on a small tmpfs; the load sets' lifetime files the same)."""
+    path = write_study(GRID)
+    out = tmp_path / "out"
+    _journal_every_point(prepare_study(load_study(path)), out)
+    real_replace = os.replace
+
+    def replace(src, dst):
+        if Path(dst).name == full_at:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        real_replace(src, dst)
+
+    monkeypatch.setattr(os, "replace", replace)
+    assert cli.main(["sweep", str(path), "--out", str(out), "-q", "--report"]) == 1
+    assert capsys.readouterr().err.strip().splitlines() == [
+        f"dtcosim sweep: error: {out / full_at}: No space left on device"]
+    assert not [p.name for p in out.iterdir() if "tmp" in p.name]
+
+
+def test_a_journal_line_that_does_not_fit_is_cut_off_and_names_the_journal(tmp_path, monkeypatch):
+    """A full disk while a sweep journals a point: the sweep's one line was replaced by a bare 'error: No space left
+    on device', raised again when the journal was closed with the half line still in its buffer."""
+    from orchestrator.study import journal as journal_module
+    from orchestrator.study.journal import read_journal
+
+    path = tmp_path / "journal.jsonl"
+    real_write = journal_module._write_all
+
+    def half_then_full(fd, data):
+        real_write(fd, data[:10])
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    with Journal(path) as journal:
+        journal.append({"key": "a", "status": "ok"})
+        monkeypatch.setattr(journal_module, "_write_all", half_then_full)
+        with pytest.raises(OSError, match="No space left on device") as info:
+            journal.append({"key": "b", "status": "ok"})
+        assert info.value.filename == str(path)
+        monkeypatch.undo()
+        journal.append({"key": "c", "status": "ok"})
+    assert [r["key"] for r in read_journal(path)] == ["a", "c"]
+    assert path.read_bytes().count(b"\n") == 2  # no torn line between them
+
+
 def test_a_full_disk_while_a_run_file_is_stored_leaves_no_partial_file(tmp_path, monkeypatch):
     """Issue 35.9: ENOSPC in the middle of a load set's run file left ``runs/<run>.npz.part``."""
     from orchestrator.study import lifetime_results
