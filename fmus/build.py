@@ -43,7 +43,7 @@ import tempfile
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Sequence
+from typing import Callable, Sequence
 
 import pythonfmu
 from pythonfmu import FmuBuilder
@@ -320,7 +320,7 @@ def drivetrain_of_preset(preset: str) -> Drivetrain:
 def build_fmu(name: str, out_dir: Path | str, preset: str = "table6", source: SourceTree | None = None,
               validate: bool = True, *, drivetrain: Drivetrain | None = None, origin: str | None = None,
               rotor_speed_rad_s: float | None = None, model: dict | None = None,
-              resources: dict[str, Path] | None = None) -> BuiltFmu:
+              resources: dict[str, Path] | None = None, report: Callable[[str], None] | None = None) -> BuiltFmu:
     """Build one FMU into ``out_dir`` (``<out_dir>/<name>.fmu``).
 
     Parameters
@@ -347,6 +347,9 @@ def build_fmu(name: str, out_dir: Path | str, preset: str = "table6", source: So
         ``{"series": ...}``); it must name the content of ``resources`` (a hash) so that the build id does.
     resources : dict of str -> Path, optional
         Extra files packed into the FMU's ``resources/`` (name inside -> file), e.g. ``series.npz``.
+    report : callable(str), optional
+        Told when another process is building into ``out_dir`` and this build waits for it
+        (:func:`fmus.build_lock.build_lock`).
     """
     _check_pythonfmu()
     kind = _kind(name)
@@ -361,7 +364,7 @@ def build_fmu(name: str, out_dir: Path | str, preset: str = "table6", source: So
     out_dir = Path(out_dir)
     # written, completed and checked under a temporary name in the same folder, then renamed: an interrupted
     # build leaves no FMU under the final name; one build at a time per folder (fmus.build_lock)
-    with build_lock(out_dir), tempfile.TemporaryDirectory(prefix=building_prefix(name), dir=out_dir) as part:
+    with build_lock(out_dir, report), tempfile.TemporaryDirectory(prefix=building_prefix(name), dir=out_dir) as part:
         built = _build_archive(name, kind, model, origin, source, Path(part), resources, validate)
         final = out_dir / f"{name}.fmu"
         os.replace(built.path, final)
@@ -436,7 +439,8 @@ def _staged_resources(tmp: Path, resources: dict[str, Path] | None) -> list[Path
 
 
 def build_all(out_dir: Path | str, preset: str = "table6", source: SourceTree | None = None,
-              names: Sequence[str] = PRESET_FMU_NAMES, validate: bool = True) -> list[BuiltFmu]:
-    """Build the FMUs ``names`` (default: every FMU of a preset) into ``out_dir``."""
-    return [build_fmu(name, out_dir, preset, source, validate) for name in names]
+              names: Sequence[str] = PRESET_FMU_NAMES, validate: bool = True,
+              report: Callable[[str], None] | None = None) -> list[BuiltFmu]:
+    """Build the FMUs ``names`` (default: every FMU of a preset) into ``out_dir`` (``report``: see :func:`build_fmu`)."""
+    return [build_fmu(name, out_dir, preset, source, validate, report=report) for name in names]
 

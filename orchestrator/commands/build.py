@@ -48,7 +48,6 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     """Build from the preset, the drivetrain file or the scenario and print what was written."""
     from fmus.build import build_all
-    from fmus.build_lock import build_lock
 
     from ..cosim.compiled_kernels import ensure_compiled_kernels
 
@@ -63,9 +62,8 @@ def run(args: argparse.Namespace) -> int:
             print(f"{path}  ({comp})")
         return 0
     if args.drivetrain is None:
-        with build_lock(fmu_dir, report=print):
-            for built in build_all(fmu_dir, args.preset, names=args.fmu or PRESET_FMUS):
-                print(f"{built.path}  ({built.name}, preset {args.preset}, build {built.build_id})")
+        for built in build_all(fmu_dir, args.preset, names=args.fmu or PRESET_FMUS, report=print):
+            print(f"{built.path}  ({built.name}, preset {args.preset}, build {built.build_id})")
         return 0
     from components.errors import ParameterError
 
@@ -78,7 +76,6 @@ def run(args: argparse.Namespace) -> int:
     spec = load_drivetrain_file(find_drivetrain(args.drivetrain))
     names = args.fmu or list(DRIVETRAIN_FMU_NAMES)
     out = args.out if args.out is not None else drivetrain_fmu_dir(fmu_dir, spec)
-    with build_lock(out, report=print):
-        for built in build_drivetrain_fmus(spec, out, names):
-            print(f"{built.path}  ({built.name}, {spec.origin}, build {built.build_id})")
+    for built in build_drivetrain_fmus(spec, out, names):
+        print(f"{built.path}  ({built.name}, {spec.origin}, build {built.build_id})")
     return 0

@@ -43,7 +43,7 @@ def build_drivetrain_fmus(spec: DrivetrainSpec, out_dir: Path, names: Iterable[s
     if report:
         report(f"building {', '.join(n + '.fmu' for n in names)} from {spec.origin} into {out_dir} ...")
     return [build_fmu(n, out_dir, drivetrain=drivetrain, origin=spec.origin, rotor_speed_rad_s=spec.rotor_speed_rad_s,
-                      validate=validate) for n in names]
+                      validate=validate, report=report) for n in names]
 
 
 def ensure_drivetrain_fmus(spec: DrivetrainSpec, fmu_dir: Path, names: Iterable[str],

@@ -54,7 +54,7 @@ def test_a_second_process_waits_for_the_first_and_says_so(tmp_path):
 
 
 def test_the_lock_is_reentrant_within_a_process(tmp_path):
-    """``dtcosim build`` holds it while fmus.build takes it again for each FMU."""
+    """Provisioning holds it while it decides and fmus.build takes it again for each FMU."""
     with build_lock(tmp_path), build_lock(tmp_path / "sub" / "..") as again:
         assert again.resolve() == tmp_path
 
