@@ -222,3 +222,28 @@ def test_a_full_disk_while_a_result_is_kept_stops_the_sweep_with_one_line(write_
     assert report.ok == 0 and not report.interrupted and len(report.problems) == 1
     assert report.problems[0].startswith(f"cannot write {out / 'runs'}/") and "the sweep stopped" in report.problems[0]
     assert (out / "results.csv").exists() and (out / "journal.jsonl").read_text() == ""
+
+
+@pytest.mark.slow
+def test_a_signal_while_a_point_is_journaled_is_counted_with_the_point(write_study, tmp_path, monkeypatch):
+    """A SIGTERM that landed between a point's journal line and its count: the sweep said "48 finished points kept"
+    of a journal that held 49 (seen sending SIGTERM to paper-sensitivity as its last point finished)."""
+    import signal
+
+    from orchestrator.study.journal import read_journal
+    from orchestrator.study.sweep import run_sweep
+
+    real_append = Journal.append
+    appended = []
+
+    def append_then_signal(self, record):
+        real_append(self, record)
+        appended.append(record["key"])
+        if len(appended) == 2:
+            signal.raise_signal(signal.SIGTERM)  # handled at once: the sweep notes it and raises it after the step
+
+    monkeypatch.setattr(Journal, "append", append_then_signal)
+    path = write_study(GRID)
+    report = run_sweep(prepare_study(load_study(path)), tmp_path / "out", workers=1, plots=False)
+    assert report.interrupted and report.signal == signal.SIGTERM
+    assert report.ok + report.failed + report.errors == len(read_journal(tmp_path / "out" / "journal.jsonl")) == 2
