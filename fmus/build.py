@@ -364,10 +364,16 @@ def build_fmu(name: str, out_dir: Path | str, preset: str = "table6", source: So
     out_dir = Path(out_dir)
     # written, completed and checked under a temporary name in the same folder, then renamed: an interrupted
     # build leaves no FMU under the final name; one build at a time per folder (fmus.build_lock)
-    with build_lock(out_dir, report), tempfile.TemporaryDirectory(prefix=building_prefix(name), dir=out_dir) as part:
-        built = _build_archive(name, kind, model, origin, source, Path(part), resources, validate)
-        final = out_dir / f"{name}.fmu"
-        os.replace(built.path, final)
+    final = out_dir / f"{name}.fmu"
+    try:
+        with build_lock(out_dir, report), tempfile.TemporaryDirectory(prefix=building_prefix(name),
+                                                                      dir=out_dir) as part:
+            built = _build_archive(name, kind, model, origin, source, Path(part), resources, validate)
+            os.replace(built.path, final)
+    except OSError as exc:  # a full disk: the error names no file, or one the build copied from
+        reason = f"{exc.filename}: {exc.strerror or exc}" if exc.filename is not None else f"{exc.strerror or exc}"
+        raise BuildError(f"{final} not built: {reason} (the build writes into {out_dir} and the temporary folder "
+                         f"{tempfile.gettempdir()})") from None
     return dataclasses.replace(built, path=final)
 
 

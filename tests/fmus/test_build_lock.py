@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 from fmus import build as fmu_build
@@ -69,3 +70,22 @@ def test_the_temporary_folders_of_killed_builds_are_removed_by_the_next_build(tm
     built = fmu_build.build_fmu("WindSource", out)
     assert check_fmu(built.path) == []
     assert sorted(p.name for p in out.iterdir()) == [".mine", "WindSource.fmu", "notes.txt"]
+
+
+def test_a_full_disk_during_a_build_names_the_fmu_and_leaves_nothing(tmp_path, monkeypatch, capsys):
+    """``dtcosim build`` on a full disk said 'error: No space left on device' (pythonfmu's zip write names no file)."""
+    import errno
+
+    from orchestrator.commands import cli
+
+    def half_an_archive(name, kind, model, origin, source, part_dir, resources, validate):
+        (part_dir / f"{name}.fmu").write_bytes(b"PK\x03\x04 half")
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(fmu_build, "_build_archive", half_an_archive)
+    out = tmp_path / "fmus"
+    assert cli.main(["build", "--out", str(out), "--fmu", "WindSource"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [f"dtcosim build: error: {out / 'WindSource.fmu'} not built: No space left on device (the build "
+                   f"writes into {out} and the temporary folder {tempfile.gettempdir()})"]
+    assert list(out.iterdir()) == []
