@@ -17,7 +17,7 @@ import pytest
 from orchestrator.commands import cli
 from orchestrator.run import run_folder
 from orchestrator.run.run_folder import OutputFolderError, RunFolder
-from tests.helpers.failing_files import FullDisk
+from tests.helpers.failing_files import FullAt, FullDisk
 
 
 def summary_of(out):
@@ -139,17 +139,7 @@ def test_a_full_disk_during_the_analyses_or_plots_keeps_what_was_written_and_say
         fmu_dir, tmp_path, monkeypatch, capsys, full_at, kept, not_done):
     """A disk that filled at a plot: the whole CSVs written before it were removed as never listed, the analyses'
     results left the summary, and the run said "not done: " with nothing after it (seen on a 100 kB tmpfs)."""
-    import errno
-    from pathlib import Path
-
-    real_replace = os.replace
-
-    def replace(src, dst):
-        if Path(dst).name == full_at:
-            raise OSError(errno.ENOSPC, "No space left on device")
-        real_replace(src, dst)
-
-    monkeypatch.setattr(os, "replace", replace)
+    monkeypatch.setattr(os, "replace", FullAt(full_at))
     out = tmp_path / "out"
     assert cli.main(["run", "--fmu-dir", str(fmu_dir), "--no-build", "--stop", "0.5", "--out", str(out), "-q"]) == 1
     summary = summary_of(out)

@@ -26,6 +26,7 @@ from orchestrator.study import plots as study_plots
 from orchestrator.study.engine import PointTask, run_point
 from orchestrator.study.journal import Journal
 from orchestrator.study.prepare import prepare_study
+from tests.helpers.failing_files import FullAt
 from tests.helpers.studies import SMALL_HEAD, SMALL_TABLES
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -77,14 +78,7 @@ def test_a_full_disk_at_the_table_or_summary_names_the_file_and_leaves_no_tempor
     path = write_study(GRID)
     out = tmp_path / "out"
     _journal_every_point(prepare_study(load_study(path)), out)
-    real_replace = os.replace
-
-    def replace(src, dst):
-        if Path(dst).name == full_at:
-            raise OSError(errno.ENOSPC, "No space left on device")
-        real_replace(src, dst)
-
-    monkeypatch.setattr(os, "replace", replace)
+    monkeypatch.setattr(os, "replace", FullAt(full_at))
     assert cli.main(["sweep", str(path), "--out", str(out), "-q", "--report"]) == 1
     assert capsys.readouterr().err.strip().splitlines() == [
         f"dtcosim sweep: error: {out / full_at}: No space left on device"]
