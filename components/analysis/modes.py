@@ -236,7 +236,7 @@ def drivetrain_modes(drivetrain: Drivetrain, operating_point: OperatingPoint, st
     model = linearise(drivetrain, operating_point, stiffness_factor)
     a = model.assembly
     cm = coupled(model, rotor)
-    modes, ss, und = modal_analysis(cm.mass, cm.damping, cm.stiffness)
+    modes, ss, _ = modal_analysis(cm.mass, cm.damping, cm.stiffness)
     names = cm.body_names
     lead = len(names) - a.n_dof
     roles = ["rotor", "carrier"][:lead] + [a.bodies[j].role for j in a.free]
@@ -253,8 +253,8 @@ def drivetrain_modes(drivetrain: Drivetrain, operating_point: OperatingPoint, st
         membership = np.pad(membership, ((0, 1), (0, 1)))
         membership[-1, -1] = 1.0
     out = []
-    for m, u_y in zip(modes, und.shapes.T):
-        u = cm.basis @ u_y  # body deviations
+    for m in modes:  # each row's own undamped shape (the rows are in the order of their eigenvalues' |lambda|)
+        u = cm.basis @ m.shape  # body deviations
         big = np.abs(u).max()
         moving = np.abs(u) > STILL_TOLERANCE * big
         planet_stages = {stages[i] for i in np.flatnonzero(moving)}

@@ -171,10 +171,13 @@ def run(args: argparse.Namespace) -> int:
             print(report.comparison_text)
         print(textwrap.fill(f"results in {Path(out_dir)}/: " + ", ".join(p.name for p in report.files.values()),
                             width=80, subsequent_indent="  ", break_on_hyphens=False, break_long_words=False))
-    for problem in report.problems:
-        print(f"dtcosim run: error: {problem}", file=sys.stderr)
     post = s.get("post_processing")
-    if post and not outcome.interrupted:  # a signal during stepping is told once, below
+    for problem in report.problems:
+        if not post or problem != post.get("error"):  # the write error that stopped them: told below, once
+            print(f"dtcosim run: error: {problem}", file=sys.stderr)
+    if post and post.get("error"):
+        print(f"dtcosim run: error: {post['error']}; not done: {', '.join(post['not_done'])}", file=sys.stderr)
+    elif post and not outcome.interrupted:  # a signal during stepping is told once, below
         print(f"dtcosim run: {post['stopped']}; not done: {', '.join(post['not_done'])}", file=sys.stderr)
     if not outcome.complete:
         print(f"dtcosim run: {outcome.error}; partial results written to {out_dir}", file=sys.stderr)

@@ -65,6 +65,10 @@ def find_fmu(scenario: Scenario, component: Component, candidates: Sequence[Path
         ``components.<name>.fmu`` when none is; the message lists the places searched.
     """
     found = next((p for p in candidates if p.is_file()), None)
+    odd = next((p for p in candidates if p.exists() and not p.is_file()), None)
+    if found is None and odd is not None:
+        raise ScenarioError(f"components.{component.name}.fmu", str(component.fmu),
+                            f"a regular FMU file ({odd} is a device, pipe or folder)", scenario.source)
     if found is None:
         raise ScenarioError(
             f"components.{component.name}.fmu", str(component.fmu),

@@ -64,6 +64,7 @@ from typing import Any, Mapping
 
 from fmus.start_values import StartValueError, write_with_start_values
 
+from ..atomic_files import atomic_path
 from ..cosim.resolved import ResolvedSystem
 from ..errors import SspError
 from ..inputs.analysis_settings import AnalysisSettings
@@ -407,26 +408,21 @@ def export_ssp(system: ResolvedSystem, path: str | Path, initial_values: Mapping
     tree = system_structure(system, initial_values, tuning)
     baked = baked_values(system, initial_values)
     resources = _resource_names(system, baked)
-    tmp = path.with_name(path.name + ".tmp")
-    try:
-        with tempfile.TemporaryDirectory(prefix="dtcosim-ssp-") as staging, \
-                zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as zf:
-            zf.writestr(SSD_NAME, ET.tostring(tree.getroot(), encoding="UTF-8", xml_declaration=True))
-            written: set[str] = set()
-            for comp in system.scenario.components:
-                arc = resources[comp.name]
-                if arc in written:
-                    continue
-                source = system.fmu_paths[comp.name]
-                if comp.name in baked:
-                    try:
-                        source = write_with_start_values(source, Path(staging) / arc, baked[comp.name])
-                    except StartValueError as exc:
-                        raise SspError(f"components.{comp.name}: {exc}") from None
-                zf.write(source, arc, compress_type=zipfile.ZIP_STORED)
-                written.add(arc)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
-    tmp.replace(path)
+    # whole or not there, and a write error (a full disk) names the .ssp
+    with atomic_path(path) as tmp, tempfile.TemporaryDirectory(prefix="dtcosim-ssp-") as staging, \
+            zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as zf:
+        zf.writestr(SSD_NAME, ET.tostring(tree.getroot(), encoding="UTF-8", xml_declaration=True))
+        written: set[str] = set()
+        for comp in system.scenario.components:
+            arc = resources[comp.name]
+            if arc in written:
+                continue
+            source = system.fmu_paths[comp.name]
+            if comp.name in baked:
+                try:
+                    source = write_with_start_values(source, Path(staging) / arc, baked[comp.name])
+                except StartValueError as exc:
+                    raise SspError(f"components.{comp.name}: {exc}") from None
+            zf.write(source, arc, compress_type=zipfile.ZIP_STORED)
+            written.add(arc)
     return path

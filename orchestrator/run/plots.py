@@ -180,19 +180,22 @@ def plot_contact_forces(outcome: RunOutcome, gearbox: ComponentRole, window, pat
 
 
 def plot_run(system: ResolvedSystem, outcome: RunOutcome, out_dir: str | Path,
-             skipped: list[dict[str, str]] | None = None) -> list[Path]:
+             skipped: list[dict[str, str]] | None = None, written: list[Path] | None = None) -> list[Path]:
     """Write the plots that the declared and recorded signals allow; returns the files written.
 
     Parameters
     ----------
     skipped : list, optional
         Receives ``{"analysis": "plot:<name>", "reason": ...}`` for each plot not drawn.
+    written : list, optional
+        Receives each file as soon as it is written (and is returned): when a plot cannot be
+        written (a full disk raises ``OSError``) the caller still knows the ones before it.
     """
     out_dir = Path(out_dir)
     skipped = [] if skipped is None else skipped
     window = system.scenario.simulation.window_s
     suffix = "" if outcome.complete else f" - INCOMPLETE, stopped at {outcome.stopped_at_s:g} s"
-    written: list[Path] = []
+    written = [] if written is None else written
     if outcome.time_s.size < 2:
         skipped.append({"analysis": "plots", "reason": "fewer than 2 samples"})
         return written

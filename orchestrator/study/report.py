@@ -21,23 +21,16 @@ import csv
 import io
 import json
 import math
-import os
 from pathlib import Path
 from typing import Any, Mapping
 
+from ..atomic_files import write_text_atomic
 from ..output_folders import STUDY_SUMMARY
 from .journal import JOURNAL_FILE, latest_by_key, read_journal
 
 TABLE_FILE = "results.csv"
 SUMMARY_FILE = STUDY_SUMMARY
 PENDING = "pending"
-
-
-def _write_atomic(path: Path, text: str) -> Path:
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    os.replace(tmp, path)
-    return path
 
 
 def point_records(prepared, records: list[dict] | None = None, out_dir: str | Path | None = None) -> list[dict | None]:
@@ -145,12 +138,12 @@ def write_outputs(prepared, out_dir: str | Path, report=None, plots: bool = True
     out.mkdir(parents=True, exist_ok=True)
     recs = point_records(prepared, out_dir=out)
     files: dict[str, Path] = {"journal": out / JOURNAL_FILE}
-    files["table"] = _write_atomic(out / TABLE_FILE, table_text(prepared, recs))
+    files["table"] = write_text_atomic(out / TABLE_FILE, table_text(prepared, recs))
     if plots:
         from .plots import plot_study
 
         for p in plot_study(prepared, recs, out):
             files[f"plot:{p.stem}"] = p
     files["summary"] = out / SUMMARY_FILE
-    _write_atomic(files["summary"], json.dumps(summary(prepared, recs, report, files), indent=2) + "\n")
+    write_text_atomic(files["summary"], json.dumps(summary(prepared, recs, report, files), indent=2) + "\n")
     return files

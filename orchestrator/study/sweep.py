@@ -158,6 +158,16 @@ class _Interrupts:
                 raise KeyboardInterrupt
 
 
+def _count(report: SweepReport, status: str) -> None:
+    """Count a journaled point's outcome in ``report``."""
+    if status == OK:
+        report.ok += 1
+    elif status == FAILED:
+        report.failed += 1
+    else:
+        report.errors += 1
+
+
 def _now() -> str:
     return _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
 
@@ -352,11 +362,13 @@ def _execute(prepared: PreparedStudy, todo: list[int], journal: Journal, report:
                     "task_wall_time_s": result.get("task_wall_time_s"), "code_version": code, "finished_at": _now(),
                 }
                 try:
-                    # storing a run's data and journaling it is one step: a signal during it is raised after both
+                    # storing a run's data, journaling it and counting it is one step: a signal during it is raised
+                    # after all three (raised between journal and count, the sweep said one point fewer was kept)
                     with interrupts.critical_section():
                         if on_result is not None and record["status"] == OK:
                             record.update(on_result(i, result))
                         journal.append(record)
+                        _count(report, record["status"])
                 except OSError as exc:  # a full disk: nothing more can be kept, so nothing more is run
                     report.problems.append(f"{describe_os_error(exc)}; the sweep stopped, the points finished "
                                            f"before are kept in {journal.path}: free some space and run the same "
@@ -364,12 +376,6 @@ def _execute(prepared: PreparedStudy, todo: list[int], journal: Journal, report:
                     with interrupts.shielded(), contextlib.suppress(Exception):
                         client.cancel(list(futures))
                     break
-                if record["status"] == OK:
-                    report.ok += 1
-                elif record["status"] == FAILED:
-                    report.failed += 1
-                else:
-                    report.errors += 1
                 if progress is not None:
                     progress(record)
         except KeyboardInterrupt:
