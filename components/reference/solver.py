@@ -384,8 +384,8 @@ def _collect(system: MonolithicSystem, t: np.ndarray, Y: np.ndarray) -> Simulati
     acc = a.inv_inertia * Q - a.kinematic_ratio * alpha_in[:, None]
     speeds = np.outer(omega_in, a.kinematic_ratio) + v
     # every series is declared where it is made (unit, kind): analyses never read them from the names
-    declared = gearbox_signals(a)
-    signals = {"omega_rotor": Signal("rad/s", "rotor speed driving the gearbox", ROTOR_SPEED),
+    signals = gearbox_signals(a)  # contact forces, shaft torques, body speeds: as the Gearbox FMU declares them
+    signals |= {"omega_rotor": Signal("rad/s", "rotor speed driving the gearbox", ROTOR_SPEED),
                "phi_rotor": Signal("rad", "rotor angle", ROTOR_ANGLE)}
     series: dict[str, np.ndarray] = {"omega_rotor": omega_in, "phi_rotor": angle_in}
     for i, name in enumerate(a.mesh_names):
@@ -397,7 +397,6 @@ def _collect(system: MonolithicSystem, t: np.ndarray, Y: np.ndarray) -> Simulati
         series[f"{name}.torque"] = loads.shaft_torque_nm[:, i]
     for i, name in enumerate(a.dof_names):
         series[f"{name}.omega"] = speeds[:, i]
-    signals.update(declared)
     out = system._out
     alpha_out = acc[:, out] + a.kinematic_ratio[out] * alpha_in
     series["torque_rotor"] = a.driver_torque(loads, alpha_in)

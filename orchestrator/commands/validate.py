@@ -153,9 +153,11 @@ def run(args: argparse.Namespace) -> int:
     from ..interop.ssp import is_ssp
 
     if args.cross_check is not None:
-        files = fmu_files(args.paths)
-        if len(files) != 1 or is_ssp(files[0]):
-            print(f"--cross-check compares one FMU with one result: give one FMU path (found {len(files)})")
+        ssps = [p for p in args.paths if is_ssp(p)]
+        files = fmu_files(p for p in args.paths if not is_ssp(p))
+        if len(files) != 1 or ssps:
+            print(f"--cross-check compares one FMU with one result: give one FMU path (found {len(files)}"
+                  + (f" and the SSP {ssps[0]})" if ssps else ")"))
             return 1
         return _cross_check(files[0], args.cross_check, args.rel_tol)
     failed, valid, found = 0, [], False

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import json
 import re
-import shutil
 import zipfile
 from pathlib import Path
 
@@ -86,4 +85,3 @@ def test_the_summary_names_the_fmu_of_an_archive_as_its_member(tmp_path, capsys)
     assert cli.main(["run", str(archive), "--out", str(tmp_path / "out"), "-q", "--no-plots"]) == 0
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert summary["fmus"]["ft"]["file"] == f"{archive}!resources/Feedthrough.fmu"
-    shutil.rmtree(tmp_path / "out")
