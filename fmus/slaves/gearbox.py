@@ -33,6 +33,7 @@ from components.model.description import build
 from components.model.drivetrain import Drivetrain
 from components.model.gearbox_model import GENERATOR_INTERFACES, SHAFT_TORQUE_MODES, STEP_INPUTS, GearboxModel
 from components.model.integrators import StepControl
+from components.model.signals import gearbox_signals
 from components.validation import choice_bounds, positive
 
 from .base import DtcosimSlave
@@ -52,17 +53,9 @@ from .interface import (
     real_parameter,
 )
 
-_MESH_KINDS = {"sun_planet": "sun-planet mesh", "ring_planet": "ring-planet mesh", "parallel": "parallel-stage mesh"}
-
 # all outputs form one group: computed in one vectorised pass (GearboxModel.output_vector)
 # at most once per step, when the first output is read
 _OUTPUTS = "outputs"
-
-
-def _planet_of(force_name: str) -> dict[str, str]:
-    """``{"planet": "2"}`` for a planet mesh force ``stage1.F_sp[2]``, ``{}`` for a parallel mesh."""
-    inside = force_name.rpartition("[")[2].rstrip("]") if force_name.endswith("]") else ""
-    return {"planet": inside} if inside else {}
 
 
 def template_of(model: Mapping[str, Any]) -> Drivetrain:
@@ -131,16 +124,9 @@ class Gearbox(DtcosimSlave):
             real_output("torque_rotor", "N.m", "torque the rotor applies to the gearbox (for the power balance)",
                         "rotor_torque"),
         ]
-        for mesh in assembly.meshes:
-            variables.append(real_output(mesh.name, "N", f"contact force of the {mesh.stage} {_MESH_KINDS[mesh.kind]} {mesh.name}",
-                                         "contact_force", stage=mesh.stage, mesh=mesh.kind, **_planet_of(mesh.name)))
-        for shaft in assembly.shafts:
-            variables.append(real_output(f"{shaft.name}.torque", "N.m",
-                                         f"torque of {shaft.name} ({shaft.upstream} -> {shaft.downstream})",
-                                         "shaft_torque", shaft=shaft.name, upstream=shaft.upstream,
-                                         downstream=shaft.downstream))
-        for body in assembly.dof_names:
-            variables.append(real_output(f"{body}.omega", "rad/s", f"absolute speed of {body}", "body_speed", body=body))
+        # every contact force, shaft torque and body speed, as the monolithic reference declares them too
+        variables += [real_output(name, s.unit, s.description, s.kind, **dict(s.info))
+                      for name, s in gearbox_signals(assembly).items()]
         out_member = assembly.stage_members[template.stages[-1].name]["output"]
         variables += [  # after the body speeds: the same order as GearboxModel.output_names
             real_output("alpha_out", "rad/s2",

@@ -224,9 +224,10 @@ def run(args: argparse.Namespace) -> int:
         from ..atomic_files import describe_os_error
 
         files = {}
-        problems.append(f"{describe_os_error(exc)}; the lifetime results are not all written; every finished run "
-                        f"is kept in {out_dir / JOURNAL_FILE} and {out_dir}/runs: free some space and run the same "
-                        "command with --report to write them")
+        if not problems:  # a full disk the sweep told already (what is kept, what to do) is not told twice
+            problems.append(f"{describe_os_error(exc)}; the lifetime results are not all written; every finished "
+                            f"run is kept in {out_dir / JOURNAL_FILE} and {out_dir}/runs: free some space and run the "
+                            "same command with --report to write them")
     counts = status_counts(point_records(prepared, out_dir=out_dir))
     if not quiet and files:
         print((out_dir / "lifetime_report.txt").read_text(), end="")

@@ -20,12 +20,18 @@ import numpy as np
 from ..cosim.outcome import RunOutcome
 from ..cosim.roles import GEARBOX, GENERATOR, WIND_SOURCE, ComponentRole
 from ..cosim.resolved import ResolvedSystem
-from ..plotting import RPM_PER_RAD_S, envelope, new_figure, new_grid, plot_envelope, save_figure
+from ..plotting import (
+    MESH_KIND_STYLES,
+    RPM_PER_RAD_S,
+    envelope,
+    new_figure,
+    new_grid,
+    plot_envelope,
+    save_figure,
+)
 from .derived import Skipped, generator_vs_ideal, single_role
 from .memory import release_between_phases
 
-#: mesh kind (declared signal info) -> label and line style
-_MESH_STYLE = {"sun_planet": ("sun-planet", "-"), "ring_planet": ("ring-planet", "--"), "parallel": ("mesh", "-")}
 
 
 def _shade_window(ax, window) -> None:
@@ -151,7 +157,7 @@ def plot_contact_forces(outcome: RunOutcome, gearbox: ComponentRole, window, pat
         _shade_window(whole, window)
         groups = symmetric_groups(stages[stage])
         for k, (var, kind, y, same) in enumerate(groups):
-            label, style = _MESH_STYLE.get(kind, (kind, "-"))
+            label, style = MESH_KIND_STYLES.get(kind, (kind, "-"))
             text = f"{var} ({label})"
             if same:
                 merged = True

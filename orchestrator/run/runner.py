@@ -45,12 +45,11 @@ def load_any(path: str | Path, step_s: float | None = None, stop_s: float | None
     ``step_s``, ``stop_s`` (``--step``, ``--stop``) are what an SSP without them uses;
     ``report`` receives the SSP import's notes (:func:`orchestrator.interop.ssp.import_ssp`).
     """
-    p = Path(path)
-    if p.suffix in (".ssp", ".ssd") or (p.is_dir() and (p / "SystemStructure.ssd").is_file()):
-        from ..interop.ssp import import_ssp
+    from ..interop.ssp import import_ssp, is_ssp
 
-        return import_ssp(p, step_s=step_s, stop_s=stop_s, report=report)
-    return load_scenario(p)
+    if is_ssp(path):
+        return import_ssp(path, step_s=step_s, stop_s=stop_s, report=report)
+    return load_scenario(Path(path))
 
 
 @dataclass

@@ -29,6 +29,7 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from ..errors import ScenarioError, suggestion
+from ..inputs.measures import Measure
 from ..inputs.study import Point, Study, StudyError, split_parameter
 from .engine import StudyPayload
 
@@ -189,11 +190,16 @@ def _solver_settings(study: Study):
         raise StudyError(f"solver ({exc.name})", exc.value, exc.expected, study.source) from None
 
 
-def _micro_run_series(drivetrain, driver, start: float) -> list[str]:
-    """Names of the series the monolithic solver records for this model (a 2-sample run)."""
+def _micro_run_units(drivetrain, driver, start: float) -> dict[str, str]:
+    """The series the monolithic solver records for this model and the unit it declares for each (a 2-sample run)."""
     from components.reference.solver import simulate_monolithic
 
-    return list(simulate_monolithic(drivetrain, driver, start + 1e-7, output_interval_s=1e-7, t_start_s=start).series)
+    return simulate_monolithic(drivetrain, driver, start + 1e-7, output_interval_s=1e-7, t_start_s=start).units
+
+
+def _with_units(measures: tuple[Measure, ...], units: Mapping[str, str]) -> tuple[Measure, ...]:
+    """The measures with the units their base declares (``units``: measure name -> unit)."""
+    return tuple(replace(m, unit=units[m.name]) if m.name in units else m for m in measures)
 
 
 def _check_measure_engines(study: Study) -> None:
@@ -241,17 +247,20 @@ def _prepare_model(study: Study) -> tuple[Study, StudyPayload, dict[str, Any]]:
     settings = _solver_settings(study)
     _check_measure_engines(study)
     series_names = {}
+    declared_units: dict[str, str] = {}
     stats = [m for m in study.measures if not m.builtin]
     if stats:
-        names = _micro_run_series(drivetrain, driver, start)
+        units = _micro_run_units(drivetrain, driver, start)
         for i, m in enumerate(study.measures):
             if m.builtin:
                 continue
             comp, var = split_parameter(m.variable)
-            if comp != MODEL_COMPONENT or var not in names:
+            if comp != MODEL_COMPONENT or var not in units:
                 raise StudyError(f"measures[{i}]", m.name, f"a variable {MODEL_COMPONENT}.<series> of the monolithic "
-                                 f"result{suggestion(var, names)}", src)
+                                 f"result{suggestion(var, units)}", src)
             series_names[m.variable] = var
+            declared_units[m.name] = units[var] or "-"  # as the solver declares its series
+    study = replace(study, measures=_with_units(study.measures, declared_units))
     payload = StudyPayload(
         study=study.name, engine="monolithic", measures=study.measures, model=model.name,
         model_parameters=dict(study.base.parameters), time_grid=(start, stop, interval), window_s=window,
@@ -345,9 +354,8 @@ def _prepare_scenario(study: Study, fmu_dir,
         for each in [system] + list(variants.systems.values() if variants else ()):
             for comp, path in each.fmu_paths.items():
                 blobs[each.interfaces[comp].sha256] = Path(path).read_bytes()
-        measures = tuple(replace(m, unit=declared_units[m.name]) if m.name in declared_units else m
-                         for m in study.measures)
-        payload = StudyPayload(study=study.name, engine="cosim", measures=measures, system=system,
+        payload = StudyPayload(study=study.name, engine="cosim", measures=_with_units(study.measures, declared_units),
+                               system=system,
                                window_s=scenario.simulation.window_s, series_names=series_names, fmu_blobs=blobs)
         settings = None
     else:
@@ -364,23 +372,21 @@ def _prepare_scenario(study: Study, fmu_dir,
         settings = _solver_settings(study)
         stats = [m for m in study.measures if not m.builtin]
         if stats:
-            series = dict.fromkeys(_micro_run_series(setup.drivetrain, RotorSpeedProcess(setup.wind), scenario.simulation.start_s))
+            units = _micro_run_units(setup.drivetrain, RotorSpeedProcess(setup.wind), scenario.simulation.start_s)
             for i, m in enumerate(study.measures):
                 if m.builtin:
                     continue
-                name = reference_name(m.variable, system, setup, series)
+                name = reference_name(m.variable, system, setup, units)
                 if name is None:
                     raise StudyError(f"measures[{i}]", m.name, "a variable of the scenario with a counterpart in the "
                                      "monolithic model (e.g. gearbox.stage1.F_sp[1], generator.omega, wind.omega)", src)
                 series_names[m.variable] = name
                 comp, var = split_parameter(m.variable)
                 fv = system.interfaces[comp].variables.get(var) if comp in system.interfaces else None
-                if fv is not None:
-                    declared_units[m.name] = fv.unit or "-"  # as the scenario's FMU declares it
-        measures = tuple(replace(m, unit=declared_units[m.name]) if m.name in declared_units else m
-                         for m in study.measures)
+                # as the scenario's FMU declares it, else as the solver declares its counterpart
+                declared_units[m.name] = (fv.unit if fv is not None else units[name]) or "-"
         payload = StudyPayload(
-            study=study.name, engine="monolithic", measures=measures, system=system,
+            study=study.name, engine="monolithic", measures=_with_units(study.measures, declared_units), system=system,
             window_s=scenario.simulation.window_s, series_names=series_names,
             solver={k: getattr(settings, k) for k in ("rtol", "atol_angle_rad", "atol_speed_rad_s", "max_step_s", "max_steps")},
         )

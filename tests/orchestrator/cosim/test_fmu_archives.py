@@ -189,7 +189,7 @@ def test_a_pipe_named_as_an_fmu_is_refused_without_blocking(toy_dir, tmp_path, c
 def test_an_fmu_inside_an_ssp_that_declares_3_gib_is_refused(tmp_path):
     from orchestrator.errors import ScenarioError
     from orchestrator.interop.ssp import import_ssp
-    from tests.helpers.ssp_documents import feedthrough, real, ssd, write_ssp
+    from tests.helpers.ssp_documents import feedthrough, real, ssd, write_ssp, zip_folder
 
     folder = write_ssp(tmp_path / "ssp", ssd(f"""
   <ssd:System name="root">
@@ -198,13 +198,9 @@ def test_an_fmu_inside_an_ssp_that_declares_3_gib_is_refused(tmp_path):
     fmu = folder / "resources" / "Feedthrough.fmu"
     declaring(fmu, tmp_path / "bomb.fmu", 3 << 30)
     shutil.copy(tmp_path / "bomb.fmu", fmu)
-    archive = tmp_path / "system.ssp"
-    with zipfile.ZipFile(archive, "w") as z:
-        for f in sorted(folder.rglob("*")):
-            if f.is_file():
-                z.write(f, f.relative_to(folder).as_posix())
-    with pytest.raises(ScenarioError, match=r"components\.ft\.fmu = .*Feedthrough\.fmu': expected a readable FMU "
-                                            r"\(expands to 3072 MiB"):
+    archive = zip_folder(folder, tmp_path / "system.ssp")
+    with pytest.raises(ScenarioError, match=r"components\.ft\.fmu = '.*/system\.ssp!resources/Feedthrough\.fmu': "
+                                            r"expected a readable FMU \(expands to 3072 MiB"):
         import_ssp(archive)
 
 

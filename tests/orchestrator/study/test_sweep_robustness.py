@@ -203,7 +203,9 @@ def test_a_signal_during_the_cluster_start_up_is_one_line(write_study, tmp_path,
 
 
 @pytest.mark.slow
-def test_a_full_disk_while_a_result_is_kept_stops_the_sweep_with_one_line(write_study, tmp_path):
+@pytest.mark.parametrize("table_fits", [True, False])
+def test_a_full_disk_while_a_result_is_kept_stops_the_sweep_with_one_line(write_study, tmp_path, monkeypatch,
+                                                                          table_fits):
     from orchestrator.study.sweep import run_sweep
 
     prepared = prepare_study(load_study(write_study(GRID)))
@@ -212,10 +214,37 @@ def test_a_full_disk_while_a_result_is_kept_stops_the_sweep_with_one_line(write_
     def no_space(i, result):
         raise OSError(errno.ENOSPC, "No space left on device", str(out / "runs" / f"{i}.npz"))
 
+    if not table_fits:  # the disk stays full: the table cannot be written after the stop either
+        monkeypatch.setattr(os, "replace", FullAt("results.csv"))
     report = run_sweep(prepared, out, workers=1, plots=False, on_result=no_space)
-    assert report.ok == 0 and not report.interrupted and len(report.problems) == 1
+    assert report.ok == 0 and not report.interrupted and len(report.problems) == 1, report.problems
     assert report.problems[0].startswith(f"cannot write {out / 'runs'}/") and "the sweep stopped" in report.problems[0]
-    assert (out / "results.csv").exists() and (out / "journal.jsonl").read_text() == ""
+    assert ("the table, plots and study.json are not all written either" in report.problems[0]) != table_fits
+    assert (out / "results.csv").exists() == table_fits and (out / "journal.jsonl").read_text() == ""
+
+
+@pytest.mark.parametrize("table_fits", [True, False])
+def test_a_sweep_stopped_by_a_full_disk_is_one_line_whether_its_table_is_written_or_not(
+        write_study, tmp_path, monkeypatch, capsys, table_fits):
+    """The stop and the table it then could not write either were two error lines for one full disk."""
+    from orchestrator.study import sweep
+
+    path = write_study(GRID)
+    out = tmp_path / "out"
+    journal = out / "journal.jsonl"
+
+    def stopped_at_the_journal(prepared, todo, journal_file, report, *args):  # as _execute stops on ENOSPC
+        report.stopped_at = f"cannot write {journal}: No space left on device"
+
+    monkeypatch.setattr(sweep, "_execute", stopped_at_the_journal)
+    if not table_fits:
+        monkeypatch.setattr(os, "replace", FullAt("results.csv"))
+    assert cli.main(["sweep", str(path), "--out", str(out), "-q", "--no-plots"]) == 1
+    either = "" if table_fits else "; the table, plots and study.json are not all written either"
+    assert capsys.readouterr().err.strip().splitlines() == [
+        f"dtcosim sweep: error: cannot write {journal}: No space left on device; the sweep stopped, the points "
+        f"finished before are kept in {journal}{either}: free some space and run the same command again to continue"]
+    assert (out / "results.csv").exists() == table_fits
 
 
 @pytest.mark.slow
