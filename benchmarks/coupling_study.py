@@ -17,7 +17,10 @@ then the largest H that keeps every Table 7 statistic within ``--tolerance``
 1e-4 rad/s), each with ``--margin`` (0.8): the ``step`` the packaged scenarios use.
 ``--algorithms`` (default ``gauss-seidel,jacobi``) gives one table and one largest H
 per master algorithm: the Jacobi column is the step for hosts that step with Jacobi
-(libcosim, ecos). ``--json FILE`` writes the largest step per algorithm, which
+(libcosim, ecos), with the scenario's coupling for Jacobi (its ``[jacobi]`` table:
+``Scenario.for_algorithm``), which ``dtcosim export-ssp --target libcosim|ecos`` and
+``dtcosim run --algorithm jacobi`` apply; its largest H is the ``step`` of that table.
+``--json FILE`` writes the largest step per algorithm, which
 ``dtcosim export-ssp --target libcosim --tuning FILE`` uses.
 
 Then, at that H, the Gearbox FMU's internal error control (``solver.rtol``,
@@ -112,7 +115,7 @@ def step_study(args) -> None:
     references = {min(steps): reference}
     for algorithm in algorithms:
         for h in steps:
-            sc = base.with_simulation(step_s=h, output_interval_s=h, algorithm=algorithm)
+            sc = base.for_algorithm(algorithm, step_s=h, output_interval_s=h)
             system = resolve_system(sc, fmu_paths=paths)
             CoSimulation(system).run(handle_sigint=False)  # warm-up: the first run also loads the compiled kernels
             outcome = CoSimulation(system).run(handle_sigint=False)
@@ -167,6 +170,8 @@ def _write_steps(args, base, largest: dict, rows: list, limits: str) -> None:
         "window_s": list(base.simulation.window_s),
         "criteria": limits,
         "largest_step_s": largest,
+        "couplings": {a: (base.jacobi.describe() if a == "jacobi" and base.jacobi is not None else "")
+                      for a in largest},
         "rows": [{"algorithm": a, "step_s": h, **r} for a, h, r in rows],
     }
     Path(args.json).write_text(json.dumps(data, indent=1) + "\n", encoding="utf-8")

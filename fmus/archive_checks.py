@@ -54,13 +54,31 @@ RECORD_MEMBER = "resources/dtcosim.json"
 PLATFORM_EXTENSIONS = {"linux64": ".so", "linux32": ".so", "win64": ".dll", "win32": ".dll", "darwin64": ".dylib"}
 
 
-def _slave_module(path: Path | str) -> str | None:
-    """The module ``resources/slavemodule.txt`` names (None: unreadable)."""
+def _slave_module_problem(path: Path | str, names: set[str]) -> str | None:
+    """What keeps a PythonFMU binary from importing the module ``resources/slavemodule.txt`` names (None: nothing).
+
+    The binary takes the file's first line as the module name, as it is: an empty line, bytes that are
+    not UTF-8 or a name that is not a module's crashed pythonfmu's binary (a segmentation fault) as a
+    module it does not carry did. A member that cannot be read is left to the archive checks.
+    """
     try:
         with zipfile.ZipFile(path) as archive:
-            return archive.read(PYTHONFMU_MODULE_FILE).decode("utf-8").strip() or None
-    except (OSError, KeyError, UnicodeDecodeError, *CORRUPT_ERRORS):
+            line = archive.read(PYTHONFMU_MODULE_FILE).split(b"\n", 1)[0]
+    except (OSError, KeyError, *CORRUPT_ERRORS):
         return None
+    cannot = "the FMU cannot create its slave"
+    try:
+        module = line.decode("utf-8")
+    except UnicodeDecodeError:
+        return f"{PYTHONFMU_MODULE_FILE} is not UTF-8 text ({line[:40]!r}): {cannot}"
+    if not module:
+        return f"{PYTHONFMU_MODULE_FILE} names no slave module (its first line is empty): {cannot}"
+    if not all(part.isidentifier() for part in module.split(".")):
+        return f"{PYTHONFMU_MODULE_FILE} names {module!r}, which is not a Python module name: {cannot}"
+    if not {f"resources/{module}.py", f"resources/{module}/__init__.py"} & names:
+        return (f"{PYTHONFMU_MODULE_FILE} names the slave module {module!r}, which is not in resources/ (no "
+                f"resources/{module}.py): {cannot}")
+    return None
 
 
 def _illegal_name(name: str) -> bool:
@@ -223,10 +241,9 @@ def archive_problems(path: str | Path, model_identifier: str | None, generation_
         problems.append(f"no {PYTHONFMU_MODULE_FILE}: a PythonFMU binary cannot find its slave without its "
                         "resources folder")
     elif "pythonfmu" in tool:
-        module = _slave_module(path)
-        if module is not None and not ({f"resources/{module}.py", f"resources/{module}/__init__.py"} & names):
-            problems.append(f"{PYTHONFMU_MODULE_FILE} names the slave module {module!r}, which is not in "
-                            f"resources/ (no resources/{module}.py): the FMU cannot create its slave")
+        problem = _slave_module_problem(path, names)
+        if problem is not None:
+            problems.append(problem)
     if tool.startswith("dtcosim") and RECORD_MEMBER not in names:
         problems.append(f"no {RECORD_MEMBER}: a dtcosim FMU reads its model from its record")
     return problems

@@ -43,7 +43,7 @@ import tempfile
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Sequence
+from typing import Callable, Sequence
 
 import pythonfmu
 from pythonfmu import FmuBuilder
@@ -54,6 +54,7 @@ from components.model.drivetrain import Drivetrain
 from components.model.wind import WindParameters
 
 from . import binary, model_description, registry, runtime_files
+from .build_lock import build_lock, building_prefix
 from .parameter_ranges import parameter_bounds
 from .records import full_record
 from .slaves import base as slave_base
@@ -319,7 +320,7 @@ def drivetrain_of_preset(preset: str) -> Drivetrain:
 def build_fmu(name: str, out_dir: Path | str, preset: str = "table6", source: SourceTree | None = None,
               validate: bool = True, *, drivetrain: Drivetrain | None = None, origin: str | None = None,
               rotor_speed_rad_s: float | None = None, model: dict | None = None,
-              resources: dict[str, Path] | None = None) -> BuiltFmu:
+              resources: dict[str, Path] | None = None, report: Callable[[str], None] | None = None) -> BuiltFmu:
     """Build one FMU into ``out_dir`` (``<out_dir>/<name>.fmu``).
 
     Parameters
@@ -346,6 +347,9 @@ def build_fmu(name: str, out_dir: Path | str, preset: str = "table6", source: So
         ``{"series": ...}``); it must name the content of ``resources`` (a hash) so that the build id does.
     resources : dict of str -> Path, optional
         Extra files packed into the FMU's ``resources/`` (name inside -> file), e.g. ``series.npz``.
+    report : callable(str), optional
+        Told when another process is building into ``out_dir`` and this build waits for it
+        (:func:`fmus.build_lock.build_lock`).
     """
     _check_pythonfmu()
     kind = _kind(name)
@@ -358,13 +362,18 @@ def build_fmu(name: str, out_dir: Path | str, preset: str = "table6", source: So
     if model is None:
         model = kind.model(drivetrain, wind)
     out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
     # written, completed and checked under a temporary name in the same folder, then renamed: an interrupted
-    # build leaves no FMU under the final name, and two builds into one folder each rename a whole archive
-    with tempfile.TemporaryDirectory(prefix=f".{name}-building-", dir=out_dir) as part:
-        built = _build_archive(name, kind, model, origin, source, Path(part), resources, validate)
-        final = out_dir / f"{name}.fmu"
-        os.replace(built.path, final)
+    # build leaves no FMU under the final name; one build at a time per folder (fmus.build_lock)
+    final = out_dir / f"{name}.fmu"
+    try:
+        with build_lock(out_dir, report), tempfile.TemporaryDirectory(prefix=building_prefix(name),
+                                                                      dir=out_dir) as part:
+            built = _build_archive(name, kind, model, origin, source, Path(part), resources, validate)
+            os.replace(built.path, final)
+    except OSError as exc:  # a full disk: the error names no file, or one the build copied from
+        reason = f"{exc.filename}: {exc.strerror or exc}" if exc.filename is not None else f"{exc.strerror or exc}"
+        raise BuildError(f"{final} not built: {reason} (the build writes into {out_dir} and the temporary folder "
+                         f"{tempfile.gettempdir()})") from None
     return dataclasses.replace(built, path=final)
 
 
@@ -436,7 +445,8 @@ def _staged_resources(tmp: Path, resources: dict[str, Path] | None) -> list[Path
 
 
 def build_all(out_dir: Path | str, preset: str = "table6", source: SourceTree | None = None,
-              names: Sequence[str] = PRESET_FMU_NAMES, validate: bool = True) -> list[BuiltFmu]:
-    """Build the FMUs ``names`` (default: every FMU of a preset) into ``out_dir``."""
-    return [build_fmu(name, out_dir, preset, source, validate) for name in names]
+              names: Sequence[str] = PRESET_FMU_NAMES, validate: bool = True,
+              report: Callable[[str], None] | None = None) -> list[BuiltFmu]:
+    """Build the FMUs ``names`` (default: every FMU of a preset) into ``out_dir`` (``report``: see :func:`build_fmu`)."""
+    return [build_fmu(name, out_dir, preset, source, validate, report=report) for name in names]
 

@@ -94,12 +94,16 @@ def check_fmu(fmu_path: Path | str) -> list[str]:
         problems = validate_fmu(str(fmu_path))
     except Exception as exc:  # noqa: BLE001 - fmpy raises plain exceptions for XML it cannot parse at all
         return [f"modelDescription.xml cannot be read ({exc})"]
-    if problems:
+    try:
+        md = read_model_description(str(fmu_path), validate=False)
+    except Exception:  # noqa: BLE001 - a description fmpy's validation found broken: its problems say why
         return list(problems)
-    md = read_model_description(str(fmu_path), validate=False)
     identifier = md.coSimulation.modelIdentifier if md.coSimulation is not None else None
-    problems = archive_problems(fmu_path, identifier, md.generationTool or "", names)
-    return problems + (convention_problems(fmu_path) if RECORD_MEMBER in names else [])
+    # what would crash a host loading it is named also beside the description's problems
+    loading = archive_problems(fmu_path, identifier, md.generationTool or "", names)
+    if problems:
+        return list(problems) + loading
+    return loading + (convention_problems(fmu_path) if RECORD_MEMBER in names else [])
 
 
 def fmu_files(paths: Iterable[Path | str]) -> list[Path]:

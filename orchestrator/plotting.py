@@ -1,7 +1,7 @@
 """Plot helpers shared by every PNG dtcosim writes (matplotlib Agg canvas, no pyplot global state).
 
 Figures, envelopes of long curves (every extreme kept), backlash shading and the
-names of contact-force kinds; the plots themselves live with their owners
+labels of the declared mesh kinds; the plots themselves live with their owners
 (:mod:`orchestrator.run.plots`, :mod:`orchestrator.run.analysis_plots`,
 :mod:`orchestrator.reports`, :mod:`orchestrator.study.plots`).
 """
@@ -9,7 +9,6 @@ names of contact-force kinds; the plots themselves live with their owners
 from __future__ import annotations
 
 import math
-import re
 from pathlib import Path
 
 import numpy as np
@@ -23,11 +22,8 @@ RPM_PER_RAD_S = 60.0 / (2.0 * math.pi)
 ENVELOPE_BINS = 2000
 
 
-FORCE_KIND_LABELS = {"sp": "sun-planet", "rp": "ring-planet", "mesh": "mesh"}
-
-
-#: contact-force variable names: stage, kind (sp, rp, mesh), planet
-FORCE_NAME_RE = re.compile(r"^(stage\d+)\.F_(sp|rp|mesh)(?:\[(\d+)\])?$")
+#: a contact force's declared mesh kind (its ``mesh`` detail) -> its label and line style in plots
+MESH_KIND_STYLES = {"sun_planet": ("sun-planet", "-"), "ring_planet": ("ring-planet", "--"), "parallel": ("mesh", "-")}
 
 
 def envelope(t: np.ndarray, y: np.ndarray, bins: int = ENVELOPE_BINS) -> tuple[np.ndarray, np.ndarray]:

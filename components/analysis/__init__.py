@@ -11,4 +11,6 @@ fatigue                 rainflow, damage-equivalent loads, a run's fatigue repor
 load_duration           load duration/revolution distributions
 contact_loss            separations, flank changes and time inside the backlash per mesh
 spectrum                amplitude spectra and spectral peaks
+gear_mesh, gear_rating  ISO 6336 mesh geometry, tooth stiffness and gear ratings
+plausibility            a drivetrain's values judged by physics (a table of rules)
 """

@@ -28,12 +28,8 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..model.contact import CONTACT_LOSS_THRESHOLD_N
-from ..reference.results import (
-    SimulationResult,
-    is_contact_force,
-    select_window,
-    series_and_time,
-)
+from ..model.signals import CONTACT_FORCE
+from ..reference.results import SimulationResult, select_window, series_and_time
 from ..validation import positive
 
 
@@ -186,25 +182,34 @@ def contact_loss_summary(
     Parameters
     ----------
     result : SimulationResult or mapping name -> ndarray
-        A monolithic result, or any mapping of series (then ``time_s`` is required);
-        FMU result columns with a ``gearbox.`` prefix work the same way.
+        A monolithic result, or any mapping of series (then ``time_s`` and ``names`` are
+        required); FMU result columns with a ``gearbox.`` prefix work the same way.
     threshold_n : float
         Force threshold [N].
     window : (float, float), optional
         Analysed window [s].
     names : list of str, optional
-        Forces to analyse; default every series whose last name part starts with ``F_``.
+        Forces to analyse, as declared (an FMU's record). Default: the series a
+        :class:`SimulationResult` declares as contact forces.
     time_s : ndarray, optional
         Sample times [s] when ``result`` is a plain mapping.
 
     Returns
     -------
     dict of str -> ContactLossStatistics
-        In the order of the series; ``as_dict()`` of each is JSON-ready.
+        In the order of ``names``; ``as_dict()`` of each is JSON-ready.
+
+    Raises
+    ------
+    ParameterError
+        ``names`` missing for a plain mapping (it declares no kinds), or naming series it does not hold.
     """
     series, t = series_and_time(result, time_s)
     if names is None:
-        names = [n for n in series if is_contact_force(n)]
+        if not isinstance(result, SimulationResult):
+            raise ParameterError("names", None, "the contact forces of a plain mapping of series, as declared (a "
+                                 "mapping declares no kinds; a SimulationResult does)")
+        names = result.names_of(CONTACT_FORCE)
     missing = [n for n in names if n not in series]
     if missing:
         raise ParameterError("names", missing, "names of recorded contact forces")

@@ -39,9 +39,10 @@ Kinds and units
 :func:`fatigue_report` is told which signals are loads, which of them are shaft
 torques (those get an LDD) and their units, as the caller knows them from the
 declarations (the FMU's record, its modelDescription units, the scenario's role
-and signals: :mod:`orchestrator.run.analyses`). Only without ``names`` does it fall
-back to the naming of the project's own reference model
-(:mod:`components.reference.results`: ``*.F_*`` forces, ``shaft<k>.torque``).
+and signals: :mod:`orchestrator.run.analyses`). Without ``names`` it takes them from
+what a monolithic result declares of its series
+(:attr:`components.reference.results.SimulationResult.signals`); a name never says
+what a series is or its unit.
 """
 
 from __future__ import annotations
@@ -55,14 +56,8 @@ import fatpack
 import numpy as np
 
 from ..errors import ParameterError
-from ..reference.results import (
-    SimulationResult,
-    is_contact_force,
-    is_shaft_torque,
-    select_window,
-    series_and_time,
-    unit_of,
-)
+from ..model.signals import CONTACT_FORCE, SHAFT_TORQUE
+from ..reference.results import SimulationResult, select_window, series_and_time
 from ..validation import finite_series, non_negative, one_of, positive
 from .load_duration import LoadDurationDistribution, load_duration_distribution
 
@@ -349,7 +344,7 @@ def fatigue_loads(
     settings: FatigueSettings | None = None,
     window: tuple[float, float] | None = None,
     name: str = "",
-    unit: str | None = None,
+    unit: str = "",
 ) -> FatigueLoads:
     """Rainflow count and damage-equivalent loads of one load signal.
 
@@ -365,7 +360,7 @@ def fatigue_loads(
     name : str
         Signal name.
     unit : str, optional
-        Unit; default from the name (:func:`components.reference.results.unit_of`).
+        Unit as declared; default ``""`` (not declared: never read from the name).
 
     Returns
     -------
@@ -379,7 +374,7 @@ def fatigue_loads(
     dels = {m: damage_equivalent_load(cyc, m, n_ref) for m in s.wohler_exponents}
     return FatigueLoads(
         name=name,
-        unit=unit if unit is not None else unit_of(name),
+        unit=unit,
         analysed_time_s=span_t,
         reference_cycles=n_ref,
         reference_frequency_hz=None if s.reference_cycles is not None else s.reference_frequency_hz,
@@ -394,11 +389,6 @@ def fatigue_loads(
 
 
 # --------------------------------------------------------------------------- run level
-def _default_load_names(series: Mapping[str, np.ndarray]) -> list[str]:
-    """Contact forces ``*.F_*`` and shaft torques ``*shaft<k>.torque`` (with or without a ``gearbox.`` prefix)."""
-    return [n for n in series if is_contact_force(n) or is_shaft_torque(n)]
-
-
 @dataclass
 class FatigueReport:
     """Fatigue loads of a run: DELs of every load signal and the LDD of every shaft torque.
@@ -453,8 +443,8 @@ def fatigue_report(
         Analysed window [s] (e.g. the statistics window [5, 60] s).
     names : list of str, optional
         Load signals, as declared (contact forces and shaft torques). Default: the
-        project's reference model's own results, every ``*.F_*`` force and
-        ``shaft<k>.torque``.
+        series a :class:`SimulationResult` declares as contact forces or shaft torques
+        (a plain mapping declares none: give them).
     time_s : ndarray, optional
         Sample times for a plain mapping.
     speeds : mapping of str -> str, optional
@@ -462,21 +452,30 @@ def fatigue_report(
         ``{"shaft3.torque": "omega_gen"}``.
     torques : sequence of str, optional
         Which of ``names`` are shaft torques (an LDD each). Default: with ``names``
-        none; without, the reference model's ``shaft<k>.torque``.
+        none; without, the series the result declares as shaft torques.
     units : mapping of str -> str, optional
         Unit of each signal as declared (its FMU's modelDescription). Default: with
-        ``names`` "" (not declared); without, the reference model's units.
+        ``names`` "" (not declared); without, the units the result declares.
 
     Returns
     -------
     FatigueReport
+
+    Raises
+    ------
+    ParameterError
+        ``names`` missing for a plain mapping, naming series it does not hold, or
+        ``torques`` not among them.
     """
     s = settings or FatigueSettings()
     series, t = series_and_time(result, time_s)
-    if names is None:  # the reference model's own results: its naming is its declaration
-        names = _default_load_names(series)
-        torques = [n for n in names if is_shaft_torque(n)] if torques is None else torques
-        units = {n: unit_of(n) for n in names} if units is None else units
+    if names is None:  # a monolithic result declares what its series are
+        if not isinstance(result, SimulationResult):
+            raise ParameterError("names", None, "the load signals of a plain mapping of series, as declared (a "
+                                 "mapping declares no kinds; a SimulationResult does)")
+        names = result.names_of(CONTACT_FORCE, SHAFT_TORQUE)
+        torques = result.names_of(SHAFT_TORQUE) if torques is None else torques
+        units = result.units if units is None else units
     names = list(names)
     torques = list(torques or ())
     units = dict(units or {})

@@ -1,4 +1,4 @@
-"""Spur-gear mesh geometry for ISO 6336: contact ratio, zone and single-contact factors, method B form factors.
+"""Spur-gear mesh geometry for ISO 6336: contact ratio, zone and single-contact factors, method B form factors, stiffness.
 
 SI (lengths in m), spur gears (helix angle 0) cut by the basic rack of ISO 53 profile A (addendum
 1 m, dedendum 1.25 m, root radius 0.38 m), profile shifts ``x``. A mesh is a pinion (``teeth_1 >
@@ -14,7 +14,15 @@ The rating that uses these is :mod:`components.analysis.gear_rating` (formulas t
   contact), at least 1; an internal wheel has ``Z_D = 1`` (ISO 6336-2);
 * ``Y_F``, ``Y_S`` by ISO 6336-3 method B (:func:`root_form_factors`); an internal gear gets the
   basic rack's (the rack limit of the external equations, a stated simplification, see
-  :mod:`components.analysis.gear_rating`).
+  :mod:`components.analysis.gear_rating`);
+* the tooth stiffness of ISO 6336-1 method B (:meth:`MeshGeometry.single_stiffness`,
+  :meth:`MeshGeometry.mesh_stiffness`): the theoretical single stiffness ``c'_th = 1 / q'`` of a solid
+  steel pair, ``q' = C1 + C2 / z_1 + C3 / z_2 + C4 x_1 + C5 x_1 / z_1 + C6 x_2 + C7 x_2 / z_2 + C8 x_1^2
+  + C9 x_2^2`` [mm um / N] (an internal wheel counts as ``z_2 = infinity``), the single stiffness ``c' =
+  c'_th C_M C_R C_B`` (spur: ``cos(beta) = 1``; ``C_M = 0.8``; ``C_R = 1``, a solid blank; ``C_B = (1 +
+  0.5 (1.2 - h_fP / m)) (1 - 0.02 (20 deg - alpha))`` of the basic rack), times ``(w / 100 N/mm)^0.25``
+  below a line load ``w`` of 100 N/mm, and the mesh stiffness ``c_gamma_alpha = c' (0.75 eps_alpha +
+  0.25)``; all per unit face width [N/m^2 in SI; 1 N/(mm um) = 1e9 N/m^2].
 """
 
 from __future__ import annotations
@@ -31,6 +39,14 @@ RACK_ADDENDUM, RACK_DEDENDUM, RACK_ROOT_RADIUS = 1.0, 1.25, 0.38
 MIN_WIDTH_TO_HEIGHT = 3.0
 #: tooth count standing for the rack in the external gear's root equations (Y_F Y_S converged to 1e-4 from 1e4 on)
 RACK_TEETH = 1.0e5
+#: C1 ... C9 of ISO 6336-1 method B's q' of a solid spur pair [mm um / N]
+SINGLE_STIFFNESS_COEFFICIENTS = (0.04723, 0.15551, 0.25791, -0.00635, -0.11654, -0.00193, -0.24188, 0.00529, 0.00182)
+#: C_M of ISO 6336-1: the measured single stiffness of solid gears over the theoretical one
+STIFFNESS_CORRECTION = 0.8
+#: the line load [N/m] (100 N/mm) below which ISO 6336-1 reduces c' by (w / 100 N/mm)^0.25
+STIFFNESS_FULL_LINE_LOAD = 1.0e5
+#: N/(mm um) in SI [N/m^2]
+N_PER_MM_UM = 1.0e9
 
 
 def involute(angle_rad: float) -> float:
@@ -178,6 +194,26 @@ class MeshGeometry:
         """N_F = (b/h)^2 / (1 + b/h + (b/h)^2), ``h = 2.25 m``, ``b/h >= 3`` (ISO 6336-1)."""
         bh = max(self.face_width_m / ((RACK_ADDENDUM + RACK_DEDENDUM) * self.module_m), MIN_WIDTH_TO_HEIGHT)
         return bh * bh / (1.0 + bh + bh * bh)
+
+    @property
+    def theoretical_single_stiffness(self) -> float:
+        """c'_th = 1 / q' of ISO 6336-1 method B [N/m^2] (an internal wheel: z_2 = infinity)."""
+        c1, c2, c3, c4, c5, c6, c7, c8, c9 = SINGLE_STIFFNESS_COEFFICIENTS
+        z1, x1, x2 = self.teeth_1, self.profile_shift_1, self.profile_shift_2
+        inv_z2 = 0.0 if self.internal else 1.0 / self.teeth_2
+        q = c1 + c2 / z1 + c3 * inv_z2 + c4 * x1 + c5 * x1 / z1 + c6 * x2 + c7 * x2 * inv_z2 + c8 * x1 * x1 \
+            + c9 * x2 * x2
+        return N_PER_MM_UM / q
+
+    def single_stiffness(self, line_load_n_per_m: float = STIFFNESS_FULL_LINE_LOAD) -> float:
+        """c' = c'_th C_M C_R C_B [N/m^2] of a solid blank (C_R = 1), reduced below 100 N/mm (module docstring)."""
+        rack = (1.0 + 0.5 * (1.2 - RACK_DEDENDUM)) * (1.0 - 0.02 * (20.0 - math.degrees(self.pressure_angle_rad)))
+        load = min(1.0, max(line_load_n_per_m, 0.0) / STIFFNESS_FULL_LINE_LOAD) ** 0.25
+        return self.theoretical_single_stiffness * STIFFNESS_CORRECTION * rack * load
+
+    def mesh_stiffness(self, line_load_n_per_m: float = STIFFNESS_FULL_LINE_LOAD) -> float:
+        """c_gamma_alpha = c' (0.75 eps_alpha + 0.25) [N/m^2]: the mean stiffness of the mesh per face width."""
+        return self.single_stiffness(line_load_n_per_m) * (0.75 * self.contact_ratio + 0.25)
 
     def root_factors(self, k: int) -> tuple[float, float]:
         """(Y_F, Y_S) of gear k by method B (an internal gear: the basic rack's, module docstring)."""

@@ -17,7 +17,7 @@ from typing import Sequence
 import numpy as np
 
 from ..errors import ParameterError
-from ..reference.results import select_window, unit_of
+from ..reference.results import select_window
 
 
 @dataclass(frozen=True)
@@ -83,7 +83,7 @@ def load_duration_distribution(
     window: tuple[float, float] | None = None,
     speed_rad_s: np.ndarray | None = None,
     name: str = "",
-    unit: str | None = None,
+    unit: str = "",
 ) -> LoadDurationDistribution:
     """Load duration distribution of one signal.
 
@@ -100,7 +100,7 @@ def load_duration_distribution(
     speed_rad_s : ndarray, shape (N,), optional
         Speed of the shaft carrying the load [rad/s]: adds revolutions per bin.
     name, unit : str
-        Signal name and unit (default unit from the name).
+        Signal name and its unit as declared (default ``""``: not declared; never read from the name).
 
     Returns
     -------
@@ -128,7 +128,7 @@ def load_duration_distribution(
     outside = float(w.sum() - time_in.sum())
     return LoadDurationDistribution(
         name=name,
-        unit=unit if unit is not None else unit_of(name),
+        unit=unit,
         edges=edges,
         time_s=time_in,
         revolutions=revs,

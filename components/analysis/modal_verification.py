@@ -33,6 +33,7 @@ import numpy as np
 
 from ..errors import SolverError
 from ..model.drivetrain import Drivetrain
+from ..model.signals import deflection_name
 from ..model.wind import ConstantSpeed
 from ..reference.results import SimulationResult
 from ..reference.solver import SolverSettings, simulate_monolithic
@@ -92,7 +93,7 @@ def deviation_state(result: SimulationResult, analysis: DrivetrainModalAnalysis)
     ndarray, shape (N, 2 n_dof)
     """
     a = analysis.model.assembly
-    d = np.stack([result[name.replace(".F_", ".d_")] for name in a.mesh_names], axis=1)
+    d = np.stack([result[deflection_name(name)] for name in a.mesh_names], axis=1)
     speeds = np.stack([result[f"{b}.omega"] for b in a.dof_names], axis=1)
     v = speeds - np.outer(result["omega_rotor"], a.kinematic_ratio)
     torque = np.stack([result[f"{s}.torque"] for s in a.shaft_names], axis=1)

@@ -295,7 +295,7 @@ def drivetrain_modes(drivetrain: Drivetrain, operating_point: OperatingPoint, st
     model = linearise(drivetrain, operating_point, stiffness_factor)
     a = model.assembly
     cm = coupled(model, rotor, free_input)
-    modes, ss, und = modal_analysis(cm.mass, cm.damping, cm.stiffness)
+    modes, ss, _ = modal_analysis(cm.mass, cm.damping, cm.stiffness)
     names = cm.body_names
     lead = len(names) - a.n_dof
     driver = a.bodies[a.driver]
@@ -317,8 +317,8 @@ def drivetrain_modes(drivetrain: Drivetrain, operating_point: OperatingPoint, st
         membership[-1, -1] = 1.0
     lateral = not all(rotation)
     out = []
-    for m, u_y in zip(modes, und.shapes.T):
-        u = cm.basis @ u_y  # body deviations
+    for m in modes:  # each row's own undamped shape (the rows are in the order of their eigenvalues' |lambda|)
+        u = cm.basis @ m.shape  # body deviations
         kinetic = cm.body_inertia_kgm2 * u * u
         energy = kinetic / kinetic.sum() if kinetic.sum() > 0 else kinetic
         if lateral:

@@ -11,6 +11,7 @@ assembly                    bodies, mesh/shaft matrices, forces and analytic Jac
 integrators                 Rosenbrock W-method with step control
 gearbox_model               the gearbox side of the co-simulation cut (the Gearbox FMU's model)
 generator, wind             generator rotor and load events; rotor-speed process (eq. 13-14)
+signals                     unit and kind of each model variable (Gearbox FMU outputs, reference series)
 
 Nothing here imports :mod:`components.reference` or :mod:`components.analysis`.
 """

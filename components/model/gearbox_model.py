@@ -39,7 +39,7 @@ from .kernel import layout as L
 
 SHAFT_TORQUE_MODES = ("average", "end")
 #: how the generator end of shaft 3 moves within a communication step (see :class:`GearboxModel`)
-GENERATOR_INTERFACES = ("motion", "inertia")
+GENERATOR_INTERFACES = ("motion", "inertia", "inertia_own")
 #: where a run starts: at the static deflection of its initial load, or undeflected (today's start before issue 29)
 STARTS = ("operating_point", "rest")
 #: the static deflection's convergence (relative generalised-force imbalance) and Newton iterations
@@ -119,7 +119,7 @@ class GearboxModel:
     extrapolate : bool
         Estimate the input slopes from the last two inputs (True) or hold the
         input speeds over the step (False).
-    generator_interface : {"motion", "inertia"}
+    generator_interface : {"motion", "inertia", "inertia_own"}
         ``motion``: the generator end of shaft 3 follows the Hermite curve of the
         generator-motion inputs (above). ``inertia`` (an interface model): the
         generator rotor's inertia (the drivetrain's ``generator.inertia_kgm2``) is a
@@ -132,7 +132,15 @@ class GearboxModel:
         generator component's angle integrates a step-mean torque, and anchoring to
         it would twist shaft 3 by that error at every communication point. Within the
         step the generator answers the shaft torque at once instead of one step
-        later, so the gearbox - generator loop adds no coupling error.
+        later, so the gearbox - generator loop adds no coupling error - when the generator
+        component is stepped after the gearbox (Gauss-Seidel). ``inertia_own``: the same
+        interface model, but the generator speed is the gearbox's own, re-anchored at every
+        communication point on its impulse balance ``I_g (w_n+1 - w_n) = h (mean shaft torque -
+        counter torque)`` (the generator component's equation, on the same torques) instead of
+        on the generator-speed input, which is not used. For hosts that step every component
+        from its partners' values of the last communication point (Jacobi: libcosim, ecos), whose
+        generator-speed input lags one step; the generator component follows the gearbox
+        (:class:`~components.model.generator.ShaftTorquePrediction`).
     rotor_derivatives : bool
         Extrapolate the rotor motion over the step from the inputs ``alpha_rotor``
         and ``jerk_rotor`` (the source's acceleration and jerk at ``t_n``: a third-order
@@ -174,9 +182,9 @@ class GearboxModel:
     ) -> None:
         self.generator_interface = one_of("generator_interface", generator_interface, GENERATOR_INTERFACES)
         self.start = one_of("start", start, STARTS)
-        inertia = self.generator_interface == "inertia"
+        inertia = self.generator_interface != "motion"
         if inertia and drivetrain.generator is None:
-            raise ParameterError("generator_interface", "inertia", "a drivetrain with a generator")
+            raise ParameterError("generator_interface", self.generator_interface, "a drivetrain with a generator")
         self.shaft_torque_mode = one_of("shaft_torque_mode", shaft_torque_mode, SHAFT_TORQUE_MODES)
         self.extrapolate = bool(extrapolate)
         self.rotor_derivatives = bool(rotor_derivatives)
@@ -222,7 +230,7 @@ class GearboxModel:
             # G^-1 (or its LU factors, pivots and pattern) and the time-derivative basis of every kept factorisation
             "winvs": (L.N_SLOTS, n, n), "pivots": (L.N_SLOTS, 2 * n + 1, n), "w_bases": (L.N_SLOTS, 3 + n_ext, n2),
             "port_jac": (2, n), "last_acc": (n,), "last_force": (m,), "last_defl": (2, m), "y": (n2,),
-            "driver": (4,), "port": (4,), "scalars": (len(L.SCALAR_NAMES),), "outputs": (n_linear + n_mag + 4,),
+            "driver": (4,), "port": (4,), "scalars": (len(L.SCALAR_NAMES),), "outputs": (n_linear + n_mag + 5,),
             "anchor": (n + 1,),
         }
         shapes["backup"] = (sum(int(np.prod(shapes[name])) for name in L.STATE_SLOTS),)
@@ -283,6 +291,7 @@ class GearboxModel:
         dims[L.D_END_TORQUE] = int(self.shaft_torque_mode == "end")
         dims[L.D_GEN_DOF] = -1 if self.generator_dof is None else self.generator_dof
         dims[L.D_ROTOR_DERIVATIVES] = int(self.rotor_derivatives)
+        dims[L.D_OWN_GEN_SPEED] = int(self.generator_interface == "inertia_own")
         dims[L.D_EXT] = a.load_matrix.shape[0]
         dims[L.D_MAGNITUDES] = self._magnitudes.shape[0]
 
@@ -407,7 +416,9 @@ class GearboxModel:
         Units: torques [N m], speeds [rad/s], contact forces [N], accelerations [rad/s^2]
         (``alpha_out``: the output member's acceleration averaged over the last step;
         ``alpha_out_max``: eq. 11's running maximum of its magnitude over every accepted
-        internal step since initialisation). The kernel writes them at every step
+        internal step since initialisation; ``omega_generator``: the generator speed the next step
+        starts from with ``inertia_own``, the generator's impulse balance over the last step with
+        ``inertia``, the extrapolated generator-speed input with ``motion``). The kernel writes them at every step
         (:func:`components.model.kernel.step.outputs`).
         """
         return self._views["outputs"].copy()
@@ -467,6 +478,7 @@ class GearboxModel:
             sc[L.S_PORT_ANGLE], sc[L.S_PORT_SPEED] = counter_torque_nm, 0.0
         sc[L.S_LAST_OMEGA_ROTOR] = omega_rotor
         sc[L.S_LAST_OMEGA_GEN] = omega_gen
+        sc[L.S_GEN_SPEED] = omega_gen
         sc[L.S_PORT_OFFSET] = 0.0
         buf, lay, dims = self._buffer, self._offsets, self._dims
         self.static_iterations = 0

@@ -79,7 +79,8 @@ def gearbox_outputs(a: Assembly, gearbox_dofs: np.ndarray, out_member: int) -> t
             columns.append(column[:, None])
             names.append(f"{element.name}.omega")
     magnitudes = [f"{e.name}.F" for e in a.elements if e.kind != "torsion"]
-    output_names = (["shaft_torque", "shaft_torque_avg"] + names + magnitudes + ["alpha_out", "alpha_out_max"])
+    output_names = (["shaft_torque", "shaft_torque_avg"] + names + magnitudes
+                    + ["alpha_out", "alpha_out_max", "omega_generator"])
     return np.column_stack(columns), np.array(pairs, dtype=float).reshape(-1, 2), output_names
 
 

@@ -173,6 +173,46 @@ class TorqueSchedule:
         return impulse, moment
 
 
+class ShaftTorquePrediction:
+    """The mean shaft torque over the coming communication step, extrapolated from the step means received.
+
+    A host that steps every component from its partners' values at the last communication point
+    (Jacobi: libcosim, ecos) gives the generator at ``t_n`` the gearbox's shaft torque averaged over the
+    step before, ``[t_n-1, t_n]``: held over ``[t_n, t_n+1]`` it lags one step, and the generator speed
+    with it (first order in ``h``). Each mean is the torque at its step's midpoint up to ``h^2 T'' / 24``;
+    the mean over the coming step is the polynomial through the last three (midpoint, mean) pairs at
+    ``t_n + h / 2``: ``3 T_n - 3 T_n-1 + T_n-2`` at a constant step, exact for a torque quadratic in time.
+    The first torque received (the gearbox's at the start time) counts as the value at ``t_0``; until
+    three are known the polynomial is of lower degree (held, then linear).
+    """
+
+    def __init__(self) -> None:
+        self.points: list[tuple[float, float]] = []  # (time the mean stands for [s], mean [N m]), at most 3
+        self.last_time: float | None = None
+
+    def predict(self, t: float, h: float, mean_nm: float) -> float:
+        """The mean torque over ``[t, t + h]`` [N m], given the mean ``mean_nm`` over the step that ended at ``t``."""
+        at = t if self.last_time is None else 0.5 * (self.last_time + t)
+        self.points = (self.points + [(at, float(mean_nm))])[-3:]
+        self.last_time = t
+        target = t + 0.5 * h
+        out = 0.0
+        for i, (ti, vi) in enumerate(self.points):
+            weight = 1.0
+            for j, (tj, _) in enumerate(self.points):
+                if j != i:
+                    weight *= (target - tj) / (ti - tj)
+            out += weight * vi
+        return out
+
+    def get_state(self) -> dict:
+        return {"points": [list(p) for p in self.points], "last_time": self.last_time}
+
+    def set_state(self, state: dict) -> None:
+        self.points = [(float(a), float(b)) for a, b in state["points"]]
+        self.last_time = None if state["last_time"] is None else float(state["last_time"])
+
+
 class GeneratorRotor:
     """The generator rotor as a stepping component (exact for a held shaft torque).
 

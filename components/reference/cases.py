@@ -26,6 +26,7 @@ from ..errors import ParameterError
 from ..model.contact import CONTACT_LOSS_THRESHOLD_N
 from ..model.drivetrain import Drivetrain
 from ..model.presets import table3_parallel, table5_planetary, table6_gearbox
+from ..model.signals import CONTACT_FORCE
 from ..model.wind import ConstantSpeed, RotorSpeedProcess, SineSpeed, WindParameters
 from .results import SimulationResult, window_statistics
 
@@ -151,15 +152,15 @@ def run_reference_case(case: ReferenceCase, **overrides) -> tuple[SimulationResu
 def case_statistics(result: SimulationResult, drivetrain: Drivetrain, window: tuple[float, float]) -> dict:
     """Statistics of a paper case (see :func:`run_case`)."""
     t = result.time_s
-    forces = [n for n in result.names if ".F_" in n]
+    forces = result.names_of(CONTACT_FORCE)  # as the solver declares them
     names = forces + [n for n in ("omega_gen", "omega_rotor", "omega_out", "torque_rotor") if n in result.series]
     stats = result.statistics(window, names)
     for st in drivetrain.stages:
-        sp = [f"{st.name}.F_sp[{i + 1}]" for i in range(getattr(st, "n_planets", 0))]
-        if sp:
-            rp = [n.replace("F_sp", "F_rp") for n in sp]
-            stats[f"{st.name}.sum_F_sp"] = window_statistics(t, sum(result[n] for n in sp), window)
-            stats[f"{st.name}.sum_F_rp"] = window_statistics(t, sum(result[n] for n in rp), window)
+        meshes = {kind: [n for n in forces if result.signals[n].detail("stage") == st.name
+                         and result.signals[n].detail("mesh") == kind] for kind in ("sun_planet", "ring_planet")}
+        if meshes["sun_planet"]:
+            stats[f"{st.name}.sum_F_sp"] = window_statistics(t, sum(result[n] for n in meshes["sun_planet"]), window)
+            stats[f"{st.name}.sum_F_rp"] = window_statistics(t, sum(result[n] for n in meshes["ring_planet"]), window)
     for n in forces:
         inside = np.abs(result[n]) < CONTACT_LOSS_THRESHOLD_N
         sel = (t >= window[0]) & (t <= window[1])

@@ -10,6 +10,10 @@ co-simulated results can be compared name by name:
 * ``omega_rotor`` [rad/s], ``torque_rotor`` [N m], ``omega_out`` [rad/s],
   ``alpha_out`` [rad/s^2] (output-gear acceleration), ``omega_gen`` [rad/s],
   ``load_torque`` [N m]
+
+What each series is - its unit and kind - is not read from these names: the solver
+declares it where it makes the series (:attr:`SimulationResult.signals`, from
+:mod:`components.model.signals`, as the Gearbox FMU declares its outputs).
 """
 
 from __future__ import annotations
@@ -20,45 +24,7 @@ from typing import Mapping
 import numpy as np
 
 from ..errors import ParameterError
-
-UNITS = {
-    "F": "N",
-    "d": "m",
-    "torque": "N.m",
-    "omega": "rad/s",
-    "alpha": "rad/s2",
-}
-
-
-def is_contact_force(name: str) -> bool:
-    """A contact-force variable: last part ``F_...`` (``stage1.F_sp[1]``, ``gearbox.stage3.F_mesh``)."""
-    return name.rsplit(".", 1)[-1].startswith("F_")
-
-
-def is_shaft_torque(name: str) -> bool:
-    """A shaft-torque variable: ``...shaft<k>.torque`` (``shaft1.torque``, ``gearbox.shaft3.torque``)."""
-    parts = name.split(".")
-    return len(parts) >= 2 and parts[-1] == "torque" and parts[-2].startswith("shaft")
-
-
-def unit_of(name: str) -> str:
-    """SI unit string of a result variable (FMI/SSP unit names: ``N``, ``N.m``, ``rad/s``)."""
-    last = name.rsplit(".", 1)[-1]
-    if last.startswith("F_"):
-        return "N"
-    if last.startswith("d_"):
-        return "m"
-    if "torque" in last:
-        return "N.m"
-    if last.startswith("omega"):
-        return "rad/s"
-    if last.startswith("alpha"):
-        return "rad/s2"
-    if last.startswith("phi"):
-        return "rad"
-    if last.startswith("time"):
-        return "s"
-    return "1"
+from ..model.signals import Signal
 
 
 def window_mask(time_s: np.ndarray, window: tuple[float, float] | None) -> np.ndarray | slice:
@@ -191,6 +157,9 @@ class SimulationResult:
         Wall-clock time of the integration [s].
     energy : EnergyAudit or None
         Energy balance over the run.
+    signals : dict of str -> Signal
+        What each series is (unit, kind, details), declared by the solver that made it
+        (:mod:`components.model.signals`); analyses select series and read units from it.
     """
 
     time_s: np.ndarray
@@ -200,6 +169,7 @@ class SimulationResult:
     wall_time_s: float = 0.0
     energy: EnergyAudit | None = None
     info: dict = field(default_factory=dict)
+    signals: dict[str, Signal] = field(default_factory=dict)
 
     def __getitem__(self, name: str) -> np.ndarray:
         try:
@@ -211,6 +181,15 @@ class SimulationResult:
     def names(self) -> list[str]:
         """Recorded variable names."""
         return list(self.series)
+
+    def names_of(self, *kinds: str) -> list[str]:
+        """The series declared as one of ``kinds`` (e.g. ``"contact_force"``), in recording order."""
+        return [n for n in self.series if n in self.signals and self.signals[n].kind in kinds]
+
+    @property
+    def units(self) -> dict[str, str]:
+        """The declared unit of every declared series."""
+        return {n: self.signals[n].unit for n in self.series if n in self.signals}
 
     def statistics(self, window: tuple[float, float] | None = None, names=None) -> dict[str, dict[str, float]]:
         """Statistics of each variable over ``window`` [s]."""

@@ -26,6 +26,19 @@ from ..model import kernel as model_kernel
 from ..model.assembly import Assembly
 from ..model.drivetrain import Drivetrain
 from ..model.gearbox_model import STARTS
+from ..model.signals import (
+    GENERATOR_ANGLE,
+    GENERATOR_SPEED,
+    GENERATOR_TORQUE,
+    OUTPUT_SPEED,
+    ROTOR_ANGLE,
+    ROTOR_SPEED,
+    ROTOR_TORQUE,
+    Signal,
+    deflection_name,
+    deflection_signal,
+    gearbox_signals,
+)
 from ..validation import finite, non_negative, one_of, positive
 from .results import EnergyAudit, SimulationResult
 
@@ -399,11 +412,16 @@ def _collect(system: MonolithicSystem, t: np.ndarray, Y: np.ndarray) -> Simulati
     Q[:, system._out] -= load_torque
     acc = a.inv_inertia * Q - a.kinematic_ratio * alpha_in[:, None]
     speeds = np.outer(omega_in, a.kinematic_ratio) + v
+    # every series is declared where it is made (unit, kind): analyses never read them from the names
+    signals = gearbox_signals(a)  # contact forces, shaft torques, body speeds: as the Gearbox FMU declares them
+    signals |= {"omega_rotor": Signal("rad/s", "rotor speed driving the gearbox", ROTOR_SPEED),
+               "phi_rotor": Signal("rad", "rotor angle", ROTOR_ANGLE)}
     series: dict[str, np.ndarray] = {"omega_rotor": omega_in, "phi_rotor": angle_in}
     for i, name in enumerate(a.mesh_names):
         series[name] = loads.contact_force_n[:, i]
     for i, name in enumerate(a.mesh_names):
-        series[name.replace(".F_", ".d_")] = loads.deflection_m[:, i]
+        series[deflection_name(name)] = loads.deflection_m[:, i]
+        signals[deflection_name(name)] = deflection_signal(name)
     for i, name in enumerate(a.shaft_names):
         series[f"{name}.torque"] = loads.shaft_torque_nm[:, i]
     for i, body in enumerate(a.bodies[j] for j in a.free):
@@ -419,9 +437,17 @@ def _collect(system: MonolithicSystem, t: np.ndarray, Y: np.ndarray) -> Simulati
     series["alpha_out"] = (
         alpha_out if a.output_body == out_member else acc[:, a.dof_index(out_member)] + a.kinematic_ratio[a.dof_index(out_member)] * alpha_in
     )
+    signals.update(
+        torque_rotor=Signal("N.m", "torque the rotor applies to the gearbox", ROTOR_TORQUE),
+        load_torque=Signal("N.m", "counter torque on the output", GENERATOR_TORQUE),
+        omega_out=Signal("rad/s", f"speed of the output member {out_member}", OUTPUT_SPEED),
+        alpha_out=Signal("rad/s2", f"angular acceleration of the output member {out_member}"),
+    )
     if a.drivetrain.generator is not None:
         series["omega_gen"] = speeds[:, out]
         series["phi_gen"] = a.kinematic_ratio[out] * angle_in + q[:, out]
+        signals.update(omega_gen=Signal("rad/s", "generator speed", GENERATOR_SPEED),
+                       phi_gen=Signal("rad", "generator angle", GENERATOR_ANGLE))
     energy = None
     if t.size >= 2:
         ke = a.kinetic_energy(speeds[[0, -1]], omega_in[[0, -1]])
@@ -433,4 +459,4 @@ def _collect(system: MonolithicSystem, t: np.ndarray, Y: np.ndarray) -> Simulati
             dissipated_j=float(Y[-1, 2 * n + 2] - Y[0, 2 * n + 2]),
             stored_change_j=float(ke[1] - ke[0] + pe1 - pe0),
         )
-    return SimulationResult(time_s=t, series=series, energy=energy)
+    return SimulationResult(time_s=t, series=series, energy=energy, signals={n: signals[n] for n in series})

@@ -6,7 +6,9 @@ and ``omega_gen``, ``phi_gen`` (far end of shaft 3). Outputs: ``shaft_torque``
 ``shaft_torque_mode``), ``shaft_torque_end``, ``shaft_torque_avg``,
 ``omega_out``, ``torque_rotor``, every contact force (``stage1.F_sp[1]``,
 ``stage1.F_rp[1]``, ..., ``stage3.F_mesh``), every shaft torque
-(``shaft1.torque``, ...), every body speed (``stage1.sun.omega``, ...), the
+(``shaft1.torque``, ...), every body speed (``stage1.sun.omega``, ...), with
+lateral-torsional stages every displacement and bearing output (``stage1.sun.x``,
+``stage1.planet_bearing[1].F``, ...; :func:`components.model.signals.gearbox_signals`), the
 output member's acceleration ``alpha_out`` (averaged over the last step) and
 its running peak magnitude ``alpha_out_max`` (eq. 11, over every internal
 solver step).
@@ -33,6 +35,7 @@ from components.model.description import build
 from components.model.drivetrain import Drivetrain
 from components.model.gearbox_model import GENERATOR_INTERFACES, SHAFT_TORQUE_MODES, STEP_INPUTS, GearboxModel
 from components.model.integrators import StepControl
+from components.model.signals import gearbox_signals
 from components.validation import choice_bounds, positive
 
 from .base import DtcosimSlave
@@ -52,55 +55,9 @@ from .interface import (
     real_parameter,
 )
 
-_MESH_KINDS = {"sun_planet": "sun-planet mesh", "ring_planet": "ring-planet mesh", "parallel": "parallel-stage mesh"}
-
 # all outputs form one group: computed in one vectorised pass (GearboxModel.output_vector)
 # at most once per step, when the first output is read
 _OUTPUTS = "outputs"
-
-
-def _planet_of(force_name: str) -> dict[str, str]:
-    """``{"planet": "2"}`` for a planet mesh force ``stage1.F_sp[2]``, ``{}`` for a parallel mesh."""
-    inside = force_name.rpartition("[")[2].rstrip("]") if force_name.endswith("]") else ""
-    return {"planet": inside} if inside else {}
-
-
-def _lateral_outputs(assembly: Assembly) -> list[Variable]:
-    """The body speeds, then what the lateral-torsional stages add: displacements, bearing forces and speeds.
-
-    In :class:`GearboxModel`'s order (:attr:`GearboxModel.output_names`): the speeds of the rotations, the
-    displacements of the translations, per bearing or support its force components (and a rolling bearing's
-    speed), then every bearing's and support's force magnitude.
-    """
-    out = []
-    bodies = [assembly.bodies[j] for j in assembly.free if assembly.bodies[j].role != "generator"]
-    for body in bodies:
-        if body.rotation:
-            out.append(real_output(f"{body.name}.omega", "rad/s", f"absolute speed of {body.name}", "body_speed",
-                                   body=body.name))
-    for body in bodies:
-        if not body.rotation:
-            out.append(real_output(body.name, "m", f"{body.coordinate} displacement of {body.name.rpartition('.')[0]} "
-                                   "(a planetary stage's carrier frame, a parallel stage's housing)",
-                                   "body_displacement", body=body.name))
-    for e in assembly.elements:
-        what = {"bearing": "bearing", "support": "support", "torsion": "torsional support"}[e.kind]
-        for c in e.components:
-            if c == "torque":
-                out.append(real_output(f"{e.name}.torque", "N.m", f"torque of the {what} {e.name} on {e.body}",
-                                       "support_torque", bearing=e.name, stage=e.stage, body=e.body))
-            else:
-                out.append(real_output(f"{e.name}.F_{c}", "N", f"{c} force of the {what} {e.name} on {e.body}"))
-        if e.speed:
-            relative = f" relative to {e.speed[1]}" if len(e.speed) > 1 else ""
-            out.append(real_output(f"{e.name}.omega", "rad/s", f"speed of {e.speed[0]}{relative} (turns the bearing "
-                                   f"{e.name})", "bearing_speed", bearing=e.name, stage=e.stage, body=e.body))
-    for e in assembly.elements:
-        if e.kind != "torsion":
-            out.append(real_output(f"{e.name}.F", "N", f"radial force magnitude of the {e.kind} {e.name} on {e.body}",
-                                   "bearing_force" if e.kind == "bearing" else "support_force", bearing=e.name,
-                                   stage=e.stage, body=e.body))
-    return out
 
 
 def template_of(model: Mapping[str, Any]) -> Drivetrain:
@@ -135,7 +92,9 @@ class Gearbox(DtcosimSlave):
                               f"{enumeration_text(GENERATOR_INTERFACES)} (motion: along the generator-motion "
                               "inputs; inertia: an interface model, the generator inertia generator_inertia "
                               "integrated in the step against the input counter_torque, its speed set to "
-                              "omega_gen at every communication point)"),
+                              "omega_gen at every communication point; inertia_own: the same, its speed set to "
+                              "its own impulse balance instead (omega_gen unused), for hosts that step with "
+                              "Jacobi, with a generator that follows omega_generator)"),
             real_parameter("generator_inertia", template.generator.inertia_kgm2, "kg.m2",
                            "generator rotor inertia of the inertia interface (the generator component's)"),
             boolean_parameter("rotor_derivatives", False,
@@ -167,15 +126,9 @@ class Gearbox(DtcosimSlave):
             real_output("torque_rotor", "N.m", "torque the rotor applies to the gearbox (for the power balance)",
                         "rotor_torque"),
         ]
-        for mesh in assembly.meshes:
-            variables.append(real_output(mesh.name, "N", f"contact force of the {mesh.stage} {_MESH_KINDS[mesh.kind]} {mesh.name}",
-                                         "contact_force", stage=mesh.stage, mesh=mesh.kind, **_planet_of(mesh.name)))
-        for shaft in assembly.shafts:
-            variables.append(real_output(f"{shaft.name}.torque", "N.m",
-                                         f"torque of {shaft.name} ({shaft.upstream} -> {shaft.downstream})",
-                                         "shaft_torque", shaft=shaft.name, upstream=shaft.upstream,
-                                         downstream=shaft.downstream))
-        variables += _lateral_outputs(assembly)
+        # every contact force, shaft torque, body speed and bearing output, as the monolithic reference declares
+        variables += [real_output(name, s.unit, s.description, s.kind, **dict(s.info))
+                      for name, s in gearbox_signals(assembly).items()]
         out_member = assembly.stage_members[template.stages[-1].name]["output"]
         variables += [  # after the body speeds: the same order as GearboxModel.output_names
             real_output("alpha_out", "rad/s2",
@@ -184,6 +137,10 @@ class Gearbox(DtcosimSlave):
                         "largest |d omega_out/dt| since initialisation over every internal solver step "
                         "(paper eq. 11; resolves tooth impacts shorter than the communication step)",
                         "output_acceleration_peak"),
+            real_output("omega_generator", "rad/s",
+                        "generator speed of the interface model: the speed the next step starts from "
+                        "(inertia_own), the generator's impulse balance over the last step (inertia), the "
+                        "extrapolated omega_gen (motion)"),
         ]
         return variables
 

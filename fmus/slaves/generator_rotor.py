@@ -4,7 +4,10 @@ Input ``shaft_torque`` [N m] (shaft 3, from the Gearbox FMU), held over a step; 
 parameter ``torque_from_input`` the counter torque is the input ``counter_torque_input`` (a
 controller's demand or a recorded torque) instead of the schedule; ``brake_torque`` is a
 high-speed-shaft brake acting against the speed;
-the rotor is integrated exactly. Parameters: ``inertia``, ``counter_torque``,
+the rotor is integrated exactly. With ``follow_gearbox`` (for hosts that step with Jacobi, beside a Gearbox
+with ``generator_interface = inertia_own``) the speed is set at every communication point to the input
+``omega_gearbox`` (the Gearbox's ``omega_generator``) and the shaft torque over the step is the one
+:class:`~components.model.generator.ShaftTorquePrediction` extrapolates from the step means received. Parameters: ``inertia``, ``counter_torque``,
 ``initial_speed``, ``initial_angle`` and four load-event slots
 ``event{i}.kind/start/duration/factor`` (kind 0 = none). Outputs ``omega``,
 ``phi`` and the counter torque currently applied, ``generator_torque``.
@@ -18,6 +21,7 @@ from typing import Any, Hashable, Iterable, Mapping
 from components.errors import ParameterError, SolverError
 from components.model.description import build
 from components.model.generator import GeneratorRotor as RotorComponent
+from components.model.generator import ShaftTorquePrediction
 from components.model.parameter_map import (
     EVENT_KIND_CODES,
     GENERATOR_FIELDS,
@@ -78,7 +82,14 @@ class GeneratorRotor(DtcosimSlave):
             boolean_parameter("torque_from_input", False,
                               "counter torque from the input counter_torque_input (e.g. a TorqueController) "
                               "instead of counter_torque and the load events"),
+            boolean_parameter("follow_gearbox", False,
+                              "for hosts that step with Jacobi (libcosim, ecos): the speed is set to the input "
+                              "omega_gearbox at every communication point and the shaft torque over a step is "
+                              "extrapolated from the last three step means received (with a Gearbox whose "
+                              "generator_interface is inertia_own, whose omega_generator feeds omega_gearbox)"),
             real_input("shaft_torque", 0.0, "N.m", "torque of shaft 3 driving the generator (Gearbox output)"),
+            real_input("omega_gearbox", speed0, "rad/s",
+                       "the Gearbox's generator speed (its output omega_generator), used with follow_gearbox only"),
             real_input("counter_torque_input", 0.0, "N.m",
                        "counter torque demand, used when torque_from_input is true (held over a step)"),
             real_input("brake_torque", 0.0, "N.m",
@@ -102,6 +113,9 @@ class GeneratorRotor(DtcosimSlave):
         self._vr_demand = self.vr["counter_torque_input"]
         self._vr_brake = self.vr["brake_torque"]
         self._from_input = bool(self.value("torque_from_input"))
+        self._vr_lead = self.vr["omega_gearbox"]
+        self._follow = bool(self.value("follow_gearbox"))
+        self._prediction = ShaftTorquePrediction()
         self._vr_out = (self.vr["omega"], self.vr["phi"], self.vr["generator_torque"])
 
     def _new_rotor(self) -> None:
@@ -110,6 +124,7 @@ class GeneratorRotor(DtcosimSlave):
 
     def _initialize(self, start_time: float) -> None:
         self._new_rotor()
+        self._prediction = ShaftTorquePrediction()
 
     def _step(self, time: float, step_size: float) -> None:
         if not step_size > 0.0:
@@ -121,6 +136,12 @@ class GeneratorRotor(DtcosimSlave):
         brake = self._values[self._vr_brake]
         if not math.isfinite(brake) or (demand is not None and not math.isfinite(demand)):
             raise SolverError(f"non-finite input (counter_torque_input={demand!r}, brake_torque={brake!r})", time)
+        if self._follow:
+            lead = self._values[self._vr_lead]
+            if not math.isfinite(lead):
+                raise SolverError(f"non-finite input omega_gearbox = {lead!r}", time)
+            self.rotor.speed_rad_s = lead
+            torque = self._prediction.predict(time, step_size, torque)
         self.rotor.step(time, step_size, torque, demand, brake)
 
     def _refresh(self, group: Hashable) -> None:
@@ -131,9 +152,11 @@ class GeneratorRotor(DtcosimSlave):
         values[i_torque] = (values[self._vr_demand] if self._from_input else self.rotor.counter_torque(self._time))
 
     def _component_state(self) -> dict:
-        return {"speed_rad_s": self.rotor.speed_rad_s, "angle_rad": self.rotor.angle_rad}
+        return {"speed_rad_s": self.rotor.speed_rad_s, "angle_rad": self.rotor.angle_rad,
+                "prediction": self._prediction.get_state()}
 
     def _restore_component_state(self, state: dict) -> None:
         self._new_rotor()
         self.rotor.speed_rad_s = float(state["speed_rad_s"])
         self.rotor.angle_rad = float(state["angle_rad"])
+        self._prediction.set_state(state["prediction"])

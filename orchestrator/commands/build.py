@@ -62,7 +62,7 @@ def run(args: argparse.Namespace) -> int:
             print(f"{path}  ({comp})")
         return 0
     if args.drivetrain is None:
-        for built in build_all(fmu_dir, args.preset, names=args.fmu or PRESET_FMUS):
+        for built in build_all(fmu_dir, args.preset, names=args.fmu or PRESET_FMUS, report=print):
             print(f"{built.path}  ({built.name}, preset {args.preset}, build {built.build_id})")
         return 0
     from components.errors import ParameterError

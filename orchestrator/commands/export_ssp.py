@@ -30,8 +30,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--out", type=Path, required=True, metavar="FILE.ssp", help="output archive")
     p.add_argument("--target", choices=("dtcosim", "libcosim", "ecos"), default="dtcosim",
                    help="the host the archive is for: libcosim and ecos step with Jacobi, so the export sets that "
-                        "algorithm and says (SSD and output) which algorithm its step was chosen for; give the step "
-                        "the coupling study finds for Jacobi with --step, or its --json file with --tuning")
+                        "algorithm with the scenario's coupling and step for it ([jacobi] table, as paper-60s "
+                        "declares) and says (SSD and output) what its step was chosen for; a scenario without one is "
+                        "warned about: give the step the coupling study finds for Jacobi with --step, or its --json "
+                        "file with --tuning")
     p.add_argument("--tuning", type=Path, default=None, metavar="FILE.json",
                    help="the largest steps per algorithm that the coupling study measured (python "
                         "benchmarks/coupling_study.py --json FILE.json): the export uses the one of the target's "
@@ -46,12 +48,11 @@ def run(args: argparse.Namespace) -> int:
     from ..cosim.master import CoSimulation
     from ..cosim.system import resolve_system
     from ..interop.ssp import export_ssp
-    from ..interop.ssp_export import PARAMETER_SET, stale_warnings, unbaked_components
+    from ..interop.ssp_export import PARAMETER_SET, host_notes, stale_warnings, unbaked_components
     from ..provision.project_fmus import ensure_fmus
     from ..provision.staleness import stale_project_fmus
 
-    scenario = scenario_options.apply(scenario_options.load(args.scenario, args, "export-ssp"), args, "export-ssp")
-    scenario, tuning, tuning_text = _tuned_for(scenario, args)
+    scenario, tuning, tuning_text = _tuned_for(scenario_options.load(args.scenario, args, "export-ssp"), args)
     paths = ensure_fmus(scenario, args.fmu_dir, build=not args.no_build,
                         report=lambda m: print(m, file=sys.stderr))
     for warning in stale_project_fmus(paths):
@@ -69,14 +70,21 @@ def run(args: argparse.Namespace) -> int:
     print(f"{out}: {len(scenario.components)} components, {len(scenario.connections)} connections"
           + (f", initial values {', '.join(f'{k} = {v:.10g}' for k, v in initial.items())}" if initial else "")
           + f"; {tuning_text}")
+    sim = scenario.simulation
+    for note in host_notes(args.target, sim.step_s, sim.stop_s):
+        print(f"dtcosim export-ssp: note: {note}", file=sys.stderr)
     return 0
 
 
 def _tuned_for(scenario, args: argparse.Namespace):
-    """(the scenario with the target host's algorithm and step, ExportTuning, what it was tuned for as text).
+    """(the scenario with the target host's algorithm, coupling and step and the command line's changes,
+    ExportTuning, what it was tuned for as text).
 
-    The step is, in this order, the one ``--tuning`` measured for the target's algorithm,
-    the one ``--step`` gives, or the scenario's (chosen for the scenario's own algorithm;
+    A target that steps with Jacobi gets the scenario's coupling for Jacobi (its ``[jacobi]`` table:
+    :meth:`~orchestrator.inputs.scenario.Scenario.for_algorithm`), then the command line's changes
+    (``--set``, ``--step``, ...). The step is, in this order, the one
+    ``--tuning`` measured for the target's algorithm, the one ``--step`` gives, the one the ``[jacobi]``
+    table declares (with what it was chosen by), or the scenario's (chosen for the scenario's own algorithm;
     a target that steps with another algorithm is warned about on stderr).
     """
     from ..errors import ScenarioError
@@ -87,6 +95,9 @@ def _tuned_for(scenario, args: argparse.Namespace):
     if args.algorithm is not None and args.algorithm != algorithm:
         raise ScenarioError("--algorithm", args.algorithm, f"{algorithm}: --target {args.target} steps with "
                             f"{algorithm}; leave --algorithm out or choose another --target", scenario.source)
+    coupling = scenario.jacobi if algorithm == "jacobi" else None
+    coupled = "" if coupling is None else coupling.describe()
+    scenario = scenario_options.apply(scenario.for_algorithm(algorithm), args, "export-ssp")
     criteria = ""
     if args.tuning is not None:
         if args.step is not None:
@@ -95,25 +106,29 @@ def _tuned_for(scenario, args: argparse.Namespace):
         step, criteria = _measured_step(args.tuning, scenario.name, algorithm)
         scenario = scenario.with_simulation(step_s=step)
     step_ms = f"{scenario.simulation.step_s * 1e3:g} ms"
+    with_coupling = f" with the scenario's coupling for {algorithm} ({coupled})" if coupled else ""
     if args.tuning is not None:
         tuned_for = algorithm
-        text = (f"target {args.target}: {algorithm} at H = {step_ms}, the largest step within the coupling study's "
-                f"criteria for {algorithm} ({criteria}; {args.tuning})")
+        text = (f"target {args.target}: {algorithm} at H = {step_ms}{with_coupling}, the largest step within the "
+                f"coupling study's criteria for {algorithm} ({criteria}; {args.tuning})")
     elif args.step is not None:
         tuned_for = algorithm
-        text = f"target {args.target}: {algorithm} at H = {step_ms} (given with --step)"
+        text = f"target {args.target}: {algorithm} at H = {step_ms}{with_coupling} (given with --step)"
+    elif coupling is not None and coupling.step_s is not None:
+        tuned_for, criteria = algorithm, coupling.step_criteria
+        text = (f"target {args.target}: {algorithm} at H = {step_ms}{with_coupling}, the step the scenario declares "
+                f"for {algorithm}" + (f": {criteria}" if criteria else ""))
     else:
-        tuned_for = own if args.algorithm is None else scenario.simulation.algorithm
-        text = f"target {args.target}: {algorithm} at H = {step_ms}, the scenario's step, chosen for {tuned_for}"
+        tuned_for = own if args.algorithm is None else args.algorithm
+        text = f"target {args.target}: {algorithm} at H = {step_ms}{with_coupling}, the scenario's step, chosen for {tuned_for}"
         if algorithm != tuned_for:
             print(f"dtcosim export-ssp: warning: {args.target} steps with {algorithm}, but H = {step_ms} is the "
                   f"scenario's step, chosen for {tuned_for}: its accuracy against the monolithic reference holds "
                   f"for {tuned_for} only; measure the largest step within the coupling study's criteria for "
                   f"{algorithm} (python benchmarks/coupling_study.py --algorithms {algorithm} --json FILE) and give "
-                  "it with --tuning FILE or --step", file=sys.stderr)
-    if algorithm != scenario.simulation.algorithm:
-        scenario = scenario.with_simulation(algorithm=algorithm)
-    return scenario, ExportTuning(args.target, tuned_for, criteria), text
+                  "it with --tuning FILE or --step, or declare the scenario's coupling and step for it "
+                  f"([{algorithm}] table)", file=sys.stderr)
+    return scenario, ExportTuning(args.target, tuned_for, criteria, coupled), text
 
 
 def _measured_step(path: Path, scenario_name: str, algorithm: str) -> tuple[float, str]:

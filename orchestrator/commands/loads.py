@@ -16,6 +16,7 @@ from pathlib import Path
 
 from .cluster_options import add_cluster_arguments, check_cluster_arguments, check_workers
 from .fmu_options import add_fmu_arguments
+from .scenario_options import add_allow_argument, allow_implausible
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -53,6 +54,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--quiet", "-q", action="store_true", help="no progress bars and no report on the terminal")
     p.add_argument("--timeout", type=float, default=None, metavar="SECONDS",
                    help="wall-clock time one run may take (overrides the set's timeout)")
+    add_allow_argument(p, "the load-case set")
     p.set_defaults(func=run)
 
 
@@ -155,6 +157,7 @@ def run(args: argparse.Namespace) -> int:
         changes["seeds"] = tuple(range(1, args.seeds + 1))
     if changes:
         lcs = replace(lcs, **changes)
+    lcs = allow_implausible(lcs, args.allow_implausible)
     out_dir = args.out if args.out is not None else default_out_dir(lcs.name)
     check_for_study(out_dir, lcs.name)  # a run's folder or another study's: refused before anything is prepared
     plc = prepare_load_cases(lcs, fmu_dir=args.fmu_dir, build=not args.no_build)
@@ -221,9 +224,10 @@ def run(args: argparse.Namespace) -> int:
         from ..atomic_files import describe_os_error
 
         files = {}
-        problems.append(f"{describe_os_error(exc)}; the lifetime results are not all written; every finished run "
-                        f"is kept in {out_dir / JOURNAL_FILE} and {out_dir}/runs: free some space and run the same "
-                        "command with --report to write them")
+        if not problems:  # a full disk the sweep told already (what is kept, what to do) is not told twice
+            problems.append(f"{describe_os_error(exc)}; the lifetime results are not all written; every finished "
+                            f"run is kept in {out_dir / JOURNAL_FILE} and {out_dir}/runs: free some space and run the "
+                            "same command with --report to write them")
     counts = status_counts(point_records(prepared, out_dir=out_dir))
     if not quiet and files:
         print((out_dir / "lifetime_report.txt").read_text(), end="")

@@ -73,11 +73,39 @@ def _progress_bar(sim):
     return bar, progress
 
 
-def run(args: argparse.Namespace) -> int:
-    """Run the scenario; write results; print a summary."""
+def checked_system(scenario, fmu_dir, build: bool, command: str, say):
+    """The scenario checked against its FMUs' model descriptions (``run --check``; nothing is instantiated).
+
+    Finds the FMUs (building missing project FMUs if ``build``), warns of stale ones and prints
+    the system's notes, as ``dtcosim <command>``; returns the
+    :class:`~orchestrator.cosim.resolved.ResolvedSystem`. ``validate`` checks an SSP with it.
+    """
     from ..cosim.system import resolve_system
     from ..provision.project_fmus import ensure_fmus
     from ..provision.staleness import stale_project_fmus
+
+    paths = ensure_fmus(scenario, fmu_dir, build=build, report=say)
+    for warning in stale_project_fmus(paths):
+        print(f"dtcosim {command}: warning: {warning}", file=sys.stderr)
+    system = resolve_system(scenario, fmu_paths=paths)
+    for note in system.notes:
+        print(f"dtcosim {command}: note: {note}", file=sys.stderr)
+    return system
+
+
+def check_report(system, name: str) -> str:
+    """What ``run --check`` prints of a valid system called ``name``: its size, orders and the loops' explicit coupling."""
+    scenario = system.scenario
+    lines = [f"{name}: valid ({len(scenario.components)} FMUs, {len(scenario.connections)} connections, "
+             f"{len(system.recorded)} recorded variables, {len(system.events)} load event(s); stepping order "
+             f"{', '.join(system.order)}; initialisation order {', '.join(system.init_order)})"]
+    lines += [f"  coupling: {delay.note}" for delay in system.delays
+              if delay.note not in system.notes]  # the loops' explicit coupling (the notes are printed before)
+    return "\n".join(lines)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run the scenario; write results; print a summary."""
     from ..run.analyses import format_analyses
     from ..run.run_folder import RunFolder
     from ..run.runner import run_scenario
@@ -86,19 +114,9 @@ def run(args: argparse.Namespace) -> int:
     say = (lambda msg: None) if quiet else (lambda msg: print(msg, file=sys.stderr))
     scenario = scenario_options.apply(scenario_options.load(args.scenario, args, "run"), args, "run")
     out_dir, out_note = (args.out, "") if args.out is not None else scenario_options.default_out_dir(scenario, args)
-    paths = ensure_fmus(scenario, args.fmu_dir, build=not args.no_build, report=say)
-    for warning in stale_project_fmus(paths):
-        print(f"dtcosim run: warning: {warning}", file=sys.stderr)
-    system = resolve_system(scenario, fmu_paths=paths)
-    for note in system.notes:
-        print(f"dtcosim run: note: {note}", file=sys.stderr)
+    system = checked_system(scenario, args.fmu_dir, not args.no_build, "run", say)
     if args.check:
-        print(f"{scenario.name}: valid ({len(scenario.components)} FMUs, {len(scenario.connections)} connections, "
-              f"{len(system.recorded)} recorded variables, {len(system.events)} load event(s); stepping order {', '.join(system.order)}; "
-              f"initialisation order {', '.join(system.init_order)})")
-        for delay in system.delays:
-            if delay.note not in system.notes:  # the loops' explicit coupling (the notes are printed above)
-                print(f"  coupling: {delay.note}")
+        print(check_report(system, scenario.name))
         return 0
     RunFolder.check(out_dir)  # a file or an unwritable folder: refused before anything is instantiated
     if out_note:
@@ -171,10 +189,13 @@ def run(args: argparse.Namespace) -> int:
             print(report.comparison_text)
         print(textwrap.fill(f"results in {Path(out_dir)}/: " + ", ".join(p.name for p in report.files.values()),
                             width=80, subsequent_indent="  ", break_on_hyphens=False, break_long_words=False))
-    for problem in report.problems:
-        print(f"dtcosim run: error: {problem}", file=sys.stderr)
     post = s.get("post_processing")
-    if post and not outcome.interrupted:  # a signal during stepping is told once, below
+    for problem in report.problems:
+        if not post or problem != post.get("error"):  # the write error that stopped them: told below, once
+            print(f"dtcosim run: error: {problem}", file=sys.stderr)
+    if post and post.get("error"):
+        print(f"dtcosim run: error: {post['error']}; not done: {', '.join(post['not_done'])}", file=sys.stderr)
+    elif post and not outcome.interrupted:  # a signal during stepping is told once, below
         print(f"dtcosim run: {post['stopped']}; not done: {', '.join(post['not_done'])}", file=sys.stderr)
     if not outcome.complete:
         print(f"dtcosim run: {outcome.error}; partial results written to {out_dir}", file=sys.stderr)

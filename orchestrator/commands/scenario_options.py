@@ -17,7 +17,7 @@ from ..inputs.master_options import ALGEBRAIC_LOOPS, ALGORITHMS, EXTRAPOLATIONS
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """``--step``, ``--stop``, ``--window``, ``--output-interval``, ``--algorithm``, ``--extrapolation``, ``--set``,
-    ``--algebraic-loops``, ``--no-feedthrough``."""
+    ``--allow-implausible``, ``--algebraic-loops``, ``--no-feedthrough``."""
     p.add_argument("--step", type=float, default=None, metavar="H", help="override the communication step [s]")
     p.add_argument("--stop", type=float, default=None, metavar="T",
                    help="override the stop time [s] (a window beyond it is clipped, a window that ended at the "
@@ -29,6 +29,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--extrapolation", choices=EXTRAPOLATIONS, default=None, help="override the input extrapolation")
     p.add_argument("--set", action="append", default=[], metavar="COMPONENT.PARAMETER=VALUE",
                    help="override a parameter value, e.g. --set wind.seed=7 (repeatable)")
+    add_allow_argument(p, "the scenario")
     p.add_argument("--algebraic-loops", choices=ALGEBRAIC_LOOPS, default=None,
                    help="override what the master does with an algebraic loop: refuse it, or iterate it at every "
                         "communication point ([simulation] algebraic_loops)")
@@ -36,6 +37,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="an output (or, with COMPONENT alone, every output without declared dependencies) that "
                         "does not depend directly on the FMU's inputs, for FMUs whose model description does not "
                         "say (repeatable; [components.X] no_feedthrough)")
+
+
+def add_allow_argument(p: argparse.ArgumentParser, where: str) -> None:
+    """``--allow-implausible COMPONENT.PARAMETER`` (repeatable): what ``[plausibility] allow`` in ``where`` keeps."""
+    p.add_argument("--allow-implausible", action="append", default=[], metavar="COMPONENT.PARAMETER",
+                   help="keep a value physics calls implausible (a deliberate study), e.g. --allow-implausible "
+                        f"gearbox.stage1.backlash (repeatable; [plausibility] allow in {where})")
 
 
 def load(spec, args: argparse.Namespace, command: str):
@@ -72,7 +80,14 @@ def apply(scenario, args: argparse.Namespace, command: str):
         scenario = scenario.with_simulation(algebraic_loops=args.algebraic_loops)
     for item in args.no_feedthrough:
         scenario = scenario.with_no_feedthrough(item.strip())
+    scenario = allow_implausible(scenario, args.allow_implausible)
     return apply_parameters(scenario, dict(parse_assignment(item) for item in args.set))
+
+
+def allow_implausible(target, keys: list[str]):
+    """A scenario, study or load-case set that also keeps the ``--allow-implausible`` keys."""
+    keys = [k.strip() for k in keys]
+    return target.with_allowed(*keys) if keys else target
 
 
 def given_overrides(args: argparse.Namespace) -> list[str]:

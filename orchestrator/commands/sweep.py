@@ -16,6 +16,7 @@ from pathlib import Path
 
 from .cluster_options import add_cluster_arguments, check_cluster_arguments, check_workers
 from .fmu_options import add_fmu_arguments
+from .scenario_options import add_allow_argument, allow_implausible
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -45,6 +46,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="wall-clock time one point may take; past it the point fails (overrides the study's "
                         "timeout; not part of the point keys: with --retry-failed, a larger value re-runs "
                         "the points that ran out of time)")
+    add_allow_argument(p, "the study")
     p.set_defaults(func=run)
 
 
@@ -87,6 +89,7 @@ def run(args: argparse.Namespace) -> int:
             study = replace(study, timeout_s=args.timeout)
         except StudyError as exc:
             raise StudyError("--timeout", exc.value, exc.expected) from None
+    study = allow_implausible(study, args.allow_implausible)
     out_dir = args.out if args.out is not None else Path("results") / study.name
     check_for_study(out_dir, study.name)  # a run's folder or another study's: refused before anything is prepared
     prepared = prepare_study(study, fmu_dir=args.fmu_dir, build=not args.no_build)

@@ -7,7 +7,10 @@ and ``resources/requirements.txt`` present) and its declared requirements agains
 this interpreter (what is missing stops the FMU from starting and fails the
 check; a version outside the tested range is a warning). A file that is not a
 zip or has a broken ``modelDescription.xml`` is reported as such, without a
-traceback. ``--cross-check RESULT.csv`` compares another host's run of an FMU with the
+traceback. An SSP (an ``.ssp`` archive, an ``.ssd`` file or an SSP folder) is checked as
+``dtcosim run --check`` checks it (its SSD against its FMUs' model descriptions; nothing is
+instantiated), then every FMU it holds is validated as above, named ``<file>.ssp!<member>``.
+``--cross-check RESULT.csv`` compares another host's run of an FMU with the
 reference it carries (:mod:`fmus.cross_check`). ``--host`` also runs each valid dtcosim FMU once in a fresh virtual
 environment holding only its declared requirements and fmpy (:mod:`fmus.selftest`).
 """
@@ -20,6 +23,7 @@ from pathlib import Path
 from fmus.requirements import check_environment, read_from_fmu
 from fmus.validation import check_fmu, fmu_files, is_dtcosim_fmu
 
+from ..archive_members import shown_path
 from ..provision.folders import default_fmu_dir
 
 
@@ -32,7 +36,13 @@ def register(sub: argparse._SubParsersAction) -> None:
                      "against each FMU's declared requirements; exit code 1 on any problem."),
     )
     p.add_argument("paths", nargs="*", type=Path, default=[default_fmu_dir()], metavar="PATH",
-                   help="FMU files or directories holding them (default: the FMU directory `dtcosim run` uses)")
+                   help="FMU files or directories holding them, or SSPs (.ssp, .ssd or an SSP folder: the system as "
+                        "`dtcosim run --check` checks it, then every FMU in it) (default: the FMU directory "
+                        "`dtcosim run` uses)")
+    p.add_argument("--step", type=float, default=None, metavar="H",
+                   help="communication step [s] for an SSP that gives none (as for `dtcosim run`)")
+    p.add_argument("--stop", type=float, default=None, metavar="T",
+                   help="stop time [s] for an SSP that gives none (as for `dtcosim run`)")
     p.add_argument("--host", action="store_true",
                    help="also run each FMU once through a bare fmpy loop in a fresh virtual environment that has "
                         "only the declared requirements (and fmpy) installed; needs pip access to the package index")
@@ -98,41 +108,75 @@ def _describe(path: Path) -> str:
     return what + (f"; requires {req.summary()}; this environment has it" if req is not None else "")
 
 
+def _check_ssp(path: Path, args: argparse.Namespace) -> list[Path] | None:
+    """Check an SSP as ``dtcosim run --check`` does and print the outcome; its FMU files, None if it failed."""
+    from components.errors import DtcosimError
+
+    from . import scenario_options
+    from .run import check_report, checked_system
+
+    try:
+        scenario = scenario_options.load(path, args, "validate")
+        system = checked_system(scenario, None, False, "validate", lambda message: None)
+    except DtcosimError as exc:
+        print(f"{path}: 1 problem(s)\n  - {exc}")
+        return None
+    print(check_report(system, str(path)))
+    return list(dict.fromkeys(system.fmu_paths.values()))  # a file two components share: once
+
+
+def _validate_fmu(path: Path) -> bool:
+    """Validate one FMU file and print the outcome; True if it is valid and can run here."""
+    shown = shown_path(path)  # an FMU of an SSP as <file>.ssp!<member>
+    if not path.is_file():
+        print(f"{shown}: {'not a regular file (a device, pipe or folder)' if path.exists() else 'no such file'}")
+        return False
+    problems = check_fmu(path)
+    warnings: list[str] = []
+    if not problems:
+        problems = _host_problems(path)
+    if not problems:
+        problems, warnings = _environment_lines(path)
+    if problems:
+        print(f"{shown}: {len(problems)} problem(s)")
+        for problem in problems:
+            print(f"  - {problem}")
+    else:
+        print(f"{shown}: ok ({_describe(path)})")
+    for warning in warnings:
+        print(f"  warning: {warning}")
+    return not problems
+
+
 def run(args: argparse.Namespace) -> int:
-    """Validate and print the problems; 0 if every FMU is valid and can run here, 1 otherwise."""
-    files = fmu_files(args.paths)
+    """Validate and print the problems; 0 if every FMU and SSP is valid and can run here, 1 otherwise."""
+    from ..interop.ssp import is_ssp
+
     if args.cross_check is not None:
-        if len(files) != 1:
-            print(f"--cross-check compares one FMU with one result: give one FMU path (found {len(files)})")
+        ssps = [p for p in args.paths if is_ssp(p)]
+        files = fmu_files(p for p in args.paths if not is_ssp(p))
+        if len(files) != 1 or ssps:
+            print(f"--cross-check compares one FMU with one result: give one FMU path (found {len(files)}"
+                  + (f" and the SSP {ssps[0]})" if ssps else ")"))
             return 1
         return _cross_check(files[0], args.cross_check, args.rel_tol)
-    if not files:
+    failed, valid, found = 0, [], False
+    for given in args.paths:  # in the order given; an SSP's FMUs after its system's line
+        if is_ssp(given):
+            held = _check_ssp(given, args)
+            failed += held is None
+            files, found = held or [], True
+        else:
+            files = fmu_files([given])
+            found = found or bool(files)
+        for path in files:
+            if not _validate_fmu(path):
+                failed += 1
+            elif is_dtcosim_fmu(path):
+                valid.append(path)
+    if not found:
         print(f"no FMU found in {', '.join(map(str, args.paths))}")
         return 1
-    failed = 0
-    valid = []
-    for path in files:
-        if not path.is_file():
-            print(f"{path}: {'not a regular file (a device, pipe or folder)' if path.exists() else 'no such file'}")
-            failed += 1
-            continue
-        problems = check_fmu(path)
-        warnings: list[str] = []
-        if not problems:
-            problems = _host_problems(path)
-        if not problems:
-            problems, warnings = _environment_lines(path)
-        if problems:
-            failed += 1
-            print(f"{path}: {len(problems)} problem(s)")
-            for problem in problems:
-                print(f"  - {problem}")
-        else:
-            print(f"{path}: ok ({_describe(path)})")
-            if is_dtcosim_fmu(path):
-                valid.append(path)
-        for warning in warnings:
-            print(f"  warning: {warning}")
     if args.host and valid:
         failed += _host_self_test(valid, args.venv)
     return 1 if failed else 0

@@ -36,6 +36,7 @@ from ctypes import (
 from pathlib import Path
 from typing import Any, Iterable
 
+from ..archive_members import shown_path
 from ..errors import FmuStepError, InitializationError, status_label
 from .fmu_interface import FmuInterface
 
@@ -96,7 +97,7 @@ def _extract(iface: FmuInterface) -> Path:
     except OSError as exc:  # a full disk, a file-size limit, a read-only temporary folder
         shutil.rmtree(target, ignore_errors=True)
         reason = exc.strerror or str(exc) or type(exc).__name__
-        raise InitializationError(f"cannot extract the FMU {iface.path} into {target}: {reason}") from None
+        raise InitializationError(f"cannot extract the FMU {shown_path(iface.path)} into {target}: {reason}") from None
     _EXTRACTED[iface.sha256] = target
     return target
 

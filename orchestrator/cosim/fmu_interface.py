@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
 
+from ..archive_members import shown_path
 from ..errors import ScenarioError
 from ..frozen_map import FrozenMap
 
@@ -195,10 +196,10 @@ def read_fmu_record(path: Path, key: str) -> dict[str, Any] | None:
                 return None
             record = json.loads(archive.read(member))
     except (OSError, zipfile.BadZipFile, zlib.error, EOFError, ValueError) as exc:
-        raise ScenarioError(key, str(path), f"an FMU with a readable {member} ({exc})") from None
+        raise ScenarioError(key, shown_path(path), f"an FMU with a readable {member} ({exc})") from None
     if not isinstance(record, dict) or record.get("format") != RECORD_FORMAT or record.get("role") not in ROLES \
             or not isinstance(record.get("model"), dict) or not isinstance(record.get("signals"), dict):
-        raise ScenarioError(key, str(path), f"an FMU whose {member} is a dtcosim record of format {RECORD_FORMAT} "
+        raise ScenarioError(key, shown_path(path), f"an FMU whose {member} is a dtcosim record of format {RECORD_FORMAT} "
                             f"with a role ({', '.join(ROLES)}), a model and signals")
     return record
 
@@ -234,10 +235,11 @@ def read_fmu_interface(path: str | Path, key: str = "fmu") -> FmuInterface:
     from fmpy import read_model_description
 
     p = Path(path).resolve()
+    shown = shown_path(path)  # a member of an .ssp as <archive>!<member>, not its temporary copy
     try:
         st = os.stat(p)
     except OSError:
-        raise ScenarioError(key, str(path), "an existing FMU file") from None
+        raise ScenarioError(key, shown, "an existing FMU file") from None
     cache_key = (str(p), st.st_size, st.st_mtime_ns)
     if cache_key in _CACHE:
         return _CACHE[cache_key]
@@ -246,20 +248,20 @@ def read_fmu_interface(path: str | Path, key: str = "fmu") -> FmuInterface:
     problems = layout_problems(p)  # before anything is decompressed: a pipe, a zip bomb, a zip-slip name
     damaged = None if problems else corrupt_member(p)
     if problems or damaged:
-        raise ScenarioError(key, str(path), f"a readable FMU ({'; '.join(problems) or damaged})")
+        raise ScenarioError(key, shown, f"a readable FMU ({'; '.join(problems) or damaged})")
     try:
         md = read_model_description(str(p), validate=False)
     except Exception as exc:  # fmpy raises plain Exceptions for broken archives/XML
-        raise ScenarioError(key, str(path), f"a readable FMU ({exc})") from None
+        raise ScenarioError(key, shown, f"a readable FMU ({exc})") from None
     if not str(md.fmiVersion).startswith("2."):
-        raise ScenarioError(key, str(path), f"an FMI 2.0 FMU (this is FMI {md.fmiVersion})")
+        raise ScenarioError(key, shown, f"an FMI 2.0 FMU (this is FMI {md.fmiVersion})")
     if md.coSimulation is None:
-        raise ScenarioError(key, str(path), "a co-simulation FMU")
+        raise ScenarioError(key, shown, "a co-simulation FMU")
     from fmus.archive_checks import archive_problems, binary_platforms
 
     problems = archive_problems(p, md.coSimulation.modelIdentifier, md.generationTool or "")
     if problems:
-        raise ScenarioError(key, str(path), f"an FMU this host can load ({'; '.join(problems)})")
+        raise ScenarioError(key, shown, f"an FMU this host can load ({'; '.join(problems)})")
     variables: dict[str, FmuVariable] = {}
     for v in md.modelVariables:
         unit = v.unit or (v.declaredType.unit if v.declaredType is not None and getattr(v.declaredType, "unit", None) else "")

@@ -18,7 +18,8 @@ declared dependencies is run as libcosim runs it, with a note in
 ``ResolvedSystem.notes``);
 values given with a unit (``"0.56 mm"``) converted to the unit the FMU declares
 (:mod:`orchestrator.cosim.declared_units`); every value within what the FMU accepts (FMI Integer range, declared bounds, a
-dtcosim model's own validation: :mod:`orchestrator.cosim.parameter_checks`); the
+dtcosim model's own validation: :mod:`orchestrator.cosim.parameter_checks`); values plausible by physics
+(:mod:`orchestrator.cosim.plausibility_checks`); the
 results within the size limits (:func:`check_sizes`). The first problem raises
 :class:`~orchestrator.errors.ScenarioError` naming the scenario key. The result,
 a :class:`~orchestrator.cosim.resolved.ResolvedSystem`, is what the master runs.
@@ -42,6 +43,7 @@ from .fmu_interface import FmuInterface, FmuVariable, read_fmu_interface
 from .coupling_delays import FEEDTHROUGH, coupling_delays
 from .graph import algebraic_loop_groups, dependency_order, find_algebraic_loop, initialization_order
 from .parameter_checks import model_problem, value_problem
+from .plausibility_checks import plausibility_problem
 from .resolved import RecordedVariable, ResolvedSystem
 from .roles import declared_roles
 from .values import transformation_problem, type_mismatch
@@ -63,6 +65,10 @@ def find_fmu(scenario: Scenario, component: Component, candidates: Sequence[Path
         ``components.<name>.fmu`` when none is; the message lists the places searched.
     """
     found = next((p for p in candidates if p.is_file()), None)
+    odd = next((p for p in candidates if p.exists() and not p.is_file()), None)
+    if found is None and odd is not None:
+        raise ScenarioError(f"components.{component.name}.fmu", str(component.fmu),
+                            f"a regular FMU file ({odd} is a device, pipe or folder)", scenario.source)
     if found is None:
         raise ScenarioError(
             f"components.{component.name}.fmu", str(component.fmu),
@@ -273,7 +279,7 @@ def resolve_system(scenario: Scenario, fmu_paths: Mapping[str, Path] | None = No
         notes=tuple(notes),
         delays=delays,
     )
-    problem = model_problem(system)
+    problem = model_problem(system) or plausibility_problem(system)
     if problem is not None:
         raise ScenarioError(*problem, src)
     check_sizes(system)

@@ -5,14 +5,17 @@ from __future__ import annotations
 import copy
 import hashlib
 import json
-from typing import Any, Mapping
+from typing import Any, Mapping, Sequence
 
 from .drivetrain_file import DrivetrainSpec, drivetrain_from_dict
+from .drivetrain_plausibility import split_path
 from .drivetrain_schema import DrivetrainFileError
 
 
-def with_entries(spec: DrivetrainSpec, entries: Mapping[str, Any]) -> DrivetrainSpec:
+def with_entries(spec: DrivetrainSpec, entries: Mapping[str, Any], allow: Sequence[str] = ()) -> DrivetrainSpec:
     """The file's document with entries changed by key path (``stages[0].planets``, ``generator.inertia``), read again.
+
+    ``allow``: flat parameter names kept although implausible besides the file's own (a study's).
 
     The content hash of the result is that of the changed document (canonical JSON), so
     FMUs built from it are kept apart from the original's.
@@ -26,26 +29,13 @@ def with_entries(spec: DrivetrainSpec, entries: Mapping[str, Any]) -> Drivetrain
     for path, value in entries.items():
         set_entry(data, path, value, spec.source)
     sha = hashlib.sha256(json.dumps(data, sort_keys=True, default=str).encode()).hexdigest()
-    return drivetrain_from_dict(data, name=spec.name, source=spec.source, sha256=sha)
-
-
-def _split_path(path: str) -> list[str | int]:
-    parts: list[str | int] = []
-    for piece in path.split("."):
-        name, _, rest = piece.partition("[")
-        if name:
-            parts.append(name)
-        while rest:
-            index, _, rest = rest.partition("]")
-            parts.append(int(index))
-            rest = rest.lstrip("[")
-    return parts
+    return drivetrain_from_dict(data, name=spec.name, source=spec.source, sha256=sha, allow=allow)
 
 
 def set_entry(data: dict, path: str, value: Any, source: str | None = None) -> None:
     """Set the entry at a key path (``stages[1].teeth.ring``) of a parsed document; the entry must exist."""
     try:
-        parts = _split_path(path)
+        parts = split_path(path)
     except ValueError:
         raise DrivetrainFileError(path, value, "a key path such as stages[0].planets", source) from None
     node: Any = data

@@ -78,9 +78,10 @@ import hashlib
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Mapping, Sequence
 
 from components import units
+from components.analysis.plausibility import Judgement
 from components.errors import ParameterError
 from components.model.bearings import Bearing, Gravity, ParallelLateral, PlanetaryLateral, RingSupport
 from components.model.contact import MeshContact
@@ -94,6 +95,7 @@ from components.model.gear_geometry import (
     ring_teeth_check,
 )
 from components.model.generator import GeneratorParameters
+from components.model.parameter_map import mesh_prefixes
 from components.model.stages import STEEL_DENSITY_KG_M3, ParallelStage, PlanetaryStage, Shaft
 
 from .drivetrain_schema import (
@@ -106,6 +108,7 @@ from .drivetrain_schema import (
     ParallelTable,
     PlanetaryTable,
 )
+from .drivetrain_plausibility import check_file, plausibility_checks
 from .drivetrain_units import FileUnits
 from .files import find_input_file, packaged_files, read_toml
 from .schema import NAME_PATTERN, read_document
@@ -141,6 +144,9 @@ class DrivetrainSpec:
         SHA-256 of the file's content (hex).
     data : mapping
         The parsed TOML document (studies change entries of it).
+    judgements : tuple of Judgement
+        Every value judged by physics at the file's rating (:mod:`.drivetrain_plausibility`); the
+        implausible ones are those the file allows.
     """
 
     name: str
@@ -152,6 +158,7 @@ class DrivetrainSpec:
     source: str | None = None
     sha256: str = ""
     data: Mapping[str, Any] = field(default_factory=dict, compare=False, repr=False)
+    judgements: tuple[Judgement, ...] = field(default=(), compare=False, repr=False)
 
     @property
     def origin(self) -> str:
@@ -204,6 +211,8 @@ class _Reader:
         self.u = FileUnits(doc.units, source)
         self.density = self.u.si("density", doc.density, "density") if doc.density is not None \
             else STEEL_DENSITY_KG_M3
+        self.file_keys: dict[str, str] = {}  # flat parameter name -> the file key its value comes from
+        self._mesh_keys: dict[str, dict[str, str]] = {}
 
     def error(self, key: str, value: Any, expected: str) -> DrivetrainFileError:
         return DrivetrainFileError(key, value, expected, self.source)
@@ -223,6 +232,7 @@ class _Reader:
                 raise self.error(f"{key}.{name}", None, f"a value for {name} (missing: give it in this mesh, the "
                                  "stage's mesh table or the file's [mesh] table)")
         e = merged["exponent"]
+        self._mesh_keys[key] = {name: where.get(name, f"{key}.{name}") for name in merged}
 
         def si(name: str, dimension: str) -> float:
             return self.u.si(where.get(name, f"{key}.{name}"), merged[name], dimension, e)
@@ -294,9 +304,25 @@ class _Reader:
         if (table.teeth is None) == (table.radii is None):
             raise self.error(f"{key}.teeth", None if table.teeth is None else "both teeth and radii",
                              "either teeth = {...} or radii = {...} (exactly one)")
-        if isinstance(table, PlanetaryTable):
-            return self.planetary(key, name, table)
-        return self.parallel(key, name, table)
+        stage, rows, checks = (self.planetary if isinstance(table, PlanetaryTable) else self.parallel)(key, name, table)
+        self._record_keys(key, stage, rows)
+        return stage, rows, checks
+
+    def _record_keys(self, key: str, stage, rows: tuple[BodyRow, ...]) -> None:
+        """The file key of every flat parameter of a stage (what a plausibility finding names)."""
+        keys = self.file_keys
+        keys[f"{stage.name}.module"], keys[f"{stage.name}.width"] = f"{key}.module", f"{key}.face_width"
+        for row in rows:
+            body = row.name.split(".", 1)[1]
+            if body == "carrier":
+                keys[f"{stage.name}.carrier_inertia"] = f"{key}.carrier_inertia"
+                continue
+            derived = row.source.startswith("derived")
+            for name in ("mass", "inertia"):
+                keys[f"{stage.name}.{body}_{name}"] = f"{key}.{body}" if derived else f"{key}.{body}.{name}"
+        for field, prefix in mesh_prefixes(stage).items():
+            for name, where in self._mesh_keys[f"{key}.{field}"].items():
+                keys.setdefault(f"{prefix}.{name}", where)
 
     def common(self, key: str, t) -> tuple[float, float, float]:
         """Module, pressure angle and face width of a stage, SI."""
@@ -513,8 +539,10 @@ class _Reader:
 
 
 def drivetrain_from_dict(data: Mapping[str, Any], name: str | None = None, source: str | None = None,
-                         sha256: str = "") -> DrivetrainSpec:
+                         sha256: str = "", allow: Sequence[str] = ()) -> DrivetrainSpec:
     """Read a parsed drivetrain document.
+
+    ``allow`` adds flat parameter names to the file's ``[plausibility] allow`` (a study's).
 
     Raises
     ------
@@ -529,7 +557,12 @@ def drivetrain_from_dict(data: Mapping[str, Any], name: str | None = None, sourc
     drivetrain, bodies, checks = reader.drivetrain()
     speed = reader.u.si("operating_point.rotor_speed", doc.operating_point.rotor_speed, "speed") \
         if doc.operating_point else DEFAULT_ROTOR_SPEED_RAD_S
-    return DrivetrainSpec(dt_name, doc.description, drivetrain, speed, bodies, checks, source, sha256, dict(data))
+    allow = [*(doc.plausibility.allow if doc.plausibility is not None else ()), *allow]
+    judgements = check_file(drivetrain, speed, allow, reader.file_keys, data, source)
+    for stage, rows in plausibility_checks(judgements, allow).items():
+        checks[stage] = tuple(checks.get(stage, ())) + rows
+    return DrivetrainSpec(dt_name, doc.description, drivetrain, speed, bodies, checks, source, sha256, dict(data),
+                          judgements)
 
 
 def load_drivetrain_file(path: str | Path) -> DrivetrainSpec:

@@ -15,7 +15,7 @@ from components.model.contact import CONTACT_LAWS
 
 from ..errors import EntryError
 from .quantities import Given, amount
-from .schema import Table
+from .schema import PlausibilityTable, Table
 
 
 class DrivetrainFileError(EntryError):
@@ -48,12 +48,6 @@ class UnitsTable(Table):
     bearing_damping: str | None = Field(None, description="a unit of a bearing's damping such as \"N.s/m\"")
     force: str | None = Field(None, description="a force unit such as \"N\" or \"kN\" (dynamic load ratings)")
     acceleration: str | None = Field(None, description="an acceleration unit such as \"m/s2\" (gravity)")
-
-
-class PlausibilityTable(Table):
-    """``[plausibility]``: the values a deliberate study keeps although physics calls them implausible."""
-
-    allow: list[str] = Field(default_factory=list, description='a list of parameter names such as "stage1.backlash"')
 
 
 class MeshTable(Table):

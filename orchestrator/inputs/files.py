@@ -122,8 +122,10 @@ def find_input_file(
     kind = error.kind
     p = Path(spec)
     if p.suffix in suffixes or p.exists():
-        if not (p.exists() if directories else p.is_file()):
+        if not p.exists():
             raise error("(file)", str(p), f"an existing {kind} file")
+        if not (directories or p.is_file()):
+            raise error("(file)", str(p), f"a regular {kind} file (this is a device, pipe or folder)")
         return p
     shipped = packaged_files(folder)
     if str(spec) in shipped:

@@ -42,8 +42,11 @@ from .load_cases import (
 from .master_options import ALGORITHMS, EXTRAPOLATIONS
 from .rating_options import BearingLifeTable, GearRatingTable, bearing_life_options, gear_rating_options
 from .overrides import SimulationOverrides
-from .schema import NAME_PATTERN, Table, flatten_parameters, read_document
+from .quantities import si_number
+from .schema import NAME_PATTERN, PlausibilityTable, Table, flatten_parameters, read_document
 _SPEED = "a finite number [m/s]"
+#: a bare number in the unit its key names, or a quantity with its unit ("10 m/s", "16 rpm", "25.4 kN m")
+_MS, _RPM, _NM = si_number("m/s"), si_number("rpm"), si_number("N.m")
 
 
 class _BaseTable(Table):
@@ -71,32 +74,32 @@ class _RunsTable(Table):
 class _WindTable(Table):
     distribution: Literal["weibull", "rayleigh"] = Field(description='"weibull" (k, A) or "rayleigh" (iec_class or mean_speed)')
     k: float | None = Field(None, gt=0, description="a Weibull shape > 0")
-    A: float | None = Field(None, gt=0, description="a Weibull scale > 0 [m/s]")
+    A: _MS | None = Field(None, gt=0, description="a Weibull scale > 0 [m/s]")
     iec_class: Literal[tuple(IEC_CLASS_MEAN_SPEED_M_S)] | None = None
-    mean_speed: float | None = Field(None, gt=0, description="an annual mean wind speed > 0 [m/s]")
+    mean_speed: _MS | None = Field(None, gt=0, description="an annual mean wind speed > 0 [m/s]")
 
 
 class _BinsTable(Table):
-    edges: list[float] | None = Field(None, min_length=2, description="increasing wind speeds [m/s]")
-    cut_in: float | None = Field(None, ge=0, description="the cut-in wind speed >= 0 [m/s]")
-    cut_out: float | None = Field(None, gt=0, description="the cut-out wind speed [m/s]")
-    width: float | None = Field(None, gt=0, description="a bin width > 0 [m/s]")
+    edges: list[_MS] | None = Field(None, min_length=2, description="increasing wind speeds [m/s]")
+    cut_in: _MS | None = Field(None, ge=0, description="the cut-in wind speed >= 0 [m/s]")
+    cut_out: _MS | None = Field(None, gt=0, description="the cut-out wind speed [m/s]")
+    width: _MS | None = Field(None, gt=0, description="a bin width > 0 [m/s]")
 
 
 class _LawTable(Table):
-    rated_wind_speed: float = Field(gt=0, description="the rated wind speed > 0 [m/s]")
-    rated_rotor_speed_rpm: float = Field(16.0, gt=0, description="the rated rotor speed > 0 [rpm]")
-    rated_torque: float = Field(25.4e3, gt=0, description="the rated generator torque > 0 [N m]")
-    rated_sigma_rpm: float = Field(0.12, gt=0, description="the rotor-speed fluctuation at rated > 0 [rpm]")
+    rated_wind_speed: _MS = Field(gt=0, description="the rated wind speed > 0 [m/s]")
+    rated_rotor_speed_rpm: _RPM = Field(16.0, gt=0, description="the rated rotor speed > 0 [rpm]")
+    rated_torque: _NM = Field(25.4e3, gt=0, description="the rated generator torque > 0 [N m]")
+    rated_sigma_rpm: _RPM = Field(0.12, gt=0, description="the rotor-speed fluctuation at rated > 0 [rpm]")
     rated_spectrum_level: float = Field(0.02, gt=0, description="the spectral level a at rated > 0 (eq. 14, rpm units)")
-    minimum_rotor_speed_rpm: float = Field(0.0, ge=0, description="a minimum rotor speed >= 0 [rpm]")
+    minimum_rotor_speed_rpm: _RPM = Field(0.0, ge=0, description="a minimum rotor speed >= 0 [rpm]")
 
 
 class _RowTable(Table):
-    wind_speed: float = Field(description=_SPEED + " inside the bin")
-    rotor_speed_rpm: float | None = Field(None, gt=0, description="a mean rotor speed > 0 [rpm]")
-    generator_torque: float | None = Field(None, description="a generator counter torque [N m]")
-    sigma_rpm: float | None = Field(None, gt=0, description="a rotor-speed fluctuation > 0 [rpm]")
+    wind_speed: _MS = Field(description=_SPEED + " inside the bin")
+    rotor_speed_rpm: _RPM | None = Field(None, gt=0, description="a mean rotor speed > 0 [rpm]")
+    generator_torque: _NM | None = Field(None, description="a generator counter torque [N m]")
+    sigma_rpm: _RPM | None = Field(None, gt=0, description="a rotor-speed fluctuation > 0 [rpm]")
     spectrum_level: float | None = Field(None, ge=0, description="a spectral level a >= 0 (eq. 14, rpm units)")
     parameters: dict[str, Any] = Field(default_factory=dict, description='a table of "component.parameter" = value')
 
@@ -146,6 +149,7 @@ class LoadCaseFile(Table):
     timeout: float | None = Field(None, gt=0, description="a wall-clock time per run > 0 [s]")
     gear_rating: GearRatingTable | None = Field(None, description="a [gear_rating] table (ISO 6336)")
     bearing_life: BearingLifeTable | None = Field(None, description="a [bearing_life] table (ISO 281)")
+    plausibility: PlausibilityTable | None = Field(None, description="a [plausibility] table with allow = [...]")
 
 
 def _wind(tab: _WindTable, src: str | None) -> WindDistribution:
@@ -309,6 +313,7 @@ def load_cases_from_dict(data: Mapping[str, Any], name: str | None = None, base_
         timeout_s=doc.timeout, description=doc.description, source=source,
         gear_rating=gear_rating_options(doc.gear_rating, LoadCaseError, source),
         bearing_life=bearing_life_options(doc.bearing_life, LoadCaseError, source),
+        allow_implausible=tuple(doc.plausibility.allow) if doc.plausibility is not None else (),
     )
 
 

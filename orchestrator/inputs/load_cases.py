@@ -235,6 +235,9 @@ class LoadCaseSet:
         ``[gear_rating]``: material, factors and S-N curves of the ISO 6336 ratings.
     bearing_life : BearingLifeOptions
         ``[bearing_life]``: reliability and a_ISO of the ISO 281 lives.
+    allow_implausible : tuple of str
+        ``"component.parameter"`` values kept although implausible by physics (``[plausibility] allow``,
+        ``--allow-implausible``).
     """
 
     name: str
@@ -258,6 +261,7 @@ class LoadCaseSet:
     source: str | None = None
     gear_rating: GearRatingOptions = field(default_factory=GearRatingOptions)
     bearing_life: BearingLifeOptions = field(default_factory=BearingLifeOptions)
+    allow_implausible: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         src = self.source
@@ -293,6 +297,10 @@ class LoadCaseSet:
                                     f"[{self.edges_m_s[b]:g}, {self.edges_m_s[b + 1]:g}) m/s)", src)
             taken[b] = i
         self.bins  # every bin has an operating point
+
+    def with_allowed(self, *keys: str) -> "LoadCaseSet":
+        """Copy that keeps these ``"component.parameter"`` values although implausible (``--allow-implausible``)."""
+        return replace(self, allow_implausible=self.allow_implausible + tuple(keys))
 
     # ---------------------------------------------------------------- bins
     def bin_of(self, wind_speed_m_s: float) -> int:

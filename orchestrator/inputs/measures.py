@@ -35,10 +35,10 @@ Measures are written as text in a study file:
     rainflow-counted over the window with :class:`components.analysis.fatigue.FatigueSettings`'
     defaults (``N_ref`` = 1 Hz x window length, half-cycle residue), the value a
     run's ``fatigue_del.csv`` gives with a default ``[analysis]``. Units as in
-    ``timeseries.csv`` (SI): for a scenario base the unit the variable's FMU
-    declares (set by :func:`orchestrator.study.prepare.prepare_study`; ``-`` when
-    it declares none); the unit parsed here from the name is the built-in
-    reference model's own, and stands only for a model base.
+    ``timeseries.csv`` (SI): the unit the base declares for the variable - its FMU
+    for a scenario base, the monolithic solver's result for a model base - set by
+    :func:`orchestrator.study.prepare.prepare_study` (``-`` when it declares none);
+    a name never gives a unit, so a parsed statistic has none until then.
 ``<component>.<stage>:load_sharing`` [-]
     The planet load-sharing factor of a planetary stage of a gearbox, e.g.
     ``gearbox.stage1:load_sharing``: over the analysis window the largest ratio of
@@ -54,7 +54,6 @@ import re
 from dataclasses import dataclass
 
 from components.errors import DtcosimError
-from components.reference.results import unit_of
 
 #: built-in measures: name -> (unit, description, engines)
 BUILTIN: dict[str, tuple[str, str, tuple[str, ...]]] = {
@@ -103,7 +102,8 @@ class Measure:
     statistic : str or None
         One of :data:`STATISTICS` (None for a built-in measure).
     unit : str
-        SI unit of the value (``"1"``: dimensionless).
+        SI unit of the value (``"1"``: dimensionless); of a statistic the unit its base declares for the
+        variable, ``""`` until :func:`orchestrator.study.prepare.prepare_study` sets it.
     description : str
     """
 
@@ -159,6 +159,6 @@ def parse_measure(text: object) -> Measure:
     if not colon or not dot or not comp or not var or (stat not in STATISTICS and m is None):
         raise MeasureError(text, expected)
     what = stat if m is None else f"damage-equivalent load (m = {m:g}, N_ref = 1 Hz x window)"
-    return Measure(text, variable, stat, unit_of(var), f"{what} of {variable}")
+    return Measure(text, variable, stat, "", f"{what} of {variable}")  # the unit: as the base declares it
 
 

@@ -105,9 +105,15 @@ class SimulationOverrides:
         return changes, notes
 
     def apply(self, scenario):
-        """``(scenario with the changes, notes)``; the changed settings are validated again (ScenarioError)."""
+        """``(scenario with the changes, notes)``; the changed settings are validated again (ScenarioError).
+
+        A new algorithm comes with the scenario's coupling for it (:meth:`Scenario.for_algorithm`: Jacobi's
+        ``[jacobi]`` table), before the other changes (a step given here replaces its step).
+        """
         if not self:
             return scenario, []
+        if self.algorithm is not None:
+            scenario = scenario.for_algorithm(self.algorithm)
         changes, notes = self.changes(scenario.simulation)
         return scenario.with_simulation(**changes), notes
 

@@ -203,6 +203,40 @@ class ParameterBinding:
 
 
 @dataclass(frozen=True)
+class JacobiCoupling:
+    """How the system is coupled when it is stepped with Jacobi (the ``[jacobi]`` table).
+
+    A host that exchanges values after every component stepped (Jacobi: libcosim, ecos) gives
+    each component its partners' values of the last communication point; a cut designed for
+    Gauss-Seidel may then need other interface settings and connections (the paper scenario:
+    the Gearbox's ``inertia_own`` interface and a generator that follows it) and another step.
+    :meth:`Scenario.for_algorithm` applies them; ``dtcosim export-ssp --target libcosim|ecos``
+    and ``--algorithm jacobi`` use it.
+
+    Attributes
+    ----------
+    step_s : float or None
+        Communication step under Jacobi [s] (None: the scenario's).
+    step_criteria : str
+        What the step was chosen by (written into an exported SSD and printed).
+    parameters : mapping of str -> mapping of str -> value
+        Component -> parameter values that replace the scenario's.
+    connections : tuple of Connection
+        Connections added to the scenario's.
+    """
+
+    step_s: float | None = None
+    step_criteria: str = ""
+    parameters: Mapping[str, Mapping[str, ParameterValue]] = field(default_factory=dict)
+    connections: tuple[Connection, ...] = ()
+
+    def describe(self) -> str:
+        """``"gearbox.generator_interface = 2, ..., gearbox.omega_generator -> generator.omega_gearbox"``."""
+        items = [f"{comp}.{name} = {value}" for comp, values in self.parameters.items() for name, value in values.items()]
+        return ", ".join(items + [str(c) for c in self.connections])
+
+
+@dataclass(frozen=True)
 class SimulationSettings:
     """Time grid and master algorithm.
 
@@ -356,6 +390,12 @@ class Scenario:
     import_notes : tuple of str
         What the SSP import passed over (other tools' annotations, skipped mapping
         entries, parameter values not applied); listed in the run's summary.
+    allow_implausible : tuple of str
+        ``"component.parameter"`` values kept although implausible by physics (``[plausibility] allow``,
+        ``--allow-implausible``; :mod:`orchestrator.cosim.plausibility_checks`).
+    jacobi : JacobiCoupling or None
+        How the system is coupled when stepped with Jacobi (``[jacobi]``; applied by
+        :meth:`for_algorithm`).
     """
 
     name: str
@@ -372,6 +412,8 @@ class Scenario:
     results_format: str = "auto"
     import_notes: tuple[str, ...] = ()
     bindings: tuple[ParameterBinding, ...] = ()
+    allow_implausible: tuple[str, ...] = ()
+    jacobi: JacobiCoupling | None = None
 
     def __post_init__(self) -> None:
         src = self.source
@@ -436,6 +478,7 @@ class Scenario:
             raise ScenarioError("analysis", self.analysis, "an AnalysisSettings", src)
         if self.results_format not in RESULTS_FORMATS:
             raise ScenarioError("record.format", self.results_format, "one of " + ", ".join(RESULTS_FORMATS), src)
+        object.__setattr__(self, "allow_implausible", tuple(dict.fromkeys(self.allow_implausible)))
 
     def _check_bindings(self, known: set[str], names: list[str], driven: Mapping[str, str],
                         set_initially: Mapping[str, int]) -> None:
@@ -500,6 +543,23 @@ class Scenario:
         """Copy with some :class:`SimulationSettings` fields replaced (validated again)."""
         return replace(self, simulation=replace(self.simulation, **changes))
 
+    def for_algorithm(self, algorithm: str, **changes) -> "Scenario":
+        """The scenario stepped with ``algorithm``: with Jacobi, its :class:`JacobiCoupling` applied.
+
+        The coupling's parameter values replace the scenario's, its connections are added and
+        its step (if any) becomes the scenario's; the result declares no coupling of its own.
+        ``changes`` are :class:`SimulationSettings` fields set at the same time (they win over
+        the coupling's step).
+        """
+        if algorithm != "jacobi" or self.jacobi is None:
+            return self.with_simulation(algorithm=algorithm, **changes)
+        coupling, scenario = self.jacobi, self
+        for comp, values in coupling.parameters.items():
+            scenario = scenario.with_parameters(comp, **values)
+        step = {} if coupling.step_s is None else {"step_s": coupling.step_s}
+        return replace(scenario, connections=scenario.connections + coupling.connections, jacobi=None,
+                       simulation=replace(scenario.simulation, algorithm="jacobi", **{**step, **changes}))
+
     def with_parameters(self, component: str, **values: ParameterValue) -> "Scenario":
         """Copy with parameter values of one component added or replaced."""
         comps = tuple(
@@ -508,6 +568,10 @@ class Scenario:
         if component not in self.component_names:
             raise ScenarioError("components", component, "a declared component: " + ", ".join(self.component_names), self.source)
         return replace(self, components=comps)
+
+    def with_allowed(self, *keys: str) -> "Scenario":
+        """Copy that keeps these ``"component.parameter"`` values although implausible (``--allow-implausible``)."""
+        return replace(self, allow_implausible=self.allow_implausible + tuple(keys))
 
     def with_no_feedthrough(self, item: str) -> "Scenario":
         """Copy where ``"component.output"`` (or ``"component"``: all its undeclared outputs) does not feed through.

@@ -50,6 +50,18 @@ TOML format (units SI; see ``docs/orchestrator.md`` for the full reference)::
 
     [analysis]                            # result analyses (orchestrator.inputs.analysis_settings)
     woehler_exponents = [3, 5, 8, 10]
+
+    [plausibility]                        # values kept although implausible by physics (a deliberate study)
+    allow = ["gearbox.stage1.backlash"]
+
+    [jacobi]                              # the coupling when stepped with Jacobi (libcosim, ecos, --algorithm jacobi)
+    step = 2e-2                           # s, optional: the step under Jacobi
+    step_criteria = "..."                 # optional: what the step was chosen by
+    [jacobi.parameters.gearbox]           # values that replace the scenario's
+    generator_interface = 2
+    [[jacobi.connections]]                # connections added to the scenario's
+    from = "gearbox.omega_generator"
+    to = "generator.omega_gearbox"
 """
 
 from __future__ import annotations
@@ -73,12 +85,13 @@ from .scenario import (
     Component,
     Connection,
     InitialBinding,
+    JacobiCoupling,
     ParameterBinding,
     Scenario,
     SimulationSettings,
     VariableRef,
 )
-from .schema import Table, flatten_parameters, read_document
+from .schema import PlausibilityTable, Table, flatten_parameters, read_document
 from .series_spec import SeriesTable, series_from_table
 
 
@@ -118,6 +131,15 @@ class _RecordTable(Table):
     format: Literal[RESULTS_FORMATS] = "auto"
 
 
+class _JacobiTable(Table):
+    step: float | None = Field(None, description="a finite number [s] (the communication step under Jacobi)")
+    step_criteria: str = Field("", description="a string: what the step was chosen by")
+    parameters: dict[str, dict[str, Any]] = Field(default_factory=dict,
+                                                  description="a table of components' parameter values")
+    connections: list[_LinkTable] = Field(default_factory=list,
+                                         description="an array of tables [[jacobi.connections]] with from/to")
+
+
 class ScenarioFile(Table):
     """The shape of a scenario TOML document (see the module docstring and ``docs/orchestrator.md``)."""
 
@@ -134,6 +156,8 @@ class ScenarioFile(Table):
     events: list[EventTable] = Field(default_factory=list,
                                      description="an array of tables [[events]] with kind, start, duration (, factor)")
     analysis: AnalysisTable | None = Field(None, description="an [analysis] table")
+    plausibility: PlausibilityTable | None = Field(None, description="a [plausibility] table with allow = [...]")
+    jacobi: _JacobiTable | None = Field(None, description="a [jacobi] table (the coupling under Jacobi)")
 
 
 _SIM_FIELDS = {"start": "start_s", "stop": "stop_s", "step": "step_s", "output_interval": "output_interval_s",
@@ -215,7 +239,14 @@ def scenario_from_dict(data: Mapping[str, Any], name: str | None = None, base_di
     except ScenarioError as exc:
         raise _rekeyed(exc, None, source) from None
 
-    return Scenario(
+    jacobi = None
+    if doc.jacobi is not None:
+        jacobi = JacobiCoupling(
+            doc.jacobi.step, doc.jacobi.step_criteria,
+            {comp: flatten_parameters(values, f"jacobi.parameters.{comp}", ScenarioError, source)
+             for comp, values in doc.jacobi.parameters.items()},
+            links(doc.jacobi.connections, "jacobi.connections", Connection))
+    scenario = Scenario(
         name=sc_name,
         description=doc.description,
         components=tuple(components),
@@ -229,7 +260,17 @@ def scenario_from_dict(data: Mapping[str, Any], name: str | None = None, base_di
         results_format=doc.record.format if doc.record is not None else "auto",
         base_dir=base_dir,
         source=source,
+        allow_implausible=tuple(doc.plausibility.allow) if doc.plausibility is not None else (),
+        jacobi=jacobi,
     )
+    if jacobi is not None:  # checked as applied; a scenario stepped with Jacobi is coupled so from the start
+        try:
+            coupled = scenario.for_algorithm("jacobi")
+        except ScenarioError as exc:
+            raise ScenarioError(f"jacobi ({exc.key})", exc.value, exc.expected, source) from None
+        if settings.algorithm == "jacobi":
+            return coupled
+    return scenario
 
 
 def _is_drivetrain_generator(fmu: str) -> bool:

@@ -25,7 +25,7 @@ import types
 import typing
 from typing import Any, Mapping, TypeVar, Union
 
-from pydantic import BaseModel, ConfigDict, ValidationError
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from ..errors import EntryError, suggestion
 
@@ -43,6 +43,17 @@ class Table(BaseModel):
 
     model_config = ConfigDict(extra="forbid", strict=True, frozen=True, allow_inf_nan=False,
                               arbitrary_types_allowed=True)
+
+
+class PlausibilityTable(Table):
+    """``[plausibility]``: values a deliberate study keeps although physics calls them implausible.
+
+    ``allow`` names parameters: flat names in a drivetrain file (``"stage1.backlash"``),
+    ``"component.parameter"`` in a scenario, study or load-case set (``"gearbox.stage1.backlash"``).
+    """
+
+    allow: list[str] = Field(default_factory=list, description='a list of parameter names such as '
+                             '"gearbox.stage1.backlash" ("stage1.backlash" in a drivetrain file)')
 
 
 def key_path(loc: tuple) -> str:

@@ -37,7 +37,7 @@ combination of axis values x every seed, in that nesting order (seeds fastest).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -89,20 +89,23 @@ class Axis:
         ``"component.parameter"`` names set together to each value (linked
         parameters, e.g. the regularisation factor of all three stages).
     values : tuple of float, int, bool or str
-        The values (SI units, as the parameter), at least one.
+        The values, at least one: as written in the study file (numbers in ``unit``, or
+        quantities with their unit such as ``"5.7 kN m/rad"``); once prepared
+        (:mod:`orchestrator.study.declared_values`) in the unit each parameter declares.
     label : str
         Name on plots (default: the first parameter).
     unit : str
-        Unit shown on plots (default ``""``: the parameter's own SI unit is not known here).
-    scale : float
-        Plots show ``value * scale`` in ``unit`` (e.g. 1e-3 for 1/m -> 1/mm).
+        The unit the numbers of ``values`` are written in (``"kN m/rad"``, ``"1/mm"``, ``"rpm"``),
+        converted to the parameter's own unit before anything runs; ``""``: the parameter's unit.
+    shown : tuple, optional
+        The values as written, once ``values`` are converted (plots and the table show them in ``unit``).
     """
 
     parameters: tuple[str, ...]
     values: tuple[ParameterValue, ...]
     label: str = ""
     unit: str = ""
-    scale: float = 1.0
+    shown: tuple[ParameterValue, ...] | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "parameters", tuple(self.parameters))
@@ -111,15 +114,23 @@ class Axis:
             raise StudyError("axes.parameters", list(self.parameters), "at least one parameter")
         if not self.values:
             raise StudyError("axes.values", list(self.values), "at least one value")
+        if self.shown is not None and len(self.shown) != len(self.values):
+            raise StudyError("axes.values", list(self.shown), f"{len(self.values)} shown values, one per value")
         if not self.label:
             object.__setattr__(self, "label", self.parameters[0])
 
     def display(self, value: ParameterValue) -> ParameterValue:
-        """A value as shown on plots and in the table (``value * scale`` for numbers, to 12 digits).
+        """A value as shown on plots and in the table: as written (in ``unit``), numbers to 12 digits.
 
-        Rounded so that 2864.8 x 1e-3 reads 2.8648, not 2.8648000000000002.
+        Rounded so that a sum of floats reads 2.8648, not 2.8648000000000002.
         """
-        return float(f"{value * self.scale:.12g}") if is_number(value) else value
+        if self.shown is not None and value in self.values:
+            value = self.shown[self.values.index(value)]
+        return float(f"{value:.12g}") if is_number(value) else value
+
+    def converted(self, values: tuple[ParameterValue, ...]) -> "Axis":
+        """The axis running ``values`` (in the parameters' units) and showing the values as written."""
+        return replace(self, values=tuple(values), shown=self.shown if self.shown is not None else self.values)
 
     @property
     def axis_label(self) -> str:
@@ -244,6 +255,9 @@ class Study:
         Directory of the study file.
     source : str, optional
         The study file (error messages).
+    allow_implausible : tuple of str
+        ``"component.parameter"`` values kept although implausible by physics (``[plausibility] allow``,
+        ``--allow-implausible``), for every point.
     """
 
     name: str
@@ -261,10 +275,11 @@ class Study:
     description: str = ""
     base_dir: Path | None = None
     source: str | None = None
+    allow_implausible: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         src = self.source
-        for attr in ("measures", "axes", "points", "seeds", "plots"):
+        for attr in ("measures", "axes", "points", "seeds", "plots", "allow_implausible"):
             object.__setattr__(self, attr, tuple(getattr(self, attr)))
         object.__setattr__(self, "points", tuple(FrozenMap(dict(p)) for p in self.points))
         if isinstance(self.simulation, Mapping):
@@ -277,6 +292,8 @@ class Study:
             raise StudyError("timeout", t, "a finite number of seconds > 0 (wall-clock time per point)", src)
         if self.engine not in ENGINES:
             raise StudyError("engine", self.engine, "one of " + ", ".join(ENGINES), src)
+        for i, key in enumerate(self.allow_implausible):
+            check_parameter_name(key, f"plausibility.allow[{i}]", src)
         if not self.measures:
             raise StudyError("measures", [], "at least one measure", src)
         names = [m.name for m in self.measures]
@@ -358,6 +375,12 @@ class Study:
         if self.seeds:
             seen[self.seed_parameter] = None
         return list(seen)
+
+    def with_allowed(self, *keys: str) -> "Study":
+        """Copy that keeps these ``"component.parameter"`` values although implausible (``--allow-implausible``)."""
+        for key in keys:
+            check_parameter_name(key, "--allow-implausible", self.source)
+        return replace(self, allow_implausible=self.allow_implausible + tuple(keys))
 
     def measure(self, name: str) -> Measure:
         """The measure called ``name``."""

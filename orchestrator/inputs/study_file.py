@@ -21,7 +21,7 @@ from .limits import MAX_AXIS_VALUES, MAX_STUDY_POINTS
 from .master_options import ALGORITHMS, EXTRAPOLATIONS
 from .measures import MeasureError, parse_measure
 from .overrides import SimulationOverrides
-from .schema import ParameterValue, Table, flatten_parameters, is_parameter_value, read_document
+from .schema import ParameterValue, PlausibilityTable, Table, flatten_parameters, is_parameter_value, read_document
 from .study import (
     DEFAULT_SEED_PARAMETER,
     ENGINES,
@@ -87,8 +87,8 @@ class _AxisTable(Table):
     num: int | None = Field(None, ge=1, le=MAX_AXIS_VALUES, description=f"an integer within [1, {MAX_AXIS_VALUES}]")
     spacing: Literal[SPACINGS] | None = None
     label: str = Field("", description="a string")
-    unit: str = Field("", description="a string")
-    scale: float = Field(1.0, description="a finite number other than 0")
+    unit: str = Field("", description="the unit of the values, e.g. \"kN m/rad\" (converted to the parameter's)")
+    scale: float | None = Field(None, description="nothing: write the values in unit")
 
 
 class _PlotTable(Table):
@@ -119,6 +119,7 @@ class StudyFile(Table):
     measures: list[str] = Field(min_length=1, description='a non-empty list such as ["I_max_acc", "cpu_time"]')
     plots: list[_PlotTable] = Field(default_factory=list, description="an array of tables [[plots]]")
     timeout: float | None = Field(None, description="a finite number of seconds > 0 (wall-clock time per point)")
+    plausibility: PlausibilityTable | None = Field(None, description="a [plausibility] table with allow = [...]")
 
 
 def _axis_values(tab: _AxisTable, key: str, source: str | None) -> tuple[ParameterValue, ...]:
@@ -179,10 +180,12 @@ def _axis(tab: _AxisTable, i: int, source: str | None) -> Axis:
     else:
         params = [check_parameter_name(p, f"{key}.parameters[{j}]", source) for j, p in enumerate(tab.parameters)]
     values = _axis_values(tab, key, source)
-    if tab.scale == 0:
-        raise StudyError(f"{key}.scale", tab.scale, "a finite number other than 0", source)
+    if tab.scale is not None:
+        raise StudyError(f"{key}.scale", tab.scale, f"no scale: an axis's unit is the unit of its values, converted to "
+                         f"the parameter's before anything runs (write the values in unit = \"{tab.unit or '...'}\"; plots "
+                         "show them as written)", source)
     try:
-        return Axis(tuple(params), values, label=tab.label, unit=tab.unit, scale=float(tab.scale))
+        return Axis(tuple(params), values, label=tab.label, unit=tab.unit)
     except StudyError as exc:
         raise StudyError(exc.key.replace("axes", key, 1), exc.value, exc.expected, source) from None
 
@@ -277,6 +280,7 @@ def study_from_dict(data: Mapping[str, Any], name: str | None = None, base_dir: 
         seeds=tuple(doc.seeds), seed_parameter=seed_parameter, simulation=SimulationOverrides.from_table(simulation),
         solver=solver, plots=tuple(_plot(tab, i, source) for i, tab in enumerate(doc.plots)),
         timeout_s=doc.timeout, description=doc.description, base_dir=base_dir, source=source,
+        allow_implausible=tuple(doc.plausibility.allow) if doc.plausibility is not None else (),
     )
 
 

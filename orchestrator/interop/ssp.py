@@ -9,8 +9,8 @@ what dtcosim does not support naming the element and its line.
 from __future__ import annotations
 
 from .ssp_export import PARAMETER_SET, export_ssp, system_structure
-from .ssp_import import SSD_NAME, import_ssp, locate_ssd
+from .ssp_import import SSD_NAME, import_ssp, is_ssp, locate_ssd
 from .ssp_xml import DTCOSIM_ANNOTATION, NS, OSP_ANNOTATION
 
 __all__ = ["DTCOSIM_ANNOTATION", "NS", "OSP_ANNOTATION", "PARAMETER_SET", "SSD_NAME", "export_ssp", "import_ssp",
-           "locate_ssd", "system_structure"]
+           "is_ssp", "locate_ssd", "system_structure"]

@@ -16,7 +16,8 @@ of them at once), the ``ssd:Connections``, and an ``ssd:DefaultExperiment``
   which libcosim's SSP loader needs;
 * ``org.dtcosim.scenario``: what SSP 1.0 has no element for - sampling interval,
   analysis window, algorithm (with ``target`` and ``stepTunedFor`` when the export
-  names its host: the algorithm the step was chosen for), extrapolation, stepping order, recorded variables
+  names its host: the algorithm the step was chosen for, the criteria it meets, the scenario's coupling for
+  that algorithm that was applied), extrapolation, stepping order, recorded variables
   and the initial bindings (``[[initial]]``), and the ``[analysis]`` settings when
   they differ from the defaults. Load events (``[[events]]``) need no annotation:
   they are the generator FMU's event-slot parameters in the parameter set.
@@ -63,6 +64,7 @@ from typing import Any, Mapping
 
 from fmus.start_values import StartValueError, write_with_start_values
 
+from ..atomic_files import atomic_path
 from ..cosim.resolved import ResolvedSystem
 from ..errors import SspError
 from ..inputs.analysis_settings import AnalysisSettings
@@ -238,13 +240,24 @@ def _resource_names(system: ResolvedSystem, baked: Mapping[str, Mapping[str, Any
 HOST_ALGORITHMS = {"dtcosim": None, "libcosim": "jacobi", "ecos": "jacobi"}
 
 
+def host_notes(target: str, step_s: float, stop_s: float) -> list[str]:
+    """What to tell the user of ``target`` to run the exported system over its whole time (measured on ecos 0.7.2)."""
+    if target != "ecos":
+        return []
+    return [f"ecos 0.7.2 writes its CSV up to one step before --stopTime (with --stopTime {stop_s:g} its last row is "
+            f"{stop_s - step_s:g} s): run it with --stepSize {step_s:g} --stopTime {stop_s + step_s:g} to have the "
+            f"sample at {stop_s:g} s"]
+
+
 @dataclass(frozen=True)
 class ExportTuning:
-    """What an export was tuned for: the ``target`` host, the algorithm its step was chosen for, the criteria met."""
+    """What an export was tuned for: the ``target`` host, the algorithm its step was chosen for, the criteria met,
+    and the scenario's coupling for the target's algorithm that was applied (``[jacobi]``, as text)."""
 
     target: str
     step_tuned_for: str
     criteria: str = ""
+    coupling: str = ""
 
 
 def system_structure(system: ResolvedSystem, initial_values: Mapping[str, float] | None = None,
@@ -348,6 +361,8 @@ def system_structure(system: ResolvedSystem, initial_values: Mapping[str, float]
         settings.set("stepTunedFor", tuning.step_tuned_for)
         if tuning.criteria:
             settings.set("stepCriteria", tuning.criteria)
+        if tuning.coupling:
+            settings.set("coupling", tuning.coupling)
     if sim.order:
         settings.set("order", " ".join(sim.order))
     if sim.algebraic_loops != "refuse":
@@ -393,26 +408,21 @@ def export_ssp(system: ResolvedSystem, path: str | Path, initial_values: Mapping
     tree = system_structure(system, initial_values, tuning)
     baked = baked_values(system, initial_values)
     resources = _resource_names(system, baked)
-    tmp = path.with_name(path.name + ".tmp")
-    try:
-        with tempfile.TemporaryDirectory(prefix="dtcosim-ssp-") as staging, \
-                zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as zf:
-            zf.writestr(SSD_NAME, ET.tostring(tree.getroot(), encoding="UTF-8", xml_declaration=True))
-            written: set[str] = set()
-            for comp in system.scenario.components:
-                arc = resources[comp.name]
-                if arc in written:
-                    continue
-                source = system.fmu_paths[comp.name]
-                if comp.name in baked:
-                    try:
-                        source = write_with_start_values(source, Path(staging) / arc, baked[comp.name])
-                    except StartValueError as exc:
-                        raise SspError(f"components.{comp.name}: {exc}") from None
-                zf.write(source, arc, compress_type=zipfile.ZIP_STORED)
-                written.add(arc)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
-    tmp.replace(path)
+    # whole or not there, and a write error (a full disk) names the .ssp
+    with atomic_path(path) as tmp, tempfile.TemporaryDirectory(prefix="dtcosim-ssp-") as staging, \
+            zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as zf:
+        zf.writestr(SSD_NAME, ET.tostring(tree.getroot(), encoding="UTF-8", xml_declaration=True))
+        written: set[str] = set()
+        for comp in system.scenario.components:
+            arc = resources[comp.name]
+            if arc in written:
+                continue
+            source = system.fmu_paths[comp.name]
+            if comp.name in baked:
+                try:
+                    source = write_with_start_values(source, Path(staging) / arc, baked[comp.name])
+                except StartValueError as exc:
+                    raise SspError(f"components.{comp.name}: {exc}") from None
+            zf.write(source, arc, compress_type=zipfile.ZIP_STORED)
+            written.add(arc)
     return path

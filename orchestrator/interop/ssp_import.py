@@ -46,6 +46,7 @@ from typing import Any, Callable
 
 from lxml import etree
 
+from ..archive_members import record_extraction
 from ..errors import ScenarioError, SspError
 from ..inputs.analysis_settings import AnalysisSettings
 from ..inputs.limits import MAX_SSP_BYTES, MAX_SSP_MEMBERS, MAX_SSP_RATIO
@@ -130,6 +131,12 @@ def _extract_ssp(path: Path) -> Path:
     return _EXTRACTED[digest]
 
 
+def is_ssp(path: str | Path) -> bool:
+    """True for what :func:`import_ssp` reads: an ``.ssp`` archive, an ``.ssd`` file or a folder holding an SSD."""
+    p = Path(path)
+    return p.suffix in (".ssp", ".ssd") or (p.is_dir() and (p / SSD_NAME).is_file())
+
+
 def locate_ssd(path: Path) -> tuple[Path, Path]:
     """(the SSD file, the folder component sources are relative to) of an archive, folder or ``.ssd``."""
     if not path.exists():
@@ -138,6 +145,7 @@ def locate_ssd(path: Path) -> tuple[Path, Path]:
         ssd, base = path / SSD_NAME, path
     elif path.suffix == ".ssp":
         base = _extract_ssp(path)
+        record_extraction(base, path)  # messages name its files <archive>!<member>
         ssd = base / SSD_NAME
     else:
         ssd, base = path, path.parent
@@ -382,4 +390,4 @@ def import_ssp(path: str | Path, step_s: float | None = None, stop_s: float | No
     )
 
 
-__all__ = ["import_ssp", "locate_ssd", "SSD_NAME", "NS", "where"]
+__all__ = ["import_ssp", "is_ssp", "locate_ssd", "SSD_NAME", "NS", "where"]

@@ -22,6 +22,7 @@ from typing import Any, Mapping
 
 from lxml import etree
 
+from ..archive_members import shown_path
 from ..errors import SspError
 from ..inputs.limits import MAX_SSP_XML_BYTES
 from ..inputs.transformations import LinearTransformation, MappingTransformation, Transformation
@@ -89,8 +90,8 @@ def tag(el) -> str:
 
 
 def where(el, path: Path | str) -> str:
-    """``<file>, line <n>`` of an element."""
-    return f"{path}, line {el.sourceline}"
+    """``<file>, line <n>`` of an element (a file of an ``.ssp`` as ``<archive>!<member>``)."""
+    return f"{shown_path(path)}, line {el.sourceline}"
 
 
 def element_error(el, path: Path | str, problem: str, remedy: str) -> SspError:
@@ -105,21 +106,22 @@ def element_error(el, path: Path | str, problem: str, remedy: str) -> SspError:
 def parse(path: Path) -> Any:
     """The root element of an SSP XML file (lxml, with line numbers); only a regular file of at most
     :data:`~orchestrator.inputs.limits.MAX_SSP_XML_BYTES` is read."""
+    shown = shown_path(path)  # a file of an .ssp as <archive>!<member>
     try:
         info = os.stat(path)
     except OSError as exc:
-        raise SspError(f"{path}: cannot be read ({exc.strerror})") from None
+        raise SspError(f"{shown}: cannot be read ({exc.strerror})") from None
     if not stat.S_ISREG(info.st_mode):
-        raise SspError(f"{path}: not a regular file (a device, pipe or folder); name the SSP file itself") from None
+        raise SspError(f"{shown}: not a regular file (a device, pipe or folder); name the SSP file itself") from None
     if info.st_size > MAX_SSP_XML_BYTES:
-        raise SspError(f"{path}: {info.st_size / 2**20:.0f} MiB, expected at most {MAX_SSP_XML_BYTES >> 20} MiB for "
+        raise SspError(f"{shown}: {info.st_size / 2**20:.0f} MiB, expected at most {MAX_SSP_XML_BYTES >> 20} MiB for "
                        "one SSP XML file") from None
     try:
         return etree.parse(str(path), etree.XMLParser(remove_blank_text=False, resolve_entities=False)).getroot()
     except OSError as exc:
-        raise SspError(f"{path}: cannot be read ({exc})") from None
+        raise SspError(f"{shown}: cannot be read ({exc})") from None
     except etree.XMLSyntaxError as exc:
-        raise SspError(f"{path}: not valid XML ({exc})") from None
+        raise SspError(f"{shown}: not valid XML ({exc})") from None
 
 
 def check_supported(root, path: Path, notes: list[str]) -> None:

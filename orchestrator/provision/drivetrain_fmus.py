@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Callable, Iterable
 
 from fmus.build import BuiltFmu, build_fmu
+from fmus.build_lock import build_lock
 from fmus.registry import DRIVETRAIN_FILE, names_built_from
 
 from ..inputs.drivetrain_file import DrivetrainSpec
@@ -42,7 +43,7 @@ def build_drivetrain_fmus(spec: DrivetrainSpec, out_dir: Path, names: Iterable[s
     if report:
         report(f"building {', '.join(n + '.fmu' for n in names)} from {spec.origin} into {out_dir} ...")
     return [build_fmu(n, out_dir, drivetrain=drivetrain, origin=spec.origin, rotor_speed_rad_s=spec.rotor_speed_rad_s,
-                      validate=validate) for n in names]
+                      validate=validate, report=report) for n in names]
 
 
 def ensure_drivetrain_fmus(spec: DrivetrainSpec, fmu_dir: Path, names: Iterable[str],
@@ -55,9 +56,15 @@ def ensure_drivetrain_fmus(spec: DrivetrainSpec, fmu_dir: Path, names: Iterable[
     folder = drivetrain_fmu_dir(fmu_dir, spec)
     names = list(dict.fromkeys(names))
     paths = {n: folder / f"{n}.fmu" for n in names}
-    todo = [n for n, p in paths.items() if not p.is_file()]
-    present = {n: p for n, p in paths.items() if p.is_file()}
-    todo += [n for n in present if broken_fmu(present[n]) or stale_project_fmus({n: present[n]})]
-    if todo:
-        build_drivetrain_fmus(spec, folder, sorted(set(todo)), report)
+
+    def todo() -> list[str]:
+        present = {n: p for n, p in paths.items() if p.is_file()}
+        return sorted({n for n in paths if n not in present}
+                      | {n for n, p in present.items() if broken_fmu(p) or stale_project_fmus({n: p})})
+
+    if todo():
+        with build_lock(folder, report):  # decided again and built by one process at a time
+            names = todo()  # another process may have built them meanwhile
+            if names:
+                build_drivetrain_fmus(spec, folder, names, report)
     return folder

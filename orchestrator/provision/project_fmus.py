@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Callable
 
 from fmus.build import build_all
+from fmus.build_lock import build_lock
 from fmus.registry import PRESET, of_file
 
 from ..cosim.compiled_kernels import ensure_compiled_kernels
@@ -67,15 +68,22 @@ def ensure_fmus(scenario: Scenario, fmu_dir: str | Path | None = None, build: bo
         for comp in scenario.components:
             if comp.series is not None:
                 ensure_series_fmu(comp.series, fmu_dir, report)
-        # missing, or broken in the folder dtcosim builds into (an interrupted build of an older version)
-        broken = [comp.name for comp in scenario.components if (fmu_dir / comp.fmu.name).is_file()
-                  and _preset_fmu(scenario, comp.name) is not None and broken_fmu(fmu_dir / comp.fmu.name)]
-        names = sorted({_preset_fmu(scenario, comp) for comp in [*missing_fmus(scenario, fmu_dir), *broken]} - {None})
-        if names:
-            if report:
-                report(f"building {', '.join(n + '.fmu' for n in names)} into {fmu_dir} ...")
-            build_all(fmu_dir, names=names)
+        if _missing_preset_fmus(scenario, fmu_dir):
+            with build_lock(fmu_dir, report):  # decided again and built by one process at a time
+                names = _missing_preset_fmus(scenario, fmu_dir)  # another process may have built them meanwhile
+                if names:
+                    if report:
+                        report(f"building {', '.join(n + '.fmu' for n in names)} into {fmu_dir} ...")
+                    build_all(fmu_dir, names=names)
     return resolve_fmu_paths(scenario, fmu_dir)
+
+
+def _missing_preset_fmus(scenario: Scenario, fmu_dir: Path) -> list[str]:
+    """The project FMUs built from a preset that ``fmu_dir`` lacks or holds broken (an interrupted build of an
+    older version), by model name."""
+    broken = [comp.name for comp in scenario.components if (fmu_dir / comp.fmu.name).is_file()
+              and _preset_fmu(scenario, comp.name) is not None and broken_fmu(fmu_dir / comp.fmu.name)]
+    return sorted({_preset_fmu(scenario, comp) for comp in [*missing_fmus(scenario, fmu_dir), *broken]} - {None})
 
 
 def _preset_fmu(scenario: Scenario, name: str) -> str | None:

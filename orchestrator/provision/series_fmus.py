@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Callable
 
 from fmus.build import BuiltFmu, build_fmu
+from fmus.build_lock import build_lock
 from fmus.registry import LOAD_RECORD, built_from
 from fmus.slaves.time_series_source import DATA_FILE
 
@@ -40,6 +41,12 @@ def build_series_fmu(spec: SeriesSpec, out_dir: Path, report: Callable[[str], No
 def ensure_series_fmu(spec: SeriesSpec, fmu_dir: Path, report: Callable[[str], None] | None = None) -> Path:
     """The TimeSeriesSource FMU of ``spec`` in ``fmu_dir``, built when missing or stale."""
     path = series_fmu_dir(fmu_dir, spec) / SERIES_FMU.file_name
-    if not path.is_file() or broken_fmu(path) or stale_project_fmus({"series": path}):
-        build_series_fmu(spec, path.parent, report)
+
+    def needed() -> bool:
+        return not path.is_file() or broken_fmu(path) is not None or bool(stale_project_fmus({"series": path}))
+
+    if needed():
+        with build_lock(path.parent, report):  # decided again and built by one process at a time
+            if needed():  # another process may have built it meanwhile
+                build_series_fmu(spec, path.parent, report)
     return path

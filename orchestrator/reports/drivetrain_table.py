@@ -15,7 +15,8 @@ def _mm(value_m: float) -> str:
 
 
 def _check(passed: bool | None) -> str:
-    return {True: "ok", False: "FAILED", None: "n/a"}[passed]
+    """A failed geometry check is an error before any table: one shown here is allowed ([plausibility])."""
+    return {True: "ok", False: "not met", None: "n/a"}[passed]
 
 
 def format_design_table(table: DesignTable, source: str = "") -> str:

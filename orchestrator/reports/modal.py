@@ -35,8 +35,15 @@ from components.errors import ParameterError
 from components.model.drivetrain import Drivetrain
 from components.model.rotor import RotorParameters
 
-from ..atomic_files import write_text_atomic
+from ..atomic_files import atomic_path, write_text_atomic
 from .modal_plots import plot_campbell, plot_mode_shapes
+
+
+def _rows_csv(path: Path, rows: list[dict]) -> Path:
+    """:func:`write_rows_csv` through a temporary file and rename: whole or not there, a write error names ``path``."""
+    with atomic_path(path) as tmp:
+        write_rows_csv(tmp, rows)
+    return path
 
 
 def format_mode_table(analysis: DrivetrainModalAnalysis) -> str:
@@ -118,7 +125,7 @@ def modal_report(
     if out_dir is not None:
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
-        files["modes.csv"] = write_rows_csv(out / "modes.csv", analysis.table_rows())
+        files["modes.csv"] = _rows_csv(out / "modes.csv", analysis.table_rows())
         summary = analysis.as_dict()
         if checks is not None:
             summary["free_response_check"] = [c.as_dict() for c in checks]
@@ -126,9 +133,9 @@ def modal_report(
         write_text_atomic(out / "modes.json", json.dumps(summary, indent=2))
         files["modes.json"] = out / "modes.json"
         files["modes.png"] = plot_mode_shapes(analysis, out / "modes.png", n_shapes)
-        files["campbell.csv"] = write_rows_csv(out / "campbell.csv", campbell.rows())
+        files["campbell.csv"] = _rows_csv(out / "campbell.csv", campbell.rows())
         crossings = campbell.crossings()
         if crossings:
-            files["campbell_crossings.csv"] = write_rows_csv(out / "campbell_crossings.csv", crossings)
+            files["campbell_crossings.csv"] = _rows_csv(out / "campbell_crossings.csv", crossings)
         files["campbell.png"] = plot_campbell(campbell, out / "campbell.png", operating_point.rotor_speed_rpm)
     return {"analysis": analysis, "campbell": campbell, "verification": checks, "files": files}

@@ -16,12 +16,12 @@ from typing import Any, Mapping
 import numpy as np
 
 from components.model.contact import CONTACT_LOSS_THRESHOLD_N
+from components.model.signals import CONTACT_FORCE, ROTOR_SPEED
 from components.reference.cases import ReferenceCase
-from components.reference.results import SimulationResult, unit_of
+from components.reference.results import SimulationResult
 
 from ..plotting import (
-    FORCE_KIND_LABELS,
-    FORCE_NAME_RE,
+    MESH_KIND_STYLES,
     new_figure,
     plot_envelope,
     save_figure,
@@ -31,24 +31,28 @@ from ..result_files import write_series_csv, write_summary
 
 
 def plot_reference(result: SimulationResult, case: ReferenceCase, path: str | Path) -> Path:
-    """Input speed [rpm] over the contact forces of every stage [N or kN]; returns ``path``."""
+    """Input speed [rpm] over the contact forces of every stage [N or kN]; returns ``path``.
+
+    The input speed, the contact forces, their stages and mesh kinds are those the solver declares
+    (:attr:`SimulationResult.signals`).
+    """
     t = result.time_s
     stages: dict[str, list[tuple[str, str]]] = {}
-    for name in result.names:
-        m = FORCE_NAME_RE.match(name)
-        if m:
-            stages.setdefault(m.group(1), []).append((name, m.group(2)))
+    for name in result.names_of(CONTACT_FORCE):
+        signal = result.signals[name]
+        stages.setdefault(signal.detail("stage"), []).append((name, signal.detail("mesh")))
     fig, axes = new_figure(1 + len(stages), height=2.4 * (1 + len(stages)) + 0.8, width=11.0)
     ax = axes[0]
-    plot_envelope(ax, t, result["omega_rotor"] * 30.0 / math.pi, lw=0.9, color="k", label="input (carrier / drive) speed")
+    for name in result.names_of(ROTOR_SPEED):
+        plot_envelope(ax, t, result[name] * 30.0 / math.pi, lw=0.9, color="k", label="input (carrier / drive) speed")
     ax.set_ylabel("speed [rpm]")
     ax.legend(loc="upper right", fontsize=8)
     for ax, (stage, forces) in zip(axes[1:], stages.items()):
         peak = max(float(np.abs(result[n]).max()) for n, _ in forces)
         scale, unit = (1e3, "kN") if peak >= 1e4 else (1.0, "N")
         for k, (name, kind) in enumerate(forces):
-            plot_envelope(ax, t, result[name] / scale, lw=0.7, ls="--" if kind == "rp" else "-", color=f"C{k % 10}",
-                  label=f"{name} ({FORCE_KIND_LABELS[kind]})")
+            label, style = MESH_KIND_STYLES.get(kind, (kind, "-"))
+            plot_envelope(ax, t, result[name] / scale, lw=0.7, ls=style, color=f"C{k % 10}", label=f"{name} ({label})")
         shade_inside_backlash(ax, t, result[forces[0][0]], CONTACT_LOSS_THRESHOLD_N,
                               f"{forces[0][0]} inside the backlash (|F| < {CONTACT_LOSS_THRESHOLD_N:g} N)")
         ax.axhline(0.0, color="k", lw=0.5)
@@ -69,7 +73,7 @@ def write_reference_outputs(result: SimulationResult, case: ReferenceCase, summa
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     names = result.names
-    header = ["time [s]"] + [f"{n} [{unit_of(n)}]" for n in names]
+    header = ["time [s]"] + [f"{n} [{result.signals[n].unit}]" for n in names]  # as the solver declares them
     values = np.column_stack([result[n] for n in names]) if names else np.empty((result.time_s.size, 0))
     files = [write_series_csv(out / "timeseries.csv", header, result.time_s, values),
              write_summary(out / "summary.json", summary)]

@@ -185,7 +185,8 @@ def _window_of(outcome: RunOutcome, window: tuple[float, float]) -> tuple[float,
 _NO_FORCES = "no contact force of a gearbox is declared and recorded (dtcosim Gearbox FMU, or role and signals)"
 
 
-def analyse_run(system: ResolvedSystem, outcome: RunOutcome, out_dir: str | Path, plots: bool = True) -> RunAnalyses:
+def analyse_run(system: ResolvedSystem, outcome: RunOutcome, out_dir: str | Path, plots: bool = True,
+                into: RunAnalyses | None = None) -> RunAnalyses:
     """Contact loss, fatigue loads and (optionally) force spectra of a run, with their files.
 
     Parameters
@@ -198,6 +199,9 @@ def analyse_run(system: ResolvedSystem, outcome: RunOutcome, out_dir: str | Path
         Directory of the CSV and PNG files (exists).
     plots : bool
         Write the PNG files.
+    into : RunAnalyses, optional
+        Filled as the analyses go (default: a new one): when a file cannot be written (a full
+        disk raises ``OSError``) the caller still has what was computed and written before.
 
     Returns
     -------
@@ -205,7 +209,7 @@ def analyse_run(system: ResolvedSystem, outcome: RunOutcome, out_dir: str | Path
     """
     out = Path(out_dir)
     settings = system.scenario.analysis
-    result = RunAnalyses()
+    result = RunAnalyses() if into is None else into
     window = _window_of(outcome, system.scenario.simulation.window_s)
     if window is None:
         for name in ("contact_loss", "fatigue", "spectrum"):

@@ -20,12 +20,18 @@ import numpy as np
 from ..cosim.outcome import RunOutcome
 from ..cosim.roles import GEARBOX, GENERATOR, WIND_SOURCE, ComponentRole
 from ..cosim.resolved import ResolvedSystem
-from ..plotting import RPM_PER_RAD_S, envelope, new_figure, new_grid, plot_envelope, save_figure
+from ..plotting import (
+    MESH_KIND_STYLES,
+    RPM_PER_RAD_S,
+    envelope,
+    new_figure,
+    new_grid,
+    plot_envelope,
+    save_figure,
+)
 from .derived import Skipped, generator_vs_ideal, single_role
 from .memory import release_between_phases
 
-#: mesh kind (declared signal info) -> label and line style
-_MESH_STYLE = {"sun_planet": ("sun-planet", "-"), "ring_planet": ("ring-planet", "--"), "parallel": ("mesh", "-")}
 
 
 def _shade_window(ax, window) -> None:
@@ -151,7 +157,7 @@ def plot_contact_forces(outcome: RunOutcome, gearbox: ComponentRole, window, pat
         _shade_window(whole, window)
         groups = symmetric_groups(stages[stage])
         for k, (var, kind, y, same) in enumerate(groups):
-            label, style = _MESH_STYLE.get(kind, (kind, "-"))
+            label, style = MESH_KIND_STYLES.get(kind, (kind, "-"))
             text = f"{var} ({label})"
             if same:
                 merged = True
@@ -180,19 +186,22 @@ def plot_contact_forces(outcome: RunOutcome, gearbox: ComponentRole, window, pat
 
 
 def plot_run(system: ResolvedSystem, outcome: RunOutcome, out_dir: str | Path,
-             skipped: list[dict[str, str]] | None = None) -> list[Path]:
+             skipped: list[dict[str, str]] | None = None, written: list[Path] | None = None) -> list[Path]:
     """Write the plots that the declared and recorded signals allow; returns the files written.
 
     Parameters
     ----------
     skipped : list, optional
         Receives ``{"analysis": "plot:<name>", "reason": ...}`` for each plot not drawn.
+    written : list, optional
+        Receives each file as soon as it is written (and is returned): when a plot cannot be
+        written (a full disk raises ``OSError``) the caller still knows the ones before it.
     """
     out_dir = Path(out_dir)
     skipped = [] if skipped is None else skipped
     window = system.scenario.simulation.window_s
     suffix = "" if outcome.complete else f" - INCOMPLETE, stopped at {outcome.stopped_at_s:g} s"
-    written: list[Path] = []
+    written = [] if written is None else written
     if outcome.time_s.size < 2:
         skipped.append({"analysis": "plots", "reason": "fewer than 2 samples"})
         return written

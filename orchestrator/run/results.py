@@ -45,6 +45,7 @@ from typing import Any, Mapping
 
 from components.reference.results import window_statistics
 
+from ..archive_members import shown_path
 from ..cosim.outcome import RunOutcome
 from ..cosim.resolved import ResolvedSystem
 from ..inputs.results_format import RESULTS_FILES, concrete_format
@@ -193,7 +194,7 @@ def build_summary(system: ResolvedSystem, outcome: RunOutcome, *, wall_time_s: f
     summary["versions"] = versions()
     summary["fmus"] = {
         name: {
-            "file": str(system.fmu_paths[name]),
+            "file": shown_path(system.fmu_paths[name]),  # a member of an .ssp: <archive>!<member>
             "sha256": iface.sha256,
             "model_name": iface.model_name,
             "guid": iface.guid,

@@ -55,8 +55,8 @@ RUNNING, COMPLETE, STOPPED, FAILED = "running", "complete", "stopped", "failed"
 PROBE_PREFIX = ".dtcosim-write-test-"
 #: what a summary shortened for a full disk keeps (:meth:`RunFolder.finish`)
 BRIEF_KEYS = ("scenario", "description", "scenario_file", "results_format", "started_at", "pid", "status",
-              "complete", "stage", "stopped_at", "error", "interrupted", "signal", "problems", "samples", "files",
-              "files_incomplete")
+              "complete", "stage", "stopped_at", "error", "interrupted", "signal", "problems", "post_processing",
+              "samples", "files", "files_incomplete")
 
 
 class OutputFolderError(EntryError):
@@ -120,10 +120,12 @@ class RunFolder:
     # ------------------------------------------------------------- checks
     @classmethod
     def check(cls, path: str | Path, key: str = "--out") -> Path:
-        """Raise :class:`OutputFolderError` unless ``path`` is (or can become) a writable folder.
+        """Raise :class:`OutputFolderError` unless ``path`` is (or can become) a writable folder no other run holds.
 
         A folder that holds a sweep's or load set's results is refused too
-        (:class:`~orchestrator.output_folders.MixedFolderError`).
+        (:class:`~orchestrator.output_folders.MixedFolderError`). The run lock is only
+        tried here (:meth:`prepare` takes it): a run into a folder in use is refused before
+        it says anything about the folder's previous run.
         """
         path = Path(path)
         if path.exists() and not path.is_dir():
@@ -139,6 +141,9 @@ class RunFolder:
         except OSError as exc:
             raise OutputFolderError(key, str(path), f"a folder dtcosim can write ({exc.strerror or exc})") from None
         check_for_run(path, key)  # a sweep's or load set's folder: refused (folders never mix)
+        probe = cls(path)
+        probe._lock(key)
+        probe.release()
         return path
 
     @classmethod

@@ -22,7 +22,7 @@ from ..cosim.resolved import ResolvedSystem
 from ..errors import FmuStepError, InitializationError, RunInterrupted, signal_name
 from ..inputs.scenario import Scenario
 from ..inputs.scenario_file import load_scenario
-from .analyses import analyse_run
+from .analyses import RunAnalyses, analyse_run
 from .comparison import compare, format_comparison, run_reference
 from .derived import Skipped, generator_vs_ideal
 from .memory import release_between_phases
@@ -45,12 +45,11 @@ def load_any(path: str | Path, step_s: float | None = None, stop_s: float | None
     ``step_s``, ``stop_s`` (``--step``, ``--stop``) are what an SSP without them uses;
     ``report`` receives the SSP import's notes (:func:`orchestrator.interop.ssp.import_ssp`).
     """
-    p = Path(path)
-    if p.suffix in (".ssp", ".ssd") or (p.is_dir() and (p / "SystemStructure.ssd").is_file()):
-        from ..interop.ssp import import_ssp
+    from ..interop.ssp import import_ssp, is_ssp
 
-        return import_ssp(p, step_s=step_s, stop_s=stop_s, report=report)
-    return load_scenario(p)
+    if is_ssp(path):
+        return import_ssp(path, step_s=step_s, stop_s=stop_s, report=report)
+    return load_scenario(Path(path))
 
 
 @dataclass
@@ -196,16 +195,17 @@ def _run_in(folder: RunFolder, stop: StopRequests, system: ResolvedSystem, wall0
     skipped: list[dict[str, str]] = []
     comparison = None
     comparison_text = ""
-    post = _PostProcessing(stop, folder)
+    post = _PostProcessing(stop, folder, compare_reference=compare_reference, plots=plots)
     if outcome.time_s.size and not problems:
         try:
             comparison, comparison_text = _post_process(system, outcome, out, post, derived, skipped,
                                                         compare_reference, plots)
-        except OSError as exc:
+        except OSError as exc:  # a full disk: what was written and computed before is kept and listed
             problems.append(describe_os_error(exc))
-            post.stopped = f"stopped: {problems[-1]}"
+            post.fail(problems[-1])
     if post.stopped:
-        derived["post_processing"] = {"stopped": post.stopped, "not_done": post.not_done}
+        derived["post_processing"] = {"stopped": post.stopped, "not_done": post.not_done,
+                                      **({"error": post.error} if post.error else {})}
     derived["analyses_skipped"] = skipped
     if outcome.start_values:
         derived.update(_settling(system, outcome))
@@ -270,13 +270,19 @@ def _finish_timeseries(writer: ResultWriter, outcome: RunOutcome, folder: RunFol
 
 
 class _PostProcessing:
-    """Stages after the co-simulation; a stop request skips the ones not started."""
+    """Stages after the co-simulation; a stop request skips the ones not started, a write error the rest."""
 
-    def __init__(self, stop: StopRequests, folder: RunFolder) -> None:
+    def __init__(self, stop: StopRequests, folder: RunFolder, *, compare_reference: bool, plots: bool) -> None:
         self.stop = stop
         self.folder = folder
         self.stopped = ""
         self.not_done: list[str] = []
+        #: the stages in the order :func:`_post_process` runs them
+        self.stages = ["generator_vs_ideal", "recorded_comparison", "analyses", *["comparison"] * compare_reference,
+                       *["plots"] * plots]
+        self.current: str | None = None
+        #: the write error that stopped the stages (None: none did)
+        self.error: str | None = None
 
     def go(self, stage: str) -> bool:
         """True if ``stage`` may start."""
@@ -285,7 +291,15 @@ class _PostProcessing:
         if self.stopped:
             self.not_done.append(stage)
             return False
+        self.current = stage
         return True
+
+    def fail(self, problem: str) -> None:
+        """A file of the current stage could not be written: the rest of it and every later stage are not done."""
+        self.stopped, self.error = f"stopped: {problem}", problem
+        self.not_done = []
+        if self.current is not None:
+            self.not_done = [f"the rest of {self.current}", *self.stages[self.stages.index(self.current) + 1:]]
 
     def commit(self, files: dict[str, Path]) -> None:
         for role, path in files.items():
@@ -309,12 +323,15 @@ def _post_process(system, outcome, out, post: _PostProcessing, derived, skipped,
         if recorded:  # simulated against recorded channels (a TimeSeriesSource playing a record)
             derived["recorded_comparison"] = recorded
     if post.go("analyses"):
-        analyses = analyse_run(system, outcome, out, plots=plots)
-        derived.update(analyses.summary)
-        if analyses.notes:
-            derived["analysis_notes"] = analyses.notes
-        skipped += analyses.skipped
-        post.commit(analyses.files)
+        analyses = RunAnalyses()
+        try:
+            analyse_run(system, outcome, out, plots=plots, into=analyses)
+        finally:  # also when a file could not be written: what was computed and written before is kept
+            derived.update(analyses.summary)
+            if analyses.notes:
+                derived["analysis_notes"] = analyses.notes
+            skipped += analyses.skipped
+            post.commit(analyses.files)
         release_between_phases(outcome.values.nbytes)  # the analyses' figures and temporaries, before the plots
     if compare_reference and post.go("comparison"):
         if not outcome.complete:
@@ -330,7 +347,11 @@ def _post_process(system, outcome, out, post: _PostProcessing, derived, skipped,
                 comparison_text = f"no monolithic comparison: {exc}"
                 skipped.append({"analysis": "comparison", "reason": str(exc)})
     if plots and post.go("plots"):
-        post.commit({f"plot:{p.stem}": p for p in plot_run(system, outcome, out, skipped)})
+        drawn: list[Path] = []
+        try:
+            plot_run(system, outcome, out, skipped, drawn)
+        finally:  # the plots written before one that could not be
+            post.commit({f"plot:{p.stem}": p for p in drawn})
         recorded_plot = plot_recorded(system, outcome, out)
         if recorded_plot is not None:
             post.commit({f"plot:{recorded_plot.stem}": recorded_plot})

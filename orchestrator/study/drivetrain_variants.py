@@ -124,6 +124,7 @@ def drivetrain_variants(study: Study, scenario, points: list[Point], fmu_dir: Pa
     users = [c for c in scenario.components if c.drivetrain is not None and c.drivetrain.sha256 == original.sha256]
     generators = [c.name for c in users if _project_role(c) == GENERATOR]
     fixed = {n: v for n, v in study.base.parameters.items() if is_file_entry(n)}
+    allow = [k.split(".", 1)[1] for k in study.allow_implausible if k.split(".", 1)[0] == gear_name]
 
     templates: list[tuple[str, DrivetrainSpec]] = []
     variants: dict[str, PointVariant] = {}
@@ -131,7 +132,7 @@ def drivetrain_variants(study: Study, scenario, points: list[Point], fmu_dir: Pa
         changes = {**fixed, **{n: v for n, v in point.parameters.items() if is_file_entry(n)}}
         try:
             spec = original if not changes else with_entries(
-                original, {FILE_ENTRY.match(n)["path"]: v for n, v in changes.items()})
+                original, {FILE_ENTRY.match(n)["path"]: v for n, v in changes.items()}, allow)
         except EntryError as exc:
             culprit = next((n for n in changes if FILE_ENTRY.match(n)["path"] == exc.key), next(iter(changes)))
             raise StudyError(_study_key(study, culprit, point), changes.get(culprit),

@@ -12,7 +12,8 @@ Each line is a JSON object with at least ``key`` (the point's identity),
 ``index``, ``status`` (``ok``, ``failed`` or ``error``), ``parameters``,
 ``measures`` and ``error``. Reading tolerates a torn last line (a crash in the
 middle of a write): it is skipped, and the next append starts on a new line.
-Only one sweep may write a journal at a time (an exclusive ``flock``).
+A line that cannot be written whole (a full disk) is cut off again and the error
+names the journal. Only one sweep may write a journal at a time (an exclusive ``flock``).
 """
 
 from __future__ import annotations
@@ -55,7 +56,7 @@ class Journal:
 
     def __enter__(self) -> "Journal":
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        fh = open(self.path, "a+b")
+        fh = open(self.path, "a+b", buffering=0)  # unbuffered: nothing left to write when the file is closed
         try:
             fcntl.flock(fh.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
@@ -65,7 +66,11 @@ class Journal:
         if fh.tell() > 0:
             fh.seek(-1, os.SEEK_END)
             if fh.read(1) != b"\n":  # a torn last line: start the next record on a line of its own
-                fh.write(b"\n")
+                try:
+                    _write_all(fh.fileno(), b"\n")
+                except OSError as exc:
+                    fh.close()
+                    raise OSError(exc.errno, exc.strerror or str(exc), str(self.path)) from None
         self._fh = fh
         return self
 
@@ -73,13 +78,21 @@ class Journal:
         self.close()
 
     def append(self, record: Mapping[str, Any]) -> None:
-        """Write one record as a line and force it to disk (flush + fsync)."""
+        """Write one record as a line and force it to disk (fsync); raises OSError naming the journal."""
         if self._fh is None:
             raise JournalError(f"{self.path} is not open for writing")
-        line = json.dumps(record, allow_nan=False, separators=(",", ":")) + "\n"
-        self._fh.write(line.encode("utf-8"))
-        self._fh.flush()
-        os.fsync(self._fh.fileno())
+        line = (json.dumps(record, allow_nan=False, separators=(",", ":")) + "\n").encode("utf-8")
+        fd = self._fh.fileno()
+        end = os.lseek(fd, 0, os.SEEK_END)
+        try:
+            _write_all(fd, line)
+            os.fsync(fd)
+        except OSError as exc:  # a full disk: no part of the line stays (the journal holds whole records)
+            try:
+                os.ftruncate(fd, end)
+            except OSError:
+                pass
+            raise OSError(exc.errno, exc.strerror or str(exc), str(self.path)) from None
 
     def close(self) -> None:
         """Release the lock and close the file."""
@@ -89,6 +102,13 @@ class Journal:
             finally:
                 self._fh.close()
                 self._fh = None
+
+
+def _write_all(fd: int, data: bytes) -> None:
+    """Write every byte of ``data`` to ``fd`` (a write may take part of it)."""
+    view = memoryview(data)
+    while view:
+        view = view[os.write(fd, view):]
 
 
 #: the statuses a journal record may have

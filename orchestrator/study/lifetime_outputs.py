@@ -13,7 +13,6 @@ from __future__ import annotations
 import csv
 import io
 import json
-import os
 from pathlib import Path
 from typing import Any
 
@@ -22,6 +21,7 @@ import numpy as np
 from components import units
 from components.analysis.lifetime import ONE_EVENT_SHARE
 
+from ..atomic_files import write_text_atomic
 from .engine import OK
 from .journal import JOURNAL_FILE, latest_by_key, read_journal
 from .lifetime_plots import plot_damage_by_bin, plot_ldd, plot_lrd
@@ -29,13 +29,6 @@ from .lifetime_results import HOURS, LifetimeResults, compute_lifetime, ranked_b
 from .load_cases import PreparedLoadCases
 from .ratings import BEARING_FILE, GEAR_FILE, bearing_rows, compute_ratings, gear_rows, report_lines
 from .ratings import summary as ratings_summary
-
-
-def _write_atomic(path: Path, text: str) -> Path:
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    os.replace(tmp, path)
-    return path
 
 
 def _csv(rows: list[list[Any]]) -> str:
@@ -228,21 +221,21 @@ def write_lifetime_outputs(plc: PreparedLoadCases, out_dir: str | Path, plots: b
     out.mkdir(parents=True, exist_ok=True)
     res = compute_lifetime(plc, out)
     files = {
-        "bins": _write_atomic(out / "bins.csv", _csv(_bins_rows(res))),
-        "runs": _write_atomic(out / "runs.csv", _csv(_runs_rows(res, out))),
-        "lifetime_del": _write_atomic(out / "lifetime_del.csv", _csv(_del_rows(res))),
-        "damage_by_bin": _write_atomic(out / "damage_by_bin.csv", _csv(_damage_rows(res))),
+        "bins": write_text_atomic(out / "bins.csv", _csv(_bins_rows(res))),
+        "runs": write_text_atomic(out / "runs.csv", _csv(_runs_rows(res, out))),
+        "lifetime_del": write_text_atomic(out / "lifetime_del.csv", _csv(_del_rows(res))),
+        "damage_by_bin": write_text_atomic(out / "damage_by_bin.csv", _csv(_damage_rows(res))),
     }
     ldd, lrd = _ldd_rows(res)
-    files["ldd"] = _write_atomic(out / "ldd.csv", _csv(ldd))
-    files["lrd"] = _write_atomic(out / "lrd.csv", _csv(lrd))
+    files["ldd"] = write_text_atomic(out / "ldd.csv", _csv(ldd))
+    files["lrd"] = write_text_atomic(out / "lrd.csv", _csv(lrd))
     ratings = compute_ratings(res)  # ISO 6336 gear ratings and ISO 281 bearing lives (orchestrator.study.ratings)
     if res.plc.ratings.meshes:
-        files["gear_rating"] = _write_atomic(out / GEAR_FILE, _csv(gear_rows(res, ratings)))
+        files["gear_rating"] = write_text_atomic(out / GEAR_FILE, _csv(gear_rows(res, ratings)))
     if res.plc.ratings.bearings:
-        files["bearing_life"] = _write_atomic(out / BEARING_FILE, _csv(bearing_rows(ratings)))
+        files["bearing_life"] = write_text_atomic(out / BEARING_FILE, _csv(bearing_rows(ratings)))
     report = report_text(res) + "\n".join(report_lines(res, ratings)) + "\n"
-    files["report"] = _write_atomic(out / "lifetime_report.txt", report)
+    files["report"] = write_text_atomic(out / "lifetime_report.txt", report)
     if plots and res.runs:
         files["plot:damage_by_bin"] = plot_damage_by_bin(res, out / "damage_by_bin.png")
         files["plot:ldd"] = plot_ldd(res, out / "ldd.png")
@@ -251,5 +244,5 @@ def write_lifetime_outputs(plc: PreparedLoadCases, out_dir: str | Path, plots: b
     doc = summary(res)
     doc["ratings"] = ratings_summary(ratings)
     doc["files"] = {k: p.name for k, p in files.items()}
-    _write_atomic(files["summary"], json.dumps(doc, indent=2) + "\n")
+    write_text_atomic(files["summary"], json.dumps(doc, indent=2) + "\n")
     return files

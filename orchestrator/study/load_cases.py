@@ -136,7 +136,7 @@ def _settled(lcs: LoadCaseSet, fmu_dir, build: bool) -> tuple[LoadCaseSet, dict 
     from ..run.runner import load_any
 
     try:
-        scenario = apply_parameters(load_any(lcs.base_path), lcs.base_parameters)
+        scenario = apply_parameters(load_any(lcs.base_path), lcs.base_parameters).with_allowed(*lcs.allow_implausible)
         system = resolve_system(scenario, fmu_paths=ensure_fmus(scenario, fmu_dir, build=build))
     except ScenarioError as exc:
         raise LoadCaseError("base.scenario", lcs.base_scenario, f"a valid scenario with its FMUs ({exc})",
@@ -159,7 +159,8 @@ def _base_system(lcs: LoadCaseSet, fmu_dir, build: bool):
         scenario = load_any(lcs.base_path)
         scenario, _ = lcs.time_grid().apply(scenario)
         paths = ensure_fmus(scenario, fmu_dir, build=build)
-        return resolve_system(apply_parameters(scenario, lcs.base_parameters), fmu_paths=paths)
+        return resolve_system(apply_parameters(scenario, lcs.base_parameters).with_allowed(*lcs.allow_implausible),
+                              fmu_paths=paths)
     except ScenarioError as exc:
         raise LoadCaseError("base.scenario", lcs.base_scenario, f"a valid scenario with its FMUs ({exc})", src) from None
 
@@ -320,7 +321,8 @@ def prepare_load_cases(lcs: LoadCaseSet, fmu_dir: str | Path | None = None, buil
                       base=Base("scenario", lcs.base_scenario, lcs.base_path, lcs.base_parameters),
                       measures=_measures(channels), points=tuple(c.parameters for c in cases),
                       simulation=lcs.time_grid(), timeout_s=lcs.timeout_s, description=lcs.description,
-                      base_dir=None if src is None else Path(src).resolve().parent, source=src)
+                      base_dir=None if src is None else Path(src).resolve().parent, source=src,
+                      allow_implausible=lcs.allow_implausible)
         prepared = prepare_study(study, fmu_dir=fmu_dir, build=build)
     except StudyError as exc:
         raise LoadCaseError(_case_label(cases, bins, exc.key), exc.value, exc.expected, src) from None

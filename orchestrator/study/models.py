@@ -50,6 +50,8 @@ class BuiltinModel:
         raises :class:`~components.errors.ParameterError` for a bad value.
     start : {"operating_point", "rest"}
         Where its runs start (:func:`components.reference.solver.simulate_monolithic`).
+    units : callable() -> dict of str -> str
+        Every parameter's SI unit (``"1/m"``, ``"N/m^e"``, ``"1"``): a value with another unit is converted to it.
     """
 
     name: str
@@ -57,6 +59,51 @@ class BuiltinModel:
     defaults: Callable[[], dict[str, float]]
     build: Callable[[Mapping[str, Any]], tuple[Any, Any]]
     start: str = "operating_point"
+    units: Callable[[], dict[str, str]] = dict
+
+    def exponent(self, name: str) -> float | None:
+        """The default exponent ``e`` of a parameter whose unit has it (``gearbox.stage1.k0`` in N/m^e), else None."""
+        from components.model.parameter_map import unit_exponent_parameter
+
+        comp, _, flat = name.partition(".")
+        other = unit_exponent_parameter(flat)
+        return self.defaults().get(f"{comp}.{other}") if other else None
+
+    def plausibility(self, base: Mapping[str, Any], allow: tuple[str, ...]):
+        """``problem(point values) -> (parameter, value, expectation) or None``: the model's values judged by physics.
+
+        The drivetrain with the point's values against the model as the study's base defines it
+        (:func:`components.analysis.plausibility.implausible`: a failure the point introduces), and the
+        input speed and output torque against that base's rating. A point the model refuses is not judged
+        here (it fails when it runs).
+        """
+        from components.analysis.plausibility import Rating, implausible, judge, judge_operation
+        from components.errors import ParameterError
+
+        prefix = MODEL_COMPONENT + "."
+        drivetrain, driver = self.build(dict(base))
+        rating = Rating.of(drivetrain, driver.speed(0.0))
+        built = judge(drivetrain, rating)
+        own = [k[len(prefix):] for k in allow if k.startswith(prefix)]
+
+        def problem(values: Mapping[str, Any]):
+            try:
+                dt, drv = self.build({**base, **values})
+            except ParameterError:
+                return None
+            given = [k[len(prefix):] for k, v in values.items() if k.startswith(prefix) and base.get(k) != v]
+            bad = [(prefix + j.key, j) for j in implausible(judge(dt, rating), own, built, given)]
+            bad += [(j.key, j) for j in implausible(judge_operation(rating, {_SPEED: drv.speed(0.0)},
+                                                                    {f"{prefix}output_torque": dt.output_torque_nm}),
+                                                    allow)]
+            if not bad:
+                return None
+            name, j = bad[0]
+            return (name, values.get(name, f"{j.value:.6g} (as the model builds it)"),
+                    f'{j.expected}; it is {j.value:.6g} {j.unit} in SI; a deliberate value is kept by [plausibility] '
+                    f'allow = ["{name}"] in the study or --allow-implausible {name}')
+
+        return problem
 
 
 _R1 = "gearbox.R1"
@@ -74,6 +121,14 @@ def _variant_defaults() -> dict[str, float]:
     out = {_R1: _DEFAULT_R1, _SPEED: _DEFAULT_SPEED}
     out.update({f"{MODEL_COMPONENT}.{k}": v for k, v in flatten(sensitivity_variant(_DEFAULT_R1, _BUILD_LAMBDA_PER_MM)).items()})
     return out
+
+
+def _variant_units() -> dict[str, str]:
+    from components.model.parameter_map import unit_of_parameter
+
+    prefix = MODEL_COMPONENT + "."
+    return {name: ("1" if name == _R1 else "rad/s" if name == _SPEED else unit_of_parameter(name[len(prefix):]))
+            for name in _variant_defaults()}
 
 
 def _variant_build(values: Mapping[str, Any]):
@@ -99,5 +154,6 @@ MODELS: dict[str, BuiltinModel] = {
         defaults=_variant_defaults,
         build=_variant_build,
         start="rest",  # Sec. 4.1: the counter torque a step at t = 0 (eq. 11 measures the start-up impact)
+        units=_variant_units,
     ),
 }

@@ -29,6 +29,7 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from ..errors import ScenarioError, suggestion
+from ..inputs.measures import Measure
 from ..inputs.study import Point, Study, StudyError, split_parameter
 from .engine import STAGE_COLUMNS, StudyPayload
 
@@ -189,11 +190,16 @@ def _solver_settings(study: Study):
         raise StudyError(f"solver ({exc.name})", exc.value, exc.expected, study.source) from None
 
 
-def _micro_run_series(drivetrain, driver, start: float) -> list[str]:
-    """Names of the series the monolithic solver records for this model (a 2-sample run)."""
+def _micro_run_units(drivetrain, driver, start: float) -> dict[str, str]:
+    """The series the monolithic solver records for this model and the unit it declares for each (a 2-sample run)."""
     from components.reference.solver import simulate_monolithic
 
-    return list(simulate_monolithic(drivetrain, driver, start + 1e-7, output_interval_s=1e-7, t_start_s=start).series)
+    return simulate_monolithic(drivetrain, driver, start + 1e-7, output_interval_s=1e-7, t_start_s=start).units
+
+
+def _with_units(measures: tuple[Measure, ...], units: Mapping[str, str]) -> tuple[Measure, ...]:
+    """The measures with the units their base declares (``units``: measure name -> unit)."""
+    return tuple(replace(m, unit=units[m.name]) if m.name in units else m for m in measures)
 
 
 def _check_measure_engines(study: Study) -> None:
@@ -203,9 +209,10 @@ def _check_measure_engines(study: Study) -> None:
                              f"({m.name} needs the {' or '.join(m.engines)} engine)", study.source)
 
 
-def _prepare_model(study: Study) -> tuple[StudyPayload, dict[str, Any]]:
+def _prepare_model(study: Study) -> tuple[Study, StudyPayload, dict[str, Any]]:
     from components.errors import ParameterError
 
+    from .declared_values import check_points, in_declared_units, model_converter
     from .models import MODEL_COMPONENT, MODELS
 
     src = study.source
@@ -213,6 +220,7 @@ def _prepare_model(study: Study) -> tuple[StudyPayload, dict[str, Any]]:
         raise StudyError("base.model", study.base.name, "one of the built-in models: " + ", ".join(MODELS), src)
     model = MODELS[study.base.name]
     defaults = model.defaults()
+    study = in_declared_units(study, model_converter(model.units(), model.exponent), base_too=True)
     checks = [(f"base.parameters.{p}", p, [v]) for p, v in study.base.parameters.items()] + _origins(study)
     for key, name, values in checks:
         if name not in defaults:
@@ -224,6 +232,7 @@ def _prepare_model(study: Study) -> tuple[StudyPayload, dict[str, Any]]:
         drivetrain, driver = model.build(dict(study.base.parameters))
     except ParameterError as exc:
         raise StudyError(f"base.parameters ({exc.name})", exc.value, exc.expected, src) from None
+    check_points(study, study.expand(), model.plausibility(dict(study.base.parameters), study.allow_implausible))
     sim = study.simulation
     start = 0.0 if sim.start_s is None else float(sim.start_s)
     stop = float(sim.stop_s)
@@ -238,35 +247,38 @@ def _prepare_model(study: Study) -> tuple[StudyPayload, dict[str, Any]]:
     settings = _solver_settings(study)
     _check_measure_engines(study)
     series_names = {}
+    declared_units: dict[str, str] = {}
     stats = [m for m in study.measures if not m.builtin]
     if stats:
-        names = _micro_run_series(drivetrain, driver, start)
+        units = _micro_run_units(drivetrain, driver, start)
         for i, m in enumerate(study.measures):
             if m.builtin:
                 continue
             comp, var = split_parameter(m.variable)
             if m.of_stage:  # the model's series of the stage's sun-planet forces, planet by planet
-                planets = [n for n in names if n.startswith(f"{var}.F_sp[")]
+                planets = [n for n in units if n.startswith(f"{var}.F_sp[")]
                 if comp != MODEL_COMPONENT or len(planets) < 2:
                     raise StudyError(f"measures[{i}]", m.name, f"a planetary stage {MODEL_COMPONENT}.<stage> of the "
                                      "model", src)
                 series_names[m.name] = STAGE_COLUMNS.join(sorted(planets, key=lambda n: int(n[n.index("[") + 1:-1])))
                 continue
-            if comp != MODEL_COMPONENT or var not in names:
+            if comp != MODEL_COMPONENT or var not in units:
                 raise StudyError(f"measures[{i}]", m.name, f"a variable {MODEL_COMPONENT}.<series> of the monolithic "
-                                 f"result{suggestion(var, names)}", src)
+                                 f"result{suggestion(var, units)}", src)
             series_names[m.variable] = var
+            declared_units[m.name] = units[var] or "-"  # as the solver declares its series
+    study = replace(study, measures=_with_units(study.measures, declared_units))
     payload = StudyPayload(
         study=study.name, engine="monolithic", measures=study.measures, model=model.name,
         model_parameters=dict(study.base.parameters), time_grid=(start, stop, interval), window_s=window,
         solver={k: getattr(settings, k) for k in ("rtol", "atol_angle_rad", "atol_speed_rad_s", "max_step_s", "max_steps")},
         series_names=series_names,
     )
-    return payload, {"model": model.name}
+    return study, payload, {"model": model.name}
 
 
 def _prepare_scenario(study: Study, fmu_dir,
-                      build: bool) -> tuple[StudyPayload, dict[str, Any], dict[str, Path], tuple[str, ...]]:
+                      build: bool) -> tuple[Study, StudyPayload, dict[str, Any], dict[str, Path], tuple[str, ...]]:
     from ..cosim.roles import GEARBOX
     from ..cosim.system import resolve_system
     from ..provision.project_fmus import ensure_fmus
@@ -286,6 +298,7 @@ def _prepare_scenario(study: Study, fmu_dir,
         paths = ensure_fmus(scenario, fmu_dir, build=build)
     except ScenarioError as exc:
         raise StudyError("base.scenario", study.base.name, f"FMUs that exist or can be built ({exc})", src) from None
+    from .declared_values import check_points, in_declared_units, scenario_converter, scenario_problem
     from .drivetrain_variants import is_file_entry
 
     by_comp: dict[str, dict[str, Any]] = {}
@@ -297,12 +310,18 @@ def _prepare_scenario(study: Study, fmu_dir,
     try:
         for comp, values in by_comp.items():
             scenario = scenario.with_parameters(comp, **values)
+        scenario = scenario.with_allowed(*study.allow_implausible)
         system = resolve_system(scenario, fmu_paths=paths)
     except ScenarioError as exc:
         raise StudyError(_study_key_of(exc), exc.value, exc.expected, src) from None
+    study = in_declared_units(study, scenario_converter(system, is_file_entry))
     for key, name, values in _origins(study):
         for value in values if not is_file_entry(name) else ():
             _check_value(system, name, value, key, src)
+    seed = study.seed_parameter if study.seeds else None  # a seed changes no value physics bounds
+    # drivetrain file entries are judged when each point's file is read again (drivetrain_variants)
+    check_points(study, study.expand(), scenario_problem(system),
+                 skip=lambda name: name == seed or is_file_entry(name))
     _check_measure_engines(study)
 
     series_names: dict[str, str] = {}
@@ -348,9 +367,8 @@ def _prepare_scenario(study: Study, fmu_dir,
         for each in [system] + list(variants.systems.values() if variants else ()):
             for comp, path in each.fmu_paths.items():
                 blobs[each.interfaces[comp].sha256] = Path(path).read_bytes()
-        measures = tuple(replace(m, unit=declared_units[m.name]) if m.name in declared_units else m
-                         for m in study.measures)
-        payload = StudyPayload(study=study.name, engine="cosim", measures=measures, system=system,
+        payload = StudyPayload(study=study.name, engine="cosim", measures=_with_units(study.measures, declared_units),
+                               system=system,
                                window_s=scenario.simulation.window_s, series_names=series_names, fmu_blobs=blobs)
         settings = None
     else:
@@ -367,30 +385,28 @@ def _prepare_scenario(study: Study, fmu_dir,
         settings = _solver_settings(study)
         stats = [m for m in study.measures if not m.builtin]
         if stats:
-            series = dict.fromkeys(_micro_run_series(setup.drivetrain, RotorSpeedProcess(setup.wind), scenario.simulation.start_s))
+            units = _micro_run_units(setup.drivetrain, RotorSpeedProcess(setup.wind), scenario.simulation.start_s)
             for i, m in enumerate(study.measures):
                 if m.builtin:
                     continue
                 if m.of_stage:
-                    names = [reference_name(c, system, setup, series) for c in _stage_forces(system, m, i, src)]
+                    names = [reference_name(c, system, setup, units) for c in _stage_forces(system, m, i, src)]
                     if any(n is None for n in names):
                         raise StudyError(f"measures[{i}]", m.name, "a stage whose planet forces the monolithic model "
                                          "has", src)
                     series_names[m.name] = STAGE_COLUMNS.join(names)
                     continue
-                name = reference_name(m.variable, system, setup, series)
+                name = reference_name(m.variable, system, setup, units)
                 if name is None:
                     raise StudyError(f"measures[{i}]", m.name, "a variable of the scenario with a counterpart in the "
                                      "monolithic model (e.g. gearbox.stage1.F_sp[1], generator.omega, wind.omega)", src)
                 series_names[m.variable] = name
                 comp, var = split_parameter(m.variable)
                 fv = system.interfaces[comp].variables.get(var) if comp in system.interfaces else None
-                if fv is not None:
-                    declared_units[m.name] = fv.unit or "-"  # as the scenario's FMU declares it
-        measures = tuple(replace(m, unit=declared_units[m.name]) if m.name in declared_units else m
-                         for m in study.measures)
+                # as the scenario's FMU declares it, else as the solver declares its counterpart
+                declared_units[m.name] = (fv.unit if fv is not None else units[name]) or "-"
         payload = StudyPayload(
-            study=study.name, engine="monolithic", measures=measures, system=system,
+            study=study.name, engine="monolithic", measures=_with_units(study.measures, declared_units), system=system,
             window_s=scenario.simulation.window_s, series_names=series_names,
             solver={k: getattr(settings, k) for k in ("rtol", "atol_angle_rad", "atol_speed_rad_s", "max_step_s", "max_steps")},
         )
@@ -402,7 +418,7 @@ def _prepare_scenario(study: Study, fmu_dir,
         identity["structures"] = {sid: {c: i.sha256 for c, i in s.interfaces.items()}
                                   for sid, s in variants.systems.items()}
         payload = replace(payload, structures=dict(variants.systems), variants=dict(variants.points))
-    return payload, identity, dict(system.fmu_paths), tuple(notes)
+    return study, payload, identity, dict(system.fmu_paths), tuple(notes)
 
 
 def _stage_forces(system, m, i: int, src) -> list[str]:
@@ -475,11 +491,11 @@ def prepare_study(study: Study, fmu_dir: str | Path | None = None, build: bool =
         Naming the study key of the first problem.
     """
     if study.base.kind == "model":
-        payload, base_identity = _prepare_model(study)
+        study, payload, base_identity = _prepare_model(study)
         fmu_paths: dict[str, Path] = {}
         notes: tuple[str, ...] = ()
     else:
-        payload, base_identity, fmu_paths, notes = _prepare_scenario(study, fmu_dir, build)
+        study, payload, base_identity, fmu_paths, notes = _prepare_scenario(study, fmu_dir, build)
     identity = {
         "engine": study.engine,
         "base": {"kind": study.base.kind, **base_identity},

@@ -3,8 +3,8 @@
 ``results.csv``
     One row per point of the study, in point order: ``index``, ``status``
     (``ok``, ``failed``, ``error`` or ``pending`` = not run yet), one column per
-    varied parameter (``component.parameter``, SI, full precision), for axes with
-    a display scale also ``label [unit]`` (e.g. ``lambda [1/mm]``), one column
+    varied parameter (``component.parameter``, in its declared unit, full precision), for axes
+    written in another unit also ``label [unit]`` as written (e.g. ``lambda [1/mm]``), one column
     per measure (``name [unit]``), ``error`` (the message of a failed point),
     ``worker``, ``task_wall_time [s]`` and ``key``.
 ``study.json``
@@ -21,23 +21,16 @@ import csv
 import io
 import json
 import math
-import os
 from pathlib import Path
 from typing import Any, Mapping
 
+from ..atomic_files import write_text_atomic
 from ..output_folders import STUDY_SUMMARY
 from .journal import JOURNAL_FILE, latest_by_key, read_journal
 
 TABLE_FILE = "results.csv"
 SUMMARY_FILE = STUDY_SUMMARY
 PENDING = "pending"
-
-
-def _write_atomic(path: Path, text: str) -> Path:
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    os.replace(tmp, path)
-    return path
 
 
 def point_records(prepared, records: list[dict] | None = None, out_dir: str | Path | None = None) -> list[dict | None]:
@@ -68,7 +61,7 @@ def table_text(prepared, recs: list[dict | None]) -> str:
     """The CSV table (see the module docstring) as text."""
     study = prepared.study
     params = study.varied_parameters
-    display = [(a, a.parameters[0]) for a in study.axes if a.scale != 1.0]
+    display = [(a, a.parameters[0]) for a in study.axes if a.shown is not None]
     header = ["index", "status", *params, *(a.axis_label for a, _ in display), *(m.column for m in study.measures),
               "error", "worker", "task_wall_time [s]", "key"]
     buf = io.StringIO()
@@ -115,8 +108,8 @@ def summary(prepared, recs: list[dict | None], report=None, files: Mapping[str, 
                  "parameters": dict(study.base.parameters)},
         "points": len(prepared.points),
         "status": status_counts(recs),
-        "axes": [{"label": a.label, "unit": a.unit, "scale": a.scale, "parameters": list(a.parameters),
-                  "values": list(a.values)} for a in study.axes],
+        "axes": [{"label": a.label, "unit": a.unit, "parameters": list(a.parameters), "values": list(a.values),
+                  "shown": list(a.shown) if a.shown is not None else None} for a in study.axes],
         "seeds": list(study.seeds),
         "measures": [{"name": m.name, "unit": m.unit, "description": m.description} for m in study.measures],
         "code_version": prepared.identity["code"],
@@ -145,12 +138,12 @@ def write_outputs(prepared, out_dir: str | Path, report=None, plots: bool = True
     out.mkdir(parents=True, exist_ok=True)
     recs = point_records(prepared, out_dir=out)
     files: dict[str, Path] = {"journal": out / JOURNAL_FILE}
-    files["table"] = _write_atomic(out / TABLE_FILE, table_text(prepared, recs))
+    files["table"] = write_text_atomic(out / TABLE_FILE, table_text(prepared, recs))
     if plots:
         from .plots import plot_study
 
         for p in plot_study(prepared, recs, out):
             files[f"plot:{p.stem}"] = p
     files["summary"] = out / SUMMARY_FILE
-    _write_atomic(files["summary"], json.dumps(summary(prepared, recs, report, files), indent=2) + "\n")
+    write_text_atomic(files["summary"], json.dumps(summary(prepared, recs, report, files), indent=2) + "\n")
     return files

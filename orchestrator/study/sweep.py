@@ -78,8 +78,11 @@ class SweepReport:
     files : dict of str -> pathlib.Path
         Written files by role (``journal``, ``table``, ``summary``, ``plot:<name>``).
     problems : list of str
-        Files that could not be written (a full disk), each with what is kept and what to do;
-        a run file or journal line that cannot be written stops the sweep.
+        Files that could not be written (a full disk), one line per failure with what is kept and what to
+        do; a run file or journal line that cannot be written stops the sweep, and its line also says
+        when the table it then could not write either is missing (not a second line).
+    stopped_at : str
+        The write that stopped the sweep (``"cannot write <file>: No space left on device"``), "" if none.
     """
 
     total: int
@@ -96,6 +99,7 @@ class SweepReport:
     out_dir: Path = Path(".")
     files: dict[str, Path] = field(default_factory=dict)
     problems: list[str] = field(default_factory=list)
+    stopped_at: str = ""
 
 
 def pending_points(prepared: PreparedStudy, records: list[dict], retry_failed: bool = False) -> list[int]:
@@ -156,6 +160,16 @@ class _Interrupts:
             if self.pending:
                 self.pending = False
                 raise KeyboardInterrupt
+
+
+def _count(report: SweepReport, status: str) -> None:
+    """Count a journaled point's outcome in ``report``."""
+    if status == OK:
+        report.ok += 1
+    elif status == FAILED:
+        report.failed += 1
+    else:
+        report.errors += 1
 
 
 def _now() -> str:
@@ -287,12 +301,20 @@ def run_sweep(
         if todo:
             _execute(prepared, todo, journal, report, workers, scheduler, progress, dashboard, on_result,
                      case_progress)
+    unwritten = ""
     try:
         report.files = write_outputs(prepared, out, report, plots=plots)
     except OSError as exc:  # a full disk while the table or the plots are drawn: the journal has every point
-        report.problems.append(f"{describe_os_error(exc)}; the table, plots and study.json are not all written; "
-                               f"every finished point is kept in {journal_path}: free some space and run the same "
-                               "command with --report to write them")
+        unwritten = describe_os_error(exc)
+    if report.stopped_at:  # one line for the full disk that stopped the sweep, whatever it kept from writing after
+        report.problems.append(f"{report.stopped_at}; the sweep stopped, the points finished before are kept in "
+                               f"{journal_path}" + ("; the table, plots and study.json are not all written either"
+                                                    if unwritten else "")
+                               + ": free some space and run the same command again to continue")
+    elif unwritten:
+        report.problems.append(f"{unwritten}; the table, plots and study.json are not all written; every finished "
+                               f"point is kept in {journal_path}: free some space and run the same command with "
+                               "--report to write them")
     report.wall_time_s = time.perf_counter() - wall0
     return report
 
@@ -352,24 +374,18 @@ def _execute(prepared: PreparedStudy, todo: list[int], journal: Journal, report:
                     "task_wall_time_s": result.get("task_wall_time_s"), "code_version": code, "finished_at": _now(),
                 }
                 try:
-                    # storing a run's data and journaling it is one step: a signal during it is raised after both
+                    # storing a run's data, journaling it and counting it is one step: a signal during it is raised
+                    # after all three (raised between journal and count, the sweep said one point fewer was kept)
                     with interrupts.critical_section():
                         if on_result is not None and record["status"] == OK:
                             record.update(on_result(i, result))
                         journal.append(record)
+                        _count(report, record["status"])
                 except OSError as exc:  # a full disk: nothing more can be kept, so nothing more is run
-                    report.problems.append(f"{describe_os_error(exc)}; the sweep stopped, the points finished "
-                                           f"before are kept in {journal.path}: free some space and run the same "
-                                           "command again to continue")
+                    report.stopped_at = describe_os_error(exc)  # told once by run_sweep, with the table
                     with interrupts.shielded(), contextlib.suppress(Exception):
                         client.cancel(list(futures))
                     break
-                if record["status"] == OK:
-                    report.ok += 1
-                elif record["status"] == FAILED:
-                    report.failed += 1
-                else:
-                    report.errors += 1
                 if progress is not None:
                     progress(record)
         except KeyboardInterrupt:

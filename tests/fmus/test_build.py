@@ -55,8 +55,9 @@ def test_fmpy_validation_reports_no_problem(fmu_path, name):
     ("Gearbox", "parameter", {"stage1.k0": "N/m^e", "stage1.c0": "N.s/m2",
                               "stage2.lambda": "1/m", "stage3.contact_law": None, "stage2.planet_inertia": "kg.m2",
                               "shaft3.stiffness": "N.m/rad", "shaft2.damping": "N.m.s/rad", "solver.rtol": "1",
-                              "solver.max_steps": None, "shaft_torque_mode": None, "extrapolate_inputs": None}),
-    ("GeneratorRotor", "input", {"shaft_torque": "N.m"}),
+                              "solver.max_steps": None, "shaft_torque_mode": None, "extrapolate_inputs": None,
+                              "generator_interface": None}),
+    ("GeneratorRotor", "input", {"shaft_torque": "N.m", "omega_gearbox": "rad/s"}),
     ("GeneratorRotor", "output", {"omega": "rad/s", "phi": "rad", "generator_torque": "N.m"}),
     ("GeneratorRotor", "parameter", {"inertia": "kg.m2", "counter_torque": "N.m", "initial_speed": "rad/s",
                                      "initial_angle": "rad", "event1.kind": None, "event4.start": "s",
@@ -79,7 +80,8 @@ def test_gearbox_exposes_every_mesh_shaft_and_body_of_the_preset(fmu_path):
     speeds = {f"stage1.{b}.omega" for b in ("sun", "planet[1]", "planet[2]", "planet[3]")}
     speeds |= {f"stage2.{b}.omega" for b in ("carrier", "sun", "planet[1]", "planet[2]", "planet[3]")}
     speeds |= {"stage3.drive.omega", "stage3.driven.omega"}
-    main = {"shaft_torque", "shaft_torque_end", "shaft_torque_avg", "omega_out", "torque_rotor", "alpha_out", "alpha_out_max"}
+    main = {"shaft_torque", "shaft_torque_end", "shaft_torque_avg", "omega_out", "torque_rotor", "alpha_out", "alpha_out_max",
+            "omega_generator"}
     assert outputs == main | forces | speeds | {"shaft1.torque", "shaft2.torque", "shaft3.torque"}
 
 

@@ -46,3 +46,23 @@ class FullDisk:
             self.refused += 1
             raise OSError(errno.ENOSPC, "No space left on device", str(path))
         return write_summary(path, summary)
+
+
+class FullAt:
+    """``os.replace`` on a disk that is full when the file named ``name`` is put in place (ENOSPC, no file name).
+
+    Every file dtcosim writes is renamed into place (:mod:`orchestrator.atomic_files`), so this is a full
+    disk at that file, after the files before it: ``monkeypatch.setattr(os, "replace", FullAt("x.png"))``.
+    """
+
+    def __init__(self, name: str) -> None:
+        import os
+
+        self.name, self.replace = name, os.replace
+
+    def __call__(self, src, dst) -> None:
+        from pathlib import Path
+
+        if Path(dst).name == self.name:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        self.replace(src, dst)

@@ -76,3 +76,14 @@ def write_ssp(folder: Path, text: str, files: dict[str, str] | None = None) -> P
     for name, content in (files or {}).items():
         (folder / name).write_text(content)
     return folder
+
+
+def zip_folder(folder: Path, archive: Path) -> Path:
+    """``archive``: an ``.ssp`` holding the files of the SSP folder ``folder`` (relative names with '/')."""
+    import zipfile
+
+    with zipfile.ZipFile(archive, "w") as zf:
+        for f in sorted(folder.rglob("*")):
+            if f.is_file():
+                zf.write(f, f.relative_to(folder).as_posix())
+    return archive

@@ -8,6 +8,16 @@ import subprocess
 import sys
 from pathlib import Path
 
+#: a study of the built-in Sec. 4.1 model, 10 ms per run, without axes (tests append them)
+MODEL_BASE = """
+name = "t"
+engine = "monolithic"
+measures = ["I_max_acc"]
+[base]
+model = "sensitivity-variant"
+[simulation]
+stop = 0.01
+"""
 #: top-level keys of the small studies: the Sec. 4.1 model, 20 ms per run
 SMALL_HEAD = """
 name = "small"

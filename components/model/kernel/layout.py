@@ -53,14 +53,16 @@ SCALAR_NAMES = (
     "time_s", "driver_angle_rad", "driver_speed_rad_s", "driver_accel_rad_s2", "port_angle_rad",
     "port_speed_rad_s", "last_step_s", "last_omega_rotor", "last_omega_gen", "shaft_torque_average_nm",
     "output_twist_rad", "alpha_out_average_rad_s2", "last_alpha", "kx", "twist_port", "shaft_k", "shaft_c",
-    "port_offset_rad",
+    "port_offset_rad", "generator_speed_rad_s",
 )
 (S_TIME, S_DRIVER_ANGLE, S_DRIVER_SPEED, S_DRIVER_ACCEL, S_PORT_ANGLE, S_PORT_SPEED, S_LAST_STEP, S_LAST_OMEGA_ROTOR,
  S_LAST_OMEGA_GEN, S_SHAFT_TORQUE_AVG, S_OUTPUT_TWIST, S_ALPHA_OUT_AVG, S_LAST_ALPHA, S_KX, S_TWIST_PORT,
- S_SHAFT_K, S_SHAFT_C, S_PORT_OFFSET) = range(len(SCALAR_NAMES))
+ S_SHAFT_K, S_SHAFT_C, S_PORT_OFFSET, S_GEN_SPEED) = range(len(SCALAR_NAMES))
 
 # entries of the integer vector ``dims``: sizes, flags, the generator's degree of freedom (-1: the motion
-# interface, the generator is the port), whether the rotor motion is extrapolated from its derivative inputs, the
-# number of external terms (0: no external loads) and of output magnitudes (bearing forces)
-D_N, D_M, D_WIDTH, D_TVS, D_EXTRAPOLATE, D_END_TORQUE, D_GEN_DOF, D_ROTOR_DERIVATIVES, D_EXT, D_MAGNITUDES = range(10)
-N_DIMS = 10
+# interface, the generator is the port), whether the rotor motion is extrapolated from its derivative inputs,
+# whether the generator speed is the gearbox's own (``inertia_own``: not re-anchored on the generator-speed input),
+# the number of external terms (0: no external loads) and of output magnitudes (bearing forces)
+(D_N, D_M, D_WIDTH, D_TVS, D_EXTRAPOLATE, D_END_TORQUE, D_GEN_DOF, D_ROTOR_DERIVATIVES, D_OWN_GEN_SPEED, D_EXT,
+ D_MAGNITUDES) = range(11)
+N_DIMS = 11

@@ -7,7 +7,10 @@ motion it had to the target extrapolated from the rotor inputs (linear accelerat
 the source's acceleration and jerk with ``rotor_derivatives``); the port is either the
 generator end of the output shaft following its own curve (``motion`` interface) or the
 counter torque held over the step with the generator rotor a degree of freedom whose speed is
-re-anchored on the generator-speed input (``inertia`` interface).
+re-anchored at every communication point: on the generator-speed input (``inertia`` interface), or on the
+gearbox's own impulse balance of the generator, ``I_g (w_n+1 - w_n) = h (mean shaft torque - counter torque)``
+(``inertia_own``: what the generator component computes from the same torques, for hosts that exchange values
+after all components stepped, Jacobi).
 
 This is the gearbox kernel's entry module: run interpreted, compiled by numba, or ahead of time
 (``AOT_EXPORTS``) - see :mod:`components.compile`.
@@ -24,13 +27,12 @@ from .dynamics import acceleration, external_terms
 from .integrator import advance
 from .layout import (
     A_PORT, A_T, ACC, ANCHOR, BACKUP, CONTACT, CONTROL, COS_ALPHA, D_END_TORQUE, D_EXT, D_EXTRAPOLATE, D_GEN_DOF, D_M,
-    D_MAGNITUDES, D_N, D_ROTOR_DERIVATIVES, D_TVS, DA, DEFL, DQ, DRIVER, DV, F0, F1, FAST, FAST_INDEX, FAST_VALUE, FD,
-    FN, FACTOR, FORCE_ROWS,
-    FV, INV_M, ISTATE, JAC_INDEX, K1, K2, K3, KAPPA, LAST_ACC, LAST_DEFL, LAST_FORCE, LOAD_RATES, MAGNITUDES, NON_FINITE_INPUT,
-    N_SLOTS, NZ_INDEX, NZ_VALUE, OFFSET, OK, PIVOTS,
-    OUT_INDEX, OUT_KINEMATIC, OUT_RATE_INDEX, OUT_VALUE, OUTPUTS, PHASING, PORT, PORT_JAC, RHS, S_ALPHA_OUT_AVG,
-    S_DRIVER_ACCEL, S_DRIVER_ANGLE, S_DRIVER_SPEED, S_KX, S_LAST_ALPHA, S_LAST_OMEGA_GEN, S_LAST_OMEGA_ROTOR,
-    S_LAST_STEP, S_OUTPUT_TWIST, S_PORT_ANGLE, S_PORT_OFFSET, S_PORT_SPEED, S_SHAFT_C, S_SHAFT_K, S_SHAFT_TORQUE_AVG, S_TIME,
+    D_MAGNITUDES, D_N, D_OWN_GEN_SPEED, D_ROTOR_DERIVATIVES, D_TVS, DA, DEFL, DQ, DRIVER, DV, F0, F1, FAST, FAST_INDEX,
+    FAST_VALUE, FD, FN, FACTOR, FORCE_ROWS, FV, INV_M, ISTATE, JAC_INDEX, K1, K2, K3, KAPPA, LAST_ACC, LAST_DEFL,
+    LAST_FORCE, LOAD_RATES, MAGNITUDES, NON_FINITE_INPUT, N_SLOTS, NZ_INDEX, NZ_VALUE, OFFSET, OK, PIVOTS, OUT_INDEX,
+    OUT_KINEMATIC, OUT_RATE_INDEX, OUT_VALUE, OUTPUTS, PHASING, PORT, PORT_JAC, RHS, S_ALPHA_OUT_AVG, S_DRIVER_ACCEL,
+    S_DRIVER_ANGLE, S_DRIVER_SPEED, S_GEN_SPEED, S_KX, S_LAST_ALPHA, S_LAST_OMEGA_GEN, S_LAST_OMEGA_ROTOR, S_LAST_STEP,
+    S_OUTPUT_TWIST, S_PORT_ANGLE, S_PORT_OFFSET, S_PORT_SPEED, S_SHAFT_C, S_SHAFT_K, S_SHAFT_TORQUE_AVG, S_TIME,
     S_TWIST_PORT, SCALARS, SENS, SLOPE, SOL, STATE_FIRST, STATE_LAST, STCS, STCS_PORT, STKS, STKS_PORT, TWIST_Q, W_BASES,
     W_EXT, W_HDT, WINVS, Y, Y1, YN, Z, ALPHA_OUT_MAX,
 )
@@ -94,9 +96,10 @@ def outputs(buf, lay, dims):
     """Every output at the current time into the ``outputs`` slot.
 
     ``[shaft torque (average or end), average, then the linear outputs, the magnitudes, alpha_out average,
-    alpha_out max]``; the linear outputs are ``[F, q, v, port angle, port speed, driver speed, driver accel] @
-    output matrix`` (held by columns, its nonzero rows only: ``out_index``, ``out_value``), the magnitudes ``hypot`` of two linear outputs each (the bearing forces; the rows of the
-    ``magnitudes`` slot index the linear outputs, -1 for none).
+    alpha_out max, generator speed]``; the linear outputs are ``[F, q, v, port angle, port speed, driver speed,
+    driver accel] @ output matrix`` (held by columns, its nonzero rows only: ``out_index``, ``out_value``), the
+    magnitudes ``hypot`` of two linear outputs each (the bearing forces; the rows of the ``magnitudes`` slot index
+    the linear outputs, -1 for none).
     """
     n = dims[D_N]
     m = dims[D_M]
@@ -114,7 +117,7 @@ def outputs(buf, lay, dims):
     z[m + 2 * n + 2] = sc[S_DRIVER_SPEED]
     z[m + 2 * n + 3] = sc[S_DRIVER_ACCEL]
     n_mag = dims[D_MAGNITUDES]
-    cols = out.shape[0] - 4 - n_mag
+    cols = out.shape[0] - 5 - n_mag
     sparse_vecmat(z, matrix(buf, lay, OUT_INDEX, cols), matrix(buf, lay, OUT_VALUE, cols), out[2:2 + cols])
     avg = sc[S_SHAFT_TORQUE_AVG]
     out[0] = out[2] if dims[D_END_TORQUE] != 0 else avg
@@ -127,6 +130,7 @@ def outputs(buf, lay, dims):
             out[2 + cols + j] = math.sqrt(a * a + b * b)
     out[2 + cols + n_mag] = sc[S_ALPHA_OUT_AVG]
     out[3 + cols + n_mag] = vector(buf, lay, ISTATE)[ALPHA_OUT_MAX]
+    out[4 + cols + n_mag] = sc[S_GEN_SPEED]
 
 
 def external(k, sc):
@@ -205,12 +209,15 @@ def gearbox_step(buf, lay, dims, t, h, omega_rotor, phi_rotor, omega_gen, phi_ge
         angle1, speed1 = linear_target(h, phi_rotor, omega_rotor, alpha)
     kx = sc[S_KX]
     dv = 0.0
+    gen_speed = omega_gen  # the generator speed the step starts from (inertia interfaces)
     if gdof >= 0:  # inertia interface: the port input is the held counter torque
         port0 = counter_torque
         port_speed0 = 0.0
         port1 = port0
         port_speed1 = 0.0
-        dv = omega_gen - kx * sc[S_DRIVER_SPEED] - y[n + gdof]
+        if dims[D_OWN_GEN_SPEED] != 0:
+            gen_speed = sc[S_GEN_SPEED]
+        dv = gen_speed - kx * sc[S_DRIVER_SPEED] - y[n + gdof]
         if not math.isfinite(dv + port0):
             return NON_FINITE_INPUT, 0.0, h, 0.0
     else:  # motion interface: the port is the generator end's deviation from the kinematic motion (its angle
@@ -265,6 +272,10 @@ def gearbox_step(buf, lay, dims, t, h, omega_rotor, phi_rotor, omega_gen, phi_ge
     # (1/h) int T dt = k mean(twist) + c (twist_end - twist_start) / h: conserves the exchanged impulse
     sc[S_SHAFT_TORQUE_AVG] = sc[S_SHAFT_K] * twist_integral / h + sc[S_SHAFT_C] * (twist_end - twist_start) / h
     sc[S_ALPHA_OUT_AVG] = (out_kin * speed1 + y[out_idx] - speed_start) / h
+    if gdof >= 0:  # the generator's impulse balance over the step (the generator component's own equation)
+        sc[S_GEN_SPEED] = gen_speed + (sc[S_SHAFT_TORQUE_AVG] - port0) * h * k.inv_m[gdof]
+    else:
+        sc[S_GEN_SPEED] = kx * speed1 + port_speed1
     outputs(buf, lay, dims)
     return OK, tau, h, 0.0
 

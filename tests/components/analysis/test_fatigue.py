@@ -70,7 +70,7 @@ def test_two_sines_counts_and_dels_are_the_hand_computed_values():
     t, y = _two_sines()
     settings = FatigueSettings(residue="repeat")
     assert _histogram(rainflow(y, residue="repeat")) == {2.0: 35.0, 6.0: 5.0}
-    fl = fatigue_loads(t, y, settings, name="shaft1.torque")
+    fl = fatigue_loads(t, y, settings, name="shaft1.torque", unit="N.m")
     assert fl.analysed_time_s == pytest.approx(10.0)
     assert fl.reference_cycles == pytest.approx(10.0)
     assert fl.cycles == 40.0
@@ -198,10 +198,14 @@ def test_fatigue_report_of_a_run_is_json_and_csv_ready(wind_run, tmp_path):
 
 
 def test_fatigue_report_of_fmu_style_columns(wind_run):
-    """Result columns of a co-simulation carry the component prefix (``gearbox.shaft1.torque``)."""
-    series = {f"gearbox.{k}": v for k, v in wind_run.series.items() if ".F_" in k or k.startswith("shaft")}
+    """Result columns of a co-simulation carry the component prefix (``gearbox.shaft1.torque``); a plain mapping
+    declares no kinds, so the caller names the loads, the torques and their units as the FMU declares them."""
+    loads = wind_run.names_of("contact_force", "shaft_torque")
+    series = {f"gearbox.{k}": wind_run[k] for k in loads}
     series["wind.omega"] = wind_run["omega_rotor"]
-    report = fatigue_report(series, time_s=wind_run.time_s, window=(1.0, 6.0))
+    report = fatigue_report(series, time_s=wind_run.time_s, window=(1.0, 6.0), names=[f"gearbox.{k}" for k in loads],
+                            torques=[f"gearbox.{k}" for k in wind_run.names_of("shaft_torque")],
+                            units={f"gearbox.{k}": wind_run.signals[k].unit for k in loads})
     assert len(report.loads) == 16 and "wind.omega" not in report.loads
     assert sorted(report.ldd) == ["gearbox.shaft1.torque", "gearbox.shaft2.torque", "gearbox.shaft3.torque"]
     assert report.loads["gearbox.shaft1.torque"].unit == "N.m"
@@ -209,6 +213,8 @@ def test_fatigue_report_of_fmu_style_columns(wind_run):
     assert report.loads["gearbox.stage3.F_mesh"].del_by_exponent == direct.loads["stage3.F_mesh"].del_by_exponent
     with pytest.raises(ParameterError, match="time_s"):
         fatigue_report(series)
+    with pytest.raises(ParameterError, match="names = None: expected the load signals of a plain mapping"):
+        fatigue_report(series, time_s=wind_run.time_s)
 
 
 def test_declared_kinds_and_units_not_names_choose_the_ldd_and_the_units():

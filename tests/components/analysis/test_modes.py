@@ -311,3 +311,48 @@ def test_spectral_peak_of_a_complex_mode_is_the_damped_frequency():
     assert spectral_peak_hz(eta, dt) == pytest.approx(0.91, rel=1e-4)
     # a real decaying oscillation would peak elsewhere (why the check projects on the complex mode)
     assert abs(spectral_peak_hz(np.real(eta), dt) / 0.91 - 1.0) > 0.02
+
+
+# ------------------------------------------------------- a user's gearbox with 4 and 5 planets (issue 29.5)
+@pytest.fixture(scope="module")
+def four_and_five_planets():
+    """Planetary stages with 4 and 5 planets and a parallel stage, lightly damped: 12 of its 15 modes oscillate."""
+    from pathlib import Path
+
+    from orchestrator.inputs.drivetrain_file import load_drivetrain_file
+
+    spec = load_drivetrain_file(Path(__file__).parents[2] / "data" / "drivetrains" / "four-and-five-planets.toml")
+    return drivetrain_modes(spec.drivetrain, TABLE6_POINT)
+
+
+def test_each_row_gives_the_undamped_and_damped_frequency_of_one_eigenvalue(four_and_five_planets):
+    """The table paired the undamped frequency of one mode with the damped frequency of another (283 -> 964 Hz)."""
+    ss = four_and_five_planets.state_space
+    oscillating = np.flatnonzero(ss.is_complex() & (ss.eigenvalues.imag > 0))
+    rows = [m.mode for m in four_and_five_planets.modes if not m.mode.overdamped]
+    assert len(rows) == oscillating.size >= 10
+    assert sorted(r.eigen_index for r in rows) == sorted(oscillating)  # every oscillating eigenvalue, once
+    for r in rows:
+        lam = ss.eigenvalues[r.eigen_index]
+        assert r.eigenvalue == lam
+        assert r.undamped_frequency_hz == pytest.approx(abs(lam) / (2 * math.pi), rel=1e-12)
+        assert r.damped_frequency_hz == pytest.approx(lam.imag / (2 * math.pi), rel=1e-12)
+        assert r.damped_frequency_hz <= r.undamped_frequency_hz
+        assert r.damping_ratio == pytest.approx(-lam.real / abs(lam), rel=1e-12)
+
+
+def test_each_row_is_described_by_its_own_shape(four_and_five_planets):
+    """Rows are ordered by |lambda|, the undamped shapes by the undamped system's frequency: the kinds and dominant
+    bodies were taken from the shape of the same position in the other order (a planet mode called rotational,
+    a rotational one 'planet stage1')."""
+    modes = four_and_five_planets.modes
+    planet = {stage: [m for m in modes if m.kind == "planet" and m.stage == stage] for stage in ("stage1", "stage2")}
+    assert [len(planet["stage1"]), len(planet["stage2"])] == [3, 4]  # n - 1 planet modes per stage
+    for group in planet.values():
+        f = [m.mode.undamped_frequency_hz for m in group]
+        assert np.ptp(f) <= 1e-9 * f[0]
+        assert all(m.dominant_bodies == f"{m.stage}.planets 100%" for m in group)
+    rotational = [m for m in modes if m.kind == "rotational"]
+    assert all(".planets 100%" not in m.dominant_bodies for m in rotational)
+    assert [m.mode.undamped_frequency_hz for m in modes] == sorted(m.mode.undamped_frequency_hz for m in modes)
+    assert [m.mode.system_frequency_hz for m in modes] != sorted(m.mode.system_frequency_hz for m in modes)

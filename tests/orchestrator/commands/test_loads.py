@@ -49,3 +49,34 @@ def test_the_packaged_paper_turbine_set_runs_and_ranks_the_bins_by_damage_share(
         assert ("lifetime damage" if label == "high-speed shaft" else "no S-N curve") in block.splitlines()[0]
     assert "gear ratings (ISO 6336-2/-3/-5/-6" in report and (out / "gear_rating.csv").is_file()
     assert (out / "damage_by_bin.png").stat().st_size > 10_000
+
+
+@pytest.mark.parametrize("stopped", [True, False])
+def test_a_full_disk_the_sweep_told_is_not_told_again_for_the_lifetime_results(tmp_path, fmu_dir, monkeypatch,
+                                                                              capsys, stopped):
+    """A load set on a full disk printed a second error line for the lifetime results it then could not write."""
+    import os
+
+    from orchestrator.commands import cli
+    from orchestrator.study import sweep
+    from tests.helpers.failing_files import FullAt
+
+    out = tmp_path / "out"
+    told = f"cannot write {out / 'journal.jsonl'}: No space left on device; the sweep stopped, ..." if stopped else ""
+
+    def full_disk_sweep(prepared, out_dir, **kwargs):  # what run_sweep reports when the disk filled up
+        report = sweep.SweepReport(total=len(prepared.points), out_dir=out_dir, problems=[told] if told else [])
+        out_dir.mkdir(parents=True, exist_ok=True)
+        return report
+
+    monkeypatch.setattr(sweep, "run_sweep", full_disk_sweep)
+    monkeypatch.setattr(os, "replace", FullAt("bins.csv"))
+    assert cli.main(["loads", "paper-turbine", "--seeds", "1", "--out", str(out), "--fmu-dir", str(fmu_dir),
+                     "-q", "--no-plots"]) == 1
+    err = [line for line in capsys.readouterr().err.strip().splitlines() if ": error: " in line]
+    if stopped:
+        assert err == [f"dtcosim loads: error: {told}"]
+    else:  # the lifetime results are the first file the disk refused: their own line
+        assert err == [f"dtcosim loads: error: cannot write {out / 'bins.csv'}: No space left on device; the lifetime "
+                       f"results are not all written; every finished run is kept in {out / 'journal.jsonl'} and "
+                       f"{out}/runs: free some space and run the same command with --report to write them"]

@@ -62,3 +62,17 @@ def test_fig17_has_a_panel_over_the_analysis_window_and_says_the_planets_are_ide
     image = Image.open(out / "contact_forces.png")
     width, height = image.size
     assert width > 1.5 * height  # two panels per stage: the whole run and the window
+
+
+def test_the_statistics_list_signals_only(toy_scenario, tmp_path):
+    """Issue 30.5: a recorded parameter is recorded, but it is no signal: the statistics leave it out."""
+    import json
+
+    from tests.helpers.scenarios import TOY_SCENARIO
+
+    path = toy_scenario(TOY_SCENARIO.replace('variables = ["src.y"', 'variables = ["src.amplitude", "src.y"'))
+    out = tmp_path / "out"
+    assert main(["run", str(path), "--out", str(out), "--no-plots", "-q"]) == 0
+    statistics = json.loads((out / "summary.json").read_text())["statistics"]
+    assert "src.y" in statistics and "int.x" in statistics and "src.amplitude" not in statistics
+    assert "src.amplitude" in (out / "timeseries.csv").read_text().splitlines()[0]

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import zipfile
 
+import pytest
+
 from tests.helpers.reference_fmus import NAMES, reference_fmu
 from tests.helpers.scenarios import dtcosim
 
@@ -62,3 +64,39 @@ def test_an_fmu_without_a_binary_for_this_platform_cannot_run_here(tmp_path):
     assert proc.returncode == 1
     assert "no co-simulation binary for this platform (linux64: binaries/linux64/Dahlquist.so)" \
         in proc.stdout and "it has binaries for: win64" in proc.stdout
+
+
+def _ssp(tmp_path, change=None):
+    from tests.helpers.ssp_documents import feedthrough, real, ssd, write_ssp, zip_folder
+
+    folder = write_ssp(tmp_path / "folder", ssd(f"""
+  <ssd:System name="root">
+    <ssd:Elements>{feedthrough("ft", real("Float64_continuous_input", "input"))}</ssd:Elements>
+  </ssd:System>"""))
+    if change is not None:
+        change(folder / "resources" / "Feedthrough.fmu")
+    return zip_folder(folder, tmp_path / "system.ssp")
+
+
+def _no_binary(fmu):
+    _copy(reference_fmu("Feedthrough"), fmu, lambda name, data: data,
+          lambda name: name.replace("binaries/linux64/Feedthrough.so", "binaries/win64/Feedthrough.dll"))
+
+
+@pytest.mark.parametrize("change, status, lines", [
+    (None, 0, ["{ssp}: valid (1 FMUs, 0 connections, 6 recorded variables, 0 load event(s); stepping order ft;",
+               "{ssp}!resources/Feedthrough.fmu: ok (FMI 2.0 co-simulation, Reference FMUs"]),
+    (_no_binary, 1, ["{ssp}: 1 problem(s)",
+                     "  - invalid scenario entry components.ft.fmu = '{ssp}!resources/Feedthrough.fmu': expected an "
+                     "FMU this host can load (no co-simulation binary for this platform"]),
+])
+def test_an_ssp_is_validated_as_run_check_checks_it_and_every_fmu_in_it(tmp_path, capsys, change, status, lines):
+    from orchestrator.commands import cli
+
+    ssp = _ssp(tmp_path, change)
+    assert cli.main(["validate", str(ssp)]) == status
+    out = capsys.readouterr().out.splitlines()
+    assert len(out) == len(lines), out
+    for line, expected in zip(out, lines):
+        assert line.startswith(expected.format(ssp=ssp)), out
+    assert "modelDescription.xml" not in "".join(out)

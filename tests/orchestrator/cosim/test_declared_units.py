@@ -57,8 +57,8 @@ def test_set_on_the_command_line_takes_the_same_quantities(paper, name, text):
 
 
 def test_the_exponent_of_k0_is_the_scenarios_value_of_that_stages_exponent(paper):
-    values = {"gearbox.stage1.exponent": 1.0, "gearbox.stage1.k0": "2e5 N/mm"}
-    assert paper(values).scenario.component("gearbox").parameters["stage1.k0"] == pytest.approx(2e8)
+    values = {"gearbox.stage1.exponent": 1.0, "gearbox.stage1.k0": "8e5 N/mm"}  # 16 N/(mm um) over 50 mm: plausible
+    assert paper(values).scenario.component("gearbox").parameters["stage1.k0"] == pytest.approx(8e8)
     with pytest.raises(ScenarioError, match=r"stage1\.k0 = '2e5 N/mm\^1\.5': expected a quantity of dimension "
                                             r"\[mass\] \[time\]\^-2 \(SI unit N/m\^e\); the unit 'N/mm\^1\.5' is "
                                             r"\[mass\] \[length\]\^-0\.5 \[time\]\^-2"):

@@ -100,6 +100,44 @@ def test_a_broken_or_unsafe_fmu_is_one_named_error_in_check_run_and_validate(toy
     assert not Path("/tmp/dtcosim-escaped.txt").exists()
 
 
+# pythonfmu's binary takes the first line of resources/slavemodule.txt as the module to import: with an empty
+# line or bytes that are not UTF-8 a run died with a segmentation fault (exit 139) after --check and validate
+# had passed the FMU, as with a module it does not carry (issue 35.1)
+SLAVE_MODULE_LINES = {
+    "empty": (b"", "resources/slavemodule.txt names no slave module (its first line is empty)"),
+    "not UTF-8": (b"caf\xe9\n", "resources/slavemodule.txt is not UTF-8 text (b'caf\\xe9')"),
+    "a space": (b"toysine_slave \n", "resources/slavemodule.txt names 'toysine_slave ', which is not a Python module"),
+    "carriage return": (b"toysine_slave\r\n", "names 'toysine_slave\\r', which is not a Python module name"),
+}
+
+
+@pytest.mark.parametrize("case", list(SLAVE_MODULE_LINES))
+def test_a_slave_module_line_pythonfmu_cannot_import_is_refused_before_loading(toy_dir, tmp_path, capsys, sine,
+                                                                               case):
+    from fmus.model_description import rewrite_archive
+
+    line, message = SLAVE_MODULE_LINES[case]
+    fmu = tmp_path / "Broken.fmu"
+    shutil.copy(sine, fmu)
+    rewrite_archive(fmu, {"resources/slavemodule.txt": line})
+    scenario = _scenario_with(tmp_path, toy_dir, fmu)
+    for extra in (["--check"], ["--out", str(tmp_path / "out"), "-q"]):
+        assert cli.main(["run", str(scenario), "--no-build", *extra]) == 1
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and message in err[0] and "the FMU cannot create its slave" in err[0], err
+    problems = [p for p in check_fmu(fmu) if "InitialUnknowns" not in p]  # fmpy's complaint about every toy
+    assert len(problems) == 1 and message in problems[0], problems
+
+
+def test_a_slave_module_on_a_later_line_is_read_as_pythonfmu_reads_it(tmp_path, sine):
+    from fmus.model_description import rewrite_archive
+
+    fmu = tmp_path / "Two-lines.fmu"
+    shutil.copy(sine, fmu)
+    rewrite_archive(fmu, {"resources/slavemodule.txt": b"toysine_slave\nanything\n"})
+    assert check_fmu(fmu) == check_fmu(sine)  # fmpy's complaint about the toy's InitialUnknowns, nothing more
+
+
 @pytest.mark.parametrize("case", ["damaged", "absolute", "3 GiB member"])
 def test_the_extraction_itself_refuses_what_the_checks_refuse(toy_dir, tmp_path, sine, case):
     """fmi_runtime extracts through extract_fmu, never fmpy's unbounded extractall."""
@@ -143,14 +181,15 @@ def test_a_pipe_named_as_an_fmu_is_refused_without_blocking(toy_dir, tmp_path, c
     scenario = _scenario_with(tmp_path, toy_dir, pipe)
     assert cli.main(["run", str(scenario), "--no-build", "--check"]) == 1
     err = capsys.readouterr().err
-    assert "components.src.fmu = 'Pipe.fmu': expected an existing FMU file" in err and err.count("\n") == 1
+    assert f"components.src.fmu = 'Pipe.fmu': expected a regular FMU file ({pipe} is a device, pipe or folder)" in err
+    assert err.count("\n") == 1
     assert check_fmu(pipe) == ["not a regular file (a device, pipe or folder)"]
 
 
 def test_an_fmu_inside_an_ssp_that_declares_3_gib_is_refused(tmp_path):
     from orchestrator.errors import ScenarioError
     from orchestrator.interop.ssp import import_ssp
-    from tests.helpers.ssp_documents import feedthrough, real, ssd, write_ssp
+    from tests.helpers.ssp_documents import feedthrough, real, ssd, write_ssp, zip_folder
 
     folder = write_ssp(tmp_path / "ssp", ssd(f"""
   <ssd:System name="root">
@@ -159,13 +198,9 @@ def test_an_fmu_inside_an_ssp_that_declares_3_gib_is_refused(tmp_path):
     fmu = folder / "resources" / "Feedthrough.fmu"
     declaring(fmu, tmp_path / "bomb.fmu", 3 << 30)
     shutil.copy(tmp_path / "bomb.fmu", fmu)
-    archive = tmp_path / "system.ssp"
-    with zipfile.ZipFile(archive, "w") as z:
-        for f in sorted(folder.rglob("*")):
-            if f.is_file():
-                z.write(f, f.relative_to(folder).as_posix())
-    with pytest.raises(ScenarioError, match=r"components\.ft\.fmu = .*Feedthrough\.fmu': expected a readable FMU "
-                                            r"\(expands to 3072 MiB"):
+    archive = zip_folder(folder, tmp_path / "system.ssp")
+    with pytest.raises(ScenarioError, match=r"components\.ft\.fmu = '.*/system\.ssp!resources/Feedthrough\.fmu': "
+                                            r"expected a readable FMU \(expands to 3072 MiB"):
         import_ssp(archive)
 
 

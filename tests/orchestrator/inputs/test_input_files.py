@@ -87,3 +87,22 @@ def test_every_file_a_user_names_is_read_only_when_regular(tmp_path, read, name,
     os.mkfifo(path)
     with pytest.raises(Exception, match=match):
         read(path)
+
+
+@pytest.mark.parametrize("command, kind", [("sweep", "study"), ("loads", "load-case set"),
+                                           ("drivetrain show", "drivetrain"), ("run", "scenario")])
+@pytest.mark.parametrize("make", ["pipe", "device", "folder"])
+def test_a_device_pipe_or_folder_named_as_an_input_is_called_so(tmp_path, capsys, command, kind, make):
+    """sweep, loads and drivetrain said "expected an existing study file" for /dev/zero, a pipe or a folder."""
+    from orchestrator.commands import cli
+
+    path = {"device": "/dev/zero", "pipe": str(tmp_path / "p.toml"), "folder": str(tmp_path / "d.toml")}[make]
+    if make == "pipe":
+        os.mkfifo(path)
+    elif make == "folder":
+        os.mkdir(path)
+    extra = ["--check"] if command in ("sweep", "loads") else []
+    assert cli.main([*command.split(), path, *extra]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"(file) = '{path}': expected a regular {kind} file (this is a device, pipe or " \
+                             "folder)" in err[0], err

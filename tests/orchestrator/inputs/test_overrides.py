@@ -42,7 +42,7 @@ def test_a_window_that_ended_before_the_stop_stays_where_it_was(paper):
 
 def _args(**given):
     base = {"stop": None, "step": None, "output_interval": None, "window": None, "algorithm": None,
-            "extrapolation": None, "set": [], "algebraic_loops": None, "no_feedthrough": []}
+            "extrapolation": None, "set": [], "algebraic_loops": None, "no_feedthrough": [], "allow_implausible": []}
     return argparse.Namespace(**{**base, **given})
 
 

@@ -11,17 +11,7 @@ from components.errors import DtcosimError
 from orchestrator.inputs.study import StudyError
 from orchestrator.inputs.study_file import find_study, load_study, study_from_dict
 from orchestrator.study.prepare import prepare_study
-from tests.helpers.studies import SMALL_STUDY, run_cli
-
-MODEL_BASE = """
-name = "t"
-engine = "monolithic"
-measures = ["I_max_acc"]
-[base]
-model = "sensitivity-variant"
-[simulation]
-stop = 0.01
-"""
+from tests.helpers.studies import MODEL_BASE, SMALL_STUDY, run_cli
 
 
 def test_paper_sensitivity_is_the_sec41_grid():
@@ -148,7 +138,7 @@ def test_point_timeout_fails_the_point_and_leaves_the_keys_alone(write_study):
     """A point past the study's timeout fails with the limit and the time reached; keys ignore the limit."""
     from orchestrator.study.engine import PointTask, run_point
 
-    text = MODEL_BASE.replace("stop = 0.01", "stop = 1.0") + '[[axes]]\nparameter = "gearbox.R1"\nvalues = [6.0]\n'
+    text = MODEL_BASE.replace("stop = 0.01", "stop = 1.0") + '[[axes]]\nparameter = "gearbox.R1"\nvalues = [8.0]\n'
     free = prepare_study(load_study(write_study(text, "free.toml")))
     limited = prepare_study(load_study(write_study("timeout = 0.001\n" + text, "limited.toml")))
     assert limited.payload.timeout_s == 0.001 and free.payload.timeout_s is None

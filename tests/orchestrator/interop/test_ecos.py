@@ -67,9 +67,12 @@ def test_readme_recipe_runs_the_exported_ssp_in_ecos(fmu_dir, tmp_path):
     assert "LD_PRELOAD" not in recipe and "PYTHONPATH" not in recipe  # the FMUs find their Python themselves
     proc = run_recipe(tmp_path, fmu_dir, recipe)
     assert proc.returncode == 0, (proc.stdout + proc.stderr)[-3000:]  # also at exit (pythonfmu's binary aborted)
+    assert "--stopTime 60.02 to have the sample at 60 s" in proc.stderr  # export-ssp --target ecos says so
     ecos = read_ecos_csv(tmp_path / "paper.csv")
-    assert ecos["time"][0] == 0.0 and ecos["time"][-1] == pytest.approx(0.98)  # ecos stops one step short of 1 s
-    # the same scenario (its H = 20 ms, as the recipe's --stepSize) through dtcosim's master with ecos's Jacobi exchange
+    # ecos writes up to one step before --stopTime: the recipe's 1.02 s gives the sample at 1 s
+    assert ecos["time"][0] == 0.0 and ecos["time"][-1] == pytest.approx(1.0)
+    # the same scenario through dtcosim's master with ecos's Jacobi exchange: --algorithm jacobi takes the scenario's
+    # coupling and step for Jacobi ([jacobi]: 20 ms, as the recipe's --stepSize), as --target ecos does
     ours = dtcosim("run", "--stop", "1", "--algorithm", "jacobi",
                    "--no-plots", "--quiet", "--fmu-dir", str(fmu_dir), "--out", str(tmp_path / "run"), cwd=tmp_path,
                    env={"DTCOSIM_FMU_DIR": str(fmu_dir)})

@@ -103,6 +103,28 @@ def paper_ssp(fmu_dir, tmp_path_factory):
 
 
 @pytest.mark.slow
+def test_a_full_disk_while_an_ssp_is_written_names_it_and_leaves_nothing(toy_scenario, tmp_path, monkeypatch,
+                                                                        capsys):
+    """export-ssp said 'error: No space left on device', naming no file (the archive's write error has none)."""
+    import errno
+
+    real_write = zipfile.ZipFile.write
+
+    def full(self, filename, arcname=None, *args, **kwargs):
+        if str(arcname).endswith("ToyIntegrator.fmu"):
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return real_write(self, filename, arcname, *args, **kwargs)
+
+    monkeypatch.setattr(zipfile.ZipFile, "write", full)
+    from orchestrator.commands.cli import main
+
+    out = tmp_path / "ssp" / "toy.ssp"
+    assert main(["export-ssp", str(toy_scenario(TOY)), "--no-build", "--out", str(out)]) == 1
+    errors = [line for line in capsys.readouterr().err.splitlines() if "error" in line]
+    assert errors == [f"dtcosim export-ssp: error: {out}: No space left on device"]
+    assert list(out.parent.iterdir()) == []
+
+
 def test_reimported_paper_ssp_runs_identically(paper_ssp, fmu_dir):
     stop = dict(stop_s=3.0, window_s=(1.0, 3.0))
     toml = load_scenario(find_scenario(None)).with_simulation(**stop)

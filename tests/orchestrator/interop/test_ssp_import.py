@@ -32,6 +32,7 @@ from tests.helpers.ssp_documents import (
     real,
     ssd,
     write_ssp,
+    zip_folder,
 )
 
 def run(folder: Path, **kwargs):
@@ -294,8 +295,6 @@ def test_transformations_survive_export_and_import(tmp_path):
 
 
 def test_other_tools_annotations_are_reported_and_ssd_folder_and_archive_read_alike(tmp_path):
-    import zipfile
-
     system = SYSTEM_PARAMETER.format(component_binding="", system_binding="").replace(
         "</ssd:Elements>\n  </ssd:System>",
         '</ssd:Elements>\n<ssd:Annotations><ssc:Annotation type="com.example.layout"><x xmlns="urn:x"/>'
@@ -304,11 +303,7 @@ def test_other_tools_annotations_are_reported_and_ssd_folder_and_archive_read_al
     notes: list[str] = []
     from_folder = import_ssp(folder, report=notes.append)
     assert len(notes) == 1 and "annotation of type 'com.example.layout' ignored" in notes[0] and "line" in notes[0]
-    archive = tmp_path / "system.ssp"
-    with zipfile.ZipFile(archive, "w") as zf:
-        for f in folder.rglob("*"):
-            if f.is_file():
-                zf.write(f, f.relative_to(folder).as_posix())
+    archive = zip_folder(folder, tmp_path / "system.ssp")
     for other in (import_ssp(folder / "SystemStructure.ssd"), import_ssp(archive)):
         assert [c.name for c in other.components] == [c.name for c in from_folder.components]
         assert other.connections == from_folder.connections and other.simulation == from_folder.simulation

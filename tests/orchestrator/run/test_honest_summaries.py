@@ -17,7 +17,7 @@ import pytest
 from orchestrator.commands import cli
 from orchestrator.run import run_folder
 from orchestrator.run.run_folder import OutputFolderError, RunFolder
-from tests.helpers.failing_files import FullDisk
+from tests.helpers.failing_files import FullAt, FullDisk
 
 
 def summary_of(out):
@@ -128,6 +128,29 @@ def test_no_room_even_for_the_short_summary_leaves_none(tmp_path, monkeypatch):
         folder.finish({"scenario": "a", "status": "complete", "complete": True, "statistics": {}})
     folder.release()
     assert list((tmp_path / "out").iterdir()) == []  # the running summary would lie: removed
+
+
+@pytest.mark.parametrize("full_at, kept, not_done", [
+    ("load_duration.png", ["contact_loss", "fatigue_del", "fatigue_ldd"], ["the rest of analyses", "plots"]),
+    ("generator_speed.png", ["contact_loss", "fatigue_del", "fatigue_ldd", "plot:load_duration", "plot:rotor_speed"],
+     ["the rest of plots"]),
+])
+def test_a_full_disk_during_the_analyses_or_plots_keeps_what_was_written_and_says_what_was_not(
+        fmu_dir, tmp_path, monkeypatch, capsys, full_at, kept, not_done):
+    """A disk that filled at a plot: the whole CSVs written before it were removed as never listed, the analyses'
+    results left the summary, and the run said "not done: " with nothing after it (seen on a 100 kB tmpfs)."""
+    monkeypatch.setattr(os, "replace", FullAt(full_at))
+    out = tmp_path / "out"
+    assert cli.main(["run", "--fmu-dir", str(fmu_dir), "--no-build", "--stop", "0.5", "--out", str(out), "-q"]) == 1
+    summary = summary_of(out)
+    assert sorted(summary["files"]) == sorted(["timeseries", *kept, "summary"])
+    assert sorted(p.name for p in out.iterdir()) == sorted(summary["files"].values())
+    assert "contact_loss" in summary and "fatigue" in summary  # what the analyses computed
+    problem = f"cannot write {out / full_at}: No space left on device"
+    assert summary["post_processing"] == {"stopped": f"stopped: {problem}", "not_done": not_done, "error": problem}
+    assert summary["problems"] == [problem] and summary["status"] == "failed"
+    errors = [line for line in capsys.readouterr().err.splitlines() if "error" in line]
+    assert errors == [f"dtcosim run: error: {problem}; not done: {', '.join(not_done)}"]
 
 
 def test_a_file_written_into_the_folder_is_named_in_the_summary_before_it_appears(tmp_path, monkeypatch):

@@ -19,6 +19,8 @@ def test_a_second_run_into_a_folder_in_use_is_refused_naming_the_holder(tmp_path
     with pytest.raises(OutputFolderError, match=rf"--out = '.*out': expected a folder no other run is writing into "
                                                 rf"\(the run with pid {os.getpid()} holds it"):
         RunFolder.prepare(tmp_path / "out", {"scenario": "b"})
+    with pytest.raises(OutputFolderError, match=f"the run with pid {os.getpid()} holds it"):
+        RunFolder.check(tmp_path / "out")  # before the command says what it will replace
     first.release()
     second = RunFolder.prepare(tmp_path / "out", {"scenario": "b"})  # free again
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["summary.json"]  # no lock file of its own
@@ -41,6 +43,7 @@ def test_two_dtcosim_runs_into_one_folder(tmp_path):
     if first.returncode == 0 and "holds it" not in second.stderr and second.returncode == 0:
         pytest.skip("the first run ended before the second started")
     assert second.returncode == 1 and f"the run with pid {first.pid} holds it" in second.stderr, second.stderr
+    assert "replacing the previous run" not in second.stderr  # it said so, then replaced nothing
     assert first.returncode == 0, first_err
     import json
     summary = json.loads((out / "summary.json").read_text())

@@ -73,8 +73,8 @@ def test_heat_map_with_ok_failed_and_pending_cells(write_study, tmp_path):
 
     text = SMALL_HEAD + SMALL_TABLES + (
         '[[axes]]\nparameter = "gearbox.R1"\nvalues = [8.0, 9.0]\nlabel = "R1"\n'
-        '[[axes]]\nparameter = "gearbox.stage3.lambda"\nvalues = [1.0e5, -6.0e5]\nlabel = "lambda_3"\n'
-        'unit = "1/mm"\nscale = 1.0e-3\n'
+        '[[axes]]\nparameter = "gearbox.stage3.lambda"\nvalues = [100.0, -600.0]\nlabel = "lambda_3"\n'
+        'unit = "1/mm"\n'  # converted to 1/m, shown as written
         '[[plots]]\nmeasure = "I_max_acc"\nfile = "imax.png"\n')
     prepared = prepare_study(load_study(write_study(text)))
     assert prepared.study.shape == (1, 2, 2, 1)

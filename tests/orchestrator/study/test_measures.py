@@ -10,15 +10,33 @@ from orchestrator.inputs.measures import MeasureError, parse_measure
 from orchestrator.study.measure_values import window_statistic
 
 
-@pytest.mark.parametrize("text, statistic, unit", [
-    ("gearbox.shaft1.torque:del4", "del4", "N.m"),
-    ("gearbox.stage3.F_mesh:del10", "del10", "N"),
-    ("gearbox.stage1.F_sp[1]:del3.5", "del3.5", "N"),
-    ("generator.omega:rms", "rms", "rad/s"),
+@pytest.mark.parametrize("text, statistic", [
+    ("gearbox.shaft1.torque:del4", "del4"),
+    ("gearbox.stage3.F_mesh:del10", "del10"),
+    ("gearbox.stage1.F_sp[1]:del3.5", "del3.5"),
+    ("generator.omega:rms", "rms"),
 ])
-def test_statistic_measures_parse(text, statistic, unit):
+def test_statistic_measures_parse_without_a_unit_read_from_the_name(text, statistic):
     m = parse_measure(text)
-    assert (m.statistic, m.unit, m.builtin) == (statistic, unit, False)
+    assert (m.statistic, m.unit, m.builtin) == (statistic, "", False)  # the base declares it (prepare_study)
+
+
+@pytest.mark.parametrize("measure, unit", [
+    ("gearbox.stage3.F_mesh:mean", "N"),
+    ("gearbox.shaft2.torque:del4", "N.m"),
+    ("gearbox.omega_out:rms", "rad/s"),
+    ("gearbox.stage3.d_mesh:max", "m"),
+    ("gearbox.alpha_out:absmax", "rad/s2"),
+])
+def test_a_model_base_measure_has_the_unit_the_monolithic_solver_declares(write_study, measure, unit):
+    from orchestrator.inputs.study_file import load_study
+    from orchestrator.study.prepare import prepare_study
+    from tests.helpers.studies import SMALL_TABLES
+
+    head = f'name = "small"\nengine = "monolithic"\nmeasures = ["cpu_time", "{measure}"]\n'
+    prepared = prepare_study(load_study(write_study(head + SMALL_TABLES)))
+    assert [m.column for m in prepared.study.measures] == ["cpu_time [s]", f"{measure} [{unit}]"]
+    assert prepared.payload.measures == prepared.study.measures
 
 
 @pytest.mark.parametrize("text", ["gearbox.shaft1.torque:del0", "gearbox.shaft1.torque:del", "x.y:delm", "x.y:del-3"])

@@ -26,6 +26,7 @@ from orchestrator.study import plots as study_plots
 from orchestrator.study.engine import PointTask, run_point
 from orchestrator.study.journal import Journal
 from orchestrator.study.prepare import prepare_study
+from tests.helpers.failing_files import FullAt
 from tests.helpers.studies import SMALL_HEAD, SMALL_TABLES
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -67,6 +68,46 @@ def test_a_full_disk_while_the_plots_are_drawn_is_one_line(write_study, tmp_path
     else:
         assert err[0] == f"dtcosim sweep: error: {out / 'imax.png'}: No space left on device"
     assert sorted(p.name for p in out.iterdir() if p.name.startswith(".")) == []  # no temporary file left
+
+
+@pytest.mark.parametrize("full_at", ["results.csv", "study.json"])
+def test_a_full_disk_at_the_table_or_summary_names_the_file_and_leaves_no_temporary_file(
+        write_study, tmp_path, monkeypatch, capsys, full_at):
+    """The table and study.json went through a writer of their own: 'error: No space left on device' naming no
+    file, and results.csv.tmp left behind (seen on a small tmpfs; the load sets' lifetime files the same)."""
+    path = write_study(GRID)
+    out = tmp_path / "out"
+    _journal_every_point(prepare_study(load_study(path)), out)
+    monkeypatch.setattr(os, "replace", FullAt(full_at))
+    assert cli.main(["sweep", str(path), "--out", str(out), "-q", "--report"]) == 1
+    assert capsys.readouterr().err.strip().splitlines() == [
+        f"dtcosim sweep: error: {out / full_at}: No space left on device"]
+    assert not [p.name for p in out.iterdir() if "tmp" in p.name]
+
+
+def test_a_journal_line_that_does_not_fit_is_cut_off_and_names_the_journal(tmp_path, monkeypatch):
+    """A full disk while a sweep journals a point: the sweep's one line was replaced by a bare 'error: No space left
+    on device', raised again when the journal was closed with the half line still in its buffer."""
+    from orchestrator.study import journal as journal_module
+    from orchestrator.study.journal import read_journal
+
+    path = tmp_path / "journal.jsonl"
+    real_write = journal_module._write_all
+
+    def half_then_full(fd, data):
+        real_write(fd, data[:10])
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    with Journal(path) as journal:
+        journal.append({"key": "a", "status": "ok"})
+        monkeypatch.setattr(journal_module, "_write_all", half_then_full)
+        with pytest.raises(OSError, match="No space left on device") as info:
+            journal.append({"key": "b", "status": "ok"})
+        assert info.value.filename == str(path)
+        monkeypatch.undo()
+        journal.append({"key": "c", "status": "ok"})
+    assert [r["key"] for r in read_journal(path)] == ["a", "c"]
+    assert path.read_bytes().count(b"\n") == 2  # no torn line between them
 
 
 def test_a_full_disk_while_a_run_file_is_stored_leaves_no_partial_file(tmp_path, monkeypatch):
@@ -162,7 +203,9 @@ def test_a_signal_during_the_cluster_start_up_is_one_line(write_study, tmp_path,
 
 
 @pytest.mark.slow
-def test_a_full_disk_while_a_result_is_kept_stops_the_sweep_with_one_line(write_study, tmp_path):
+@pytest.mark.parametrize("table_fits", [True, False])
+def test_a_full_disk_while_a_result_is_kept_stops_the_sweep_with_one_line(write_study, tmp_path, monkeypatch,
+                                                                          table_fits):
     from orchestrator.study.sweep import run_sweep
 
     prepared = prepare_study(load_study(write_study(GRID)))
@@ -171,7 +214,59 @@ def test_a_full_disk_while_a_result_is_kept_stops_the_sweep_with_one_line(write_
     def no_space(i, result):
         raise OSError(errno.ENOSPC, "No space left on device", str(out / "runs" / f"{i}.npz"))
 
+    if not table_fits:  # the disk stays full: the table cannot be written after the stop either
+        monkeypatch.setattr(os, "replace", FullAt("results.csv"))
     report = run_sweep(prepared, out, workers=1, plots=False, on_result=no_space)
-    assert report.ok == 0 and not report.interrupted and len(report.problems) == 1
+    assert report.ok == 0 and not report.interrupted and len(report.problems) == 1, report.problems
     assert report.problems[0].startswith(f"cannot write {out / 'runs'}/") and "the sweep stopped" in report.problems[0]
-    assert (out / "results.csv").exists() and (out / "journal.jsonl").read_text() == ""
+    assert ("the table, plots and study.json are not all written either" in report.problems[0]) != table_fits
+    assert (out / "results.csv").exists() == table_fits and (out / "journal.jsonl").read_text() == ""
+
+
+@pytest.mark.parametrize("table_fits", [True, False])
+def test_a_sweep_stopped_by_a_full_disk_is_one_line_whether_its_table_is_written_or_not(
+        write_study, tmp_path, monkeypatch, capsys, table_fits):
+    """The stop and the table it then could not write either were two error lines for one full disk."""
+    from orchestrator.study import sweep
+
+    path = write_study(GRID)
+    out = tmp_path / "out"
+    journal = out / "journal.jsonl"
+
+    def stopped_at_the_journal(prepared, todo, journal_file, report, *args):  # as _execute stops on ENOSPC
+        report.stopped_at = f"cannot write {journal}: No space left on device"
+
+    monkeypatch.setattr(sweep, "_execute", stopped_at_the_journal)
+    if not table_fits:
+        monkeypatch.setattr(os, "replace", FullAt("results.csv"))
+    assert cli.main(["sweep", str(path), "--out", str(out), "-q", "--no-plots"]) == 1
+    either = "" if table_fits else "; the table, plots and study.json are not all written either"
+    assert capsys.readouterr().err.strip().splitlines() == [
+        f"dtcosim sweep: error: cannot write {journal}: No space left on device; the sweep stopped, the points "
+        f"finished before are kept in {journal}{either}: free some space and run the same command again to continue"]
+    assert (out / "results.csv").exists() == table_fits
+
+
+@pytest.mark.slow
+def test_a_signal_while_a_point_is_journaled_is_counted_with_the_point(write_study, tmp_path, monkeypatch):
+    """A SIGTERM that landed between a point's journal line and its count: the sweep said "48 finished points kept"
+    of a journal that held 49 (seen sending SIGTERM to paper-sensitivity as its last point finished)."""
+    import signal
+
+    from orchestrator.study.journal import read_journal
+    from orchestrator.study.sweep import run_sweep
+
+    real_append = Journal.append
+    appended = []
+
+    def append_then_signal(self, record):
+        real_append(self, record)
+        appended.append(record["key"])
+        if len(appended) == 2:
+            signal.raise_signal(signal.SIGTERM)  # handled at once: the sweep notes it and raises it after the step
+
+    monkeypatch.setattr(Journal, "append", append_then_signal)
+    path = write_study(GRID)
+    report = run_sweep(prepare_study(load_study(path)), tmp_path / "out", workers=1, plots=False)
+    assert report.interrupted and report.signal == signal.SIGTERM
+    assert report.ok + report.failed + report.errors == len(read_journal(tmp_path / "out" / "journal.jsonl")) == 2
