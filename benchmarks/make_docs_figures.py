@@ -4,7 +4,8 @@ Runs the packaged study ``paper-sensitivity`` (Sec. 4.1, 7 x 7 points on the mon
 engine; what ``dtcosim sweep paper-sensitivity`` runs) into a temporary folder (or ``--work``),
 copies its heat maps into ``--out`` under the names docs/ uses (:data:`FIGURES`), and prints the
 tables docs/studies.md quotes: I_max,acc over R1 x lambda, and CPU time, LSODA steps and
-right-hand-side calls per lambda (means over R1). I_max,acc, steps and calls are deterministic;
+right-hand-side calls per lambda (means over R1). The other figures are each made by a benchmark script
+of this folder (:data:`SCRIPTS`, e.g. ``load_sharing.png`` by ``load_sharing.py``). I_max,acc, steps and calls are deterministic;
 CPU times move with the load of the machine.
 
 Nothing is written into the source tree unless ``--out`` names it::
@@ -18,6 +19,8 @@ import argparse
 import csv
 import shutil
 import statistics
+import subprocess
+import sys
 import tempfile
 from collections import defaultdict
 from pathlib import Path
@@ -30,6 +33,10 @@ from orchestrator.study.sweep import run_sweep
 FIGURES = {
     "study-fig12-I_max_acc.png": "fig12_I_max_acc.png",
     "study-fig13-cpu_time.png": "fig13_cpu_time.png",
+}
+#: docs/img name -> the benchmark script (beside this one) that makes it with ``--out``
+SCRIPTS = {
+    "load_sharing.png": "load_sharing.py",
 }
 
 
@@ -89,6 +96,9 @@ def main() -> None:
             print(f"{args.out / name}  (from {made} of dtcosim sweep paper-sensitivity)")
         print()
         print_tables(work / "results.csv")
+    for name, script in SCRIPTS.items():
+        subprocess.run([sys.executable, str(Path(__file__).with_name(script)), "--out", str(args.out / name)], check=True)
+        print(f"{args.out / name}  (from benchmarks/{script})")
 
 
 if __name__ == "__main__":

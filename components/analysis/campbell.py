@@ -210,6 +210,7 @@ def campbell_diagram(
     rotor_orders: Sequence[int] = (1, 3),
     mesh_harmonics: Sequence[int] = (1,),
     rotor: RotorParameters | None = None,
+    free_input: bool = False,
 ) -> CampbellDiagram:
     """Linearise at every rotor speed under a load law and collect the modes.
 
@@ -224,6 +225,8 @@ def campbell_diagram(
         Excitation lines (see :func:`excitation_frequencies`).
     rotor : RotorParameters, optional
         A torque-driven rotor (free drivetrain); default: the rotor held.
+    free_input : bool
+        The input member free, no rotor (:func:`components.analysis.modes.drivetrain_modes`).
 
     Returns
     -------
@@ -238,7 +241,7 @@ def campbell_diagram(
     kinds: list[str] = []
     labels: list[str] = []
     for i, (speed, torque) in enumerate(zip(w, torques)):
-        an = drivetrain_modes(drivetrain, OperatingPoint(float(speed), float(torque)), rotor=rotor)
+        an = drivetrain_modes(drivetrain, OperatingPoint(float(speed), float(torque)), rotor=rotor, free_input=free_input)
         und.append([m.mode.undamped_frequency_hz for m in an.modes])
         dmp.append([m.mode.damped_frequency_hz for m in an.modes])
         zeta.append([m.mode.damping_ratio for m in an.modes])

@@ -149,6 +149,7 @@ def static_equilibrium(
     stiffness_factor: np.ndarray | float = 1.0,
     rtol: float = 1e-11,
     max_iterations: int = 60,
+    rotor_speed_rad_s: float = 0.0,
 ) -> StaticEquilibrium:
     """Deviation angles at which meshes and shafts carry a constant output torque.
 
@@ -171,6 +172,9 @@ def static_equilibrium(
         of generalised-force magnitudes on one body.
     max_iterations : int
         Newton iterations before :class:`EquilibriumError`.
+    rotor_speed_rad_s : float
+        Rotor speed [rad/s]: the centrifugal force on the planets of lateral-torsional stages (their gravity
+        at the rotor angle 0).
 
     Returns
     -------
@@ -182,12 +186,12 @@ def static_equilibrium(
         raise ParameterError("output_torque_nm", torque, "non-zero (unloaded teeth float in the backlash)")
     zeros = np.zeros(a.n_dof)
     try:
-        q, iterations, _ = a.static_deflection(torque, stiffness_factor, rtol=rtol,
-                                               max_iterations=max_iterations)
+        q, iterations, _ = a.static_deflection(torque, stiffness_factor, rtol=rtol, max_iterations=max_iterations,
+                                               driver_speed_rad_s=rotor_speed_rad_s)
     except SolverError as exc:
         raise EquilibriumError(str(exc).rsplit(" (at t =", 1)[0]) from None
     loads = a.loads(q, zeros, stiffness_factor=stiffness_factor)
-    residual = a.generalised_forces(loads) - _output_load(a, torque)
+    residual = a.generalised_forces(loads) + a.external_forces(0.0, rotor_speed_rad_s) - _output_load(a, torque)
     return StaticEquilibrium(
         q_rad=q,
         contact_force_n=loads.contact_force_n.copy(),
@@ -249,7 +253,8 @@ def linearise(drivetrain: Drivetrain, operating_point: OperatingPoint, stiffness
     if not isinstance(operating_point, OperatingPoint):
         raise ParameterError("operating_point", operating_point, "an OperatingPoint")
     a = Assembly(drivetrain)
-    eq = static_equilibrium(a, operating_point.output_torque_nm, stiffness_factor)
+    eq = static_equilibrium(a, operating_point.output_torque_nm, stiffness_factor,
+                            rotor_speed_rad_s=operating_point.rotor_speed_rad_s)
     dq, dv, _, _ = a.acceleration_jacobian(eq.q_rad, np.zeros(a.n_dof), stiffness_factor=stiffness_factor)
     m = a.inertia_kgm2
     k = -(m[:, None] * dq)

@@ -6,10 +6,13 @@
 kinetic-energy share of every body and the strain-energy share of every mesh group
 and shaft.
 
-Mode kinds: for a purely torsional model with ``n`` equally spaced identical planets
-the *planet modes* (only the planets of one stage move, the central members stand
-still) have multiplicity ``n - 1``; the other (*rotational*) modes are simple (Lin and
-Parker, 1999).
+Mode kinds (Lin and Parker, 1999): *planet modes* - only the planets of one stage move, the
+central members (sun, carrier, ring; the other stages) stand still; multiplicity ``n - 1`` in a
+torsional model with ``n`` equally spaced identical planets, ``n - 3`` in a lateral-torsional one.
+*Rotational modes* - no central member translates; simple. *Translational modes* (lateral-torsional
+stages) - no central member rotates, they translate; multiplicity 2. A mode that fits none (unequal
+planets, several lateral stages coupled) is *coupled*. Whether a coordinate moves is judged by its
+share of the modal kinetic energy (translations and rotations alike).
 """
 
 from __future__ import annotations
@@ -29,23 +32,38 @@ from .rotor_coupling import ROTOR_BODY, coupled
 #: name of the main shaft's strain-energy group (torque-driven rotor with a flexible main shaft)
 MAIN_SHAFT = "main_shaft"
 
-#: Shape components below this fraction of the largest count as "not moving" (mode kinds).
+#: Shape components below this fraction of the largest count as "not moving" (planet modes of a torsional model).
 STILL_TOLERANCE = 1e-6
+#: Shares of the modal kinetic energy below this count as "not moving" (the kinds of lateral-torsional modes).
+STILL_ENERGY = 1e-9
+#: Natural frequencies within this relative distance belong to one repeated mode (multiplicity).
+REPEATED_TOLERANCE = 1e-6
 
 
 # --------------------------------------------------------------------------- drivetrain modes
 def _element_groups(a: Assembly) -> tuple[list[str], np.ndarray]:
-    """Names of mesh groups / shafts and the (n_group, n_mesh + n_shaft) membership matrix."""
+    """Names of mesh groups / shafts / bearings and the (n_group, n_mesh + n_shaft + n_spring) membership matrix.
+
+    A stage's planet bearings are one group, as its meshes of one kind are.
+    """
     names: list[str] = []
     member = []
-    for i, mesh in enumerate(a.meshes):
-        g = f"{mesh.stage}.{mesh.kind}"
-        if g not in names:
-            names.append(g)
-        member.append(names.index(g))
+
+    def add(group: str) -> None:
+        if group not in names:
+            names.append(group)
+        member.append(names.index(group))
+
+    for mesh in a.meshes:
+        add(f"{mesh.stage}.{mesh.kind}")
     for s in a.shafts:
-        names.append(s.name)
-        member.append(len(names) - 1)
+        add(s.name)
+    row_group = [""] * a.n_spring
+    for e in a.elements:
+        for r in e.rows:
+            row_group[r] = f"{e.stage}.planet_bearings" if e.name.startswith(f"{e.stage}.planet_bearing[") else e.name
+    for group in row_group:
+        add(group)
     mat = np.zeros((len(names), len(member)))
     mat[member, np.arange(len(member))] = 1.0
     return names, mat
@@ -71,7 +89,8 @@ class DrivetrainMode:
     mode : Mode
         The generic mode (frequencies, damping, flags, shapes).
     kind : str
-        ``"planet"`` (only the planets of ``stage`` move; multiplicity n - 1) or ``"rotational"``.
+        ``"planet"`` (only the planets of ``stage`` move), ``"rotational"``, ``"translational"``, ``"coupled"``
+        or ``"rigid"`` (module docstring).
     stage : str or None
         The stage of a planet mode.
     shape_referred : ndarray, shape (n_dof,)
@@ -84,6 +103,8 @@ class DrivetrainMode:
         Share of the modal strain energy per mesh group (``stage1.sun_planet``, ...) and shaft.
     dominant_elements : str
         The springs holding most of the modal strain energy.
+    multiplicity : int
+        How many modes of this kind (and stage) share its natural frequency (Lin and Parker: 1, 2 or n - 3).
     """
 
     mode: Mode
@@ -93,6 +114,7 @@ class DrivetrainMode:
     dominant_bodies: str
     strain_energy_fraction: dict[str, float]
     dominant_elements: str
+    multiplicity: int = 1
 
     def as_dict(self, dof_names: list[str]) -> dict:
         """Plain dict (JSON-ready)."""
@@ -102,6 +124,7 @@ class DrivetrainMode:
             "mode": m.index,
             "kind": self.kind,
             "stage": self.stage,
+            "multiplicity": self.multiplicity,
             "undamped_frequency_hz": m.undamped_frequency_hz,
             "damped_frequency_hz": None if m.overdamped else m.damped_frequency_hz,
             "damping_ratio": m.damping_ratio,
@@ -133,7 +156,9 @@ class DrivetrainModalAnalysis:
     bodies : list of str, optional
         Names of the shapes' components (default: the model's degrees of freedom).
     rotor : RotorParameters or None
-        The torque-driven rotor; None: the rotor speed is held.
+        The torque-driven rotor; None: the rotor speed is held (or the input is free).
+    free_input : bool
+        The stage-1 input member is free, no rotor on it.
     """
 
     modes: list[DrivetrainMode]
@@ -141,6 +166,7 @@ class DrivetrainModalAnalysis:
     state_space: StateSpaceModes
     bodies: list[str] | None = None
     rotor: RotorParameters | None = None
+    free_input: bool = False
 
     @property
     def dof_names(self) -> list[str]:
@@ -149,8 +175,8 @@ class DrivetrainModalAnalysis:
 
     @property
     def rotor_held(self) -> bool:
-        """True if the rotor speed was held (prescribed); False with a torque-driven rotor."""
-        return self.rotor is None
+        """True if the rotor speed was held (prescribed); False with a torque-driven rotor or a free input."""
+        return self.rotor is None and not self.free_input
 
     @property
     def underdamped(self) -> list[DrivetrainMode]:
@@ -172,6 +198,7 @@ class DrivetrainModalAnalysis:
             row = {
                 "mode": m.index,
                 "kind": dm.kind if dm.stage is None else f"{dm.kind} ({dm.stage})",
+                "multiplicity": dm.multiplicity,
                 "undamped_frequency_hz": m.undamped_frequency_hz,
                 "damped_frequency_hz": m.damped_frequency_hz,
                 "damping_ratio": m.damping_ratio,
@@ -191,7 +218,8 @@ class DrivetrainModalAnalysis:
         eq = self.model.equilibrium
         return {
             "operating_point": self.model.operating_point.as_dict(),
-            "rotor": "held (prescribed speed)" if self.rotor is None else {
+            "rotor": ("free input member, no rotor" if self.free_input else "held (prescribed speed)")
+            if self.rotor is None else {
                 "driven_by": "torque", "inertia_kgm2": self.rotor.inertia_kgm2,
                 "shaft_stiffness_nm_rad": self.rotor.shaft_stiffness_nm_rad,
                 "shaft_damping_nms_rad": self.rotor.shaft_damping_nms_rad,
@@ -211,8 +239,36 @@ class DrivetrainModalAnalysis:
         }
 
 
+def _kind(energy: np.ndarray, roles: list[str], stages: list[str], rotation: list[bool],
+          rigid: bool) -> tuple[str, str | None]:
+    """The kind of a mode from the kinetic-energy shares of its coordinates (module docstring) and its stage."""
+    moving = energy > STILL_ENERGY
+    planets = {stages[i] for i in np.flatnonzero(moving) if roles[i] == "planet"}
+    central = moving & np.array([r != "planet" for r in roles])
+    if rigid:
+        return "rigid", None
+    if moving.any() and not central.any() and len(planets) == 1:
+        return "planet", planets.pop()
+    if not (central & ~np.array(rotation)).any():
+        return "rotational", None
+    if not (central & np.array(rotation)).any():
+        return "translational", None
+    return "coupled", None
+
+
+def _multiplicities(out: list[DrivetrainMode]) -> list[DrivetrainMode]:
+    """Each mode with the number of modes of its kind and stage at its natural frequency."""
+    f = np.array([dm.mode.system_frequency_hz for dm in out])
+    counts = []
+    for dm, fi in zip(out, f):
+        same = [o for o, fj in zip(out, f) if o.kind == dm.kind and o.stage == dm.stage
+                and abs(fj - fi) <= REPEATED_TOLERANCE * max(abs(fi), 1e-300)]
+        counts.append(len(same))
+    return [replace(dm, multiplicity=c) for dm, c in zip(out, counts)]
+
+
 def drivetrain_modes(drivetrain: Drivetrain, operating_point: OperatingPoint, stiffness_factor: np.ndarray | float = 1.0,
-                     rotor: RotorParameters | None = None) -> DrivetrainModalAnalysis:
+                     rotor: RotorParameters | None = None, free_input: bool = False) -> DrivetrainModalAnalysis:
     """Linearise a drivetrain at an operating point and analyse its modes.
 
     Parameters
@@ -228,6 +284,9 @@ def drivetrain_modes(drivetrain: Drivetrain, operating_point: OperatingPoint, st
         A torque-driven rotor (and main shaft) on the stage-1 carrier: the drivetrain is free
         at both ends (:func:`components.analysis.rotor_coupling.free_rotor`). None: the rotor
         speed is held (a wind source prescribes it).
+    free_input : bool
+        The stage-1 input member free and no rotor on it (a gearbox on its own; Lin and Parker's free
+        vibration); its rigid-body rotation is removed.
 
     Returns
     -------
@@ -235,43 +294,49 @@ def drivetrain_modes(drivetrain: Drivetrain, operating_point: OperatingPoint, st
     """
     model = linearise(drivetrain, operating_point, stiffness_factor)
     a = model.assembly
-    cm = coupled(model, rotor)
+    cm = coupled(model, rotor, free_input)
     modes, ss, _ = modal_analysis(cm.mass, cm.damping, cm.stiffness)
     names = cm.body_names
     lead = len(names) - a.n_dof
-    roles = ["rotor", "carrier"][:lead] + [a.bodies[j].role for j in a.free]
-    stages = [ROTOR_BODY, a.bodies[a.driver].stage][:lead] + [a.bodies[j].stage for j in a.free]
+    driver = a.bodies[a.driver]
+    coords = [driver if name != ROTOR_BODY else None for name in names[:lead]] + [a.bodies[j] for j in a.free]
+    roles = [b.role if b is not None else "rotor" for b in coords]
+    stages = [b.stage if b is not None else ROTOR_BODY for b in coords]
+    rotation = [b.rotation if b is not None else True for b in coords]
     group_names, membership = _element_groups(a)
-    body_groups = [f"{stages[i]}.planets" if roles[i] == "planet" else names[i] for i in range(len(names))]
+    body_groups = [f"{stages[i]}.planets" if roles[i] == "planet" else names[i].rpartition(".")[0]
+                   if not rotation[i] else names[i] for i in range(len(names))]
     body_group_names = list(dict.fromkeys(body_groups))
     body_membership = np.array([[g == h for h in body_groups] for g in body_group_names], dtype=float)
     k_mesh = a.cos_alpha * model.equilibrium.mesh_stiffness_n_per_m
-    k_elem = np.concatenate([k_mesh, a.shaft_k])
-    rows = np.vstack([a.A, a.S])
+    k_elem = np.concatenate([k_mesh, a.shaft_k, a.bearing_k])
+    rows = np.vstack([a.A, a.S, a.B])
     if cm.main_shaft is not None:
         group_names = group_names + [MAIN_SHAFT]
         membership = np.pad(membership, ((0, 1), (0, 1)))
         membership[-1, -1] = 1.0
+    lateral = not all(rotation)
     out = []
     for m in modes:  # each row's own undamped shape (the rows are in the order of their eigenvalues' |lambda|)
         u = cm.basis @ m.shape  # body deviations
-        big = np.abs(u).max()
-        moving = np.abs(u) > STILL_TOLERANCE * big
-        planet_stages = {stages[i] for i in np.flatnonzero(moving)}
-        if moving.any() and all(roles[i] == "planet" for i in np.flatnonzero(moving)) and len(planet_stages) == 1:
-            kind, stage = "planet", planet_stages.pop()
-        elif m.kind == "rigid":
-            kind, stage = "rigid", None
-        else:
-            kind, stage = "rotational", None
-        referred = normalise_shape(u / cm.kinematic_ratio)
+        kinetic = cm.body_inertia_kgm2 * u * u
+        energy = kinetic / kinetic.sum() if kinetic.sum() > 0 else kinetic
+        if lateral:
+            kind, stage = _kind(energy, roles, stages, rotation, m.kind == "rigid")
+        else:  # by the shape itself: a torsional planet mode is exact to the last digits
+            moving = np.abs(u) > STILL_TOLERANCE * np.abs(u).max()
+            planet_stages = {stages[i] for i in np.flatnonzero(moving)}
+            if moving.any() and all(roles[i] == "planet" for i in np.flatnonzero(moving)) and len(planet_stages) == 1:
+                kind, stage = "planet", planet_stages.pop()
+            else:
+                kind, stage = ("rigid" if m.kind == "rigid" else "rotational"), None
+        kappa = cm.kinematic_ratio
+        referred = normalise_shape(np.divide(u, kappa, out=u.copy(), where=kappa != 0.0))  # translations as they are
         strain = k_elem * (rows @ (cm.to_gearbox @ u)) ** 2
         if cm.main_shaft is not None:
             twist, k_shaft = cm.main_shaft
             strain = np.append(strain, k_shaft * (twist @ u) ** 2)
         strain_share = membership @ strain / strain.sum() if strain.sum() > 0 else membership @ strain
-        kinetic = cm.body_inertia_kgm2 * u * u
-        energy = kinetic / kinetic.sum() if kinetic.sum() > 0 else kinetic
         mode = replace(m, kind=kind, shape=normalise_shape(u), energy_fraction=energy)
         out.append(
             DrivetrainMode(
@@ -284,7 +349,7 @@ def drivetrain_modes(drivetrain: Drivetrain, operating_point: OperatingPoint, st
                 dominant_elements=_share_text(group_names, strain_share),
             )
         )
-    return DrivetrainModalAnalysis(out, model, ss, list(names), rotor)
+    return DrivetrainModalAnalysis(_multiplicities(out), model, ss, list(names), rotor, free_input)
 
 
 def two_inertia_frequency_hz(stiffness_nm_per_rad: float, inertia1_kgm2: float, inertia2_kgm2: float) -> float:

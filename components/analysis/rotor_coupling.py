@@ -61,7 +61,7 @@ class CoupledModel:
     main_shaft : tuple of (ndarray, float) or None
         With a flexible main shaft: its twist row over ``z`` and its stiffness [N m/rad].
     rotor : RotorParameters or None
-        None: the rotor is held (a prescribed speed).
+        None: the rotor is held (a prescribed speed), or there is none (a free input member).
     """
 
     mass: np.ndarray
@@ -77,8 +77,8 @@ class CoupledModel:
 
     @property
     def held(self) -> bool:
-        """True if the rotor speed is prescribed."""
-        return self.rotor is None
+        """True if the rotor speed is prescribed (the input member is no coordinate)."""
+        return len(self.body_names) == self.mass.shape[0] and self.rotor is None
 
 
 def held_rotor(model: LinearModel) -> CoupledModel:
@@ -89,25 +89,29 @@ def held_rotor(model: LinearModel) -> CoupledModel:
                         np.diag(model.mass).copy(), model.assembly.kinematic_ratio.copy(), eye, None, None)
 
 
-def free_rotor(model: LinearModel, rotor: RotorParameters) -> CoupledModel:
+def free_rotor(model: LinearModel, rotor: RotorParameters | None) -> CoupledModel:
     """The drivetrain driven by a torque on a rotor inertia (and main shaft), rigid-body mode removed.
 
     Parameters
     ----------
     model : LinearModel
         The rotor-held linearisation (its stiffness and damping are the gearbox's).
-    rotor : RotorParameters
+    rotor : RotorParameters or None
         Rotor inertia; with ``shaft_stiffness > 0`` the main shaft (stiffness, damping) and
-        the inertia lumped at its gearbox end.
+        the inertia lumped at its gearbox end. None: no rotor, the stage-1 input member is free
+        with its own inertia (a gearbox on its own, as in the free vibration of Lin and Parker, 1999).
     """
-    if not isinstance(rotor, RotorParameters):
+    if rotor is not None and not isinstance(rotor, RotorParameters):
         raise ParameterError("rotor", rotor, "a RotorParameters")
     a = model.assembly
     n_q = model.mass.shape[0]
     kappa = a.kinematic_ratio
     carrier = a.bodies[a.driver].name
     j_driver = a.driver_inertia_kgm2
-    if rotor.has_shaft:
+    if rotor is None:
+        names = [carrier]
+        inertia_lead = [j_driver]
+    elif rotor.has_shaft:
         names = [ROTOR_BODY, carrier]
         inertia_lead = [rotor.inertia_kgm2, rotor.carrier_inertia_kgm2 + j_driver]
     else:
@@ -122,7 +126,7 @@ def free_rotor(model: LinearModel, rotor: RotorParameters) -> CoupledModel:
     k_z = p.T @ model.stiffness @ p
     c_z = p.T @ model.damping @ p
     shaft = None
-    if rotor.has_shaft:
+    if rotor is not None and rotor.has_shaft:
         s = np.zeros(n_z)
         s[0], s[1] = 1.0, -1.0
         k_z += rotor.shaft_stiffness_nm_rad * np.outer(s, s)
@@ -141,6 +145,10 @@ def free_rotor(model: LinearModel, rotor: RotorParameters) -> CoupledModel:
                         names + list(model.dof_names), inertia, ratio, p, shaft, rotor)
 
 
-def coupled(model: LinearModel, rotor: RotorParameters | None) -> CoupledModel:
-    """:func:`held_rotor` without a rotor, else :func:`free_rotor`."""
+def coupled(model: LinearModel, rotor: RotorParameters | None, free_input: bool = False) -> CoupledModel:
+    """:func:`held_rotor` without a rotor, else :func:`free_rotor`; ``free_input``: the input member free, no rotor."""
+    if free_input:
+        if rotor is not None:
+            raise ParameterError("free_input", True, "no rotor (a free input member has no rotor on it)")
+        return free_rotor(model, None)
     return held_rotor(model) if rotor is None else free_rotor(model, rotor)

@@ -47,29 +47,11 @@ from .contact import ContactLaw, MeshContact
 from .drivetrain import Drivetrain
 from .kernel.stiffness import N_PHASING_ROWS
 from .mesh_stiffness import MeshPhasing
+from .sparse import column_sparsity, dense_rows
+from .stage_rows import CONSTANT, COS, OMEGA2, SIN, Body, Rows, SpringElement, parallel_rows, planetary_rows
 from .stages import PlanetaryStage
 
-
-@dataclass(frozen=True)
-class Body:
-    """A rigid rotating body.
-
-    Attributes
-    ----------
-    name : str
-        e.g. ``"stage1.planet[2]"``, ``"generator"``.
-    inertia_kgm2 : float
-        Polar inertia [kg m^2] (a carrier includes the planets' orbital inertia).
-    stage : str
-        Stage name, or ``"generator"``.
-    role : str
-        ``carrier``, ``sun``, ``planet``, ``drive``, ``driven`` or ``generator``.
-    """
-
-    name: str
-    inertia_kgm2: float
-    stage: str
-    role: str
+__all__ = ["Assembly", "Body", "InternalLoads", "Mesh", "ShaftElement", "SpringElement", "column_sparsity"]
 
 
 @dataclass(frozen=True)
@@ -143,6 +125,11 @@ class InternalLoads:
     shaft_twist_rad: np.ndarray
     shaft_twist_rate_rad_s: np.ndarray
     shaft_torque_nm: np.ndarray
+    #: the deflection [m] (torsional supports: [rad]), its rate and the force [N] ([N m]) of every bearing row,
+    #: shape (..., n_spring)
+    bearing_deflection_m: np.ndarray | None = None
+    bearing_rate_m_s: np.ndarray | None = None
+    bearing_force_n: np.ndarray | None = None
 
 
 class Assembly:
@@ -176,73 +163,45 @@ class Assembly:
             raise ParameterError("cut_at_generator", True, "a drivetrain with a generator to cut at")
         self.drivetrain = drivetrain
         self.cut_at_generator = cut_at_generator
-        bodies: list[Body] = []
-        mesh_rows: list[dict[int, float]] = []
-        meshes: list[tuple[str, str, str, MeshContact, int, float, float]] = []
+        rows = Rows()
         shaft_rows: list[tuple[int, int]] = []
         shafts: list[ShaftElement] = []
-
-        def body(name: str, inertia: float, stage: str, role: str) -> int:
-            bodies.append(Body(name, float(inertia), stage, role))
-            return len(bodies) - 1
+        bodies = rows.bodies
 
         def shaft(sh, a: int, b: int) -> None:
             shaft_rows.append((a, b))
             shafts.append(ShaftElement(sh.name, bodies[a].name, bodies[b].name, sh.stiffness_nm_per_rad, sh.damping_nms_per_rad))
 
+        gravity = drivetrain.gravity.in_plane_m_s2 if drivetrain.gravity is not None else 0.0
         previous_output = -1
         stage_members: dict[str, dict[str, int]] = {}
         for k, st in enumerate(drivetrain.stages):
-            n = st.name
-            if isinstance(st, PlanetaryStage):
-                r_s, r_p, r_r = st.sun_radius_m, st.planet_radius_m, st.ring_radius_m
-                c = body(f"{n}.carrier", st.carrier_total_inertia_kgm2, n, "carrier")
-                s = body(f"{n}.sun", st.sun_inertia_kgm2, n, "sun")
-                planets = [body(f"{n}.planet[{i + 1}]", st.planet_inertia_kgm2, n, "planet") for i in range(st.n_planets)]
-                z_s = 2.0 * r_s / st.module_m
-                z_r = 2.0 * r_r / st.module_m
-                positions = st.planet_positions_rad  # psi_i: given, or equally spaced
-                for i, p in enumerate(planets):  # eq. 8
-                    psi = positions[i]
-                    mesh_rows.append({s: -r_s, p: -r_p, c: r_s + r_p})
-                    meshes.append((f"{n}.F_sp[{i + 1}]", n, "sun_planet", st.sun_mesh, c, z_r, -z_s * psi))
-                for i, p in enumerate(planets):  # eq. 10, ring fixed
-                    psi = positions[i]
-                    mesh_rows.append({p: r_p, c: r_r - r_p})
-                    meshes.append((f"{n}.F_rp[{i + 1}]", n, "ring_planet", st.ring_mesh, c, z_r, z_r * psi))
-                members = {"input": c, "output": s}
-            else:
-                d1 = body(f"{n}.drive", st.drive_inertia_kgm2, n, "drive")
-                d2 = body(f"{n}.driven", st.driven_inertia_kgm2, n, "driven")
-                mesh_rows.append({d1: st.drive_radius_m, d2: -st.driven_radius_m})
-                meshes.append((f"{n}.F_mesh", n, "parallel", st.mesh, d1, st.drive_teeth, 0.0))
-                members = {"input": d1, "output": d2}
-            stage_members[n] = members
+            build = planetary_rows if isinstance(st, PlanetaryStage) else parallel_rows
+            members = build(rows, st, gravity, k == 0)
+            stage_members[st.name] = members
             if k > 0:
                 shaft(drivetrain.shafts[k - 1], previous_output, members["input"])
             previous_output = members["output"]
         generator_index = None
         if drivetrain.generator is not None:
-            generator_index = body("generator", drivetrain.generator.inertia_kgm2, "generator", "generator")
+            generator_index = rows.body("generator", drivetrain.generator.inertia_kgm2, "generator", "generator")
             shaft(drivetrain.output_shaft, previous_output, generator_index)
         output_index = generator_index if generator_index is not None else previous_output
 
         nb = len(bodies)
-        A = np.zeros((len(mesh_rows), nb))
-        for i, row in enumerate(mesh_rows):
-            for j, coef in row.items():
-                A[i, j] = coef
+        A = dense_rows(rows.mesh_rows, nb)
         S = np.zeros((len(shaft_rows), nb))
         for i, (a, b) in enumerate(shaft_rows):
             S[i, a] = 1.0
             S[i, b] = -1.0
+        B = dense_rows(rows.spring_rows, nb)
 
         driver = 0
         ports = [generator_index] if cut_at_generator else []
         free = [j for j in range(nb) if j != driver and j not in ports]
 
-        # kinematic ratios: [A; S] kappa = 0 with kappa_driver = 1 (exact for consistent geometry)
-        G = np.vstack([A, S])
+        # kinematic ratios: [A; S; B] kappa = 0 with kappa_driver = 1 (exact for consistent geometry)
+        G = np.vstack([A, S, B])
         rest = [j for j in range(nb) if j != driver]
         kappa_rest, *_ = np.linalg.lstsq(G[:, rest], -G[:, driver], rcond=None)
         kappa_all = np.zeros(nb)
@@ -255,16 +214,19 @@ class Assembly:
         self.bodies = bodies
         self.meshes = [
             Mesh(name, stage, kind, contact, float(teeth * kappa_all[ref]), float(off))
-            for (name, stage, kind, contact, ref, teeth, off) in meshes
+            for (name, stage, kind, contact, ref, teeth, off) in rows.meshes
         ]
         self.shafts = shafts
+        #: the bearings and supports of the lateral-torsional stages (their spring rows: :attr:`B`)
+        self.elements: list[SpringElement] = list(rows.elements)
         self.stage_members = {k: {r: bodies[i].name for r, i in v.items()} for k, v in stage_members.items()}
         self.free = np.array(free, dtype=int)
         self.ports = np.array(ports, dtype=int)
         self.driver = driver
         self.n_dof = len(free)
-        self.n_mesh = len(mesh_rows)
+        self.n_mesh = len(rows.mesh_rows)
         self.n_shaft = len(shaft_rows)
+        self.n_spring = len(rows.spring_rows)
         self.kinematic_ratio_all = kappa_all
         self.kinematic_ratio = kappa_all[free]
         self.port_ratio = kappa_all[ports]
@@ -274,23 +236,38 @@ class Assembly:
         self.driver_inertia_kgm2 = bodies[driver].inertia_kgm2
         self.law = ContactLaw([m.contact for m in self.meshes])
         self.cos_alpha = np.array([math.cos(m.contact.pressure_angle_rad) for m in self.meshes])
+        #: constant deflection of every mesh [m] (planet pin position errors): ``d = A q + e``
+        self.mesh_offset = np.array(rows.mesh_offsets, dtype=float)
         self.A_all = A
         self.S_all = S
+        self.B_all = B
         self.A = np.ascontiguousarray(A[:, free])
         self.A_port = np.ascontiguousarray(A[:, ports])
         self.S = np.ascontiguousarray(S[:, free])
         self.S_port = np.ascontiguousarray(S[:, ports])
+        #: the bearing rows of the free bodies, their stiffness [N/m or N m/rad] and damping
+        self.B = np.ascontiguousarray(B[:, free])
+        self.bearing_k = np.array(rows.spring_k, dtype=float)
+        self.bearing_c = np.array(rows.spring_c, dtype=float)
         self.a_driver = A[:, driver].copy()
         self.s_driver = S[:, driver].copy()
+        self.b_driver = B[:, driver].copy()
         self.BT = np.ascontiguousarray((self.cos_alpha[:, None] * self.A).T)  # (n_dof, n_mesh)
         self.BT_driver = self.cos_alpha * self.a_driver
         self.shaft_k = np.array([s.stiffness_nm_per_rad for s in shafts])
         self.shaft_c = np.array([s.damping_nms_per_rad for s in shafts])
+        #: every spring row of the kernel: the shafts, then the bearings (rows, stiffness, damping, driver column)
+        self.springs = np.ascontiguousarray(np.vstack([self.S, self.B]))
+        self.springs_k = np.concatenate([self.shaft_k, self.bearing_k])
+        self.springs_c = np.concatenate([self.shaft_c, self.bearing_c])
+        self.springs_driver = np.concatenate([self.s_driver, self.b_driver])
+        springs_port = np.vstack([self.S_port, B[:, ports]])
         self.ST = np.ascontiguousarray(self.S.T)
-        self.STkS = self.ST @ (self.shaft_k[:, None] * self.S)
-        self.STcS = self.ST @ (self.shaft_c[:, None] * self.S)
-        self.STkS_port = self.ST @ (self.shaft_k[:, None] * self.S_port)
-        self.STcS_port = self.ST @ (self.shaft_c[:, None] * self.S_port)
+        self.STkS = self.springs.T @ (self.springs_k[:, None] * self.springs)
+        self.STcS = self.springs.T @ (self.springs_c[:, None] * self.springs)
+        self.STkS_port = self.springs.T @ (self.springs_k[:, None] * springs_port)
+        self.STcS_port = self.springs.T @ (self.springs_c[:, None] * springs_port)
+        self._external_loads(rows, kappa_all, free)
         out_free = np.flatnonzero(self.free == output_index)
         self.output_dof = int(out_free[0]) if out_free.size else None  # None when the output is the port
         self.output_body = bodies[output_index].name
@@ -298,7 +275,7 @@ class Assembly:
         # matrices for the single-state fast path (mesh forces + shafts folded into constant matrices)
         self.A_T = np.ascontiguousarray(self.A.T)  # (n_dof, n_mesh)
         self._neg_B = np.ascontiguousarray(-(self.cos_alpha[:, None] * self.A))  # (n_mesh, n_dof)
-        self._shaft_QY = np.ascontiguousarray(-np.vstack([self.STkS.T, self.STcS.T]))  # y = [q, v] -> shaft torques on dofs
+        self._shaft_QY = np.ascontiguousarray(-np.vstack([self.STkS.T, self.STcS.T]))  # y = [q, v] -> spring forces
         self._port_Q = -np.stack([self.STkS_port, self.STcS_port])  # (2, n_dof, n_port)
         if self.ports.size > 1:
             raise ParameterError("ports", self.ports.size, "at most one prescribed port")
@@ -311,12 +288,12 @@ class Assembly:
         #: the port input's weights on the mesh deflections and shaft twists (zero without a port)
         self.port_deflection = self.A_port[:, 0].copy() if self.ports.size else np.zeros(self.n_mesh)
         self.port_twist = self.S_port[:, 0].copy() if self.ports.size else np.zeros(self.n_shaft)
-        #: the folded matrix: q_ddot = [force, q, v, u, u_dot, alpha_in] @ fast_matrix (u, u_dot: the port input,
-        #: see above); what the kernel (:func:`components.model.kernel.dynamics.acceleration`) evaluates
+        #: the folded matrix: q_ddot = [force, q, v, u, u_dot, alpha_in, external terms] @ fast_matrix (u, u_dot:
+        #: the port input, see above; the external terms: :attr:`load_terms`); what the kernel
+        #: (:func:`components.model.kernel.dynamics.acceleration`) evaluates
+        scaled = np.vstack([self._neg_B, self._shaft_QY, port_q[None, :], port_v[None, :]]) * self.inv_inertia
         self.fast_matrix = np.ascontiguousarray(
-            np.vstack([self._neg_B, self._shaft_QY, port_q[None, :], port_v[None, :], -self.kinematic_ratio[None, :]])
-            * np.append(self.inv_inertia[None, :].repeat(self._neg_B.shape[0] + 2 * self.n_dof + 2, 0), [np.ones(self.n_dof)], 0)
-        )
+            np.vstack([scaled, -self.kinematic_ratio[None, :], self.load_matrix * self.inv_inertia]))
         #: per mesh: mesh-cycle phase per driver radian [rad/rad], its offset [rad], stiffness variation, contact ratio
         self.mesh_phase_rate = np.array([m.teeth_per_driver_rad for m in self.meshes])
         self.mesh_phase_offset = np.array([m.phase_offset_rad for m in self.meshes])
@@ -329,25 +306,42 @@ class Assembly:
         self.phasing_table = self.phasing.table if self.phasing is not None else np.zeros((N_PHASING_ROWS, self.n_mesh))
         #: d q_ddot / d F, shape (n_mesh, n_dof): the force rows of the folded matrix
         self.force_rows = np.ascontiguousarray(self.fast_matrix[: self.n_mesh])
-        self.nz_index, self.nz_value = self._mesh_sparsity()
+        #: the nonzero columns of every mesh row of ``A`` (free bodies) and their entries: the kernel's Jacobian
+        #: sums over these only
+        self.nz_index, self.nz_value = column_sparsity(self.A.T)
+        #: the folded matrix by columns, its nonzero rows only: what the kernel's accelerations sum
+        self.fast_index, self.fast_value = column_sparsity(self.fast_matrix)
+        #: the columns each row of the Jacobian blocks dq/dv can hold (shafts, bearings and the bodies of one mesh)
+        pattern = (self.STkS != 0.0) | (self.STcS != 0.0) | np.eye(self.n_dof, dtype=bool)
+        for row in self.A:
+            cols = np.flatnonzero(row)
+            pattern[np.ix_(cols, cols)] = True
+        self.jacobian_index = column_sparsity(pattern.T.astype(float))[0]
 
-    def _mesh_sparsity(self) -> tuple[np.ndarray, np.ndarray]:
-        """Nonzero columns of every mesh row of ``A`` (free bodies) and their entries, padded with -1 / 0.
+    def _external_loads(self, rows: Rows, kappa_all: np.ndarray, free: list[int]) -> None:
+        """:attr:`load_rates` and :attr:`load_matrix` from the stages' loads (none without a lateral stage).
 
-        Returns
-        -------
-        index, value : ndarray, shape (n_mesh, width)
-            ``width`` is the largest number of free bodies one mesh touches (at least 1); the kernel's
-            Jacobian sums over these only.
+        The external generalised forces are ``terms @ load_matrix`` with ``terms = [omega_in^2, 1, cos(r_1 th_in),
+        sin(r_1 th_in), ...]`` (:func:`components.model.kernel.dynamics.external_terms`), ``r_k = load_rates[k]``
+        the kinematic ratio of a carrier whose frame gravity turns in.
         """
-        rows = [np.flatnonzero(row) for row in self.A]
-        width = max([1] + [r.size for r in rows])
-        index = np.full((self.n_mesh, width), -1.0)
-        value = np.zeros((self.n_mesh, width))
-        for i, cols in enumerate(rows):
-            index[i, : cols.size] = cols
-            value[i, : cols.size] = self.A[i, cols]
-        return index, value
+        frames = list(dict.fromkeys(f for _, term, f, _ in rows.loads if term in (COS, SIN)))
+        #: frame rate of each cos/sin pair of the external terms [rad per driver rad]
+        self.load_rates = np.array([kappa_all[f] for f in frames], dtype=float)
+        n_terms = 2 + 2 * len(frames) if self.drivetrain.lateral else 0
+        where = {j: i for i, j in enumerate(free)}
+        matrix = np.zeros((n_terms, len(free)))
+        for body, term, frame, coefficient in rows.loads:
+            if body not in where:
+                continue
+            if term == OMEGA2:
+                matrix[0, where[body]] += coefficient * kappa_all[frame] ** 2
+            elif term == CONSTANT:
+                matrix[1, where[body]] += coefficient
+            else:
+                matrix[2 + 2 * frames.index(frame) + (term == SIN), where[body]] += coefficient
+        #: external generalised forces per external term, shape (n_terms, n_dof) (0 rows: no lateral stage)
+        self.load_matrix = matrix
 
     # ------------------------------------------------------------------ names
     @property
@@ -408,7 +402,7 @@ class Assembly:
         derivatives : bool
             Also the force derivatives (for a Jacobian); False leaves them None and costs less.
         """
-        d = q @ self.A.T
+        d = q @ self.A.T + self.mesh_offset
         dd = v @ self.A.T
         s = q @ self.S.T
         sd = v @ self.S.T
@@ -418,25 +412,48 @@ class Assembly:
             s = s + q_port @ self.S_port.T
             sd = sd + v_port @ self.S_port.T
         torque = self.shaft_k * s + self.shaft_c * sd
+        b, bd = q @ self.B.T, v @ self.B.T
+        bearing = (b, bd, self.bearing_k * b + self.bearing_c * bd)
         if not derivatives:
             force, elastic = self.law.force_and_elastic(d, dd, stiffness_factor)
-            return InternalLoads(d, dd, force, None, None, elastic, s, sd, torque)
+            return InternalLoads(d, dd, force, None, None, elastic, s, sd, torque, *bearing)
         cf = self.law.evaluate(d, dd, stiffness_factor)
-        return InternalLoads(d, dd, cf.force, cf.d_force_d_deflection, cf.d_force_d_rate, cf.elastic, s, sd, torque)
+        return InternalLoads(d, dd, cf.force, cf.d_force_d_deflection, cf.d_force_d_rate, cf.elastic, s, sd, torque,
+                             *bearing)
 
     def generalised_forces(self, loads: InternalLoads) -> np.ndarray:
-        """Generalised torques on the free bodies from meshes and shafts [N m], shape (..., n_dof)."""
-        return -(loads.contact_force_n @ self.BT.T) - loads.shaft_torque_nm @ self.S
+        """Generalised forces on the free bodies from meshes, shafts and bearings [N m, N], shape (..., n_dof)."""
+        return -(loads.contact_force_n @ self.BT.T) - loads.shaft_torque_nm @ self.S - loads.bearing_force_n @ self.B
+
+    def external_terms(self, driver_angle_rad: np.ndarray | float, driver_speed_rad_s: np.ndarray | float) -> np.ndarray:
+        """The external terms ``[omega^2, 1, cos(r_k th), sin(r_k th), ...]`` at driver angles and speeds, shape
+        (..., n_terms) (none without a lateral stage; the kernel's :func:`~.kernel.dynamics.external_terms`)."""
+        angle = np.asarray(driver_angle_rad, dtype=float)
+        speed = np.asarray(driver_speed_rad_s, dtype=float)
+        shape = np.broadcast(angle, speed).shape
+        if not self.load_matrix.shape[0]:
+            return np.zeros(shape + (0,))
+        phase = np.broadcast_to(angle, shape)[..., None] * self.load_rates
+        trig = np.stack([np.cos(phase), np.sin(phase)], axis=-1).reshape(shape + (2 * self.load_rates.size,))
+        return np.concatenate([np.broadcast_to(speed, shape)[..., None] ** 2, np.ones(shape + (1,)), trig], axis=-1)
+
+    def external_forces(self, driver_angle_rad: np.ndarray | float, driver_speed_rad_s: np.ndarray | float) -> np.ndarray:
+        """Gravity and centrifugal forces on the free bodies [N], shape (..., n_dof) (zero without lateral stages)."""
+        terms = self.external_terms(driver_angle_rad, driver_speed_rad_s)
+        if not terms.shape[-1]:
+            return np.zeros(terms.shape[:-1] + (self.n_dof,))
+        return terms @ self.load_matrix
 
     def driver_torque(self, loads: InternalLoads, driver_acceleration: np.ndarray | float) -> np.ndarray:
         """Torque the kinematic driver applies to the gearbox [N m] (rotor torque).
 
-        ``T_rotor = I_in alpha_in + cos(alpha) a_in . F + s_in . T_shaft``.
+        ``T_rotor = I_in alpha_in + cos(alpha) a_in . F + s_in . T_shaft + b_in . F_bearing``.
         """
         return (
             self.driver_inertia_kgm2 * driver_acceleration
             + loads.contact_force_n @ self.BT_driver
             + loads.shaft_torque_nm @ self.s_driver
+            + loads.bearing_force_n @ self.b_driver
         )
 
     # ------------------------------------------------------------- dynamics
@@ -449,14 +466,16 @@ class Assembly:
         q_port: np.ndarray | None = None,
         v_port: np.ndarray | None = None,
         stiffness_factor: np.ndarray | float = 1.0,
+        driver_angle_rad: float = 0.0,
+        driver_speed_rad_s: float = 0.0,
     ) -> np.ndarray:
-        """Deviation accelerations ``q_ddot`` [rad/s^2], shape (n_dof,).
+        """Deviation accelerations ``q_ddot`` [rad/s^2, m/s^2], shape (n_dof,).
 
         ``output_torque_nm`` is the counter torque braking the output body (ignored
-        when the output is a port).
+        when the output is a port); the driver's angle and speed set the external loads.
         """
         loads = self.loads(q, v, q_port, v_port, stiffness_factor)
-        Q = self.generalised_forces(loads)
+        Q = self.generalised_forces(loads) + self.external_forces(driver_angle_rad, driver_speed_rad_s)
         if self.output_dof is not None:
             Q[self.output_dof] -= output_torque_nm
         return self.inv_inertia * Q - self.kinematic_ratio * driver_acceleration
@@ -498,16 +517,17 @@ class Assembly:
         stks_port = self.STkS_port[:, 0].copy() if self.ports.size else np.zeros(n)
         stcs_port = self.STcS_port[:, 0].copy() if self.ports.size else np.zeros(n)
         model_kernel.monolithic(kernel)[0].jacobian(
-            y, port, port_rate, factor, self.A_T, self.port_deflection, self.law.table, np.zeros((2, m)), self.nz_index,
-            self.nz_value, self.cos_alpha, self.STkS, self.STcS, stks_port, stcs_port, self.inv_inertia, np.zeros(m),
+            y, port, port_rate, factor, self.port_deflection, self.mesh_offset, self.law.table,
+            np.zeros((2, m)), self.nz_index, self.nz_value, self.cos_alpha, self.STkS, self.STcS, stks_port, stcs_port, self.inv_inertia, np.zeros(m),
             np.zeros(m), dq, dv, port_jac)
         if not self.ports.size:
             return dq, dv, np.zeros((n, 0)), np.zeros((n, 0))
         return dq, dv, port_jac[0][:, None], port_jac[1][:, None]
 
     def static_deflection(self, load_nm: float, stiffness_factor: np.ndarray | float = 1.0,
-                          kernel: str | None = None, rtol: float = 1e-11,
-                          max_iterations: int = 60) -> tuple[np.ndarray, int, float]:
+                          kernel: str | None = None, rtol: float = 1e-11, max_iterations: int = 60,
+                          driver_angle_rad: float = 0.0,
+                          driver_speed_rad_s: float = 0.0) -> tuple[np.ndarray, int, float]:
         """Deviation angles at which meshes and shafts carry the counter torque ``load_nm`` at constant speed.
 
         :func:`components.model.kernel.statics.static_deflection` (Newton from two linear-spring guesses)
@@ -526,6 +546,8 @@ class Assembly:
             generalised-force magnitudes on one body.
         max_iterations : int
             Newton iterations.
+        driver_angle_rad, driver_speed_rad_s : float
+            Where gravity points and how fast the planets orbit (the external loads of lateral stages).
 
         Returns
         -------
@@ -547,10 +569,13 @@ class Assembly:
         n, m = self.n_dof, self.n_mesh
         y = np.zeros(2 * n)
         factor = np.ascontiguousarray(np.broadcast_to(np.asarray(stiffness_factor, dtype=float), (m,)))
+        n_ext = self.load_matrix.shape[0]
+        z = np.zeros(m + 2 * n + 4 + n_ext)
+        z[m + 2 * n + 3:m + 2 * n + 3 + n_ext] = self.external_terms(driver_angle_rad, driver_speed_rad_s)
         status, iterations, imbalance = model_kernel.monolithic(kernel)[0].static_deflection(
-            y, n, float(load_nm), factor, math.copysign(1.0, load_nm), self.A_T, self.port_deflection,
-            self.fast_matrix, self.law.table, self.nz_index, self.nz_value, self.cos_alpha, self.STkS, self.STcS,
-            np.zeros(n), np.zeros(n), self.inv_inertia, np.zeros(m + 2 * n + 4), np.zeros((2, m)), np.zeros(n),
+            y, n, float(load_nm), factor, math.copysign(1.0, load_nm), self.A_T, self.port_deflection, self.mesh_offset,
+            self.fast_matrix, self.fast_index, self.fast_value, self.law.table, self.nz_index, self.nz_value, self.cos_alpha, self.STkS, self.STcS,
+            np.zeros(n), np.zeros(n), self.inv_inertia, z, np.zeros((2, m)), np.zeros(n),
             np.zeros(m), np.zeros(m), np.zeros((n, n)), np.zeros((n, n)), np.zeros((2, n)), np.zeros((n, n)),
             np.zeros((n, n)), np.zeros(n), np.zeros(n), np.zeros(m), np.zeros(2 * n), rtol, max_iterations)
         if status != 0:
@@ -565,13 +590,13 @@ class Assembly:
         return 0.5 * (speeds_rad_s**2 @ self.inertia_kgm2) + 0.5 * self.driver_inertia_kgm2 * np.asarray(driver_speed_rad_s) ** 2
 
     def potential_energy(self, loads: InternalLoads) -> float:
-        """Elastic energy [J] stored in meshes and shafts at one state."""
+        """Elastic energy [J] stored in meshes, shafts and bearings at one state."""
         mesh = float(self.cos_alpha @ self.law.potential_energy(loads.deflection_m))
         shafts = float(0.5 * self.shaft_k @ loads.shaft_twist_rad**2)
-        return mesh + shafts
+        return mesh + shafts + float(0.5 * self.bearing_k @ loads.bearing_deflection_m**2)
 
     def dissipation_power(self, loads: InternalLoads) -> np.ndarray:
-        """Power dissipated by mesh and shaft damping [W], shape (...)."""
+        """Power dissipated by mesh, shaft and bearing damping [W], shape (...)."""
         mesh = ((loads.contact_force_n - loads.elastic_force_n) * loads.deflection_rate_m_s) @ self.cos_alpha
         shaft = (self.shaft_c * loads.shaft_twist_rate_rad_s**2).sum(axis=-1)
-        return mesh + shaft
+        return mesh + shaft + (self.bearing_c * loads.bearing_rate_m_s**2).sum(axis=-1)

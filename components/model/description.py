@@ -18,6 +18,7 @@ import math
 from typing import Any, Mapping
 
 from ..errors import ParameterError
+from .bearings import Bearing, Gravity, ParallelLateral, PlanetaryLateral, RingSupport
 from .contact import MeshContact
 from .drivetrain import Drivetrain
 from .generator import GeneratorParameters, LoadEvent
@@ -29,7 +30,7 @@ from .wind import WindParameters
 #: the classes a description may contain, by the name written into it
 TYPES: dict[str, type] = {cls.__name__: cls for cls in (
     Drivetrain, PlanetaryStage, ParallelStage, Shaft, MeshContact, GeneratorParameters, LoadEvent, WindParameters,
-    RotorParameters, TorqueLawParameters,
+    RotorParameters, TorqueLawParameters, Bearing, RingSupport, PlanetaryLateral, ParallelLateral, Gravity,
 )}
 _TYPE_KEY = "type"
 

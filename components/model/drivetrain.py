@@ -14,6 +14,7 @@ from dataclasses import dataclass, field, replace
 
 from ..errors import ParameterError
 from ..validation import finite, set_fields
+from .bearings import Gravity, NamedBearing
 from .contact import MeshContact
 from .generator import GeneratorParameters, LoadEvent, TorqueSchedule
 from .stages import ParallelStage, PlanetaryStage, Shaft, Stage
@@ -37,6 +38,8 @@ class Drivetrain:
         Counter torque [N m] on the last stage's output member when there is no generator.
     output_events : tuple of LoadEvent
         Load events on that counter torque (no generator).
+    gravity : Gravity or None
+        Gravity on the bodies of lateral-torsional stages (None: none).
     """
 
     stages: tuple[Stage, ...]
@@ -45,6 +48,7 @@ class Drivetrain:
     output_shaft: Shaft | None = None
     output_torque_nm: float = 0.0
     output_events: tuple[LoadEvent, ...] = field(default_factory=tuple)
+    gravity: Gravity | None = None
 
     def __post_init__(self) -> None:
         stages = tuple(self.stages)
@@ -80,6 +84,18 @@ class Drivetrain:
                 )
         elif self.output_shaft is not None:
             raise ParameterError("output_shaft", self.output_shaft, "None without a generator")
+        if self.gravity is not None and not isinstance(self.gravity, Gravity):
+            raise ParameterError("gravity", self.gravity, "a Gravity or None")
+
+    @property
+    def lateral(self) -> bool:
+        """True if any stage is modelled lateral-torsionally."""
+        return any(st.lateral is not None for st in self.stages)
+
+    @property
+    def bearings(self) -> tuple[NamedBearing, ...]:
+        """Every rolling bearing of the lateral-torsional stages, by name (for the ISO 281 lives)."""
+        return tuple(b for st in self.stages for b in st.bearings)
 
     @property
     def ratio(self) -> float:

@@ -31,7 +31,8 @@ from ..compile.jit import entry_point
 from ..errors import ParameterError, SolverError
 from ..validation import finite, one_of
 from . import kernel as model_kernel
-from .assembly import Assembly
+from .assembly import Assembly, column_sparsity
+from .gearbox_outputs import gearbox_outputs
 from .drivetrain import Drivetrain
 from .integrators import StepControl
 from .kernel import layout as L
@@ -211,18 +212,25 @@ class GearboxModel:
         a = self.assembly
         n, m, n2 = a.n_dof, a.n_mesh, 2 * a.n_dof
         width = a.nz_index.shape[1]
-        n_linear = 3 + m + a.n_shaft + len(self.gearbox_dofs)
+        n_ext = a.load_matrix.shape[0]
+        n_linear, n_mag = self._out_index.shape[0], self._magnitudes.shape[0]
         shapes = {
-            "a_t": (n, m), "a_port": (m,), "fast": (m + n2 + 3, n), "contact": a.law.table.shape, "stks": (n, n),
-            "stcs": (n, n), "stks_port": (n,), "stcs_port": (n,), "inv_m": (n,), "phasing": a.phasing_table.shape,
-            "kappa": (n,), "force_rows": (m, n), "nz_index": (m, width), "nz_value": (m, width), "cos_alpha": (m,),
-            "control": (L.N_CONTROL,), "twist_q": (n2,), "output_matrix": (m + n2 + 4, n_linear),
-            "z": (m + n2 + 4,), "defl": (2, m), "acc": (n,), "fd": (m,), "fv": (m,), "factor": (m,), "slope": (m,),
-            "sens": (m,), **{name: (n2,) for name in ("f0", "f1", "fn", "k1", "k2", "k3", "y1", "yn", "rhs", "w_hdt")},
-            "da": (n,), "istate": (L.N_ISTATE,), "dq": (n, n), "dv": (n, n),
-            "winvs": (2, n2, n2), "w_bases": (2, 3, n2),  # the active W^-1 and the one kept (istate[ACTIVE])
+            "a_t": (n, m), "a_port": (m,), "fast": (m + n2 + 3 + n_ext, n), "contact": a.law.table.shape,
+            "stks": (n, n), "stcs": (n, n), "stks_port": (n,), "stcs_port": (n,), "inv_m": (n,),
+            "phasing": a.phasing_table.shape, "kappa": (n,), "force_rows": (m, n), "nz_index": (m, width),
+            "nz_value": (m, width), "cos_alpha": (m,), "control": (L.N_CONTROL,), "twist_q": (n2,),
+            "offset": (m,), "load_rates": a.load_rates.shape, "magnitudes": (n_mag, 2),
+            "fast_index": a.fast_index.shape, "fast_value": a.fast_value.shape, "jac_index": a.jacobian_index.shape,
+            "out_index": self._out_index.shape, "out_value": self._out_index.shape,
+            "z": (m + n2 + 4 + n_ext,), "defl": (2, m), "acc": (n,), "fd": (m,), "fv": (m,), "factor": (m,),
+            "slope": (m,), "sens": (m,),
+            **{name: (n2,) for name in ("f0", "f1", "fn", "k1", "k2", "k3", "y1", "yn", "rhs", "w_hdt")},
+            "w_ext": (max(n_ext, 1),),
+            "da": (n,), "sol": (n,), "istate": (L.N_ISTATE,), "dq": (n, n), "dv": (n, n),
+            # G^-1 (or its LU factors, pivots and pattern) and the time-derivative basis of every kept factorisation
+            "winvs": (L.N_SLOTS, n, n), "pivots": (L.N_SLOTS, 2 * n + 1, n), "w_bases": (L.N_SLOTS, 3 + n_ext, n2),
             "port_jac": (2, n), "last_acc": (n,), "last_force": (m,), "last_defl": (2, m), "y": (n2,),
-            "driver": (4,), "port": (4,), "scalars": (len(L.SCALAR_NAMES),), "outputs": (n_linear + 5,),
+            "driver": (4,), "port": (4,), "scalars": (len(L.SCALAR_NAMES),), "outputs": (n_linear + n_mag + 5,),
             "anchor": (n + 1,),
         }
         shapes["backup"] = (sum(int(np.prod(shapes[name])) for name in L.STATE_SLOTS),)
@@ -231,6 +239,8 @@ class GearboxModel:
     def _allocate(self) -> None:
         """The buffer with its views, constants and sizes."""
         a = self.assembly
+        output_matrix, self._magnitudes, self._output_names = gearbox_outputs(a, self.gearbox_dofs, self._out_member)
+        self._out_index, self._out_value = column_sparsity(output_matrix)
         shapes = self._slot_shapes()
         sizes = [int(np.prod(shapes[name])) for name in L.SLOTS]
         self._offsets = np.concatenate(([0], np.cumsum(sizes))).astype(np.int64)
@@ -255,13 +265,18 @@ class GearboxModel:
         v["force_rows"][:] = a.force_rows
         v["nz_index"][:], v["nz_value"][:] = a.nz_index, a.nz_value
         v["cos_alpha"][:] = a.cos_alpha
+        v["offset"][:] = a.mesh_offset
+        v["load_rates"][:] = a.load_rates
+        v["magnitudes"][:] = self._magnitudes
         c = self.control
         v["control"][:] = (c.rtol, c.atol_q, c.atol_v, c.h_min, float(c.max_steps), float(c.jacobian_max_age),
                            self._out_kinematic, float(self._out_rate_index))
         # output-shaft twist = twist_q . q + twist_port * port angle (its rate: the same weights on v)
         self._twist_q = np.concatenate((a.S[-1], np.zeros(a.n_dof)))
         v["twist_q"][:] = self._twist_q
-        v["output_matrix"][:] = self._build_output_matrix()
+        v["out_index"][:], v["out_value"][:] = self._out_index, self._out_value
+        v["fast_index"][:], v["fast_value"][:] = a.fast_index, a.fast_value
+        v["jac_index"][:] = a.jacobian_index
         sc = self._scalars
         sc[L.S_KX] = self._kx
         sc[L.S_TWIST_PORT] = float(a.port_twist[-1])
@@ -277,32 +292,8 @@ class GearboxModel:
         dims[L.D_GEN_DOF] = -1 if self.generator_dof is None else self.generator_dof
         dims[L.D_ROTOR_DERIVATIVES] = int(self.rotor_derivatives)
         dims[L.D_OWN_GEN_SPEED] = int(self.generator_interface == "inertia_own")
-
-    def _build_output_matrix(self) -> np.ndarray:
-        """Linear map ``z -> [shaft_torque_end, omega_out, torque_rotor, forces, shaft torques, speeds]``.
-
-        ``z = [contact forces (n_mesh), q, v (n_dof each), port angle, port speed,
-        driver speed, driver acceleration]``: every output except the step-averaged
-        shaft torque is linear in ``z``.
-        """
-        a = self.assembly
-        n, m, ns = a.n_dof, a.n_mesh, a.n_shaft
-        rows = m + 2 * n + 4
-        shafts = np.zeros((rows, ns))
-        shafts[m : m + n] = (a.shaft_k[:, None] * a.S).T
-        shafts[m + n : m + 2 * n] = (a.shaft_c[:, None] * a.S).T
-        shafts[m + 2 * n] = a.shaft_k * a.port_twist
-        shafts[m + 2 * n + 1] = a.shaft_c * a.port_twist
-        speeds = np.zeros((rows, n))
-        speeds[m + n : m + 2 * n] = np.eye(n)
-        speeds[m + 2 * n + 2] = a.kinematic_ratio
-        forces = np.zeros((rows, m))
-        forces[:m] = np.eye(m)
-        rotor = shafts @ a.s_driver  # shaft reactions on the driven carrier
-        rotor[:m] += a.BT_driver  # mesh reactions
-        rotor[m + 2 * n + 3] += a.driver_inertia_kgm2  # carrier (and orbital planet) inertia
-        return np.column_stack((shafts[:, -1], speeds[:, self._out_member], rotor, forces, shafts,
-                                speeds[:, self.gearbox_dofs]))
+        dims[L.D_EXT] = a.load_matrix.shape[0]
+        dims[L.D_MAGNITUDES] = self._magnitudes.shape[0]
 
     # the scalar state lives in the buffer
     time_s = _buffer_scalar(L.S_TIME, "Current time [s].")
@@ -406,23 +397,18 @@ class GearboxModel:
     def rotor_torque_from(self, shaft_torques_nm: np.ndarray) -> float:
         """Rotor torque [N m] given the current shaft torques [N m], shape (n_shaft,)."""
         a = self.assembly
+        bearing = self.y.reshape(2, a.n_dof) @ a.B.T
         return float(
             a.driver_inertia_kgm2 * self.driver_accel_rad_s2
             + self.contact_force_n @ a.BT_driver
             + shaft_torques_nm @ a.s_driver
+            + (a.bearing_k * bearing[0] + a.bearing_c * bearing[1]) @ a.b_driver
         )
 
     @property
     def output_names(self) -> list[str]:
         """Names of the entries of :meth:`output_vector`, in order (FMU variable names)."""
-        a = self.assembly
-        return (
-            ["shaft_torque", "shaft_torque_avg", "shaft_torque_end", "omega_out", "torque_rotor"]
-            + a.mesh_names
-            + [f"{s}.torque" for s in a.shaft_names]
-            + [f"{a.dof_names[j]}.omega" for j in self.gearbox_dofs]
-            + ["alpha_out", "alpha_out_max", "omega_generator"]
-        )
+        return list(self._output_names)
 
     def output_vector(self) -> np.ndarray:
         """Every output at the current time, ordered as :attr:`output_names` (a copy).
@@ -475,7 +461,8 @@ class GearboxModel:
         self._state[:] = 0.0
         ist = self._istate
         ist[L.AGE] = -1.0  # no Jacobian yet
-        ist[L.HD] = ist[L.HD_PREV] = -1.0  # no factorisation
+        ist[L.HD] = -1.0  # no factorisation
+        ist[L.SLOT_HD:L.SLOT_HD + L.N_SLOTS] = -1.0
         sc = self._scalars
         sc[[L.S_LAST_STEP, L.S_SHAFT_TORQUE_AVG, L.S_OUTPUT_TWIST, L.S_ALPHA_OUT_AVG, L.S_DRIVER_ACCEL,
             L.S_LAST_ALPHA]] = 0.0

@@ -31,6 +31,16 @@ planets), not parameters. Per shaft ``shaftK``: ``stiffness`` [N m/rad],
 ``damping`` [N m s/rad]. Generator: ``generator.inertia`` [kg m^2],
 ``generator.counter_torque`` [N m]. Without a generator: ``output_torque`` [N m].
 
+Lateral-torsional stages (:mod:`components.model.bearings`) add per planetary stage ``carrier_mass``
+[kg], ``sun_bearing_stiffness``, ``carrier_bearing_stiffness``, ``planet_bearing_stiffness`` [N/m]
+and their ``..._damping`` [N s/m]; with a moving ring ``ring_mass`` [kg], ``ring_inertia`` [kg m^2],
+``ring_support_stiffness`` [N/m], ``ring_support_damping`` [N s/m], ``ring_torsional_stiffness``
+[N m/rad], ``ring_torsional_damping`` [N m s/rad]; per parallel stage ``drive_bearing_stiffness``,
+``driven_bearing_stiffness`` and their damping. A stage with pin position errors has
+``pin_error_radial[i]`` and ``pin_error_tangential[i]`` [m] per planet ``i`` (1-based); gravity
+``gravity.acceleration`` [m/s^2] and ``gravity.shaft_tilt`` [rad]. Bearing types and load
+ratings, the ring's presence and the line of centres are structure.
+
 The WindSource and GeneratorRotor FMUs' parameters have flat names of their own
 (:func:`wind_from_values`: ``omega0``, ``a``, ``sigma``,
 ``n_harmonics``, ``f_min``, ``f_max``, ``seed``, ``amplitude``;
@@ -49,6 +59,7 @@ from typing import Mapping
 
 from ..errors import ParameterError
 from ..validation import choice_bounds
+from .bearings import Bearing
 from .contact import CONTACT_LAW_DESCRIPTIONS, CONTACT_LAWS, MeshContact
 from .drivetrain import Drivetrain
 from .generator import EVENT_KINDS, GeneratorParameters, LoadEvent
@@ -78,6 +89,12 @@ UNITS: dict[str, str] = {
     "contact_law": "1", "impact_depth": "m", "impact_damping": "N.s/m", "contact_ratio": "1",
     "stiffness_variation": "1", "stiffness": "N.m/rad", "damping": "N.m.s/rad", "inertia": "kg.m2",
     "counter_torque": "N.m", "output_torque": "N.m",
+    "carrier_mass": "kg", "ring_mass": "kg", "ring_inertia": "kg.m2", "ring_torsional_stiffness": "N.m/rad",
+    "ring_torsional_damping": "N.m.s/rad", "pin_error_radial": "m", "pin_error_tangential": "m",
+    "acceleration": "m/s2", "shaft_tilt": "rad",
+    **{f"{member}_{kind}": unit for member in ("sun_bearing", "carrier_bearing", "planet_bearing", "ring_support",
+                                               "drive_bearing", "driven_bearing")
+       for kind, unit in (("stiffness", "N/m"), ("damping", "N.s/m"))},
 }
 
 DESCRIPTIONS: dict[str, str] = {
@@ -94,6 +111,15 @@ DESCRIPTIONS: dict[str, str] = {
     "contact_ratio": "contact ratio (time-varying stiffness)", "stiffness_variation": "relative mesh-stiffness variation (0: off)",
     "stiffness": "torsional stiffness", "damping": "torsional damping", "inertia": "rotor inertia",
     "counter_torque": "generator counter torque", "output_torque": "counter torque on the output gear",
+    "carrier_mass": "carrier mass (its translation)", "ring_mass": "ring mass", "ring_inertia": "ring polar inertia",
+    "ring_torsional_stiffness": "torsional stiffness of the ring's support",
+    "ring_torsional_damping": "torsional damping of the ring's support",
+    "pin_error_radial": "radial position error of the planet's pin", "pin_error_tangential":
+    "tangential position error of the planet's pin (in the direction of normal rotation)",
+    "acceleration": "gravity", "shaft_tilt": "rotor shaft tilt",
+    **{f"{member}_{kind}": f"radial {kind} of the {member.replace('_', ' ')}"
+       for member in ("sun_bearing", "carrier_bearing", "planet_bearing", "ring_support", "drive_bearing",
+                      "driven_bearing") for kind in ("stiffness", "damping")},
 }
 
 _MESH_FIELDS = {
@@ -124,14 +150,19 @@ def unit_exponent_parameter(name: str) -> str:
     return "" if other is None else (f"{prefix}.{other}" if prefix else other)
 
 
+def _field(name: str) -> str:
+    """The field of a flat name: its last part without an index (``stage1.pin_error_radial[2]`` -> ``pin_error_radial``)."""
+    return name.rsplit(".", 1)[-1].split("[", 1)[0]
+
+
 def unit_of_parameter(name: str) -> str:
     """Unit string of a flat parameter name (``"N/m^e"`` has the exponent e)."""
-    return UNITS.get(name.rsplit(".", 1)[-1], "1")
+    return UNITS.get(_field(name), "1")
 
 
 def description_of_parameter(name: str) -> str:
     """Short description of a flat parameter name."""
-    return DESCRIPTIONS.get(name.rsplit(".", 1)[-1], name)
+    return DESCRIPTIONS.get(_field(name), name)
 
 
 def _mesh_values(prefix: str, mesh: MeshContact) -> dict[str, float]:
@@ -152,6 +183,69 @@ def mesh_prefixes(stage) -> dict[str, str]:
     return {"sun_mesh": f"{stage.name}.sun_mesh", "ring_mesh": f"{stage.name}.ring_mesh"}
 
 
+def _bearings(stage) -> dict[str, str]:
+    """Flat-name member -> the lateral table's field of each bearing of a lateral stage (``{}`` torsional)."""
+    lat = stage.lateral
+    if lat is None:
+        return {}
+    if isinstance(stage, PlanetaryStage):
+        return {"sun_bearing": "sun_bearing", "carrier_bearing": "carrier_bearing", "planet_bearing": "planet_bearing"}
+    return {"drive_bearing": "drive_bearing", "driven_bearing": "driven_bearing"}
+
+
+def _lateral_values(st) -> dict[str, float]:
+    """The flat values of a stage's lateral model and pin errors (module docstring)."""
+    out: dict[str, float] = {}
+    lat = st.lateral
+    for member, field_name in _bearings(st).items():
+        b = getattr(lat, field_name)
+        out[f"{st.name}.{member}_stiffness"] = b.stiffness_n_per_m
+        out[f"{st.name}.{member}_damping"] = b.damping_ns_per_m
+    if isinstance(st, PlanetaryStage):
+        if lat is not None:
+            out[f"{st.name}.carrier_mass"] = lat.carrier_mass_kg
+            if lat.ring is not None:
+                r = lat.ring
+                out.update({f"{st.name}.ring_mass": r.mass_kg, f"{st.name}.ring_inertia": r.inertia_kgm2,
+                            f"{st.name}.ring_support_stiffness": r.bearing.stiffness_n_per_m,
+                            f"{st.name}.ring_support_damping": r.bearing.damping_ns_per_m,
+                            f"{st.name}.ring_torsional_stiffness": r.torsional_stiffness_nm_per_rad,
+                            f"{st.name}.ring_torsional_damping": r.torsional_damping_nms_per_rad})
+        for i, (radial, tangential) in enumerate(st.pin_errors_m or ()):
+            out[f"{st.name}.pin_error_radial[{i + 1}]"] = radial
+            out[f"{st.name}.pin_error_tangential[{i + 1}]"] = tangential
+    return out
+
+
+def _lateral_changes(st, values: Mapping[str, float]) -> dict:
+    """The stage's ``lateral`` and ``pin_errors_m`` with the given flat values (unchanged where none is given)."""
+    changes: dict = {}
+    lat = st.lateral
+    get = lambda key, default: values.get(f"{st.name}.{key}", default)  # noqa: E731
+
+    def bearing(member: str, b: Bearing) -> Bearing:
+        return replace(b, stiffness_n_per_m=get(f"{member}_stiffness", b.stiffness_n_per_m),
+                       damping_ns_per_m=get(f"{member}_damping", b.damping_ns_per_m))
+
+    if lat is not None:
+        lat_changes = {f: bearing(member, getattr(lat, f)) for member, f in _bearings(st).items()}
+        if isinstance(st, PlanetaryStage):
+            lat_changes["carrier_mass_kg"] = get("carrier_mass", lat.carrier_mass_kg)
+            if lat.ring is not None:
+                r = lat.ring
+                lat_changes["ring"] = replace(
+                    r, mass_kg=get("ring_mass", r.mass_kg), inertia_kgm2=get("ring_inertia", r.inertia_kgm2),
+                    bearing=bearing("ring_support", r.bearing),
+                    torsional_stiffness_nm_per_rad=get("ring_torsional_stiffness", r.torsional_stiffness_nm_per_rad),
+                    torsional_damping_nms_per_rad=get("ring_torsional_damping", r.torsional_damping_nms_per_rad))
+        changes["lateral"] = replace(lat, **lat_changes)
+    if isinstance(st, PlanetaryStage) and st.pin_errors_m is not None:
+        changes["pin_errors_m"] = tuple(
+            (get(f"pin_error_radial[{i + 1}]", r), get(f"pin_error_tangential[{i + 1}]", t))
+            for i, (r, t) in enumerate(st.pin_errors_m))
+    return changes
+
+
 def flatten(drivetrain: Drivetrain) -> dict[str, float]:
     """All parameter values of a drivetrain by flat name (SI units)."""
     out: dict[str, float] = {}
@@ -160,6 +254,10 @@ def flatten(drivetrain: Drivetrain) -> dict[str, float]:
         out.update({f"{st.name}.{k}": float(getattr(st, f)) for k, f in fields.items()})
         for field_name, prefix in mesh_prefixes(st).items():
             out.update(_mesh_values(prefix, getattr(st, field_name)))
+        out.update(_lateral_values(st))
+    if drivetrain.gravity is not None:
+        out["gravity.acceleration"] = drivetrain.gravity.acceleration_m_s2
+        out["gravity.shaft_tilt"] = drivetrain.gravity.shaft_tilt_rad
     for sh in drivetrain.all_shafts:
         out[f"{sh.name}.stiffness"] = sh.stiffness_nm_per_rad
         out[f"{sh.name}.damping"] = sh.damping_nms_per_rad
@@ -217,10 +315,11 @@ def unflatten(template: Drivetrain, values: Mapping[str, float]) -> Drivetrain:
         for field_name, prefix in mesh_prefixes(st).items():
             changes[field_name] = _mesh_from(prefix, getattr(st, field_name), values)
         try:
+            changes.update(_lateral_changes(st, values))
             stages.append(replace(st, **changes))
         except ParameterError as exc:
             local = exc.name.split(".", 1)[-1]
-            flat = next((f"{st.name}.{k}" for k, f in fields.items() if f == local), exc.name)
+            flat = next((f"{st.name}.{k}" for k, f in fields.items() if f == local), f"{st.name}.{exc.name}")
             raise ParameterError(flat, exc.value, exc.expected, exc.bounds) from None
 
     def shaft(sh: Shaft) -> Shaft:
@@ -234,6 +333,13 @@ def unflatten(template: Drivetrain, values: Mapping[str, float]) -> Drivetrain:
             raise ParameterError(exc.name.replace("_nm_per_rad", "").replace("_nms_per_rad", ""), exc.value, exc.expected, exc.bounds) from None
 
     shafts = tuple(shaft(sh) for sh in template.shafts)
+    if template.gravity is not None:
+        try:
+            template = replace(template, gravity=replace(
+                template.gravity, acceleration_m_s2=values.get("gravity.acceleration", template.gravity.acceleration_m_s2),
+                shaft_tilt_rad=values.get("gravity.shaft_tilt", template.gravity.shaft_tilt_rad)))
+        except ParameterError as exc:
+            raise ParameterError(exc.name, exc.value, exc.expected, exc.bounds) from None
     if template.generator is not None:
         from .generator import GeneratorParameters
 

@@ -28,6 +28,10 @@ OUTPUT_SPEED = "output_speed"
 ROTOR_TORQUE = "rotor_torque"
 ROTOR_SPEED, ROTOR_ANGLE = "rotor_speed", "rotor_angle"
 GENERATOR_SPEED, GENERATOR_ANGLE, GENERATOR_TORQUE = "generator_speed", "generator_angle", "generator_torque"
+#: what a lateral-torsional stage adds (:mod:`components.model.bearings`): a translation's displacement, a
+#: bearing's (or ring support's) radial force magnitude, a bearing's speed, a ring's torsional support torque
+BODY_DISPLACEMENT, BEARING_FORCE, SUPPORT_FORCE = "body_displacement", "bearing_force", "support_force"
+BEARING_SPEED, SUPPORT_TORQUE = "bearing_speed", "support_torque"
 
 #: a mesh kind of :class:`~components.model.assembly.Mesh` -> its words in a description
 MESH_KIND_WORDS = {"sun_planet": "sun-planet mesh", "ring_planet": "ring-planet mesh",
@@ -69,10 +73,14 @@ def _planet_of(mesh_name: str) -> tuple[tuple[str, str], ...]:
 
 
 def gearbox_signals(assembly: Assembly) -> dict[str, Signal]:
-    """Every contact force, shaft torque and body speed of an assembly, in that order, by variable name.
+    """Every contact force, shaft torque, body speed and bearing output of an assembly, by variable name.
 
-    The names are those the assembly gives (``stage1.F_sp[1]``, ``shaft1.torque``,
-    ``stage1.sun.omega``): the Gearbox FMU's output names and the reference's series names.
+    In the order of :attr:`components.model.gearbox_model.GearboxModel.output_names`: the contact
+    forces, the shaft torques, the speeds of the rotations, the displacements of the translations
+    (lateral-torsional stages), per bearing or support its force components (and a bearing's
+    speed), then every bearing's and support's force magnitude. The names are those the assembly
+    gives (``stage1.F_sp[1]``, ``shaft1.torque``, ``stage1.sun.omega``, ``stage1.sun.x``,
+    ``stage1.planet_bearing[2].F``): the Gearbox FMU's output names and the reference's series names.
     """
     out: dict[str, Signal] = {}
     for mesh in assembly.meshes:
@@ -82,8 +90,35 @@ def gearbox_signals(assembly: Assembly) -> dict[str, Signal]:
         out[f"{shaft.name}.torque"] = Signal(
             "N.m", f"torque of {shaft.name} ({shaft.upstream} -> {shaft.downstream})", SHAFT_TORQUE,
             (("shaft", shaft.name), ("upstream", shaft.upstream), ("downstream", shaft.downstream)))
-    for body in assembly.dof_names:
-        out[f"{body}.omega"] = Signal("rad/s", f"absolute speed of {body}", BODY_SPEED, (("body", body),))
+    bodies = [assembly.bodies[j] for j in assembly.free]
+    for body in bodies:
+        if body.rotation:
+            out[f"{body.name}.omega"] = Signal("rad/s", f"absolute speed of {body.name}", BODY_SPEED,
+                                               (("body", body.name),))
+    for body in bodies:
+        if not body.rotation:
+            out[body.name] = Signal("m", f"{body.coordinate} displacement of {body.name.rpartition('.')[0]} (a "
+                                    "planetary stage's carrier frame, a parallel stage's housing)", BODY_DISPLACEMENT,
+                                    (("body", body.name),))
+    def where(e) -> tuple[tuple[str, str], ...]:
+        return (("bearing", e.name), ("stage", e.stage), ("body", e.body))
+
+    for e in assembly.elements:
+        what = {"bearing": "bearing", "support": "support", "torsion": "torsional support"}[e.kind]
+        for c in e.components:
+            if c == "torque":
+                out[f"{e.name}.torque"] = Signal("N.m", f"torque of the {what} {e.name} on {e.body}", SUPPORT_TORQUE,
+                                                 where(e))
+            else:
+                out[f"{e.name}.F_{c}"] = Signal("N", f"{c} force of the {what} {e.name} on {e.body}")
+        if e.speed:
+            relative = f" relative to {e.speed[1]}" if len(e.speed) > 1 else ""
+            out[f"{e.name}.omega"] = Signal("rad/s", f"speed of {e.speed[0]}{relative} (turns the bearing {e.name})",
+                                            BEARING_SPEED, where(e))
+    for e in assembly.elements:
+        if e.kind != "torsion":
+            out[f"{e.name}.F"] = Signal("N", f"radial force magnitude of the {e.kind} {e.name} on {e.body}",
+                                        BEARING_FORCE if e.kind == "bearing" else SUPPORT_FORCE, where(e))
     return out
 
 

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 from .. import units
 from ..errors import ParameterError
 from ..validation import finite, integer_at_least, non_negative, positive, set_fields
+from .bearings import NamedBearing, ParallelLateral, PlanetaryLateral, pin_errors
 from .contact import MeshContact
 
 STEEL_DENSITY_KG_M3 = 7800.0
@@ -59,7 +60,13 @@ class PlanetaryStage:
     planet_angles_rad : tuple of float, optional
         Carrier angle ``psi_i`` [rad] of each planet, increasing in ``[0, 2 pi)``; None
         (default) means equally spaced, ``psi_i = 2 pi (i - 1) / n``. The torsional model
-        uses them for the mesh phasing only (:mod:`components.model.mesh_stiffness`).
+        uses them for the mesh phasing only (:mod:`components.model.mesh_stiffness`), the
+        lateral one for the directions of the meshes and planet bearings too.
+    lateral : PlanetaryLateral or None
+        The lateral-torsional model (bearings, carrier mass, ring support); None (default): torsional.
+    pin_errors_m : tuple of (float, float) or None
+        Position error of each planet's pin on the carrier, ``(radial, tangential)`` [m] (tangential
+        positive in the direction of normal rotation); in both models. None: none.
     """
 
     name: str
@@ -76,6 +83,8 @@ class PlanetaryStage:
     width_m: float = 0.05
     module_m: float = 0.01
     planet_angles_rad: tuple[float, ...] | None = None
+    lateral: PlanetaryLateral | None = None
+    pin_errors_m: tuple[tuple[float, float], ...] | None = None
 
     kind = "planetary"
 
@@ -103,6 +112,15 @@ class PlanetaryStage:
                 raise ParameterError(f"{n}.{field_name}", getattr(self, field_name), "a MeshContact")
         if self.planet_angles_rad is not None:
             set_fields(self, planet_angles_rad=_planet_angles(n, self.planet_angles_rad, self.n_planets))
+        if self.lateral is not None and not isinstance(self.lateral, PlanetaryLateral):
+            raise ParameterError(f"{n}.lateral", self.lateral, "a PlanetaryLateral or None (torsional)")
+        if self.pin_errors_m is not None:
+            errors = pin_errors(n, self.pin_errors_m, self.n_planets)
+            worst = max(abs(x) for pair in errors for x in pair)
+            if worst > 0.1 * self.module_m:  # a tenth of a module: far beyond any manufacturing tolerance
+                raise ParameterError(f"{n}.pin_errors_m", worst, f"at most a tenth of the module "
+                                     f"({0.1 * self.module_m:g} m): a pin position error, not a geometry change")
+            set_fields(self, pin_errors_m=errors)
 
     @staticmethod
     def radii_from_teeth(name: str, module_mm: float, z_sun: float, z_ring: float) -> tuple[float, float]:
@@ -126,6 +144,16 @@ class PlanetaryStage:
         if self.planet_angles_rad is not None:
             return self.planet_angles_rad
         return tuple(2.0 * math.pi * i / self.n_planets for i in range(self.n_planets))
+
+    @property
+    def bearings(self) -> tuple[NamedBearing, ...]:
+        """The stage's rolling bearings by name (lateral model; none in the torsional one)."""
+        lat = self.lateral
+        if lat is None:
+            return ()
+        named = [(f"{self.name}.sun_bearing", lat.sun_bearing), (f"{self.name}.carrier_bearing", lat.carrier_bearing)]
+        named += [(f"{self.name}.planet_bearing[{i + 1}]", lat.planet_bearing) for i in range(self.n_planets)]
+        return tuple(NamedBearing(name, b.bearing_type, b.dynamic_load_rating_n) for name, b in named)
 
     @property
     def planet_radius_m(self) -> float:
@@ -174,6 +202,8 @@ class PlanetaryStage:
             width_m=self.width_m,
             module_m=self.module_m,
             planet_angles_rad=self.planet_angles_rad,
+            lateral=self.lateral,
+            pin_errors_m=self.pin_errors_m,
         )
 
 
@@ -204,6 +234,8 @@ class ParallelStage:
         Contact parameters.
     width_m : float
         Face width [m] (informational).
+    lateral : ParallelLateral or None
+        The lateral-torsional model (the gears' bearings); None (default): torsional.
     """
 
     name: str
@@ -216,6 +248,7 @@ class ParallelStage:
     mesh: MeshContact
     width_m: float = 0.05
     module_m: float = 0.01
+    lateral: ParallelLateral | None = None
 
     kind = "parallel"
 
@@ -234,6 +267,17 @@ class ParallelStage:
         )
         if not isinstance(self.mesh, MeshContact):
             raise ParameterError(f"{n}.mesh", self.mesh, "a MeshContact")
+        if self.lateral is not None and not isinstance(self.lateral, ParallelLateral):
+            raise ParameterError(f"{n}.lateral", self.lateral, "a ParallelLateral or None (torsional)")
+
+    @property
+    def bearings(self) -> tuple[NamedBearing, ...]:
+        """The stage's rolling bearings by name (lateral model; none in the torsional one)."""
+        lat = self.lateral
+        if lat is None:
+            return ()
+        return tuple(NamedBearing(f"{self.name}.{member}_bearing", b.bearing_type, b.dynamic_load_rating_n)
+                     for member, b in (("drive", lat.drive_bearing), ("driven", lat.driven_bearing)))
 
     @property
     def ratio(self) -> float:

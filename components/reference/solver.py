@@ -125,6 +125,8 @@ class MonolithicSystem:
         self.deadline = math.inf  # time.perf_counter() value past which rhs raises (see start_clock)
         self.wall_time_limit_s = 0.0
         self._motion = getattr(driver, "motion", None)
+        #: the driver angle sets the mesh stiffness or the direction of gravity
+        self._needs_angle = a.time_varying_stiffness or a.load_rates.size > 0
         # the monolithic right-hand side is not compiled ahead of time: numba's just-in-time kernel, or interpreted
         self._module, self.kernel, self.kernel_note = model_kernel.monolithic(kernel)
         self._rhs_args, self._jac_args = self._kernel_arrays()
@@ -137,18 +139,20 @@ class MonolithicSystem:
         self._ones = np.ones(m)
         self._rhs_out = np.zeros(2 * n + 3)
         rhs_args = (
-            self._out, self._kappa_out, float(a.driver_inertia_kgm2), c(a.A_T), np.zeros(m), c(a.fast_matrix),
-            a.law.table, c(a.S), c(a.shaft_k, dtype=float), c(a.shaft_c, dtype=float), c(a.BT_driver),
-            c(a.s_driver), c(a.cos_alpha), c(a.inv_inertia), np.zeros(m), np.zeros(m), np.zeros((2, m)),
-            np.zeros(m + 2 * n + 4), np.zeros(n), self._rhs_out,
+            self._out, self._kappa_out, float(a.driver_inertia_kgm2), a.nz_index, a.nz_value, np.zeros(m),
+            c(a.mesh_offset),
+            c(a.fast_matrix), a.law.table, c(a.load_rates), c(a.springs), c(a.springs_k, dtype=float),
+            c(a.springs_c, dtype=float), c(a.BT_driver), c(a.springs_driver), c(a.cos_alpha), c(a.inv_inertia),
+            np.zeros(m), np.zeros(m), np.zeros((2, m)), np.zeros(m + 2 * n + 4 + a.load_matrix.shape[0]), np.zeros(n),
+            self._rhs_out,
         )
         jac_args = (
-            c(a.A_T), np.zeros(m), a.law.table, np.zeros((2, m)), a.nz_index, a.nz_value, c(a.cos_alpha),
-            c(a.STkS), c(a.STcS), np.zeros(n), np.zeros(n), c(a.inv_inertia), np.zeros(m), np.zeros(m),
+            np.zeros(m), c(a.mesh_offset), a.law.table, np.zeros((2, m)), a.nz_index, a.nz_value,
+            c(a.cos_alpha), c(a.STkS), c(a.STcS), np.zeros(n), np.zeros(n), c(a.inv_inertia), np.zeros(m), np.zeros(m),
             np.zeros((n, n)), np.zeros((n, n)), np.zeros((2, n)), self._jac,
         )
         # compile or load from the disk cache now, not inside the timed integration
-        self._module.monolithic_rhs(np.zeros(2 * n + 3), 0.0, 0.0, self._ones, 0.0, *rhs_args)
+        self._module.monolithic_rhs(np.zeros(2 * n + 3), 0.0, 0.0, 0.0, self._ones, 0.0, *rhs_args)
         self._module.monolithic_jacobian(np.zeros(2 * n + 3), self._ones, *jac_args)
         return rhs_args, jac_args
 
@@ -157,15 +161,15 @@ class MonolithicSystem:
         self.wall_time_limit_s = float(wall_time_limit_s)
         self.deadline = time.perf_counter() + wall_time_limit_s if wall_time_limit_s > 0 else math.inf
 
-    def _driver_state(self, t: float) -> tuple[float, float, float | np.ndarray]:
-        """Driver speed [rad/s], acceleration [rad/s^2] and the mesh stiffness factors at ``t``, one evaluation."""
+    def _driver_state(self, t: float) -> tuple[float, float, float, float | np.ndarray]:
+        """Driver angle [rad], speed [rad/s], acceleration [rad/s^2] and the mesh stiffness factors at ``t``."""
         if self._motion is not None:
             angle, omega, alpha = self._motion(t)
         else:
             omega, alpha = float(self.driver.speed(t)), float(self.driver.acceleration(t))
-            angle = float(self.driver.angle(t)) if self.assembly.time_varying_stiffness else 0.0
+            angle = float(self.driver.angle(t)) if self._needs_angle else 0.0
         kfac = self.assembly.stiffness_factor(angle) if self.assembly.time_varying_stiffness else 1.0
-        return omega, alpha, kfac
+        return angle, omega, alpha, kfac
 
     def _stiffness_factor(self, t: float) -> np.ndarray | float:
         """Mesh stiffness factors at ``t`` (1.0 without the option; the driver angle only is evaluated)."""
@@ -178,9 +182,9 @@ class MonolithicSystem:
         self.rhs_calls += 1
         if time.perf_counter() > self.deadline:
             raise WallTimeLimitError(self.wall_time_limit_s, t)
-        omega_in, alpha_in, kfac = self._driver_state(t)
+        angle_in, omega_in, alpha_in, kfac = self._driver_state(t)
         factor = self._ones if type(kfac) is float else np.ascontiguousarray(kfac, dtype=float)
-        self._module.monolithic_rhs(np.ascontiguousarray(y, dtype=float), omega_in, alpha_in, factor,
+        self._module.monolithic_rhs(np.ascontiguousarray(y, dtype=float), omega_in, alpha_in, angle_in, factor,
                                     self.load_torque_nm, *self._rhs_args)
         return self._rhs_out.copy()
 
@@ -276,8 +280,9 @@ def simulate_monolithic(
             raise ParameterError("initial_state", y0.shape, f"finite [q, v] of shape ({2 * n},)")
         y[: 2 * n] = y0
     elif start == "operating_point" and float(system.schedule(t0)) != 0.0:
-        y[:n] = system.assembly.static_deflection(float(system.schedule(t0)), system._stiffness_factor(t0),
-                                                  kernel=kernel)[0]
+        angle0, omega0, _, kfac0 = system._driver_state(t0)
+        y[:n] = system.assembly.static_deflection(float(system.schedule(t0)), kfac0, kernel=kernel,
+                                                  driver_angle_rad=angle0, driver_speed_rad_s=omega0)[0]
     Y = np.full((t_out.size, y.size), np.nan)
     Y[0] = y
     hmax = settings.max_step_s
@@ -363,6 +368,30 @@ def simulate_monolithic(
     return result
 
 
+def element_series(a: Assembly, force: np.ndarray, speeds: np.ndarray, omega_in: np.ndarray) -> dict[str, np.ndarray]:
+    """The bearings' and supports' outputs (the Gearbox FMU's names): components, magnitude and bearing speed.
+
+    ``force``: the bearing rows' forces, shape (N, n_spring); ``speeds``: the free bodies' absolute speeds.
+    """
+    names = [b.name for b in a.bodies]
+
+    def speed(body: str) -> np.ndarray:
+        j = names.index(body)
+        free = np.flatnonzero(a.free == j)
+        return speeds[:, int(free[0])] if free.size else a.kinematic_ratio_all[j] * omega_in
+
+    out: dict[str, np.ndarray] = {}
+    for e in a.elements:
+        parts = [force[:, r] for r in e.rows]
+        for component, part in zip(e.components, parts):
+            out[f"{e.name}.{'torque' if component == 'torque' else 'F_' + component}"] = part
+        if e.kind != "torsion":
+            out[f"{e.name}.F"] = np.sqrt(sum(p * p for p in parts))
+        if e.speed:
+            out[f"{e.name}.omega"] = speed(e.speed[0]) - (speed(e.speed[1]) if len(e.speed) > 1 else 0.0)
+    return out
+
+
 def _collect(system: MonolithicSystem, t: np.ndarray, Y: np.ndarray) -> SimulationResult:
     """Evaluate every recorded variable on the sampled states."""
     a = system.assembly
@@ -379,7 +408,7 @@ def _collect(system: MonolithicSystem, t: np.ndarray, Y: np.ndarray) -> Simulati
     kfac = a.stiffness_factor(angle_in) if a.time_varying_stiffness else 1.0
     loads = a.loads(q, v, stiffness_factor=kfac, derivatives=False)
     load_torque = np.asarray(system.schedule(t), dtype=float) * np.ones_like(t)
-    Q = a.generalised_forces(loads)
+    Q = a.generalised_forces(loads) + a.external_forces(angle_in, omega_in)
     Q[:, system._out] -= load_torque
     acc = a.inv_inertia * Q - a.kinematic_ratio * alpha_in[:, None]
     speeds = np.outer(omega_in, a.kinematic_ratio) + v
@@ -395,8 +424,9 @@ def _collect(system: MonolithicSystem, t: np.ndarray, Y: np.ndarray) -> Simulati
         signals[deflection_name(name)] = deflection_signal(name)
     for i, name in enumerate(a.shaft_names):
         series[f"{name}.torque"] = loads.shaft_torque_nm[:, i]
-    for i, name in enumerate(a.dof_names):
-        series[f"{name}.omega"] = speeds[:, i]
+    for i, body in enumerate(a.bodies[j] for j in a.free):
+        series[f"{body.name}.omega" if body.rotation else body.name] = speeds[:, i] if body.rotation else q[:, i]
+    series.update(element_series(a, loads.bearing_force_n, speeds, omega_in))
     out = system._out
     alpha_out = acc[:, out] + a.kinematic_ratio[out] * alpha_in
     series["torque_rotor"] = a.driver_torque(loads, alpha_in)

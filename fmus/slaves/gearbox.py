@@ -6,7 +6,9 @@ and ``omega_gen``, ``phi_gen`` (far end of shaft 3). Outputs: ``shaft_torque``
 ``shaft_torque_mode``), ``shaft_torque_end``, ``shaft_torque_avg``,
 ``omega_out``, ``torque_rotor``, every contact force (``stage1.F_sp[1]``,
 ``stage1.F_rp[1]``, ..., ``stage3.F_mesh``), every shaft torque
-(``shaft1.torque``, ...), every body speed (``stage1.sun.omega``, ...), the
+(``shaft1.torque``, ...), every body speed (``stage1.sun.omega``, ...), with
+lateral-torsional stages every displacement and bearing output (``stage1.sun.x``,
+``stage1.planet_bearing[1].F``, ...; :func:`components.model.signals.gearbox_signals`), the
 output member's acceleration ``alpha_out`` (averaged over the last step) and
 its running peak magnitude ``alpha_out_max`` (eq. 11, over every internal
 solver step).
@@ -124,7 +126,7 @@ class Gearbox(DtcosimSlave):
             real_output("torque_rotor", "N.m", "torque the rotor applies to the gearbox (for the power balance)",
                         "rotor_torque"),
         ]
-        # every contact force, shaft torque and body speed, as the monolithic reference declares them too
+        # every contact force, shaft torque, body speed and bearing output, as the monolithic reference declares
         variables += [real_output(name, s.unit, s.description, s.kind, **dict(s.info))
                       for name, s in gearbox_signals(assembly).items()]
         out_member = assembly.stage_members[template.stages[-1].name]["output"]

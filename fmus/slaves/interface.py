@@ -68,6 +68,8 @@ UNITS: dict[str, UnitDefinition] = {
         _unit("W", {"kg": 1, "m": 2, "s": -3}, kW=1.0e-3),
         _unit("N.m.s2/rad2", {"kg": 1, "m": 2, "rad": -2}),  # the torque law's k of k w^2
         _unit("N.m/s", {"kg": 1, "m": 2, "s": -3}),  # torque rate
+        _unit("N/m", {"kg": 1, "s": -2}),  # bearing stiffness
+        _unit("m/s2", {"m": 1, "s": -2}),  # gravity
     )
 }
 

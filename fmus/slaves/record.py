@@ -44,7 +44,9 @@ ROLES = (WIND_SOURCE, GEARBOX, GENERATOR, TIME_SERIES, ROTOR, TORQUE_CONTROLLER)
 SIGNALS: dict[str, dict[str, bool]] = {
     WIND_SOURCE: {"rotor_speed": False, "rotor_angle": False, "rotor_acceleration": False, "rotor_jerk": False},
     GEARBOX: {"contact_force": True, "shaft_torque": True, "body_speed": True, "output_speed": False,
-              "rotor_torque": False, "generator_shaft_torque": True, "output_acceleration_peak": False},
+              "rotor_torque": False, "generator_shaft_torque": True, "output_acceleration_peak": False,
+              "body_displacement": True, "bearing_force": True, "support_force": True, "bearing_speed": True,
+              "support_torque": True},
     GENERATOR: {"generator_speed": False, "generator_angle": False, "generator_torque": False},
     # "recorded": a channel of a record, info {"channel", "unit" (as recorded), "quantity" (the signal kind
     # of another role it is the record of, e.g. generator_speed), "record"}

@@ -63,6 +63,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="Campbell rotor-speed range [rpm] (default 4 20)")
     p.add_argument("--speed-points", type=int, default=33, help="Campbell speed points (default 33)")
     p.add_argument("--shapes", type=int, default=8, help="modes drawn in modes.png (default 8)")
+    p.add_argument("--free-input", action="store_true",
+                   help="with --drivetrain or --preset: the stage-1 input member free and no rotor on it (a gearbox "
+                        "on its own, as in Lin and Parker's free vibration; its rigid-body rotation removed); "
+                        "default: held at the rotor speed")
     p.add_argument("--verify", action="store_true",
                    help="also simulate the free response after an impulse and compare every underdamped mode")
     p.set_defaults(func=run)
@@ -146,17 +150,23 @@ def run(args: argparse.Namespace) -> int:
         modal_report,
     )
 
-    if args.verify and rotor is not None:
-        raise ParameterError("--verify", True, "a scenario with a held rotor (a prescribed speed): the free-response "
+    if args.verify and (rotor is not None or args.free_input):
+        raise ParameterError("--verify", True, "a held rotor (a prescribed speed): the free-response "
                              "check simulates the drivetrain at a prescribed rotor speed")
+    if args.free_input and args.scenario is not None:
+        raise ParameterError("--free-input", True, "--drivetrain or --preset (a scenario's rotor is held by its "
+                             "source or driven by its Rotor)")
     report = modal_report(
-        drivetrain, op, out_dir, law, rpm(np.linspace(lo, hi, args.speed_points)), args.shapes, args.verify, rotor
+        drivetrain, op, out_dir, law, rpm(np.linspace(lo, hi, args.speed_points)), args.shapes, args.verify, rotor,
+        args.free_input,
     )
     an = report["analysis"]
     eq = an.model.equilibrium
     print(f"dtcosim modes: {origin} at {op.rotor_speed_rpm:.6g} rpm, output torque {op.output_torque_nm:.6g} N m "
           f"({source})")
-    if rotor is None:
+    if args.free_input:
+        print("input member free, no rotor (rigid-body rotation removed): the modes of the gearbox on its own")
+    elif rotor is None:
         print("rotor held at the operating speed (a prescribed speed): the modes of the drivetrain between a held "
               "rotor and the generator")
     else:

@@ -83,6 +83,7 @@ from typing import Any, Mapping, Sequence
 from components import units
 from components.analysis.plausibility import Judgement
 from components.errors import ParameterError
+from components.model.bearings import Bearing, Gravity, ParallelLateral, PlanetaryLateral, RingSupport
 from components.model.contact import MeshContact
 from components.model.design_table import BodyRow, DesignTable, design_table
 from components.model.drivetrain import Drivetrain
@@ -99,6 +100,7 @@ from components.model.stages import STEEL_DENSITY_KG_M3, ParallelStage, Planetar
 
 from .drivetrain_schema import (
     STAGE_TABLES,
+    BearingTable,
     DrivetrainFile,
     DrivetrainFileError,
     GearTable,
@@ -381,17 +383,77 @@ class _Reader:
         # precedence: the file's [mesh] < the stage's mesh < its sun_mesh / ring_mesh
         sun_mesh = self.mesh(f"{key}.sun_mesh", alpha, (t.mesh, t.sun_mesh), (f"{key}.mesh", f"{key}.sun_mesh"))
         ring_mesh = self.mesh(f"{key}.ring_mesh", alpha, (t.mesh, t.ring_mesh), (f"{key}.mesh", f"{key}.ring_mesh"))
+        lateral = self.planetary_lateral(key, t)
+        errors = None
+        if t.pin_errors is not None:
+            if len(t.pin_errors) != t.planets:
+                raise self.error(f"{key}.pin_errors", len(t.pin_errors), f"{t.planets} tables {{radial, tangential}}, "
+                                 "one per planet ({} for a planet without error)")
+            errors = tuple((u.si(f"{key}.pin_errors[{j}].radial", e.radial, "length"),
+                            u.si(f"{key}.pin_errors[{j}].tangential", e.tangential, "length"))
+                           for j, e in enumerate(t.pin_errors))
         try:
             stage = PlanetaryStage(
                 name=name, sun_radius_m=r_s, ring_radius_m=r_r, n_planets=t.planets,
                 sun_mass_kg=sun.mass_kg, sun_inertia_kgm2=sun.inertia_kgm2,
                 planet_mass_kg=planet.mass_kg, planet_inertia_kgm2=planet.inertia_kgm2,
                 sun_mesh=sun_mesh, ring_mesh=ring_mesh, carrier_inertia_kgm2=carrier.inertia_kgm2,
-                width_m=width, module_m=module, planet_angles_rad=angles,
+                width_m=width, module_m=module, planet_angles_rad=angles, lateral=lateral, pin_errors_m=errors,
             )
         except ParameterError as exc:
             raise self.error(f"{key} ({exc.name})", exc.value, exc.expected) from None
         return stage, (carrier, sun, planet), tuple(checks)
+
+    # -- the lateral-torsional model
+    def bearing(self, key: str, t: BearingTable) -> Bearing:
+        u = self.u
+        try:
+            return Bearing(u.si(f"{key}.stiffness", t.stiffness, "bearing_stiffness"),
+                           u.si(f"{key}.damping", t.damping, "bearing_damping"), t.type,
+                           None if t.C is None else u.si(f"{key}.C", t.C, "force"))
+        except ParameterError as exc:
+            raise self.error(f"{key} ({exc.name})", exc.value, exc.expected) from None
+
+    def only_lateral(self, key: str, t, names: tuple[str, ...]) -> None:
+        """Refuse the lateral model's entries in a torsional stage."""
+        for name in names:
+            if getattr(t, name) is not None:
+                raise self.error(f"{key}.{name}", "given", 'model = "lateral" for this entry (the torsional model '
+                                 "has no bearings, carrier mass or moving ring)")
+
+    def planetary_lateral(self, key: str, t: PlanetaryTable) -> PlanetaryLateral | None:
+        if t.model != "lateral":
+            self.only_lateral(key, t, ("bearings", "carrier_mass", "ring"))
+            return None
+        for name in ("bearings", "carrier_mass"):
+            if getattr(t, name) is None:
+                raise self.error(f"{key}.{name}", None, f'a value for {name} with model = "lateral" (bearings = '
+                                 "{sun, carrier, planet}, carrier_mass)")
+        u = self.u
+        ring = None
+        if t.ring is not None:
+            r = t.ring
+            try:
+                ring = RingSupport(u.si(f"{key}.ring.mass", r.mass, "mass"), u.si(f"{key}.ring.inertia", r.inertia,
+                                   "inertia"), self.bearing(f"{key}.ring.support", r.support),
+                                   u.si(f"{key}.ring.torsional_stiffness", r.torsional_stiffness, "torsional_stiffness"),
+                                   u.si(f"{key}.ring.torsional_damping", r.torsional_damping, "torsional_damping"))
+            except ParameterError as exc:
+                raise self.error(f"{key}.ring ({exc.name})", exc.value, exc.expected) from None
+        b = t.bearings
+        return PlanetaryLateral(u.si(f"{key}.carrier_mass", t.carrier_mass, "mass"),
+                                self.bearing(f"{key}.bearings.sun", b.sun), self.bearing(f"{key}.bearings.carrier", b.carrier),
+                                self.bearing(f"{key}.bearings.planet", b.planet), ring)
+
+    def parallel_lateral(self, key: str, t: ParallelTable) -> ParallelLateral | None:
+        if t.model != "lateral":
+            self.only_lateral(key, t, ("bearings", "centre_angle"))
+            return None
+        if t.bearings is None:
+            raise self.error(f"{key}.bearings", None, 'bearings = {drive, driven} with model = "lateral"')
+        angle = self.u.si(f"{key}.centre_angle", t.centre_angle, "angle") if t.centre_angle is not None else 0.0
+        return ParallelLateral(self.bearing(f"{key}.bearings.drive", t.bearings.drive),
+                               self.bearing(f"{key}.bearings.driven", t.bearings.driven), angle)
 
     def parallel(self, key: str, name: str, t: ParallelTable):
         u = self.u
@@ -409,6 +471,7 @@ class _Reader:
                 name=name, drive_radius_m=r1, driven_radius_m=r2, drive_mass_kg=drive.mass_kg,
                 drive_inertia_kgm2=drive.inertia_kgm2, driven_mass_kg=driven.mass_kg,
                 driven_inertia_kgm2=driven.inertia_kgm2, mesh=mesh, width_m=width, module_m=module,
+                lateral=self.parallel_lateral(key, t),
             )
         except ParameterError as exc:
             raise self.error(f"{key} ({exc.name})", exc.value, exc.expected) from None
@@ -422,6 +485,11 @@ class _Reader:
             stage, rows, stage_checks = self.stage(i, data)
             if stage.name in bodies:
                 raise self.error(f"stages[{i}].name", stage.name, "a stage name not used by another stage")
+            if i > 0 and isinstance(stage, PlanetaryStage) and stage.lateral is not None \
+                    and not stage.carrier_inertia_kgm2 > 0.0:
+                raise self.error(f"stages[{i}].carrier_inertia", 0.0, '> 0 with model = "lateral" (the planets\' '
+                                 "masses are bodies of their own there, not part of the carrier's inertia; only the "
+                                 "first stage's carrier turns with the rotor and needs none)")
             stages.append(stage)
             bodies[stage.name] = rows
             checks[stage.name] = stage_checks
@@ -445,14 +513,26 @@ class _Reader:
             taken.add(name)
             shafts.append(Shaft(name, self.u.si(f"shafts[{k}].stiffness", t.stiffness, "torsional_stiffness"),
                                 self.u.si(f"shafts[{k}].damping", t.damping, "torsional_damping")))
+        gravity = None
+        if doc.gravity is not None:
+            if not any(st.lateral is not None for st in stages):
+                raise self.error("gravity", "given", 'a stage with model = "lateral" (gravity acts on the bodies\' '
+                                 "translations; the torsional model has none)")
+            try:
+                gravity = Gravity(self.u.si("gravity.acceleration", doc.gravity.acceleration, "acceleration"),
+                                  self.u.si("gravity.shaft_tilt", doc.gravity.shaft_tilt, "angle"))
+            except ParameterError as exc:
+                raise self.error(exc.name, exc.value, exc.expected) from None
         try:
             if doc.generator is not None:
                 gen = GeneratorParameters(self.u.si("generator.inertia", doc.generator.inertia, "inertia"),
                                           self.u.si("generator.counter_torque", doc.generator.counter_torque,
                                                     "torque"))
-                dt = Drivetrain(tuple(stages), tuple(shafts[:-1]), generator=gen, output_shaft=shafts[-1])
+                dt = Drivetrain(tuple(stages), tuple(shafts[:-1]), generator=gen, output_shaft=shafts[-1],
+                                gravity=gravity)
             else:
-                dt = Drivetrain(tuple(stages), tuple(shafts), output_torque_nm=self.u.si("output.torque", doc.output.torque, "torque"))
+                dt = Drivetrain(tuple(stages), tuple(shafts), gravity=gravity,
+                                output_torque_nm=self.u.si("output.torque", doc.output.torque, "torque"))
         except ParameterError as exc:
             raise self.error(f"(drivetrain) {exc.name}", exc.value, exc.expected) from None
         return dt, bodies, checks

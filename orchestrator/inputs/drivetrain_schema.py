@@ -44,6 +44,10 @@ class UnitsTable(Table):
     torsional_damping: str | None = Field(None, description="a unit such as \"N.mm.s/deg\" or \"N.m.s/rad\"")
     torque: str | None = Field(None, description="a torque unit such as \"N.mm\" or \"kN m\"")
     speed: str | None = Field(None, description="a speed unit such as \"rpm\" or \"rad/s\"")
+    bearing_stiffness: str | None = Field(None, description="a unit of a bearing's stiffness such as \"N/m\" or \"kN/mm\"")
+    bearing_damping: str | None = Field(None, description="a unit of a bearing's damping such as \"N.s/m\"")
+    force: str | None = Field(None, description="a force unit such as \"N\" or \"kN\" (dynamic load ratings)")
+    acceleration: str | None = Field(None, description="an acceleration unit such as \"m/s2\" (gravity)")
 
 
 class MeshTable(Table):
@@ -94,6 +98,55 @@ class ParallelRadii(Table):
     driven: amount(gt=0) = Field(description="a pitch radius > 0 [length unit]")
 
 
+class BearingTable(Table):
+    """A bearing or support of the lateral-torsional model: isotropic radial stiffness and damping; ISO 281 data."""
+
+    stiffness: amount(ge=0) = Field(description="a number >= 0: radial stiffness [bearing_stiffness unit]")
+    damping: amount(ge=0) = Field(Given(0.0, "N.s/m"), description="a number >= 0: radial damping [bearing_damping unit]")
+    type: Literal["ball", "roller"] | None = Field(None, description='"ball" or "roller" (ISO 281)')
+    C: amount(gt=0) | None = Field(None, description="a number > 0: ISO 281 dynamic load rating [force unit]")
+
+
+class PlanetaryBearings(Table):
+    """``bearings`` of a lateral planetary stage: sun and carrier supports, each planet's bearing."""
+
+    sun: BearingTable
+    carrier: BearingTable
+    planet: BearingTable
+
+
+class ParallelBearings(Table):
+    """``bearings`` of a lateral parallel stage."""
+
+    drive: BearingTable
+    driven: BearingTable
+
+
+class RingTable(Table):
+    """``ring`` of a lateral planetary stage: a ring that moves on its supports (absent: rigidly fixed)."""
+
+    mass: amount(gt=0) = Field(description="a number > 0 [mass unit]")
+    inertia: amount(gt=0) = Field(description="a number > 0 [inertia unit]")
+    support: BearingTable
+    torsional_stiffness: amount(gt=0) = Field(description="a number > 0 [torsional_stiffness unit]")
+    torsional_damping: amount(ge=0) = Field(Given(0.0, "N.m.s/rad"),
+                                            description="a number >= 0 [torsional_damping unit]")
+
+
+class PinErrorTable(Table):
+    """A planet pin's position error on the carrier (tangential: in the direction of normal rotation)."""
+
+    radial: amount() = Field(Given(0.0, "m"), description="a number [length unit]")
+    tangential: amount() = Field(Given(0.0, "m"), description="a number [length unit]")
+
+
+class GravityTable(Table):
+    """``[gravity]``: gravity on the bodies of lateral-torsional stages, the rotor shaft tilted up by ``shaft_tilt``."""
+
+    acceleration: amount(ge=0) = Field(Given(9.80665, "m/s^2"), description="a number >= 0 [acceleration unit]")
+    shaft_tilt: amount(ge=0) = Field(Given(0.0, "deg"), description="a number >= 0: rotor shaft tilt [angle unit]")
+
+
 class _StageCommon(Table):
     name: str | None = Field(None, description="a stage name (letters, digits, '_', '-')")
     module: amount(gt=0) = Field(description="a number > 0: the gear module [length unit]")
@@ -115,6 +168,12 @@ class PlanetaryTable(_StageCommon):
     mesh: MeshTable | None = None
     sun_mesh: MeshTable | None = None
     ring_mesh: MeshTable | None = None
+    model: Literal["torsional", "lateral"] = Field("torsional", description='"torsional" (default) or "lateral"')
+    bearings: PlanetaryBearings | None = None
+    carrier_mass: amount(gt=0) | None = Field(None, description="a number > 0 [mass unit] (lateral model)")
+    ring: RingTable | None = None
+    pin_errors: list[PinErrorTable] | None = Field(None, description="a list of tables {radial, tangential}, one "
+                                                                    "per planet")
 
 
 class ParallelTable(_StageCommon):
@@ -126,6 +185,10 @@ class ParallelTable(_StageCommon):
     drive: GearTable
     driven: GearTable
     mesh: MeshTable | None = None
+    model: Literal["torsional", "lateral"] = Field("torsional", description='"torsional" (default) or "lateral"')
+    bearings: ParallelBearings | None = None
+    centre_angle: amount() | None = Field(None, description="a number: direction drive -> driven centre from the "
+                                                            "horizontal [angle unit] (lateral model; default 0)")
 
 
 class ShaftTable(Table):
@@ -161,6 +224,7 @@ class DrivetrainFile(Table):
     generator: GeneratorTable | None = Field(None, description="a [generator] table with inertia, counter_torque")
     output: OutputTable | None = Field(None, description="an [output] table with torque")
     operating_point: OperatingPointTable | None = Field(None, description="an [operating_point] table")
+    gravity: GravityTable | None = Field(None, description="a [gravity] table (lateral-torsional stages)")
 
 
 #: the table of each stage kind

@@ -23,6 +23,7 @@ DIMENSIONS: dict[str, str] = {
     "length": "m", "angle": "rad", "mass": "kg", "density": "kg/m3", "inertia": "kg.m2",
     "contact_stiffness": "N/m^e", "contact_damping": "N.s/m2", "regularisation": "1/m", "impact_damping": "N.s/m",
     "torsional_stiffness": "N.m/rad", "torsional_damping": "N.m.s/rad", "torque": "N.m", "speed": "rad/s",
+    "bearing_stiffness": "N/m", "bearing_damping": "N.s/m", "force": "N", "acceleration": "m/s^2",
 }
 
 

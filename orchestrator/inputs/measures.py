@@ -39,6 +39,12 @@ Measures are written as text in a study file:
     for a scenario base, the monolithic solver's result for a model base - set by
     :func:`orchestrator.study.prepare.prepare_study` (``-`` when it declares none);
     a name never gives a unit, so a parsed statistic has none until then.
+``<component>.<stage>:load_sharing`` [-]
+    The planet load-sharing factor of a planetary stage of a gearbox, e.g.
+    ``gearbox.stage1:load_sharing``: over the analysis window the largest ratio of
+    the most loaded planet's sun-mesh force to the planets' mean
+    (:mod:`components.analysis.load_sharing`), from the contact forces the gearbox
+    declares for that stage (recorded for the study).
 """
 
 from __future__ import annotations
@@ -58,6 +64,8 @@ BUILTIN: dict[str, tuple[str, str, tuple[str, ...]]] = {
     "rhs_calls": ("1", "right-hand-side evaluations", ("monolithic",)),
 }
 STATISTICS = ("mean", "std", "min", "max", "absmax", "rms")
+#: statistics of a planetary stage (``component.stage:<name>``) rather than of one variable
+STAGE_STATISTICS = ("load_sharing",)
 #: ``del<m>``: damage-equivalent load for the Woehler exponent m (> 0)
 _DEL_RE = re.compile(r"^del(\d+(?:\.\d+)?)$")
 
@@ -106,6 +114,11 @@ class Measure:
     description: str
 
     @property
+    def of_stage(self) -> bool:
+        """True for a statistic of a planetary stage (``gearbox.stage1:load_sharing``): ``variable`` names the stage."""
+        return self.statistic in STAGE_STATISTICS
+
+    @property
     def builtin(self) -> bool:
         """True for ``I_max_acc``, ``cpu_time``, ``wall_time``, ``steps``, ``rhs_calls``."""
         return self.variable is None
@@ -130,7 +143,8 @@ def parse_measure(text: object) -> Measure:
         Neither a built-in name nor ``component.variable:statistic``.
     """
     expected = ("a built-in measure (" + ", ".join(BUILTIN) + ") or 'component.variable:statistic' with statistic "
-                + " | ".join(STATISTICS) + " | del<m> (damage-equivalent load, e.g. del4)")
+                + " | ".join(STATISTICS) + " | del<m> (damage-equivalent load, e.g. del4), or "
+                "'component.stage:load_sharing'")
     if not isinstance(text, str) or not text:
         raise MeasureError(text, expected)
     if text in BUILTIN:
@@ -138,6 +152,9 @@ def parse_measure(text: object) -> Measure:
         return Measure(text, None, None, unit, description)
     variable, colon, stat = text.rpartition(":")
     comp, dot, var = variable.partition(".")
+    if stat in STAGE_STATISTICS and comp and var:
+        return Measure(text, variable, stat, "1", f"planet load-sharing factor of {variable} (max over the window "
+                       "of the largest planet's sun-mesh force over the mean)")
     m = wohler_exponent_of(stat)
     if not colon or not dot or not comp or not var or (stat not in STATISTICS and m is None):
         raise MeasureError(text, expected)

@@ -48,14 +48,16 @@ def _rows_csv(path: Path, rows: list[dict]) -> Path:
 
 def format_mode_table(analysis: DrivetrainModalAnalysis) -> str:
     """The modal table as fixed-width text."""
-    head = f"{'mode':>4}  {'kind':<17}{'undamped f [Hz]':>16}{'damped f [Hz]':>15}{'zeta':>10}  {'overdamped':<11}dominant bodies (kinetic energy) | springs (strain energy)"
+    head = f"{'mode':>4}  {'kind':<21}{'undamped f [Hz]':>16}{'damped f [Hz]':>15}{'zeta':>10}  {'overdamped':<11}dominant bodies (kinetic energy) | springs (strain energy)"
     lines = [head, "-" * len(head)]
     for dm in analysis.modes:
         m = dm.mode
         kind = dm.kind if dm.stage is None else f"{dm.kind} {dm.stage}"
+        kind += f" x{dm.multiplicity}" if dm.multiplicity > 1 else ""
         fd = "-" if m.overdamped else f"{m.damped_frequency_hz:.5g}"
+        zeta = m.damping_ratio if abs(m.damping_ratio) > 1e-12 else 0.0  # an undamped system's round-off
         lines.append(
-            f"{m.index:>4}  {kind:<17}{m.undamped_frequency_hz:>16.5g}{fd:>15}{m.damping_ratio:>10.4g}  "
+            f"{m.index:>4}  {kind:<21}{m.undamped_frequency_hz:>16.5g}{fd:>15}{zeta:>10.4g}  "
             f"{'yes' if m.overdamped else 'no':<11}{dm.dominant_bodies} | {dm.dominant_elements}"
         )
     return "\n".join(lines)
@@ -80,6 +82,7 @@ def modal_report(
     n_shapes: int = 8,
     verify: bool = False,
     rotor: RotorParameters | None = None,
+    free_input: bool = False,
 ) -> dict:
     """Modal analysis, Campbell diagram (and optionally the free-response check) with files.
 
@@ -100,6 +103,8 @@ def modal_report(
         Also run :func:`components.analysis.modal_verification.free_response_check` (held rotor only).
     rotor : RotorParameters, optional
         A torque-driven rotor: the drivetrain free at both ends (default: the rotor held).
+    free_input : bool
+        The stage-1 input member free, no rotor (a gearbox on its own).
 
     Returns
     -------
@@ -107,13 +112,14 @@ def modal_report(
         ``{"analysis", "campbell", "verification", "files"}``: the result objects and the
         written paths (a plain-JSON summary is in ``modes.json``).
     """
-    if verify and rotor is not None:
+    if verify and (rotor is not None or free_input):
         raise ParameterError("verify", True, "a held rotor (the free-response check prescribes the rotor speed)")
-    analysis = drivetrain_modes(drivetrain, operating_point, rotor=rotor)
+    analysis = drivetrain_modes(drivetrain, operating_point, rotor=rotor, free_input=free_input)
     law = load_law or LoadLaw("quadratic", abs(operating_point.rotor_speed_rad_s), operating_point.output_torque_nm)
     if campbell_speeds_rad_s is None:
         campbell_speeds_rad_s = np.linspace(4.0, 20.0, 33) * np.pi / 30.0
-    campbell: CampbellDiagram = campbell_diagram(drivetrain, campbell_speeds_rad_s, law, rotor=rotor)
+    campbell: CampbellDiagram = campbell_diagram(drivetrain, campbell_speeds_rad_s, law, rotor=rotor,
+                                                 free_input=free_input)
     checks = free_response_check(drivetrain, operating_point, analysis) if verify else None
     files: dict[str, Path] = {}
     if out_dir is not None:

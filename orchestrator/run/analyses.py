@@ -21,7 +21,10 @@ never by a variable's name:
   stage, with every stage's gear-mesh frequency at the mean rotor speed marked ->
   ``summary["spectrum"]``, ``contact_force_spectra.png``; written when a mesh
   stiffness varies in time (``spectrum = "auto"``), always, or never;
-* the **event response** plot with load events.
+* the **event response** plot with load events;
+* **load sharing** (:mod:`components.analysis.load_sharing`) of every planetary stage whose
+  planets' sun-planet ``contact_force`` are all recorded (declared ``stage``, ``mesh`` and
+  ``planet``): the load-sharing factor over the window -> ``summary["load_sharing"]``.
 
 Mesh frequencies, shaft speeds and the stiffness variation come from the Gearbox
 FMU's record (:func:`orchestrator.cosim.physics_view.gearbox_drivetrain`). An
@@ -43,6 +46,7 @@ from components.analysis.contact_loss import (
     write_contact_loss_csv,
 )
 from components.analysis.fatigue import fatigue_report, write_del_csv, write_ldd_csv
+from components.analysis.load_sharing import load_sharing
 from components.analysis.spectrum import amplitude_spectrum
 from components.errors import DtcosimError
 
@@ -105,15 +109,21 @@ class _Signals:
     stage: dict[str, str]  # contact-force column -> stage
     mesh: dict[str, str]  # contact-force column -> mesh kind (sun_planet, ring_planet, parallel)
     shaft_speed: dict[str, list[str]]  # shaft-torque column -> recorded speed columns of its bodies
+    planets: dict[str, dict[int, str | None]]  # planetary stage -> planet -> its sun-planet force column (None: not
+    # recorded)
 
 
 def _recorded_signals(system: ResolvedSystem, series: dict[str, np.ndarray]) -> _Signals:
     forces, torques, stage, mesh, speeds = [], [], {}, {}, {}
+    planets: dict[str, dict[int, str | None]] = {}
     generator_speed = [r.column("generator_speed") for r in system.with_role(GENERATOR)]
     for role in system.with_role(GEARBOX):
         body_speed = {s.info.get("body"): f"{role.component}.{s.variable}" for s in role.of_kind("body_speed")}
         for s in role.of_kind("contact_force"):
             col = f"{role.component}.{s.variable}"
+            if s.info.get("mesh") == "sun_planet" and str(s.info.get("planet", "")).isdigit():
+                key = f"{role.component}.{s.info.get('stage', '')}"
+                planets.setdefault(key, {})[int(s.info["planet"])] = col if col in series else None
             if col in series:
                 forces.append(col)
                 stage[col] = s.info.get("stage", role.component)
@@ -127,7 +137,7 @@ def _recorded_signals(system: ResolvedSystem, series: dict[str, np.ndarray]) -> 
             if s.info.get("downstream") == "generator":
                 cands += generator_speed
             speeds[col] = [c for c in cands if c is not None and c in series]
-    return _Signals(forces, torques, stage, mesh, speeds)
+    return _Signals(forces, torques, stage, mesh, speeds, planets)
 
 
 @dataclass(frozen=True)
@@ -264,6 +274,8 @@ def analyse_run(system: ResolvedSystem, outcome: RunOutcome, out_dir: str | Path
 
                     result.files["plot:load_duration"] = plot_load_duration(list(report.ldd.values()), out / LDD_PLOT)
 
+    _load_sharing(result, series, t, window, sig)
+
     if system.events and plots:
         if forces:
             result.files["plot:event_response"] = _plot_events(system, outcome, series, sig, out / EVENT_PLOT)
@@ -291,6 +303,30 @@ def analyse_run(system: ResolvedSystem, outcome: RunOutcome, out_dir: str | Path
                             t, {n: series[n] for n in chosen}, out / SPECTRUM_PLOT, marks, window, fmax)
                         summary["file"] = SPECTRUM_PLOT
     return result
+
+
+def _load_sharing(result: RunAnalyses, series, t, window, sig: _Signals) -> None:
+    """``summary["load_sharing"]``: the load-sharing factor of every planetary stage with every planet recorded."""
+    if not sig.planets:
+        result.skip("load_sharing", "no planetary stage's sun-planet contact forces are declared")
+        return
+    inside = (t >= window[0] - 1e-12) & (t <= window[1] + 1e-12)
+    out, missing = {}, []
+    for stage, planets in sig.planets.items():
+        columns = [planets[i] for i in sorted(planets)]
+        if len(columns) < 2 or any(c is None for c in columns):
+            missing.append(stage)
+            continue
+        try:
+            out[stage] = load_sharing(stage, np.column_stack([series[c][inside] for c in columns]),
+                                      tuple(columns)).as_dict()
+        except DtcosimError as exc:
+            missing.append(f"{stage} ({exc})")
+    if out:
+        result.summary["load_sharing"] = {"window_s": list(window), "stages": out}
+    if missing:
+        result.skip("load_sharing", "not every planet's sun-planet force recorded (or no load) for: "
+                    + ", ".join(missing))
 
 
 def _first_per_stage(sig: _Signals) -> list[str]:
@@ -397,6 +433,11 @@ def format_analyses(summary: dict[str, Any]) -> str:
                      f"{1e3 * m['longest_episode_s']:.2f}"]
                     for name, m in cl["meshes"].items() if m["separations"] or m["time_in_backlash_s"] > 0]
             lines += fit_table(["mesh", "separations", "flank changes", "in backlash", "longest"], rows)
+    sharing = summary.get("load_sharing")
+    if sharing:
+        lines.append("planet load sharing (largest planet sun-mesh force / mean, max over the window): " + ", ".join(
+            f"{stage.partition('.')[2] or stage} {s['factor']:.4f} (planet {s['most_loaded_planet']})"
+            for stage, s in sharing["stages"].items()))
     fat = summary.get("fatigue")
     if fat:
         exps = [f"m={m:g}" for m in fat["wohler_exponents"]]

@@ -45,7 +45,10 @@ from typing import Any, Mapping
 from components.errors import DtcosimError, WallTimeLimitError
 
 from ..inputs.measures import Measure
-from .measure_values import max_abs_rate, window_statistic
+from .measure_values import max_abs_rate, window_load_sharing, window_statistic
+
+#: joins the force columns of a stage measure in ``StudyPayload.series_names``
+STAGE_COLUMNS = "|"
 
 #: outcome statuses of a point
 OK, FAILED = "ok", "failed"
@@ -76,7 +79,9 @@ class StudyPayload:
         :class:`components.reference.solver.SolverSettings` fields (monolithic engine).
     series_names : mapping of str -> str
         Monolithic engine: measure variable ``component.variable`` -> series name of
-        :class:`components.reference.results.SimulationResult`.
+        :class:`components.reference.results.SimulationResult`. A stage measure
+        (``gearbox.stage1:load_sharing``) -> its planets' force columns (co-simulation) or series
+        (monolithic), joined by :data:`STAGE_COLUMNS`.
     fmu_blobs : mapping of str -> bytes
         Co-simulation: FMU file content by SHA-256.
     timeout_s : float or None
@@ -248,6 +253,9 @@ def _monolithic(payload: StudyPayload, task: PointTask) -> tuple[dict[str, float
             except WallTimeLimitError as exc:  # name the point's limit, not what was left of it
                 raise WallTimeLimitError(payload.timeout_s, exc.time_s) from None
             out[m.name] = peak.value_rad_s2
+        elif m.of_stage:
+            forces = [result.series[c] for c in payload.series_names[m.name].split(STAGE_COLUMNS)]
+            out[m.name] = window_load_sharing(result.time_s, forces, payload.window_s)
         else:
             series = result.series[payload.series_names[m.variable]]
             out[m.name] = window_statistic(result.time_s, series, payload.window_s, m.statistic)
@@ -298,6 +306,9 @@ def _cosim(payload: StudyPayload, task: PointTask) -> tuple[dict[str, float], di
                 out[m.name] = float(outcome.column(variable)[-1])
             else:
                 out[m.name] = max_abs_rate(outcome.time_s, outcome.column(variable))
+        elif m.of_stage:
+            forces = [outcome.column(c) for c in payload.series_names[m.name].split(STAGE_COLUMNS)]
+            out[m.name] = window_load_sharing(outcome.time_s, forces, system.scenario.simulation.window_s)
         else:
             values = outcome.column(m.variable)
             out[m.name] = window_statistic(outcome.time_s, values, system.scenario.simulation.window_s, m.statistic)

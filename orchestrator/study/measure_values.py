@@ -48,6 +48,16 @@ def window_statistic(time_s: np.ndarray, values: np.ndarray, window: tuple[float
     return float(fatigue_loads(t[inside], x, FatigueSettings(wohler_exponents=(m,))).del_by_exponent[m])
 
 
+def window_load_sharing(time_s: np.ndarray, forces: list[np.ndarray], window: tuple[float, float]) -> float:
+    """The load-sharing factor (:func:`components.analysis.load_sharing.load_sharing`) of planet forces over ``window``."""
+    from components.analysis.load_sharing import load_sharing
+
+    inside = window_mask(np.asarray(time_s, dtype=float), window)
+    if not inside.any():
+        return float("nan")
+    return load_sharing("stage", np.column_stack([np.asarray(f, dtype=float)[inside] for f in forces])).factor
+
+
 def max_abs_rate(time_s: np.ndarray, values: np.ndarray) -> float:
     """Largest ``|dx/dt|`` between consecutive samples [unit of x per s].
 

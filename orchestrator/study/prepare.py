@@ -31,7 +31,7 @@ from typing import Any, Mapping
 from ..errors import ScenarioError, suggestion
 from ..inputs.measures import Measure
 from ..inputs.study import Point, Study, StudyError, split_parameter
-from .engine import StudyPayload
+from .engine import STAGE_COLUMNS, StudyPayload
 
 #: the module that computes a point (:func:`orchestrator.study.engine.run_point`): its import closure is the code
 #: a point's numbers depend on
@@ -255,6 +255,13 @@ def _prepare_model(study: Study) -> tuple[Study, StudyPayload, dict[str, Any]]:
             if m.builtin:
                 continue
             comp, var = split_parameter(m.variable)
+            if m.of_stage:  # the model's series of the stage's sun-planet forces, planet by planet
+                planets = [n for n in units if n.startswith(f"{var}.F_sp[")]
+                if comp != MODEL_COMPONENT or len(planets) < 2:
+                    raise StudyError(f"measures[{i}]", m.name, f"a planetary stage {MODEL_COMPONENT}.<stage> of the "
+                                     "model", src)
+                series_names[m.name] = STAGE_COLUMNS.join(sorted(planets, key=lambda n: int(n[n.index("[") + 1:-1])))
+                continue
             if comp != MODEL_COMPONENT or var not in units:
                 raise StudyError(f"measures[{i}]", m.name, f"a variable {MODEL_COMPONENT}.<series> of the monolithic "
                                  f"result{suggestion(var, units)}", src)
@@ -325,6 +332,12 @@ def _prepare_scenario(study: Study, fmu_dir,
         for i, m in enumerate(study.measures):
             if m.builtin and m.name != "I_max_acc":
                 continue
+            if m.of_stage:
+                columns = _stage_forces(system, m, i, src)
+                series_names[m.name] = STAGE_COLUMNS.join(columns)
+                declared_units[m.name] = "1"
+                extra += [c for c in columns if scenario.recorded and c not in {r.column for r in system.recorded}]
+                continue
             if m.name == "I_max_acc":
                 signals = {s.kind: s.variable for s in gearbox[0].signals} if len(gearbox) == 1 else {}
                 # the FMU's running peak over its internal steps (eq. 11 exactly) where it has one;
@@ -376,6 +389,13 @@ def _prepare_scenario(study: Study, fmu_dir,
             for i, m in enumerate(study.measures):
                 if m.builtin:
                     continue
+                if m.of_stage:
+                    names = [reference_name(c, system, setup, units) for c in _stage_forces(system, m, i, src)]
+                    if any(n is None for n in names):
+                        raise StudyError(f"measures[{i}]", m.name, "a stage whose planet forces the monolithic model "
+                                         "has", src)
+                    series_names[m.name] = STAGE_COLUMNS.join(names)
+                    continue
                 name = reference_name(m.variable, system, setup, units)
                 if name is None:
                     raise StudyError(f"measures[{i}]", m.name, "a variable of the scenario with a counterpart in the "
@@ -401,6 +421,24 @@ def _prepare_scenario(study: Study, fmu_dir,
     return study, payload, identity, dict(system.fmu_paths), tuple(notes)
 
 
+def _stage_forces(system, m, i: int, src) -> list[str]:
+    """The sun-planet force columns (planet order) a gearbox declares for the stage of a stage measure."""
+    from ..cosim.roles import GEARBOX
+
+    comp, _, stage = m.variable.partition(".")
+    role = next((r for r in system.with_role(GEARBOX) if r.component == comp), None)
+    planets = {}
+    for s in role.of_kind("contact_force") if role is not None else ():
+        if s.info.get("stage") == stage and s.info.get("mesh") == "sun_planet" and str(s.info.get("planet")).isdigit():
+            planets[int(s.info["planet"])] = f"{comp}.{s.variable}"
+    if len(planets) < 2:
+        stages = sorted({f"{r.component}.{s.info.get('stage')}" for r in system.with_role(GEARBOX)
+                         for s in r.of_kind("contact_force") if s.info.get("mesh") == "sun_planet"})
+        raise StudyError(f"measures[{i}]", m.name, "a planetary stage of a gearbox of the base scenario whose "
+                         f"planets' sun-planet forces are declared: {', '.join(stages) or 'none'}", src)
+    return [planets[k] for k in sorted(planets)]
+
+
 def _variants(study: Study, scenario, fmu_dir, build: bool):
     """The drivetrain structures of a study varying drivetrain file entries, the measures checked on each."""
     from ..provision.folders import default_fmu_dir
@@ -414,6 +452,9 @@ def _variants(study: Study, scenario, fmu_dir, build: bool):
     for sid, each in (variants.systems.items() if variants else ()):
         for i, m in enumerate(study.measures):
             if m.builtin:
+                continue
+            if m.of_stage:
+                _stage_forces(each, m, i, study.source)
                 continue
             comp, var = split_parameter(m.variable)
             if comp not in each.interfaces or var not in each.interfaces[comp].variables:

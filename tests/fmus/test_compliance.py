@@ -13,8 +13,9 @@ What runs here (the FMI Compliance Checker's sources are not on this machine; se
 * the FMI Compliance Checker itself (``fmuCheck.linux64``) where it is built: on PATH or named by
   ``$DTCOSIM_FMUCHECK``; skipped otherwise.
 
-"Every FMU": the five built from the paper's preset, a TimeSeriesSource built from a record, and an FMU copy
-with the start values ``dtcosim export-ssp`` writes into an archive.
+"Every FMU": the five built from the paper's preset, a TimeSeriesSource built from a record, an FMU copy
+with the start values ``dtcosim export-ssp`` writes into an archive, and the Gearbox of the lateral-torsional
+``paper-table6-lateral`` (its displacement and bearing outputs).
 """
 
 from __future__ import annotations
@@ -36,8 +37,8 @@ from fmus.start_values import write_with_start_values
 
 pytestmark = pytest.mark.slow
 
-#: the FMUs checked: every model of the registry, and an exported copy with other start values
-CHECKED = (*FMU_NAMES, "Gearbox-exported")
+#: the FMUs checked: every model of the registry, an exported copy with other start values, a lateral Gearbox
+CHECKED = (*FMU_NAMES, "Gearbox-exported", "Gearbox-lateral")
 FMUCHECK_VARIABLE = "DTCOSIM_FMUCHECK"
 
 SERIES_SCENARIO = """
@@ -60,6 +61,7 @@ interpolation = "linear"
 @pytest.fixture(scope="module")
 def every_fmu(fmu_path, tmp_path_factory) -> dict[str, Path]:
     """Name -> FMU: the session's three, the other preset FMUs, a TimeSeriesSource and an exported copy."""
+    from orchestrator.inputs.drivetrain_file import find_drivetrain, load_drivetrain_file
     from orchestrator.inputs.scenario_file import load_scenario
     from orchestrator.provision.series_fmus import ensure_series_fmu
 
@@ -74,6 +76,9 @@ def every_fmu(fmu_path, tmp_path_factory) -> dict[str, Path]:
     fmus["TimeSeriesSource"] = ensure_series_fmu(spec, out / "series")
     fmus["Gearbox-exported"] = write_with_start_values(
         fmus["Gearbox"], out / "exported" / "Gearbox.fmu", {"generator_interface": 1, "stage1.k0": 2.0e9})
+    lateral = load_drivetrain_file(find_drivetrain("paper-table6-lateral")).drivetrain
+    fmus["Gearbox-lateral"] = build_fmu("Gearbox", out / "lateral", drivetrain=lateral,
+                                        origin="drivetrain paper-table6-lateral").path
     assert set(fmus) == set(CHECKED)
     return fmus
 

@@ -1,59 +1,98 @@
 """The drivetrain's equations of motion from its assembled matrices: deflections, accelerations, Jacobian.
 
 The stage kinds are assembled into constant matrices once
-(:class:`components.model.assembly.Assembly`): mesh deflections ``d = A q + a_port u`` (eq. 8,
-10 and the parallel mesh in deviation angles), shaft twists ``S q``, and the folded matrix
-``fast`` with ``q_ddot = [F, q, v, u, u_dot, alpha_in] @ fast``, which holds the inverse
-inertias, the mesh moment arms ``-r_b = -r cos(alpha)`` (eq. 5-7), the shafts, the port input
-``u`` and the driver acceleration. Here they are evaluated for one state ``y = [q, v]``.
+(:class:`components.model.assembly.Assembly`): mesh deflections ``d = A q + a_port u + e`` (eq. 8,
+10 and the parallel mesh in deviation coordinates; ``e`` the constant offsets of planet pin
+position errors), shaft and bearing rows ``S q``, and the folded matrix ``fast`` with
+``q_ddot = [F, q, v, u, u_dot, alpha_in, w] @ fast``, which holds the inverse inertias, the
+mesh moment arms ``-r_b = -r cos(alpha)`` (eq. 5-7), the shafts and bearings, the port input
+``u``, the driver acceleration and the external loads (gravity, centrifugal force) per external
+term ``w = [omega_in^2, 1, cos(r_k th_in), sin(r_k th_in), ...]`` (:func:`external_terms`; none
+without a lateral-torsional stage). Here they are evaluated for one state ``y = [q, v]``.
 """
 
 from __future__ import annotations
 
+import math
+
 from .contact import contact_force, stiffness_sensitivity
-from .linalg import axpy, vecmat, vecmat_sum
+from .linalg import axpy, copy, sparse_vecmat
 from .stiffness import stiffness_factors
 
 
-def deflections(y, n, a_t, a_port, port, port_rate, out):
-    """Mesh deflections [m] (row 0) and their rates [m/s] (row 1) of ``y = [q, v, ...]`` and the port input."""
-    vecmat(y[:n], a_t, out[0])
-    vecmat(y[n:2 * n], a_t, out[1])
+def deflections(y, n, nz_index, nz_value, a_port, offset, port, port_rate, out):
+    """Mesh deflections [m] (row 0) and their rates [m/s] (row 1) of ``y = [q, v, ...]``, the port input and
+    the constant offsets; every mesh row ``A`` through its nonzero columns (``nz_index``, ``nz_value``)."""
+    sparse_vecmat(y[:n], nz_index, nz_value, out[0])
+    sparse_vecmat(y[n:2 * n], nz_index, nz_value, out[1])
     axpy(port, a_port, out[0])
     axpy(port_rate, a_port, out[1])
+    axpy(1.0, offset, out[0])
 
 
-def _deflections_loop(y, n, a_t, a_port, port, port_rate, out):
-    """:func:`deflections` in one pass over ``a_t`` (the same sums in the same order)."""
-    for i in range(a_t.shape[1]):
+def _deflections_loop(y, n, nz_index, nz_value, a_port, offset, port, port_rate, out):
+    """:func:`deflections` in one pass over the nonzero columns (the same sums in the same order)."""
+    for i in range(nz_index.shape[0]):
         d = 0.0
         r = 0.0
-        for j in range(n):
-            d += y[j] * a_t[j, i]
-            r += y[n + j] * a_t[j, i]
-        out[0, i] = d + port * a_port[i]
+        for p in range(nz_index.shape[1]):
+            j = int(nz_index[i, p])
+            if j < 0:
+                break
+            d += y[j] * nz_value[i, p]
+            r += y[n + j] * nz_value[i, p]
+        out[0, i] = d + port * a_port[i] + offset[i]
         out[1, i] = r + port_rate * a_port[i]
 
 
-def acceleration(y, port, port_rate, alpha, factor, a_t, a_port, fast, contact, z, defl, acc):
-    """Deviation accelerations ``q_ddot`` [rad/s^2] into ``acc``.
+def external_terms(angle, speed, rates, out):
+    """The external terms ``w = [omega^2, 1, cos(r_1 th), sin(r_1 th), ...]`` at the driver angle ``th`` [rad] and
+    speed ``omega`` [rad/s] into ``out`` (its length: ``2 + 2 len(rates)``, or 0 without external loads)."""
+    if out.shape[0] == 0:
+        return
+    out[0] = speed * speed
+    out[1] = 1.0
+    for k in range(rates.shape[0]):
+        out[2 + 2 * k] = math.cos(rates[k] * angle)
+        out[3 + 2 * k] = math.sin(rates[k] * angle)
 
-    Writes the deflections into ``defl``, the forces [N] into ``z[:n_mesh]`` and ``u, u_dot, alpha_in``
-    after ``n_mesh + 2 n`` entries of ``z``.
+
+def external_term_rates(angle, speed, accel, rates, out):
+    """The time derivatives of :func:`external_terms` at the driver angle, speed and acceleration ``accel``
+    [rad/s^2] into ``out``: ``[2 omega alpha, 0, -r omega sin(r th), r omega cos(r th), ...]``."""
+    if out.shape[0] == 0:
+        return
+    out[0] = 2.0 * speed * accel
+    out[1] = 0.0
+    for k in range(rates.shape[0]):
+        w = rates[k] * speed
+        out[2 + 2 * k] = -w * math.sin(rates[k] * angle)
+        out[3 + 2 * k] = w * math.cos(rates[k] * angle)
+
+
+def acceleration(y, port, port_rate, alpha, factor, nz_index, nz_value, a_port, offset, fast_index, fast_value, contact,
+                 z, defl, acc):
+    """Deviation accelerations ``q_ddot`` [rad/s^2] into ``acc``: ``z @ fast`` with the folded matrix held by
+    columns, its nonzero rows only (``fast_index``, ``fast_value``).
+
+    Writes the deflections into ``defl``, the forces [N] into ``z[:n_mesh]``, ``y`` after them and ``u, u_dot,
+    alpha_in`` after ``n_mesh + 2 n`` entries of ``z``; the external terms after them must be set
+    (:func:`external_terms`) where ``fast`` has external rows.
     """
     m = defl.shape[1]
     n2 = y.shape[0]
-    deflections(y, n2 // 2, a_t, a_port, port, port_rate, defl)
+    deflections(y, n2 // 2, nz_index, nz_value, a_port, offset, port, port_rate, defl)
     for i in range(m):
         z[i] = contact_force(defl[0, i], defl[1, i], factor[i], contact[i])[0]
+    copy(y, z[m:m + n2])
     z[m + n2] = port
     z[m + n2 + 1] = port_rate
     z[m + n2 + 2] = alpha
-    vecmat_sum(z[:m], fast[:m], y, fast[m:m + n2], z[m + n2:m + n2 + 3], fast[m + n2:], acc)
+    sparse_vecmat(z, fast_index, fast_value, acc)
 
 
-def jacobian(y, port, port_rate, factor, a_t, a_port, contact, defl, nz_index, nz_value, cos_alpha, stks, stcs,
-             stks_port, stcs_port, inv_m, fd, fv, dq, dv, port_jac):
+def jacobian(y, port, port_rate, factor, a_port, offset, contact, defl, nz_index, nz_value, cos_alpha, stks,
+             stcs, stks_port, stcs_port, inv_m, fd, fv, dq, dv, port_jac):
     """Jacobian blocks of ``q_ddot``: ``dq``, ``dv`` (n x n) and the port columns (rows of ``port_jac``).
 
     ``dq = -M^-1 (sum_i cos(alpha_i) dF_i/dd a_i a_i^T + S^T k S)`` summed over the few bodies each
@@ -63,7 +102,7 @@ def jacobian(y, port, port_rate, factor, a_t, a_port, contact, defl, nz_index, n
     n = dq.shape[0]
     m = fd.shape[0]
     width = nz_index.shape[1]
-    deflections(y, n, a_t, a_port, port, port_rate, defl)
+    deflections(y, n, nz_index, nz_value, a_port, offset, port, port_rate, defl)
     for i in range(m):
         _, fd[i], fv[i], _ = contact_force(defl[0, i], defl[1, i], factor[i], contact[i])
     for j in range(n):
@@ -98,13 +137,13 @@ def jacobian(y, port, port_rate, factor, a_t, a_port, contact, defl, nz_index, n
         port_jac[1, j] *= s
 
 
-def stiffness_rate(y, n, angle, speed, port, port_rate, a_t, a_port, contact, phasing, force_rows, factor, slope,
-                   defl, sens, out):
+def stiffness_rate(y, n, angle, speed, port, port_rate, nz_index, nz_value, a_port, offset, contact, phasing,
+                   force_rows, factor, slope, defl, sens, out):
     """``out += (dF/df df/dt) @ d q_ddot/dF``: the partial time derivative of ``q_ddot`` that a time-varying
     mesh stiffness adds at driver angle ``angle`` [rad] and speed ``speed`` [rad/s] (its factor ``f`` moves
     with the driver angle). Leaves the factors at ``angle`` in ``factor``."""
     stiffness_factors(angle, phasing, factor, slope)
-    deflections(y, n, a_t, a_port, port, port_rate, defl)
+    deflections(y, n, nz_index, nz_value, a_port, offset, port, port_rate, defl)
     for i in range(sens.shape[0]):
         sens[i] = stiffness_sensitivity(defl[0, i], defl[1, i], factor[i], contact[i]) * (slope[i] * speed)
     for j in range(out.shape[0]):

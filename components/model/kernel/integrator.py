@@ -10,8 +10,8 @@ and ``W^-1 = (I - h d J)^-1``, ``d = 1 / (2 + sqrt 2)``::
     k3 = W^-1 (f(y + h k2) - e32 (k2 - f1) - 2 (k1 - f0) + h d f_t),    e32 = 6 + sqrt 2
     y_new = y + h k2,     err = h / 6 max |k1 - 2 k2 + k3| / (atol + rtol max(|y|, |y_new|))
 
-* ``W^-1`` comes from one ``n x n`` inverse (the Schur complement of the ``2n x 2n`` stage
-  matrix, :func:`factor`), formed once per Jacobian and step size; the inverse of the step size
+* ``W^-1`` is applied by blocks through one ``n x n`` inverse (the Schur complement of the ``2n x 2n``
+  stage matrix, :func:`factor`, :func:`solve`), formed once per Jacobian and step size; the inverse of the step size
   used before is kept too (:func:`use_factorisation`): a communication step whose last internal
   step was shortened to end on the communication point starts the next one with the step size
   before, and takes its inverse back (in the paper's co-simulation at H = 5 ms, a third of the
@@ -20,7 +20,15 @@ and ``W^-1 = (I - h d J)^-1``, ``d = 1 / (2 + sqrt 2)``::
   refreshed only when older than ``jacobian_max_age`` accepted steps or after a rejected step;
   a stale Jacobian that hurts accuracy causes a rejection, which forces a refresh.
 * **Step control**: ``h_new = h min(5, 0.9 err^(-1/3))``, kept unchanged for factors in [1, 2]
-  (the factorisation is reused). After a second rejection at the same time with a fresh Jacobian
+  (the factorisation is reused).
+* **Large models** (more than :data:`LU_ABOVE` degrees of freedom: the lateral-torsional gearboxes),
+  where factorising costs most: ``G`` is kept as LU factors, four factorisations are kept (least
+  recently used replaced), and the step sizes are made to recur: the rest of a communication step
+  is divided into equal steps of at most the proposed size, and once the first internal step of a
+  communication step was rejected (new inputs start a transient there, where the proposal from the
+  smooth end of the last step fails two or three times in a lateral-torsional gearbox), the next
+  ones start with at most the step their predecessor's first step proposed, while that is smaller
+  than the proposal. Smaller models keep the plain policy (their factorisations cost little). After a second rejection at the same time with a fresh Jacobian
   the controller uses the order observed between the two attempts, ``p = log(err1 / err2) /
   log(h1 / h2)`` clipped to [0.2, 3], and proposes ``h (0.9 / err)^(1/p)`` (at least a tenth of
   ``h``): at a communication point the inputs change their acceleration, which starts a fast,
@@ -38,41 +46,45 @@ import math
 
 import numpy as np
 
-from .dynamics import acceleration, jacobian, stiffness_rate
+from .dynamics import acceleration, external_term_rates, external_terms, jacobian, stiffness_rate
 from .layout import (
-    ACCEPTED, ACTIVE, AGE, ALPHA_OUT_MAX, ATOL_Q, ATOL_V, BASIS_PREV_VALID, BASIS_VALID, H_MIN, H_NEXT, HD, HD_PREV,
+    ACCEPTED, ACTIVE, AGE, ALPHA_OUT_MAX, ATOL_Q, ATOL_V, CLOCK, H_FIRST, H_MIN, H_NEXT, HD, N_SLOTS, SLOT_BASIS,
+    SLOT_HD, SLOT_USED,
     JAC_MAX_AGE, JACOBIANS, MAX_STEPS, OK, OUT_KINEMATIC, OUT_RATE_INDEX, REJECTED, RTOL, STEP_TOO_SMALL,
     TOO_MANY_STEPS,
 )
-from .linalg import copy, invert, matmul, matvec
+from .linalg import copy, invert, lu_factor, lu_pattern, lu_solve, matvec, matvec_pattern
 from .motion import accel, jerk, rate, value
 from .stiffness import stiffness_factors
 
 D = 1.0 / (2.0 + math.sqrt(2.0))
+#: above this many degrees of freedom (a lateral-torsional gearbox) a factorisation is what a step costs most: ``G`` is
+#: kept as its LU factors (n^3/3 operations, not an inverse's n^3), and the step sizes are made to recur so that
+#: the kept factorisations are used again (equal internal steps, the first-step cap; module docstring)
+LU_ABOVE = 24
 E32 = 6.0 + math.sqrt(2.0)
 #: bounds of the error order observed between two rejected attempts
 ORDER_MIN, ORDER_MAX = 0.2, 3.0
 
 
-def factor(hd, dq, dv, winv):
-    """``W^-1 = (I - hd J)^-1`` for ``J = [[0, I], [dq, dv]]`` through the ``n x n`` Schur complement."""
+def factor(hd, dq, dv, ginv, piv):
+    """``G = I - hd dv - hd^2 dq``, the Schur complement of ``W = I - hd J``, ``J = [[0, I], [dq, dv]]``, which is
+    all :func:`solve` needs of ``W^-1``: kept as ``G^-1`` (up to :data:`LU_ABOVE` degrees of freedom) or as its LU
+    factors, pivots and their nonzero pattern ``piv`` (rows: pivots, then per column of ``L`` and of ``U`` its
+    nonzero rows, see :func:`.linalg.lu_pattern`)."""
     n = dq.shape[0]
     g = -hd * dv - (hd * hd) * dq
     for i in range(n):
         g[i, i] += 1.0
-    ginv = np.empty((n, n))
-    invert(g, ginv)
-    s = np.empty((n, n))
-    matmul(ginv, dq, s)
-    winv[:n, :n] = (hd * hd) * s
-    winv[:n, n:] = hd * ginv
-    winv[n:, :n] = hd * s
-    winv[n:, n:] = ginv
-    for i in range(n):
-        winv[i, i] += 1.0
+    if n > LU_ABOVE:
+        ginv[:, :] = g
+        lu_factor(ginv, piv[0])
+        lu_pattern(ginv, piv[1:n + 1], piv[n + 1:])
+    else:
+        invert(g, ginv)
 
 
-def _factor_loop(hd, dq, dv, winv):
+def _factor_loop(hd, dq, dv, ginv, piv):
     """:func:`factor` as loops (the same operations; numba compiles it without temporaries)."""
     n = dq.shape[0]
     g = np.empty((n, n))
@@ -80,39 +92,66 @@ def _factor_loop(hd, dq, dv, winv):
         for j in range(n):
             g[i, j] = -hd * dv[i, j] - (hd * hd) * dq[i, j]
         g[i, i] += 1.0
-    ginv = np.empty((n, n))
-    invert(g, ginv)
-    for i in range(n):
-        for j in range(n):
-            s = 0.0
-            for k in range(n):
-                s += ginv[i, k] * dq[k, j]
-            winv[i, j] = (hd * hd) * s
-            winv[i, n + j] = hd * ginv[i, j]
-            winv[n + i, j] = hd * s
-            winv[n + i, n + j] = ginv[i, j]
-        winv[i, i] += 1.0
-
-
-def use_factorisation(hd, dq, dv, winvs, istate):
-    """Make ``W^-1`` for ``hd`` the active one of the two kept (``winvs``, shape (2, 2n, 2n)); returns its slot.
-
-    The slot not in use holds the factorisation of the step size used before (same Jacobian).
-    """
-    other = 1 - int(istate[ACTIVE])
-    if hd == istate[HD_PREV]:
-        istate[HD_PREV] = istate[HD]
-        valid = istate[BASIS_VALID]
-        istate[BASIS_VALID] = istate[BASIS_PREV_VALID]
-        istate[BASIS_PREV_VALID] = valid
+    if n > LU_ABOVE:
+        for i in range(n):
+            for j in range(n):
+                ginv[i, j] = g[i, j]
+        lu_factor(ginv, piv[0])
+        lu_pattern(ginv, piv[1:n + 1], piv[n + 1:])
     else:
-        istate[HD_PREV] = istate[HD]
-        istate[BASIS_PREV_VALID] = istate[BASIS_VALID]
-        factor(hd, dq, dv, winvs[other])
-        istate[BASIS_VALID] = 0.0
+        invert(g, ginv)
+
+
+def apply_g(ginv, piv, b, out):
+    """``out = G^-1 b`` (:func:`factor`'s inverse or LU factors)."""
+    n = ginv.shape[0]
+    if n > LU_ABOVE:
+        lu_solve(ginv, piv[0], piv[1:n + 1], piv[n + 1:], b, out)
+    else:
+        matvec(ginv, b, out)
+
+
+def solve(ginv, piv, dq, dq_index, hd, r, out, work):
+    """``out = W^-1 r`` by blocks: ``x2 = G^-1 (r2 + hd dq r1)``, ``x1 = r1 + hd x2`` (``work``: n entries;
+    ``dq_index``: the columns each row of ``dq`` can hold)."""
+    n = dq.shape[0]
+    matvec_pattern(dq, dq_index, r[:n], work)
+    for i in range(n):
+        work[i] = r[n + i] + hd * work[i]
+    apply_g(ginv, piv, work, out[n:])
+    for i in range(n):
+        out[i] = r[i] + hd * out[n + i]
+
+
+def solve_lower(ginv, piv, hd, b, out):
+    """``out = W^-1 [0, b]`` = ``[hd G^-1 b, G^-1 b]``."""
+    n = ginv.shape[0]
+    apply_g(ginv, piv, b, out[n:])
+    for i in range(n):
+        out[i] = hd * out[n + i]
+
+
+def use_factorisation(hd, dq, dv, winvs, pivots, istate):
+    """Make the factorisation for ``hd`` the active one of the ``N_SLOTS`` kept (same Jacobian), factorising it into
+    the least recently used slot where none is kept; returns its slot."""
+    istate[CLOCK] += 1.0
+    slot = -1
+    for s in range(N_SLOTS):
+        if istate[SLOT_HD + s] == hd:
+            slot = s
+            break
+    if slot < 0:
+        slot = 0
+        for s in range(1, N_SLOTS):
+            if istate[SLOT_USED + s] < istate[SLOT_USED + slot]:
+                slot = s
+        factor(hd, dq, dv, winvs[slot], pivots[slot])
+        istate[SLOT_HD + slot] = hd
+        istate[SLOT_BASIS + slot] = 0.0
+    istate[SLOT_USED + slot] = istate[CLOCK]
     istate[HD] = hd
-    istate[ACTIVE] = float(other)
-    return other
+    istate[ACTIVE] = float(slot)
+    return slot
 
 
 def twist_and_rate(twist_q, y, n, twist_port, port, tau):
@@ -129,34 +168,51 @@ def refresh_jacobian(k, y, t, angle0, driver, port):
     """Evaluate the Jacobian at local time ``t`` and state ``y``; every kept factorisation is void."""
     if k.tvs:
         stiffness_factors(angle0 + value(driver, t), k.phasing, k.factor, k.slope)
-    jacobian(y, value(port, t), rate(port, t), k.factor, k.a_t, k.a_port, k.contact, k.defl, k.nz_index, k.nz_value,
-             k.cos_alpha, k.stks, k.stcs, k.stks_port, k.stcs_port, k.inv_m, k.fd, k.fv, k.dq, k.dv, k.port_jac)
+    jacobian(y, value(port, t), rate(port, t), k.factor, k.a_port, k.offset, k.contact, k.defl, k.nz_index,
+             k.nz_value, k.cos_alpha, k.stks, k.stcs, k.stks_port, k.stcs_port, k.inv_m, k.fd, k.fv, k.dq, k.dv,
+             k.port_jac)
     ist = k.istate
     ist[AGE] = 0.0
     ist[HD] = -1.0
-    ist[HD_PREV] = -1.0
+    for s in range(N_SLOTS):
+        ist[SLOT_HD + s] = -1.0
     ist[JACOBIANS] += 1.0
 
 
-def time_derivative_term(k, y, t, h, hd, angle0, driver, port, winv, w_basis):
-    """``h d W^-1 [0, f_t]`` into ``k.w_hdt``: the prescribed motions' part of the stages at local time ``t``."""
+def time_derivative_term(k, y, t, h, hd, angle0, driver, port, winv, piv, w_basis):
+    """``h d W^-1 [0, f_t]`` into ``k.w_hdt``: the prescribed motions' part of the stages at local time ``t``
+    (and the external loads', which move with the driver angle and speed)."""
     n = k.dq.shape[0]
     n2 = 2 * n
     w_hdt = k.w_hdt
-    if not k.tvs:  # f_t = [port speed, port accel, driver jerk] @ [pj0; pj1; -kappa]: W^-1 of the rows once
+    n_ext = k.n_ext
+    ext = k.fast[k.fast.shape[0] - n_ext:]  # the external rows (none without external loads)
+    rates = k.w_ext[:n_ext]  # the time derivatives of the external terms
+    external_term_rates(angle0 + value(driver, t), rate(driver, t), accel(driver, t), k.load_rates, rates)
+    if not k.tvs:  # f_t = [port speed, port accel, driver jerk, external rates] @ [pj0; pj1; -kappa; external
+        # rows]: W^-1 of the rows once per factorisation
         ist = k.istate
-        if ist[BASIS_VALID] == 0.0:
-            matvec(winv[:, n:], k.port_jac[0], w_basis[0])
-            matvec(winv[:, n:], k.port_jac[1], w_basis[1])
-            matvec(winv[:, n:], k.kappa, w_basis[2])
+        active = int(ist[ACTIVE])
+        if ist[SLOT_BASIS + active] == 0.0:
+            solve_lower(winv, piv, hd, k.port_jac[0], w_basis[0])
+            solve_lower(winv, piv, hd, k.port_jac[1], w_basis[1])
+            solve_lower(winv, piv, hd, k.kappa, w_basis[2])
             for i in range(n2):
                 w_basis[2, i] = -w_basis[2, i]
-            ist[BASIS_VALID] = 1.0
+            for r in range(n_ext):
+                if r != 1:  # the constant term has no rate
+                    solve_lower(winv, piv, hd, ext[r], w_basis[3 + r])
+            ist[SLOT_BASIS + active] = 1.0
         c0 = hd * rate(port, t)
         c1 = hd * accel(port, t)
         c2 = hd * jerk(driver)
         for i in range(n2):
             w_hdt[i] = w_basis[0, i] * c0 + w_basis[1, i] * c1 + w_basis[2, i] * c2
+        for r in range(n_ext):
+            if r != 1:
+                c = hd * rates[r]
+                for i in range(n2):
+                    w_hdt[i] += w_basis[3 + r, i] * c
         return
     pr = rate(port, t)
     pa = accel(port, t)
@@ -164,10 +220,13 @@ def time_derivative_term(k, y, t, h, hd, angle0, driver, port, winv, w_basis):
     da = k.da
     for j in range(n):
         da[j] = k.port_jac[0, j] * pr + k.port_jac[1, j] * pa - k.kappa[j] * jk
-    stiffness_rate(y, n, angle0 + value(driver, t), rate(driver, t), value(port, t), pr, k.a_t, k.a_port, k.contact,
-                   k.phasing, k.force_rows, k.factor, k.slope, k.defl, k.sens, da)
+    stiffness_rate(y, n, angle0 + value(driver, t), rate(driver, t), value(port, t), pr, k.nz_index, k.nz_value,
+                   k.a_port, k.offset, k.contact, k.phasing, k.force_rows, k.factor, k.slope, k.defl, k.sens, da)
+    for r in range(n_ext):
+        for j in range(n):
+            da[j] += rates[r] * ext[r, j]
     da *= hd
-    matvec(winv[:, n:], da, w_hdt)
+    solve_lower(winv, piv, hd, da, w_hdt)
 
 
 def evaluate(k, y, t, angle0, driver, port, out):
@@ -175,8 +234,11 @@ def evaluate(k, y, t, angle0, driver, port, out):
     n = k.dq.shape[0]
     if k.tvs:
         stiffness_factors(angle0 + value(driver, t), k.phasing, k.factor, k.slope)
-    acceleration(y, value(port, t), rate(port, t), accel(driver, t), k.factor, k.a_t, k.a_port, k.fast, k.contact,
-                 k.z, k.defl, k.acc)
+    if k.n_ext:
+        first = k.fast.shape[0] - k.n_ext
+        external_terms(angle0 + value(driver, t), rate(driver, t), k.load_rates, k.z[first:first + k.n_ext])
+    acceleration(y, value(port, t), rate(port, t), accel(driver, t), k.factor, k.nz_index, k.nz_value, k.a_port,
+                 k.offset, k.fast_index, k.fast_value, k.contact, k.z, k.defl, k.acc)
     copy(y[n:], out[:n])
     copy(k.acc, out[n:])
 
@@ -224,9 +286,14 @@ def advance(k, y, t_end, alpha_shift, driver, port, angle0, twist_q, twist_port)
     k.factor[:] = 1.0
     active = int(ist[ACTIVE])
     winv = k.winvs[active]
+    piv = k.pivots[active]
     w_basis = k.w_bases[active]
     t = 0.0
     h = ist[H_NEXT] if ist[H_NEXT] > 0.0 else t_end - t
+    large = n > LU_ABOVE
+    if large and 0.0 < ist[H_FIRST] < h:  # the transient the new inputs start at a communication point: the first
+        h = ist[H_FIRST]  # step the last one allowed (else the proposal from the smooth end of the step is rejected)
+    first_rejected = False
     for i in range(n):
         f0[i] = y[n + i]
         f0[n + i] = k.last_acc[i] + k.kappa[i] * alpha_shift
@@ -242,30 +309,34 @@ def advance(k, y, t_end, alpha_shift, driver, port, angle0, twist_q, twist_port)
         last = h >= remaining * (1.0 - 1e-12)
         if last:
             h = remaining
+        elif large:  # equal steps to the communication point: their sizes recur, and so do their factorisations
+            pieces = math.ceil(remaining / h * (1.0 - 1e-12))
+            h = remaining / pieces
         if ist[AGE] < 0.0 or ist[AGE] >= max_age:
             refresh_jacobian(k, y, t, angle0, driver, port)
         # ---- one step
         hd = h * D
         if hd != ist[HD]:
-            active = use_factorisation(hd, k.dq, k.dv, k.winvs, ist)
+            active = use_factorisation(hd, k.dq, k.dv, k.winvs, k.pivots, ist)
             winv = k.winvs[active]
+            piv = k.pivots[active]
             w_basis = k.w_bases[active]
-        time_derivative_term(k, y, t, h, hd, angle0, driver, port, winv, w_basis)
-        matvec(winv, f0, k1)
+        time_derivative_term(k, y, t, h, hd, angle0, driver, port, winv, piv, w_basis)
+        solve(winv, piv, k.dq, k.jac_index, hd, f0, k1, k.sol)
         for i in range(n2):
             k1[i] += w_hdt[i]
             y1[i] = y[i] + (0.5 * h) * k1[i]
         evaluate(k, y1, t + 0.5 * h, angle0, driver, port, f1)
         for i in range(n2):
             rhs[i] = f1[i] - k1[i]
-        matvec(winv, rhs, k2)
+        solve(winv, piv, k.dq, k.jac_index, hd, rhs, k2, k.sol)
         for i in range(n2):
             k2[i] += k1[i]
             yn[i] = y[i] + h * k2[i]
         evaluate(k, yn, t + h, angle0, driver, port, fn)
         for i in range(n2):
             rhs[i] = fn[i] - E32 * (k2[i] - f1[i]) - 2.0 * (k1[i] - f0[i])
-        matvec(winv, rhs, k3)
+        solve(winv, piv, k.dq, k.jac_index, hd, rhs, k3, k.sol)
         err = 0.0
         for i in range(n2):
             k3[i] += w_hdt[i]
@@ -283,6 +354,7 @@ def advance(k, y, t_end, alpha_shift, driver, port, angle0, twist_q, twist_port)
             prev_h = -1.0
             ist[ACCEPTED] += 1.0
             ist[AGE] += 1.0
+            first = t == 0.0
             t = t_end if last else t + h
             copy(yn, y)
             copy(fn, f0)
@@ -301,6 +373,8 @@ def advance(k, y, t_end, alpha_shift, driver, port, angle0, twist_q, twist_port)
             twist_r = rate_b
             fac = 5.0 if err == 0.0 else min(5.0, 0.9 * err ** (-1.0 / 3.0))
             fac = 1.0 if 1.0 <= fac <= 2.0 else fac  # keep the step (and the factorisation)
+            if first:  # keep the first step's own proposal for the next communication point while it binds
+                ist[H_FIRST] = h * fac if first_rejected or (0.0 < ist[H_FIRST] and h * fac < ist[H_NEXT]) else 0.0
             if not last or fac < 1.0:
                 ist[H_NEXT] = h * fac
             else:  # a step shortened to hit t_end must not shrink the proposal
@@ -308,6 +382,7 @@ def advance(k, y, t_end, alpha_shift, driver, port, angle0, twist_q, twist_port)
             h = ist[H_NEXT]
         else:
             ist[REJECTED] += 1.0
+            first_rejected = first_rejected or t == 0.0
             if ist[AGE] > 0.0:  # retry with a fresh Jacobian before shrinking the step much
                 refresh_jacobian(k, y, t, angle0, driver, port)
                 h *= max(0.5, min(1.0, 0.9 * err ** (-1.0 / 3.0))) if math.isfinite(err) else 0.1

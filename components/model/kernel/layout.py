@@ -8,12 +8,16 @@ region. :class:`components.model.gearbox_model.GearboxModel` allocates and fills
 
 from __future__ import annotations
 
-# entries of the integrator's state vector ``istate``: step-size memory and counters, Jacobian age, the ``h d``
-# of the active factorisation ``W^-1`` and of the other one kept (``HD_PREV``, -1: none), their time-derivative
-# basis flags, which of the two slots is active, eq. 11's running maximum
-(H_NEXT, ACCEPTED, REJECTED, JACOBIANS, AGE, HD, BASIS_VALID, ALPHA_OUT_MAX, HD_PREV, BASIS_PREV_VALID,
- ACTIVE) = range(11)
-N_ISTATE = 11
+# entries of the integrator's state vector ``istate``: step-size memory and counters, Jacobian age, the ``h d`` of
+# the active factorisation (``G^-1`` of ``W``, or its LU factors) and its slot, eq. 11's running maximum, the step
+# the last communication step's first internal step proposed for the next one's (0: none yet), a clock; then per
+# kept factorisation (``N_SLOTS``) its ``h d`` (-1: none), whether its time-derivative basis is valid, and when it
+# was last used (the least recently used is replaced)
+(H_NEXT, ACCEPTED, REJECTED, JACOBIANS, AGE, HD, ALPHA_OUT_MAX, ACTIVE, H_FIRST, CLOCK) = range(10)
+#: factorisations kept: the step sizes of one communication step recur in the next (integrator's equal steps)
+N_SLOTS = 4
+SLOT_HD, SLOT_BASIS, SLOT_USED = 10, 10 + N_SLOTS, 10 + 2 * N_SLOTS
+N_ISTATE = 10 + 3 * N_SLOTS
 
 # entries of the settings vector ``control``
 RTOL, ATOL_Q, ATOL_V, H_MIN, MAX_STEPS, JAC_MAX_AGE, OUT_KINEMATIC, OUT_RATE_INDEX = range(8)
@@ -24,19 +28,22 @@ OK, STEP_TOO_SMALL, TOO_MANY_STEPS, NON_FINITE_INPUT = range(4)
 
 # slots of the buffer, in this order (GearboxModel gives their shapes)
 CONSTANT_SLOTS = ("a_t", "a_port", "fast", "contact", "stks", "stcs", "stks_port", "stcs_port", "inv_m", "phasing",
-                  "kappa", "force_rows", "nz_index", "nz_value", "cos_alpha", "control", "twist_q", "output_matrix")
+                  "kappa", "force_rows", "nz_index", "nz_value", "cos_alpha", "control", "twist_q", "offset",
+                  "load_rates", "magnitudes", "fast_index", "fast_value", "out_index", "out_value", "jac_index")
 WORK_SLOTS = ("z", "defl", "acc", "fd", "fv", "factor", "slope", "sens", "f0", "f1", "fn", "k1", "k2", "k3", "y1",
-              "yn", "rhs", "w_hdt", "da")
+              "yn", "rhs", "w_hdt", "da", "w_ext", "sol")
 #: the state a failed step restores: contiguous, so that saving it is one copy into "backup"
-STATE_SLOTS = ("istate", "dq", "dv", "winvs", "w_bases", "port_jac", "last_acc", "last_force", "last_defl", "y")
+STATE_SLOTS = ("istate", "dq", "dv", "winvs", "pivots", "w_bases", "port_jac", "last_acc", "last_force", "last_defl",
+               "y")
 #: the inputs' curves, scalars, outputs, and the generator speed and loads before the inertia interface's
 #: re-anchoring (restored on failure)
 STEP_SLOTS = ("backup", "driver", "port", "scalars", "outputs", "anchor")
 SLOTS = CONSTANT_SLOTS + WORK_SLOTS + STATE_SLOTS + STEP_SLOTS
 (A_T, A_PORT, FAST, CONTACT, STKS, STCS, STKS_PORT, STCS_PORT, INV_M, PHASING, KAPPA, FORCE_ROWS, NZ_INDEX, NZ_VALUE,
- COS_ALPHA, CONTROL, TWIST_Q, OUTPUT_MATRIX,
- Z, DEFL, ACC, FD, FV, FACTOR, SLOPE, SENS, F0, F1, FN, K1, K2, K3, Y1, YN, RHS, W_HDT, DA,
- ISTATE, DQ, DV, WINVS, W_BASES, PORT_JAC, LAST_ACC, LAST_FORCE, LAST_DEFL, Y,
+ COS_ALPHA, CONTROL, TWIST_Q, OFFSET, LOAD_RATES, MAGNITUDES, FAST_INDEX, FAST_VALUE, OUT_INDEX, OUT_VALUE,
+ JAC_INDEX,
+ Z, DEFL, ACC, FD, FV, FACTOR, SLOPE, SENS, F0, F1, FN, K1, K2, K3, Y1, YN, RHS, W_HDT, DA, W_EXT, SOL,
+ ISTATE, DQ, DV, WINVS, PIVOTS, W_BASES, PORT_JAC, LAST_ACC, LAST_FORCE, LAST_DEFL, Y,
  BACKUP, DRIVER, PORT, SCALARS, OUTPUTS, ANCHOR) = range(len(SLOTS))
 #: first and last slot of the restorable state
 STATE_FIRST, STATE_LAST = ISTATE, Y
@@ -53,7 +60,9 @@ SCALAR_NAMES = (
  S_SHAFT_K, S_SHAFT_C, S_PORT_OFFSET, S_GEN_SPEED) = range(len(SCALAR_NAMES))
 
 # entries of the integer vector ``dims``: sizes, flags, the generator's degree of freedom (-1: the motion
-# interface, the generator is the port), whether the rotor motion is extrapolated from its derivative inputs and
-# whether the generator speed is the gearbox's own (``inertia_own``: not re-anchored on the generator-speed input)
-D_N, D_M, D_WIDTH, D_TVS, D_EXTRAPOLATE, D_END_TORQUE, D_GEN_DOF, D_ROTOR_DERIVATIVES, D_OWN_GEN_SPEED = range(9)
-N_DIMS = 9
+# interface, the generator is the port), whether the rotor motion is extrapolated from its derivative inputs,
+# whether the generator speed is the gearbox's own (``inertia_own``: not re-anchored on the generator-speed input),
+# the number of external terms (0: no external loads) and of output magnitudes (bearing forces)
+(D_N, D_M, D_WIDTH, D_TVS, D_EXTRAPOLATE, D_END_TORQUE, D_GEN_DOF, D_ROTOR_DERIVATIVES, D_OWN_GEN_SPEED, D_EXT,
+ D_MAGNITUDES) = range(11)
+N_DIMS = 11

@@ -1,4 +1,4 @@
-"""Linear-algebra primitives of the kernels: copy, matrix products, axpy, inversion.
+"""Linear-algebra primitives of the kernels: copy, matrix products, axpy, inversion, LU factorisation and solve.
 
 Each is written once with numpy calls (what the interpreted kernel runs) and once as the loop
 numba compiles without BLAS or LAPACK (``COMPILED``; :mod:`components.compile.jit` swaps them
@@ -43,6 +43,25 @@ def axpy(alpha, x, y):
     y += alpha * x
 
 
+def matvec_pattern(w, index, x, out):
+    """``out = w @ x`` over the nonzero pattern of ``w`` only: ``out[i] = sum_p w[i, index[i, p]] x[index[i, p]]``
+    (``index < 0``: padding), summed from the first."""
+    idx = index.astype(np.int64)
+    valid = idx >= 0
+    safe = np.where(valid, idx, 0)
+    terms = np.where(valid, np.take_along_axis(w, safe, axis=1) * x[safe], 0.0)
+    out[:] = np.cumsum(terms, axis=1)[:, -1] if terms.shape[1] else 0.0
+
+
+def sparse_vecmat(x, index, value, out):
+    """``out = x @ w`` for a sparse ``w`` held by columns: ``out[j] = sum_p x[index[j, p]] value[j, p]`` over the
+    nonzero rows of column ``j`` in ascending order (``index < 0``: padding), summed from the first."""
+    idx = index.astype(np.int64)
+    valid = idx >= 0
+    terms = np.where(valid, x[np.where(valid, idx, 0)] * value, 0.0)
+    out[:] = np.cumsum(terms, axis=1)[:, -1] if terms.shape[1] else 0.0
+
+
 def invert(g, out):
     """``out = g^-1`` by Gauss-Jordan elimination with partial pivoting (``g`` is overwritten)."""
     n = g.shape[0]
@@ -64,6 +83,54 @@ def invert(g, out):
             g[rows] -= np.outer(f[rows], g[col])
             out[rows] -= np.outer(f[rows], out[col])
     return out
+
+
+def lu_factor(a, piv):
+    """LU factorisation with partial pivoting in place: ``P a = L U`` (``L`` unit lower, below the diagonal of
+    ``a``; ``U`` on and above it), the row swapped with row ``k`` in ``piv[k]`` (as a float)."""
+    n = a.shape[0]
+    for k in range(n):
+        p = k + int(np.argmax(np.abs(a[k:, k])))
+        piv[k] = p
+        if p != k:
+            a[[k, p]] = a[[p, k]]
+        inv_p = 1.0 / float(a[k, k])  # a zero pivot raises ZeroDivisionError, as in the compiled form
+        a[k + 1:, k] *= inv_p
+        f = a[k + 1:, k]
+        rows = np.flatnonzero(f)
+        if rows.size:
+            a[k + 1 + rows, k + 1:] -= np.outer(f[rows], a[k, k + 1:])
+
+
+def lu_pattern(lu, lower, upper):
+    """The nonzero rows of every column of ``L`` (below the diagonal, ascending) into ``lower`` and of ``U`` (above
+    it, ascending) into ``upper``, padded with -1: what :func:`lu_solve` visits."""
+    n = lu.shape[0]
+    lower[:] = -1.0
+    upper[:] = -1.0
+    for j in range(n):
+        below = np.flatnonzero(lu[j + 1:, j]) + j + 1
+        above = np.flatnonzero(lu[:j, j])
+        lower[j, :below.size] = below
+        upper[j, :above.size] = above
+
+
+def lu_solve(lu, piv, lower, upper, b, out):
+    """``out = a^-1 b`` from :func:`lu_factor`'s ``lu`` and ``piv``: column-oriented substitutions over the nonzero
+    rows of each column (:func:`lu_pattern`'s ``lower`` and ``upper``)."""
+    n = lu.shape[0]
+    out[:] = b
+    for k in range(n):
+        p = int(piv[k])
+        if p != k:
+            out[k], out[p] = out[p], out[k]
+    for j in range(n):
+        rows = lower[j][lower[j] >= 0.0].astype(np.int64)
+        out[rows] -= lu[rows, j] * out[j]
+    for j in range(n - 1, -1, -1):
+        out[j] = out[j] / lu[j, j]
+        rows = upper[j][upper[j] >= 0.0].astype(np.int64)
+        out[rows] -= lu[rows, j] * out[j]
 
 
 # ---------------------------------------------------------------- the compiled forms
@@ -115,6 +182,28 @@ def _axpy_loop(alpha, x, y):
         y[i] += alpha * x[i]
 
 
+def _matvec_pattern_loop(w, index, x, out):
+    for i in range(index.shape[0]):
+        s = 0.0
+        for p in range(index.shape[1]):
+            j = int(index[i, p])
+            if j < 0:
+                break
+            s += w[i, j] * x[j]
+        out[i] = s
+
+
+def _sparse_vecmat_loop(x, index, value, out):
+    for j in range(index.shape[0]):
+        s = 0.0
+        for p in range(index.shape[1]):
+            i = int(index[j, p])
+            if i < 0:
+                break
+            s += x[i] * value[j, p]
+        out[j] = s
+
+
 def _invert_loop(g, out):
     n = g.shape[0]
     for i in range(n):
@@ -149,8 +238,81 @@ def _invert_loop(g, out):
     return out
 
 
+def _lu_factor_loop(a, piv):
+    n = a.shape[0]
+    for k in range(n):
+        p = k
+        best = abs(a[k, k])
+        for r in range(k + 1, n):
+            if abs(a[r, k]) > best:
+                best = abs(a[r, k])
+                p = r
+        piv[k] = p
+        if p != k:
+            for j in range(n):
+                tmp = a[k, j]
+                a[k, j] = a[p, j]
+                a[p, j] = tmp
+        inv_p = 1.0 / a[k, k]
+        for r in range(k + 1, n):
+            a[r, k] *= inv_p
+        for r in range(k + 1, n):
+            f = a[r, k]
+            if f != 0.0:
+                for j in range(k + 1, n):
+                    a[r, j] -= f * a[k, j]
+
+
+def _lu_pattern_loop(lu, lower, upper):
+    n = lu.shape[0]
+    for j in range(n):
+        c = 0
+        for i in range(j + 1, n):
+            if lu[i, j] != 0.0:
+                lower[j, c] = i
+                c += 1
+        for i in range(c, n):
+            lower[j, i] = -1.0
+        c = 0
+        for i in range(j):
+            if lu[i, j] != 0.0:
+                upper[j, c] = i
+                c += 1
+        for i in range(c, n):
+            upper[j, i] = -1.0
+
+
+def _lu_solve_loop(lu, piv, lower, upper, b, out):
+    n = lu.shape[0]
+    for i in range(n):
+        out[i] = b[i]
+    for k in range(n):
+        p = int(piv[k])
+        if p != k:
+            tmp = out[k]
+            out[k] = out[p]
+            out[p] = tmp
+    for j in range(n):
+        x = out[j]
+        for c in range(n):
+            i = int(lower[j, c])
+            if i < 0:
+                break
+            out[i] -= lu[i, j] * x
+    for j in range(n - 1, -1, -1):
+        out[j] = out[j] / lu[j, j]
+        x = out[j]
+        for c in range(n):
+            i = int(upper[j, c])
+            if i < 0:
+                break
+            out[i] -= lu[i, j] * x
+
+
 #: the loops numba compiles in place of the numpy forms (see :mod:`components.compile.jit`)
 COMPILED = {"copy": _copy_loop, "matvec": _matvec_loop, "vecmat": _vecmat_loop, "axpy": _axpy_loop,
-            "vecmat_sum": _vecmat_sum_loop, "matmul": _matmul_loop, "invert": _invert_loop}
+            "vecmat_sum": _vecmat_sum_loop, "matmul": _matmul_loop, "invert": _invert_loop,
+            "lu_factor": _lu_factor_loop, "lu_solve": _lu_solve_loop, "lu_pattern": _lu_pattern_loop, "sparse_vecmat": _sparse_vecmat_loop,
+            "matvec_pattern": _matvec_pattern_loop}
 #: inlined into their callers by numba (no call boundary on the hot path)
-INLINE = ("copy", "matvec", "vecmat", "vecmat_sum", "axpy")
+INLINE = ("copy", "matvec", "vecmat", "vecmat_sum", "axpy", "sparse_vecmat", "matvec_pattern")

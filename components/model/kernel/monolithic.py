@@ -14,31 +14,34 @@ in time) or interpreted.
 from __future__ import annotations
 
 from .contact import contact_force, mesh_forces, regularised
-from .dynamics import deflections, jacobian
+from .dynamics import deflections, external_terms, jacobian
 from .linalg import copy, vecmat
 from .statics import static_deflection  # noqa: F401 - an entry of this module (Assembly.static_deflection)
 from .stiffness import stiffness_factors
 
 
-def monolithic_rhs(y, omega, alpha, factor, load, out_dof, kappa_out, inertia_in, a_t, a_port, fast, contact, s_mat,
-                   shaft_k, shaft_c, bt_driver, s_driver, cos_alpha, inv_m, force, elastic, defl, z, acc, out):
+def monolithic_rhs(y, omega, alpha, angle, factor, load, out_dof, kappa_out, inertia_in, nz_index, nz_value, a_port,
+                   offset, fast, contact, load_rates, s_mat, shaft_k, shaft_c, bt_driver, s_driver, cos_alpha, inv_m, force, elastic,
+                   defl, z, acc, out):
     """``[v, q_ddot, rotor power, output power, dissipated power]`` into ``out``.
 
-    The accelerations through the folded matrix (no port), the counter torque ``load`` [N m] on the
-    output body, the rotor torque ``I_in alpha + cos(alpha) a_in . F + s_in . T``, and the dissipation
-    ``((F - F_el) d_dot) . cos(alpha) + sum c s_dot^2``.
+    The accelerations through the folded matrix (no port; the external loads at the driver angle
+    ``angle`` and speed ``omega``), the counter torque ``load`` [N m] on the output body, the rotor
+    torque ``I_in alpha + cos(alpha) a_in . F + s_in . T`` (``s_mat`` ... ``s_driver``: every spring
+    row, shafts and bearings), and the dissipation ``((F - F_el) d_dot) . cos(alpha) + sum c s_dot^2``.
     """
     n = inv_m.shape[0]
     m = force.shape[0]
     n2 = 2 * n
-    deflections(y, n, a_t, a_port, 0.0, 0.0, defl)
+    deflections(y, n, nz_index, nz_value, a_port, offset, 0.0, 0.0, defl)
     mesh_forces(defl, factor, contact, force, elastic)
     copy(force, z[:m])
     copy(y[:n2], z[m:m + n2])
     z[m + n2] = 0.0
     z[m + n2 + 1] = 0.0
     z[m + n2 + 2] = alpha
-    vecmat(z[:m + n2 + 3], fast, acc)
+    external_terms(angle, omega, load_rates, z[m + n2 + 3:fast.shape[0]])
+    vecmat(z[:fast.shape[0]], fast, acc)
     acc[out_dof] -= inv_m[out_dof] * load
     rotor = inertia_in * alpha
     dissipation = 0.0
@@ -60,12 +63,12 @@ def monolithic_rhs(y, omega, alpha, factor, load, out_dof, kappa_out, inertia_in
     out[n2 + 2] = dissipation
 
 
-def monolithic_jacobian(y, factor, a_t, a_port, contact, defl, nz_index, nz_value, cos_alpha, stks, stcs, stks_port,
-                        stcs_port, inv_m, fd, fv, dq, dv, port_jac, jac):
+def monolithic_jacobian(y, factor, a_port, offset, contact, defl, nz_index, nz_value, cos_alpha, stks, stcs,
+                        stks_port, stcs_port, inv_m, fd, fv, dq, dv, port_jac, jac):
     """The acceleration rows of the monolithic Jacobian ``jac`` (the rest is fixed)."""
     n = inv_m.shape[0]
-    jacobian(y, 0.0, 0.0, factor, a_t, a_port, contact, defl, nz_index, nz_value, cos_alpha, stks, stcs, stks_port,
-             stcs_port, inv_m, fd, fv, dq, dv, port_jac)
+    jacobian(y, 0.0, 0.0, factor, a_port, offset, contact, defl, nz_index, nz_value, cos_alpha, stks, stcs,
+             stks_port, stcs_port, inv_m, fd, fv, dq, dv, port_jac)
     jac[n:2 * n, :n] = dq
     jac[n:2 * n, n:2 * n] = dv
 

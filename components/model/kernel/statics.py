@@ -22,13 +22,16 @@ from .linalg import invert, matvec
 CONVERGED, NOT_CONVERGED, SINGULAR = range(3)
 
 
-def _linear_guess(y, n, port, flank, stiffness, a_t, a_port, fast, contact, g, ginv, c):
-    """``q`` (into ``y[:n]``) of the meshes as linear springs ``F = k (d - flank j_t/2)``: ``G q + c = 0``."""
+def _linear_guess(y, n, port, flank, stiffness, a_t, a_port, offset, fast, contact, z, g, ginv, c):
+    """``q`` (into ``y[:n]``) of the meshes as linear springs ``F = k (d - flank j_t/2)``: ``G q + c = 0`` (with the
+    external loads of the terms in ``z``)."""
     m = contact.shape[0]
     for j in range(n):
         cj = port * fast[m + 2 * n, j]
+        for t in range(m + 2 * n + 3, fast.shape[0]):
+            cj += z[t] * fast[t, j]
         for i in range(m):
-            cj += stiffness[i] * (a_port[i] * port - flank * contact[i, HALF_JT]) * fast[i, j]
+            cj += stiffness[i] * (a_port[i] * port + offset[i] - flank * contact[i, HALF_JT]) * fast[i, j]
         c[j] = cj
         for k in range(n):
             s = fast[m + k, j]
@@ -41,10 +44,12 @@ def _linear_guess(y, n, port, flank, stiffness, a_t, a_port, fast, contact, g, g
         y[j] = -y[j]
 
 
-def _imbalance(y, n, port, factor, a_t, a_port, fast, contact, z, defl, acc, inv_m):
+def _imbalance(y, n, port, factor, nz_index, nz_value, a_port, offset, fast, fast_index, fast_value, contact, z, defl,
+               acc, inv_m):
     """``(max |M a|, max over bodies of the sum of the magnitudes of its generalised forces)`` at ``y`` [N m]."""
     m = contact.shape[0]
-    acceleration(y, port, 0.0, 0.0, factor, a_t, a_port, fast, contact, z, defl, acc)
+    acceleration(y, port, 0.0, 0.0, factor, nz_index, nz_value, a_port, offset, fast_index, fast_value, contact, z, defl,
+                 acc)
     worst = 0.0
     scale = 0.0
     for j in range(n):
@@ -54,16 +59,20 @@ def _imbalance(y, n, port, factor, a_t, a_port, fast, contact, z, defl, acc, inv
             s += abs(z[i] * fast[i, j])
         for i in range(2 * n):
             s += abs(y[i] * fast[m + i, j])
-        for i in range(m + 2 * n, m + 2 * n + 3):
+        for i in range(m + 2 * n, fast.shape[0]):  # the port, its rate, the driver acceleration, external loads
             s += abs(z[i] * fast[i, j])
         scale = max(scale, s / inv_m[j])
     return worst, scale
 
 
-def static_deflection(y, n, port, factor, flank, a_t, a_port, fast, contact, nz_index, nz_value, cos_alpha, stks,
-                      stcs, stks_port, stcs_port, inv_m, z, defl, acc, fd, fv, dq, dv, port_jac, g, ginv, c, step,
+def static_deflection(y, n, port, factor, flank, a_t, a_port, offset, fast, fast_index, fast_value, contact, nz_index,
+                      nz_value, cos_alpha,
+                      stks, stcs, stks_port, stcs_port, inv_m, z, defl, acc, fd, fv, dq, dv, port_jac, g, ginv, c, step,
                       stiffness, trial, rtol, max_iterations):
     """Solve ``a(q, v, u) = 0`` for ``q = y[:n]`` at the port input ``u = port`` (``v = y[n:]`` kept, normally 0).
+
+    The external loads are those of the external terms already in ``z`` (:func:`.dynamics.external_terms`;
+    gravity at one driver angle, the centrifugal force at one speed).
 
     Parameters
     ----------
@@ -72,6 +81,8 @@ def static_deflection(y, n, port, factor, flank, a_t, a_port, fast, contact, nz_
     rtol : float
         Converged when the largest generalised-force imbalance is below ``rtol`` times the largest
         sum of generalised-force magnitudes on one body.
+    fast, fast_index, fast_value : ndarray
+        The folded matrix, and by columns (:func:`.dynamics.acceleration`).
     g, ginv, dq, dv : ndarray (n, n); c, step, acc : ndarray (n,); stiffness : ndarray (n_mesh,);
     trial : ndarray like ``y``; the others as :func:`.dynamics.jacobian`
         Work arrays.
@@ -85,9 +96,9 @@ def static_deflection(y, n, port, factor, flank, a_t, a_port, fast, contact, nz_
     m = contact.shape[0]
     for i in range(m):  # the stiffness at 1 cm penetration: soft, a safe start
         stiffness[i] = contact[i, K0] * factor[i] * 0.01 ** (contact[i, EXPONENT] - 1.0)
-    _linear_guess(y, n, port, flank, stiffness, a_t, a_port, fast, contact, g, ginv, c)
+    _linear_guess(y, n, port, flank, stiffness, a_t, a_port, offset, fast, contact, z, g, ginv, c)
     for i in range(m):  # the secant stiffness of the contact law at those forces
-        d = port * a_port[i]
+        d = port * a_port[i] + offset[i]
         for k in range(n):
             d += y[k] * a_t[k, i]
         force = abs(stiffness[i] * (d - flank * contact[i, HALF_JT]))
@@ -95,20 +106,22 @@ def static_deflection(y, n, port, factor, flank, a_t, a_port, fast, contact, nz_
         e = contact[i, EXPONENT]
         penetration = max((force / k0) ** (1.0 / e), 1e-9)
         stiffness[i] = k0 * penetration ** (e - 1.0)
-    _linear_guess(y, n, port, flank, stiffness, a_t, a_port, fast, contact, g, ginv, c)
-    worst, scale = _imbalance(y, n, port, factor, a_t, a_port, fast, contact, z, defl, acc, inv_m)
+    _linear_guess(y, n, port, flank, stiffness, a_t, a_port, offset, fast, contact, z, g, ginv, c)
+    worst, scale = _imbalance(y, n, port, factor, nz_index, nz_value, a_port, offset, fast, fast_index, fast_value,
+                              contact, z, defl, acc, inv_m)
     iterations = 0
     while worst > rtol * scale:
         if iterations >= max_iterations:
             return NOT_CONVERGED, iterations, worst / scale
         iterations += 1
-        jacobian(y, port, 0.0, factor, a_t, a_port, contact, defl, nz_index, nz_value, cos_alpha, stks, stcs,
+        jacobian(y, port, 0.0, factor, a_port, offset, contact, defl, nz_index, nz_value, cos_alpha, stks, stcs,
                  stks_port, stcs_port, inv_m, fd, fv, dq, dv, port_jac)
         for j in range(n):
             for k in range(n):
                 g[j, k] = dq[j, k]
         invert(g, ginv)
-        acceleration(y, port, 0.0, 0.0, factor, a_t, a_port, fast, contact, z, defl, acc)
+        acceleration(y, port, 0.0, 0.0, factor, nz_index, nz_value, a_port, offset, fast_index, fast_value, contact, z,
+                     defl, acc)
         matvec(ginv, acc, step)
         for j in range(n):
             if not math.isfinite(step[j]):
@@ -119,7 +132,8 @@ def static_deflection(y, n, port, factor, flank, a_t, a_port, fast, contact, nz_
                 trial[j] = y[j]
             for j in range(n):
                 trial[j] = y[j] - alpha * step[j]
-            new_worst, new_scale = _imbalance(trial, n, port, factor, a_t, a_port, fast, contact, z, defl, acc, inv_m)
+            new_worst, new_scale = _imbalance(trial, n, port, factor, nz_index, nz_value, a_port, offset, fast,
+                                              fast_index, fast_value, contact, z, defl, acc, inv_m)
             if new_worst < worst or alpha < 1e-6:
                 break
             alpha *= 0.5

@@ -23,20 +23,20 @@ from collections import namedtuple
 
 import numpy as np
 
-from .dynamics import acceleration
+from .dynamics import acceleration, external_terms
 from .integrator import advance
 from .layout import (
-    A_PORT, A_T, ACC, ANCHOR, BACKUP, CONTACT, CONTROL, COS_ALPHA, D_END_TORQUE, D_EXTRAPOLATE, D_GEN_DOF, D_M, D_N,
-    D_OWN_GEN_SPEED, D_ROTOR_DERIVATIVES, D_TVS, DA, DEFL, DQ, DRIVER, DV, F0, F1, FAST, FD, FN, FACTOR, FORCE_ROWS, FV,
-    INV_M, ISTATE, K1, K2, K3, KAPPA, LAST_ACC, LAST_DEFL, LAST_FORCE, NON_FINITE_INPUT, NZ_INDEX, NZ_VALUE, OK,
-    OUT_KINEMATIC, OUT_RATE_INDEX, OUTPUT_MATRIX, OUTPUTS, PHASING, PORT, PORT_JAC, RHS, S_ALPHA_OUT_AVG,
-    S_DRIVER_ACCEL, S_DRIVER_ANGLE, S_DRIVER_SPEED, S_KX, S_LAST_ALPHA, S_LAST_OMEGA_GEN, S_LAST_OMEGA_ROTOR,
-    S_GEN_SPEED, S_LAST_STEP, S_OUTPUT_TWIST, S_PORT_ANGLE, S_PORT_OFFSET, S_PORT_SPEED, S_SHAFT_C, S_SHAFT_K,
-    S_SHAFT_TORQUE_AVG, S_TIME,
-    S_TWIST_PORT, SCALARS, SENS, SLOPE, STATE_FIRST, STATE_LAST, STCS, STCS_PORT, STKS, STKS_PORT, TWIST_Q, W_BASES,
-    W_HDT, WINVS, Y, Y1, YN, Z, ALPHA_OUT_MAX,
+    A_PORT, A_T, ACC, ANCHOR, BACKUP, CONTACT, CONTROL, COS_ALPHA, D_END_TORQUE, D_EXT, D_EXTRAPOLATE, D_GEN_DOF, D_M,
+    D_MAGNITUDES, D_N, D_OWN_GEN_SPEED, D_ROTOR_DERIVATIVES, D_TVS, DA, DEFL, DQ, DRIVER, DV, F0, F1, FAST, FAST_INDEX,
+    FAST_VALUE, FD, FN, FACTOR, FORCE_ROWS, FV, INV_M, ISTATE, JAC_INDEX, K1, K2, K3, KAPPA, LAST_ACC, LAST_DEFL,
+    LAST_FORCE, LOAD_RATES, MAGNITUDES, NON_FINITE_INPUT, N_SLOTS, NZ_INDEX, NZ_VALUE, OFFSET, OK, PIVOTS, OUT_INDEX,
+    OUT_KINEMATIC, OUT_RATE_INDEX, OUT_VALUE, OUTPUTS, PHASING, PORT, PORT_JAC, RHS, S_ALPHA_OUT_AVG, S_DRIVER_ACCEL,
+    S_DRIVER_ANGLE, S_DRIVER_SPEED, S_GEN_SPEED, S_KX, S_LAST_ALPHA, S_LAST_OMEGA_GEN, S_LAST_OMEGA_ROTOR, S_LAST_STEP,
+    S_OUTPUT_TWIST, S_PORT_ANGLE, S_PORT_OFFSET, S_PORT_SPEED, S_SHAFT_C, S_SHAFT_K, S_SHAFT_TORQUE_AVG, S_TIME,
+    S_TWIST_PORT, SCALARS, SENS, SLOPE, SOL, STATE_FIRST, STATE_LAST, STCS, STCS_PORT, STKS, STKS_PORT, TWIST_Q, W_BASES,
+    W_EXT, W_HDT, WINVS, Y, Y1, YN, Z, ALPHA_OUT_MAX,
 )
-from .linalg import copy, vecmat
+from .linalg import copy, sparse_vecmat
 from .motion import accel, fit, linear_target, taylor_target
 from .statics import static_deflection
 from .stiffness import stiffness_factors
@@ -44,11 +44,12 @@ from .stiffness import stiffness_factors
 #: everything :func:`~.integrator.advance` reads and writes: views of the buffer
 Gearbox = namedtuple("Gearbox", (
     "a_t", "a_port", "fast", "contact", "stks", "stcs", "stks_port", "stcs_port", "inv_m", "phasing", "kappa",
-    "force_rows", "nz_index", "nz_value", "cos_alpha", "control",
+    "force_rows", "nz_index", "nz_value", "cos_alpha", "control", "offset", "load_rates", "fast_index", "fast_value",
+    "jac_index",
     "z", "defl", "acc", "fd", "fv", "factor", "slope", "sens", "f0", "f1", "fn", "k1", "k2", "k3", "y1", "yn", "rhs",
-    "w_hdt", "da",
-    "istate", "dq", "dv", "winvs", "w_bases", "port_jac", "last_acc", "last_force", "last_defl", "state", "backup",
-    "tvs",
+    "w_hdt", "da", "w_ext", "sol",
+    "istate", "dq", "dv", "winvs", "pivots", "w_bases", "port_jac", "last_acc", "last_force", "last_defl", "state", "backup",
+    "tvs", "n_ext",
 ))
 
 
@@ -68,33 +69,37 @@ def views(buf, lay, dims):
     n = dims[D_N]
     m = dims[D_M]
     n2 = 2 * n
-    winvs = vector(buf, lay, WINVS).reshape((2, n2, n2))
-    w_bases = vector(buf, lay, W_BASES).reshape((2, 3, n2))
+    winvs = vector(buf, lay, WINVS).reshape((N_SLOTS, n, n))
+    w_bases = vector(buf, lay, W_BASES).reshape((N_SLOTS, 3 + dims[D_EXT], n2))
     return Gearbox(
-        matrix(buf, lay, A_T, n), vector(buf, lay, A_PORT), matrix(buf, lay, FAST, m + n2 + 3),
+        matrix(buf, lay, A_T, n), vector(buf, lay, A_PORT), matrix(buf, lay, FAST, m + n2 + 3 + dims[D_EXT]),
         matrix(buf, lay, CONTACT, m), matrix(buf, lay, STKS, n), matrix(buf, lay, STCS, n),
         vector(buf, lay, STKS_PORT), vector(buf, lay, STCS_PORT), vector(buf, lay, INV_M),
         matrix(buf, lay, PHASING, 7), vector(buf, lay, KAPPA), matrix(buf, lay, FORCE_ROWS, m),
         matrix(buf, lay, NZ_INDEX, m), matrix(buf, lay, NZ_VALUE, m), vector(buf, lay, COS_ALPHA),
-        vector(buf, lay, CONTROL),
+        vector(buf, lay, CONTROL), vector(buf, lay, OFFSET), vector(buf, lay, LOAD_RATES),
+        matrix(buf, lay, FAST_INDEX, n), matrix(buf, lay, FAST_VALUE, n), matrix(buf, lay, JAC_INDEX, n),
         vector(buf, lay, Z), matrix(buf, lay, DEFL, 2), vector(buf, lay, ACC), vector(buf, lay, FD),
         vector(buf, lay, FV), vector(buf, lay, FACTOR), vector(buf, lay, SLOPE), vector(buf, lay, SENS),
         vector(buf, lay, F0), vector(buf, lay, F1), vector(buf, lay, FN), vector(buf, lay, K1), vector(buf, lay, K2),
         vector(buf, lay, K3), vector(buf, lay, Y1), vector(buf, lay, YN), vector(buf, lay, RHS),
-        vector(buf, lay, W_HDT), vector(buf, lay, DA),
-        vector(buf, lay, ISTATE), matrix(buf, lay, DQ, n), matrix(buf, lay, DV, n), winvs, w_bases,
+        vector(buf, lay, W_HDT), vector(buf, lay, DA), vector(buf, lay, W_EXT), vector(buf, lay, SOL),
+        vector(buf, lay, ISTATE), matrix(buf, lay, DQ, n), matrix(buf, lay, DV, n), winvs,
+        vector(buf, lay, PIVOTS).reshape((N_SLOTS, 2 * n + 1, n)), w_bases,
         matrix(buf, lay, PORT_JAC, 2), vector(buf, lay, LAST_ACC), vector(buf, lay, LAST_FORCE),
         matrix(buf, lay, LAST_DEFL, 2), buf[lay[STATE_FIRST]:lay[STATE_LAST + 1]], vector(buf, lay, BACKUP),
-        dims[D_TVS] != 0,
+        dims[D_TVS] != 0, dims[D_EXT],
     )
 
 
 def outputs(buf, lay, dims):
     """Every output at the current time into the ``outputs`` slot.
 
-    ``[shaft torque (average or end), average, then the linear outputs, alpha_out average, alpha_out max,
-    generator speed]``;
-    the linear outputs are ``[F, q, v, port angle, port speed, driver speed, driver accel] @ output_matrix``.
+    ``[shaft torque (average or end), average, then the linear outputs, the magnitudes, alpha_out average,
+    alpha_out max, generator speed]``; the linear outputs are ``[F, q, v, port angle, port speed, driver speed,
+    driver accel] @ output matrix`` (held by columns, its nonzero rows only: ``out_index``, ``out_value``), the
+    magnitudes ``hypot`` of two linear outputs each (the bearing forces; the rows of the ``magnitudes`` slot index
+    the linear outputs, -1 for none).
     """
     n = dims[D_N]
     m = dims[D_M]
@@ -111,14 +116,27 @@ def outputs(buf, lay, dims):
     z[m + 2 * n + 1] = sc[S_PORT_SPEED]
     z[m + 2 * n + 2] = sc[S_DRIVER_SPEED]
     z[m + 2 * n + 3] = sc[S_DRIVER_ACCEL]
-    cols = out.shape[0] - 5
-    vecmat(z, matrix(buf, lay, OUTPUT_MATRIX, m + 2 * n + 4), out[2:2 + cols])
+    n_mag = dims[D_MAGNITUDES]
+    cols = out.shape[0] - 5 - n_mag
+    sparse_vecmat(z, matrix(buf, lay, OUT_INDEX, cols), matrix(buf, lay, OUT_VALUE, cols), out[2:2 + cols])
     avg = sc[S_SHAFT_TORQUE_AVG]
     out[0] = out[2] if dims[D_END_TORQUE] != 0 else avg
     out[1] = avg
-    out[2 + cols] = sc[S_ALPHA_OUT_AVG]
-    out[3 + cols] = vector(buf, lay, ISTATE)[ALPHA_OUT_MAX]
-    out[4 + cols] = sc[S_GEN_SPEED]
+    if n_mag:
+        pairs = matrix(buf, lay, MAGNITUDES, n_mag)
+        for j in range(n_mag):
+            a = out[2 + int(pairs[j, 0])]
+            b = out[2 + int(pairs[j, 1])] if pairs[j, 1] >= 0.0 else 0.0
+            out[2 + cols + j] = math.sqrt(a * a + b * b)
+    out[2 + cols + n_mag] = sc[S_ALPHA_OUT_AVG]
+    out[3 + cols + n_mag] = vector(buf, lay, ISTATE)[ALPHA_OUT_MAX]
+    out[4 + cols + n_mag] = sc[S_GEN_SPEED]
+
+
+def external(k, sc):
+    """The external terms at the current driver angle and speed into ``k.z`` (:func:`.dynamics.external_terms`)."""
+    first = k.fast.shape[0] - k.n_ext
+    external_terms(sc[S_DRIVER_ANGLE], sc[S_DRIVER_SPEED], k.load_rates, k.z[first:first + k.n_ext])
 
 
 def current_loads(buf, lay, dims):
@@ -131,8 +149,9 @@ def current_loads(buf, lay, dims):
         stiffness_factors(sc[S_DRIVER_ANGLE], k.phasing, k.factor, k.slope)
     else:
         k.factor[:] = 1.0
-    acceleration(vector(buf, lay, Y), sc[S_PORT_ANGLE], sc[S_PORT_SPEED], sc[S_LAST_ALPHA], k.factor, k.a_t,
-                 k.a_port, k.fast, k.contact, k.z, k.defl, k.acc)
+    external(k, sc)
+    acceleration(vector(buf, lay, Y), sc[S_PORT_ANGLE], sc[S_PORT_SPEED], sc[S_LAST_ALPHA], k.factor, k.nz_index,
+                 k.nz_value, k.a_port, k.offset, k.fast_index, k.fast_value, k.contact, k.z, k.defl, k.acc)
     copy(k.acc, k.last_acc)
     copy(k.z[:m], k.last_force)
     copy(k.defl[0], k.last_defl[0])
@@ -154,9 +173,11 @@ def settle(buf, lay, dims, flank, rtol, max_iterations):
         stiffness_factors(sc[S_DRIVER_ANGLE], k.phasing, k.factor, k.slope)
     else:
         k.factor[:] = 1.0
+    external(k, sc)
     y = vector(buf, lay, Y)
     status, iterations, imbalance = static_deflection(
-        y, n, sc[S_PORT_ANGLE], k.factor, flank, k.a_t, k.a_port, k.fast, k.contact, k.nz_index, k.nz_value,
+        y, n, sc[S_PORT_ANGLE], k.factor, flank, k.a_t, k.a_port, k.offset, k.fast, k.fast_index, k.fast_value,
+        k.contact, k.nz_index, k.nz_value,
         k.cos_alpha, k.stks, k.stcs, k.stks_port, k.stcs_port, k.inv_m, k.z, k.defl, k.acc, k.fd, k.fv, k.dq, k.dv,
         k.port_jac, np.empty((n, n)), np.empty((n, n)), np.empty(n), np.empty(n), np.empty(m), np.empty(2 * n), rtol,
         max_iterations)
@@ -259,7 +280,7 @@ def gearbox_step(buf, lay, dims, t, h, omega_rotor, phi_rotor, omega_gen, phi_ge
     return OK, tau, h, 0.0
 
 
-INLINE = ("vector", "matrix", "views")
+INLINE = ("vector", "matrix", "views", "external")
 #: entry points of the ahead-of-time compiled module (:mod:`components.compile.aot`) and their signatures
 AOT_EXPORTS = {
     "gearbox_step": "Tuple((i8, f8, f8, f8))(f8[::1], i8[::1], i8[::1], f8, f8, f8, f8, f8, f8, f8, f8, f8)",

@@ -214,14 +214,15 @@ def test_the_kernels_stiffness_rate_is_the_time_derivative_of_the_acceleration()
 
     def acc(angle):
         out, z, defl = np.zeros(n), np.zeros(m + 2 * n + 4), np.zeros((2, m))
-        dynamics.acceleration(y, port, 0.0, 0.0, a.stiffness_factor(angle), a.A_T, a.port_deflection, a.fast_matrix,
-                              a.law.table, z, defl, out)
+        dynamics.acceleration(y, port, 0.0, 0.0, a.stiffness_factor(angle), a.nz_index, a.nz_value, a.port_deflection,
+                              a.mesh_offset, a.fast_index, a.fast_value, a.law.table, z, defl, out)
         return out
 
     h = 1e-9 * speed
     fd = (acc(tau_angle + h) - acc(tau_angle - h)) / (2 * h / speed)
     analytic = np.zeros(n)
-    dynamics.stiffness_rate(y, n, tau_angle, speed, port, 0.0, a.A_T, a.port_deflection, a.law.table,
+    dynamics.stiffness_rate(y, n, tau_angle, speed, port, 0.0, a.nz_index, a.nz_value, a.port_deflection, a.mesh_offset,
+                            a.law.table,
                             a.phasing_table, a.force_rows, np.zeros(m), np.zeros(m), np.zeros((2, m)), np.zeros(m),
                             analytic)
     assert np.abs(analytic).max() > 1e3  # the stiffness term dominates here

@@ -141,8 +141,8 @@ def test_the_kernels_folded_acceleration_equals_the_matrix_form(form):
     for scale in (1e-4, 1e-3, 1e-2):
         y = rng.normal(size=2 * n) * scale
         acc, z, defl = np.zeros(n), np.zeros(m + 2 * n + 4), np.zeros((2, m))
-        step.acceleration(y, 0.3, 0.02, 0.7, np.ones(m), a.A_T, a.port_deflection, a.fast_matrix, a.law.table, z, defl,
-                          acc)
+        step.acceleration(y, 0.3, 0.02, 0.7, np.ones(m), a.nz_index, a.nz_value, a.port_deflection, a.mesh_offset,
+                          a.fast_index, a.fast_value, a.law.table, z, defl, acc)
         ref = a.acceleration(y[:n], y[n:], 0.7, 0.0, np.array([0.3]), np.array([0.02]))
         np.testing.assert_allclose(acc, ref, rtol=1e-10, atol=1e-9 * np.abs(ref).max())
 

@@ -118,3 +118,11 @@ def test_a_study_measure_has_the_unit_its_fmu_declares_not_one_read_from_its_nam
     assert [m.column for m in prepared.study.measures] == ["gearbox.F_x:max [N.m]", "gearbox.shaft1.torque:del4 [N]",
                                                           "cpu_time [s]"]
     assert prepared.payload.measures == prepared.study.measures
+
+
+def test_a_stage_measure_parses_as_the_load_sharing_of_a_stage():
+    m = parse_measure("gearbox.stage1:load_sharing")
+    assert (m.variable, m.statistic, m.unit, m.of_stage, m.builtin) == ("gearbox.stage1", "load_sharing", "1", True,
+                                                                         False)
+    with pytest.raises(MeasureError, match="'component.stage:load_sharing'"):
+        parse_measure("stage1:load_sharing")
