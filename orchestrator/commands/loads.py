@@ -14,6 +14,7 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
+from .catalogue import help_line
 from .cluster_options import add_cluster_arguments, check_cluster_arguments, check_workers
 from .fmu_options import add_fmu_arguments
 
@@ -22,7 +23,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``loads`` subcommand."""
     p = sub.add_parser(
         "loads",
-        help="run a load-case set (wind-speed bins x seeds) and write lifetime DELs, Miner damage, LDD and LRD",
+        help=help_line("loads"),
         description=(
             "Run every case of a load-case set (each wind-speed bin at its operating point, with several seeds) "
             "on Dask workers (a LocalCluster by default, or an existing cluster), then weight the runs by the wind "

@@ -15,6 +15,7 @@ from pathlib import Path
 
 from ..inputs.results_format import RESULTS_FORMATS
 from . import scenario_options
+from .catalogue import help_line
 from .fmu_options import add_fmu_arguments
 
 
@@ -22,7 +23,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``run`` subcommand."""
     p = sub.add_parser(
         "run",
-        help="run a co-simulation scenario (default: the paper's 60 s scenario) and write results and plots",
+        help=help_line("run"),
         description=(
             "Run a co-simulation scenario through its FMUs with the fixed-step master and write "
             "timeseries.csv (or timeseries.parquet for long runs, see --results), summary.json and PNG plots. SCENARIO is a TOML file, an .ssp/.ssd file, or the "

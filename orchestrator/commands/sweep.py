@@ -14,6 +14,7 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
+from .catalogue import help_line
 from .cluster_options import add_cluster_arguments, check_cluster_arguments, check_workers
 from .fmu_options import add_fmu_arguments
 
@@ -22,7 +23,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``sweep`` subcommand."""
     p = sub.add_parser(
         "sweep",
-        help="run a parameter study (grid, explicit points, seeds) on Dask workers and write a table and plots",
+        help=help_line("sweep"),
         description=(
             "Run every point of a study on Dask workers (a LocalCluster by default, or an existing cluster) "
             "with the co-simulation or the monolithic engine, and write journal.jsonl (one line per finished "
