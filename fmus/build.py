@@ -179,6 +179,31 @@ def build_config(name: str, model: dict) -> dict:
             "dtcosim": components.__version__, "binary": binary.source_digest()}
 
 
+def stamped_files(source: SourceTree | None = None) -> list[Path]:
+    """Every file :func:`code_hash` may read, for any FMU: the ``.py`` files of ``components`` and ``fmus/slaves``,
+    the FMU binary's C sources and the runtime guard."""
+    source = source or SourceTree.installed()
+    files = [path for folder in (source.components_dir, source.slaves_dir) for path in sorted(Path(folder).rglob("*.py"))
+             if "__pycache__" not in path.parts]
+    files += [binary.NATIVE_DIR / name for name in (*binary.SOURCES, binary.HEADER)]
+    return files + [runtime_files.GUARD_SOURCE]
+
+
+def sources_stamp(source: SourceTree | None = None) -> str:
+    """A stamp of everything :func:`code_hash` reads, by file stats: equal stamps, equal hashes.
+
+    The path, size and modification time of each of :func:`stamped_files`, and the versions
+    in :func:`build_config`. Nothing is read or hashed: a check that remembers its verdict
+    under this stamp (and the FMU file's stats) repeats it in milliseconds
+    (:mod:`orchestrator.provision.staleness`).
+    """
+    entries = [f"{BUILD_FORMAT} {pythonfmu.__version__} {components.__version__}"]
+    for path in stamped_files(source):
+        st = path.stat()
+        entries.append(f"{path} {st.st_size} {st.st_mtime_ns}")
+    return hashlib.sha256("\n".join(entries).encode()).hexdigest()[:16]
+
+
 def code_hash(name: str, model: dict, source: SourceTree | None = None) -> str:
     """12-hex-digit hash of the code embedded in FMU ``name`` and of the model it is built from."""
     source = source or SourceTree.installed()

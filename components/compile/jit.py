@@ -102,6 +102,11 @@ def try_compiled(source: KernelSource) -> tuple[ModuleType | None, str | None]:
     return _attempts[key]
 
 
+def already_compiled(source: KernelSource) -> ModuleType | None:
+    """The just-in-time module of ``source`` if this process has loaded it already (nothing is loaded here)."""
+    return _attempts.get(source.shared_name, (None, None))[0]
+
+
 def entry_point(function, argument_types: tuple):
     """``function`` for one signature without numba's per-call type resolution, where it is a numba dispatcher.
 

@@ -481,7 +481,8 @@ class Assembly:
         stiffness_factor : ndarray or float
             Mesh stiffness multiplier.
         kernel : {"auto", "numpy", "compiled"}, optional
-            Form of the kernel.
+            Form of the kernel (``auto``: the interpreted one unless numba's is loaded already: a short
+            evaluation, :func:`components.model.kernel.monolithic`).
 
         Returns
         -------
@@ -497,7 +498,7 @@ class Assembly:
         dq, dv, port_jac = np.zeros((n, n)), np.zeros((n, n)), np.zeros((2, n))
         stks_port = self.STkS_port[:, 0].copy() if self.ports.size else np.zeros(n)
         stcs_port = self.STcS_port[:, 0].copy() if self.ports.size else np.zeros(n)
-        model_kernel.monolithic(kernel)[0].jacobian(
+        model_kernel.monolithic(kernel, brief=True)[0].jacobian(
             y, port, port_rate, factor, self.A_T, self.port_deflection, self.law.table, np.zeros((2, m)), self.nz_index,
             self.nz_value, self.cos_alpha, self.STkS, self.STcS, stks_port, stcs_port, self.inv_inertia, np.zeros(m),
             np.zeros(m), dq, dv, port_jac)
@@ -520,7 +521,8 @@ class Assembly:
         stiffness_factor : float or ndarray, shape (n_mesh,)
             Mesh stiffness multiplier (time-varying stiffness frozen at one phase); 1 = mean.
         kernel : {"auto", "numpy", "compiled"}, optional
-            Form of the kernel.
+            Form of the kernel (``auto``: the interpreted one unless numba's is loaded already: a short
+            evaluation, :func:`components.model.kernel.monolithic`).
         rtol : float
             Converged when the largest generalised-force imbalance is below ``rtol`` times the largest sum of
             generalised-force magnitudes on one body.
@@ -547,7 +549,7 @@ class Assembly:
         n, m = self.n_dof, self.n_mesh
         y = np.zeros(2 * n)
         factor = np.ascontiguousarray(np.broadcast_to(np.asarray(stiffness_factor, dtype=float), (m,)))
-        status, iterations, imbalance = model_kernel.monolithic(kernel)[0].static_deflection(
+        status, iterations, imbalance = model_kernel.monolithic(kernel, brief=True)[0].static_deflection(
             y, n, float(load_nm), factor, math.copysign(1.0, load_nm), self.A_T, self.port_deflection,
             self.fast_matrix, self.law.table, self.nz_index, self.nz_value, self.cos_alpha, self.STkS, self.STcS,
             np.zeros(n), np.zeros(n), self.inv_inertia, np.zeros(m + 2 * n + 4), np.zeros((2, m)), np.zeros(n),

@@ -213,7 +213,8 @@ class MeshPhasing:
         angles = np.ascontiguousarray(np.atleast_1d(np.asarray(driver_angles_rad, dtype=float)))
         factor = np.empty((angles.size, self.table.shape[1]))
         slope = np.empty_like(factor)
-        model_kernel.monolithic(kernel)[0].stiffness_factors_many(angles, self.table, factor, slope)
+        brief = factor.size <= model_kernel.BRIEF_EVALUATIONS
+        model_kernel.monolithic(kernel, brief=brief)[0].stiffness_factors_many(angles, self.table, factor, slope)
         return factor, slope
 
     def factor(self, driver_angle_rad: float) -> np.ndarray:
