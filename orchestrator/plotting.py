@@ -190,9 +190,9 @@ def axes_pixels(ax) -> int:
 #: zlib level of the PNG files: 1 costs about a third of the default 6's time; the palette keeps them small
 PNG_COMPRESS_LEVEL = 1
 
-#: how text is rendered: FreeType's outlines unhinted, at the pixel grid (matplotlib's default hints every
-#: glyph at 8 x the horizontal resolution; the text then costs about a fifth more for no better reading at 110 dpi)
-TEXT_RENDERING = {"text.hinting": "no_hinting", "text.hinting_factor": 1}
+#: how text is rendered: FreeType's outlines unhinted (matplotlib's default auto-hints every glyph: the
+#: text then costs about a fifth more for no better reading at 110 dpi)
+TEXT_RENDERING = {"text.hinting": "no_hinting"}
 
 
 def encode_png(canvas, path: Path) -> None:
