@@ -87,7 +87,7 @@ def run(args: argparse.Namespace) -> int:
     say = (lambda msg: None) if quiet else (lambda msg: print(msg, file=sys.stderr))
     scenario = scenario_options.apply(scenario_options.load(args.scenario, args, "run"), args, "run")
     out_dir, out_note = (args.out, "") if args.out is not None else scenario_options.default_out_dir(scenario, args)
-    paths = ensure_fmus(scenario, args.fmu_dir, build=not args.no_build, report=say)
+    paths = ensure_fmus(scenario, args.fmu_dir, build=not args.no_build, report=say, kernels_in_background=True)
     for warning in stale_project_fmus(paths):
         print(f"dtcosim run: warning: {warning}", file=sys.stderr)
     system = resolve_system(scenario, fmu_paths=paths)

@@ -15,7 +15,8 @@ from dataclasses import replace
 from pathlib import Path
 
 from .catalogue import help_line
-from .cluster_options import add_cluster_arguments, check_cluster_arguments, check_workers
+from .cluster_options import add_cluster_arguments, check_cluster_arguments, check_workers, ran
+from .cluster_options import where as cluster_where
 from .fmu_options import add_fmu_arguments
 
 
@@ -108,7 +109,7 @@ def run(args: argparse.Namespace) -> int:
         return 0
 
     check_cluster_arguments(args, "sweep")
-    where = f"scheduler {args.scheduler}" if args.scheduler else f"a LocalCluster of {args.workers or os.cpu_count()} workers"
+    where = cluster_where(args)
     bar = None
     progress = None
 
@@ -127,7 +128,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         report = run_sweep(prepared, out_dir, workers=args.workers, scheduler=args.scheduler,
                            retry_failed=args.retry_failed, progress=forward, on_start=on_start,
-                           plots=not args.no_plots, dashboard=args.dashboard)
+                           plots=not args.no_plots, dashboard=args.dashboard, executor=args.executor)
     finally:
         if bar is not None:
             bar.close()
@@ -136,7 +137,7 @@ def run(args: argparse.Namespace) -> int:
         finished = report.ok + report.failed + report.errors
         if report.submitted:
             print(f"{study.name}: {finished} of {report.submitted} submitted points finished ({report.ok} ok, "
-                  f"{report.failed} failed, {report.errors} errors) on {report.workers} workers in "
+                  f"{report.failed} failed, {report.errors} errors) {ran(report)} in "
                   f"{report.compute_time_s:.2f} s (whole command {report.wall_time_s:.2f} s); "
                   f"{report.skipped} skipped (already in the journal)")
         else:

@@ -142,7 +142,8 @@ async def signalled_start(self):
     return await start(self)
 
 nanny.Nanny.start_unsafe = signalled_start
-cli.end_process(cli.main(["sweep", {study!r}, "--workers", "1", "--out", {out!r}, "-q", "--no-plots"]))
+cli.end_process(cli.main(["sweep", {study!r}, "--workers", "1", "--out", {out!r}, "-q", "--no-plots",
+                          "--executor", "dask"]))
 """
 
 
