@@ -32,6 +32,7 @@ checked with ``fmpy.validation``.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import hashlib
 import importlib
 import importlib.util
@@ -163,7 +164,16 @@ def embedded_modules(name: str, source: SourceTree | None = None) -> dict[str, S
 
 
 def _embedded_files(name: str, source: SourceTree) -> list[tuple[str, Path]]:
-    """(path inside the embedded package, source file) of every module FMU ``name`` carries."""
+    """(path inside the embedded package, source file) of every module FMU ``name`` carries.
+
+    Found by parsing the modules (:func:`embedded_modules`), once per FMU and state of the sources
+    (:func:`sources_stamp`) in a process: a build needs it three times.
+    """
+    return list(_embedded_files_of(name, source, sources_stamp(source)))
+
+
+@functools.lru_cache(maxsize=64)
+def _embedded_files_of(name: str, source: SourceTree, stamp: str) -> tuple[tuple[str, Path], ...]:
     out = []
     for mod in embedded_modules(name, source).values():
         if mod.name.startswith("fmus.slaves"):
@@ -172,7 +182,7 @@ def _embedded_files(name: str, source: SourceTree) -> list[tuple[str, Path]]:
             rel = "components/" + mod.path.relative_to(source.components_dir).as_posix()
         out.append((rel, mod.path))
     out.append((runtime_files.GUARD_FILE, runtime_files.GUARD_SOURCE))  # the requirement check the FMU runs first
-    return out
+    return tuple(out)
 
 
 def build_config(name: str, model: dict) -> dict:

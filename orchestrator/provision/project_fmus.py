@@ -31,7 +31,7 @@ from .series_fmus import ensure_series_fmu
 
 
 def ensure_fmus(scenario: Scenario, fmu_dir: str | Path | None = None, build: bool = True,
-                report: Callable[[str], None] | None = None) -> dict[str, Path]:
+                report: Callable[[str], None] | None = None, kernels_in_background: bool = False) -> dict[str, Path]:
     """Resolve every FMU path, building the project's missing FMUs first.
 
     Parameters
@@ -43,6 +43,11 @@ def ensure_fmus(scenario: Scenario, fmu_dir: str | Path | None = None, build: bo
         Build missing project FMUs into ``fmu_dir``; if False a missing FMU is an error.
     report : callable(str), optional
         Receives progress messages ("building Gearbox.fmu ...").
+    kernels_in_background : bool
+        Missing compiled kernels: built in the background while this process runs them
+        interpreted (``dtcosim run``: one run does not pay for a machine's compile), instead of
+        built before anything else (studies, whose many points would all run interpreted);
+        see :func:`~orchestrator.cosim.compiled_kernels.ensure_compiled_kernels`.
 
     Returns
     -------
@@ -56,7 +61,8 @@ def ensure_fmus(scenario: Scenario, fmu_dir: str | Path | None = None, build: bo
     """
     fmu_dir = default_fmu_dir() if fmu_dir is None else Path(fmu_dir)
     if build:
-        ensure_compiled_kernels(report)  # the kernels the FMUs and the master step, once per machine
+        # the kernels the FMUs and the master step, once per machine
+        ensure_compiled_kernels(report, background=kernels_in_background)
         wanted: dict[str, tuple[DrivetrainSpec, list[str]]] = {}
         for comp in scenario.components:
             if comp.drivetrain is not None:

@@ -43,6 +43,27 @@ def test_fmpy_validation_reports_no_problem(fmu_path, name):
     assert check_fmu(fmu_path(name)) == []
 
 
+@pytest.mark.parametrize("old, new", [
+    (None, None),  # as built: plain structured names
+    ('name="stage1.k0"', 'name="stage1..k0"'),  # illegal
+    ('name="stage1.k0"', 'name="stage1.\'k 0\'"'),  # quoted: legal, parsed by fmpy
+    ('name="stage1.k0"', 'name="shaft1.torque"'),  # a duplicate
+    ('<Unknown index=', '<Unknown index="9999" x='),  # a model structure entry of no variable
+])
+def test_the_build_finds_what_fmpys_validation_finds(fmu_path, tmp_path, old, new):
+    from fmus.validation import fmpy_problems
+
+    fmu = tmp_path / "Gearbox.fmu"
+    shutil.copy(fmu_path("Gearbox"), fmu)
+    if old is not None:
+        xml = read_member(fmu).decode()
+        assert old in xml
+        rewrite_archive(fmu, {"modelDescription.xml": xml.replace(old, new, 1).encode()})
+    expected = validate_fmu(str(fmu))
+    assert fmpy_problems(fmu) == expected
+    assert (expected == []) == (old is None or "'" in new)
+
+
 @pytest.mark.parametrize("name, causality, expected", [
     ("WindSource", "output", {"omega": "rad/s", "phi": "rad"}),
     ("WindSource", "parameter", {"omega0": "rad/s", "a": "rad/s", "sigma": "rad/s", "n_harmonics": None,
