@@ -379,7 +379,7 @@ def _background(lock: Path, items: Sequence[str]) -> int:
         for item in items:
             shared, _, provider = item.partition("=")
             kernel = AotKernel(shared, provider)
-            if kernel.file().is_file():
+            if kernel.file().is_file() or failed_before(kernel) is not None:  # built, or failed, by a builder before
                 continue
             t0 = time.perf_counter()
             try:

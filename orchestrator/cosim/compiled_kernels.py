@@ -115,7 +115,7 @@ def _in_background(todo: list[AotKernel], report: Callable[[str], None] | None) 
         return "the kernels could not be compiled in the background"
     os.environ[JIT_VARIABLE] = "0"  # compiling them just in time now would cost as much as the build
     if report:
-        what = "are being" if running is not None else f"{len(todo)} kernel(s) are being"
-        report(f"the kernels {what} compiled ahead of time in the background for later runs (pid {pid}, log "
-               f"{build_log()}); until they are, runs step them interpreted, which takes longer")
+        what = (f"the kernels are still being compiled ahead of time in the background (pid {pid}" if running is not None
+                else f"compiling {len(todo)} kernel(s) ahead of time in the background for later runs (pid {pid}")
+        report(f"{what}, log {build_log()}); until they are built, runs step them interpreted, which takes longer")
     return f"being compiled in the background (pid {pid})"
