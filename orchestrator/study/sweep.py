@@ -82,7 +82,7 @@ class SweepReport:
     wall_time_s : float
         The whole call [s] (cluster start-up and output files included).
     compute_time_s : float
-        First submission to last result [s].
+        First point started (here) or submitted (to the cluster) to the last result [s].
     workers : int
         Workers of the cluster when the sweep started (0 if none ran).
     in_process : int
@@ -389,6 +389,7 @@ def _run_here(prepared: PreparedStudy, todo: list[int], journal: Journal, report
     stop = StopRequests(enabled=False)  # the requests of _Interrupts' handler, checked by the running point
     times: list[float] = []
     left = list(todo)
+    t0 = time.perf_counter()
     with _Interrupts(stop) as interrupts:
         try:
             while left:
@@ -421,6 +422,8 @@ def _run_here(prepared: PreparedStudy, todo: list[int], journal: Journal, report
             report.interrupted = True
             report.signal = interrupts.signum or signal.SIGINT
             return []
+        finally:
+            report.compute_time_s += time.perf_counter() - t0
     return []
 
 
@@ -480,7 +483,7 @@ def _execute(prepared: PreparedStudy, todo: list[int], journal: Journal, report:
                     client.cancel(list(futures))
         finally:
             if t0 is not None:
-                report.compute_time_s = time.perf_counter() - t0
+                report.compute_time_s += time.perf_counter() - t0
             with interrupts.shielded(), quiet:  # a signal while the cluster closes is noted, never raised
                 if interrupts.pending:
                     quiet.enter_context(_quiet_dask_logs())
