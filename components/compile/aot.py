@@ -31,6 +31,7 @@ when such a name is asked for.
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import importlib.machinery
 import importlib.util
@@ -41,7 +42,7 @@ import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
-from typing import Callable, Sequence
+from typing import Callable, Iterator, Sequence
 
 from .numba_cache import user_cache_root
 from .sources import KernelSource
@@ -346,6 +347,25 @@ def build_in_background(kernels: Sequence[AotKernel]) -> int | None:
     except OSError:
         return None
     return child.pid
+
+
+@contextlib.contextmanager
+def build_lock(timeout_s: float = 900.0) -> Iterator[None]:
+    """Be the one builder of this machine's kernels for the block: after a builder in progress has ended (another
+    process's ``dtcosim build``, a background build, a parallel test worker), so that nothing is compiled twice."""
+    import time
+
+    lock = build_lock_file()
+    lock.parent.mkdir(parents=True, exist_ok=True)
+    deadline = time.monotonic() + timeout_s
+    while not _take(lock):
+        if time.monotonic() > deadline:
+            raise TimeoutError(f"the build of pid {background_builder()} ({lock}) did not end in {timeout_s:g} s")
+        time.sleep(0.2)
+    try:
+        yield
+    finally:
+        lock.unlink(missing_ok=True)
 
 
 def _take(lock: Path) -> bool:

@@ -23,6 +23,7 @@ from components.compile.aot import (
     background_builder,
     build_in_background,
     build_in_subprocess,
+    build_lock,
     build_log,
     enabled,
     failed_before,
@@ -33,7 +34,7 @@ from components.model.kernel import AHEAD_OF_TIME
 
 from .stepping.compiled_loop import aot_loop_kernel
 
-#: how long ``dtcosim build`` waits for a build in the background to end before building itself [s]
+#: how long a build waits for another process's build of the kernels to end [s]
 WAIT_FOR_BACKGROUND_S = 900.0
 
 
@@ -87,20 +88,20 @@ def ensure_compiled_kernels(report: Callable[[str], None] | None = None, retry: 
     if background:
         return _in_background(todo, report)
     running = background_builder()
-    if running is not None:
-        if report:
-            report(f"waiting for the kernels being compiled ahead of time in the background (pid {running}) ...")
-        deadline = time.monotonic() + WAIT_FOR_BACKGROUND_S
-        while background_builder() is not None and time.monotonic() < deadline:
-            time.sleep(0.5)
-        todo = [k for k in missing(aot_kernels()) if retry or failed_before(k) is None]
-        if not todo:
-            return None
-    if report:
-        report(f"compiling {len(todo)} kernel(s) ahead of time into {aot_directory()} (once per machine and "
-               "version) ...")
-    start = time.perf_counter()
-    problem = build_in_subprocess(todo)
+    if running is not None and report:
+        report(f"waiting for the kernels being compiled ahead of time by another process (pid {running}) ...")
+    try:
+        with build_lock(WAIT_FOR_BACKGROUND_S):  # one builder at a time: what another built is not built again
+            todo = [k for k in missing(aot_kernels()) if retry or failed_before(k) is None]
+            if not todo:
+                return None
+            if report:
+                report(f"compiling {len(todo)} kernel(s) ahead of time into {aot_directory()} (once per machine and "
+                       "version) ...")
+            start = time.perf_counter()
+            problem = build_in_subprocess(todo)
+    except (OSError, TimeoutError) as exc:  # an unwritable cache, a builder that never ends: just in time instead
+        problem = f"{type(exc).__name__}: {exc}"
     if report:
         report(f"kernels not compiled ahead of time ({problem}); numba compiles them just in time instead" if problem
                else f"compiled {len(todo)} kernel(s) ahead of time in {time.perf_counter() - start:.0f} s")
