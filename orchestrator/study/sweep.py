@@ -355,21 +355,22 @@ def _keep(prepared: PreparedStudy, i: int, result: dict[str, Any], journal: Jour
         "finished_at": _now(),
     }
     try:
-        # storing a run's data and journaling it is one step: a signal during it is raised after both
+        # storing a run's data, journaling it and counting it is one step: a signal during it is raised after all
+        # three (raised between journal and count, the sweep would say one point fewer was kept)
         with interrupts.critical_section():
             if on_result is not None and record["status"] == OK:
                 record.update(on_result(i, result))
             journal.append(record)
+            if record["status"] == OK:
+                report.ok += 1
+            elif record["status"] == FAILED:
+                report.failed += 1
+            else:
+                report.errors += 1
     except OSError as exc:  # a full disk: nothing more can be kept, so nothing more is run
         report.problems.append(f"{describe_os_error(exc)}; the sweep stopped, the points finished before are kept "
                                f"in {journal.path}: free some space and run the same command again to continue")
         return False
-    if record["status"] == OK:
-        report.ok += 1
-    elif record["status"] == FAILED:
-        report.failed += 1
-    else:
-        report.errors += 1
     if progress is not None:
         progress(record)
     return True
