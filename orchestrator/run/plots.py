@@ -146,12 +146,10 @@ def plot_contact_forces(outcome: RunOutcome, gearbox: ComponentRole, window, pat
                         title_suffix: str = "") -> Path | None:
     """Every recorded contact force the gearbox declares [kN], one row per stage (Fig. 17).
 
-    Each row shows the whole run with the analysis window shaded. Where a force leaves
-    the window's range outside the window (a start-up peak, an event before it) and so
-    sets the whole run's scale, a second column shows the analysis window alone, scaled
-    to it, where the fluctuation the statistics describe is visible (:func:`window_limits`);
-    a run that starts settled needs no second column. Planet meshes that carry the same
-    force (by symmetry) are drawn once (:func:`symmetric_groups`).
+    Left: the whole run (the analysis window shaded), where the start-up peak
+    sets the scale; right: the analysis window alone, scaled to it (:func:`window_limits`),
+    where the fluctuation the statistics describe is visible. Planet meshes that carry the
+    same force (by symmetry) are drawn once (:func:`symmetric_groups`).
     """
     recorded = {c.column: i for i, c in enumerate(outcome.columns)}
     stages: dict[str, list[tuple[str, str, np.ndarray]]] = {}
@@ -162,19 +160,17 @@ def plot_contact_forces(outcome: RunOutcome, gearbox: ComponentRole, window, pat
                 (s.variable, s.info.get("mesh", "parallel"), outcome.values[:, i]))  # [N], a view: no copy
     if not stages:
         return None
+    names = list(stages)
+    fig, axes = new_grid(len(names), 2, height=2.6 * len(names) + 1.0, width=15.0, margins=_FORCE_MARGINS)
     t = outcome.time_s
-    groups = {stage: symmetric_groups(series) for stage, series in stages.items()}
-    limits = {stage: window_limits(t, [y for _, _, y, _ in g], window, 0.08) for stage, g in groups.items()}
-    zoomed = any(lim is not None and lim[2] for lim in limits.values())
-    fig, axes = new_grid(len(groups), 2 if zoomed else 1, height=2.6 * len(groups) + 1.0, width=15.0 if zoomed else 11.0,
-                         margins=_FORCE_MARGINS)
     bins = axes_pixels(axes[0][0])
     legends = []
     merged = False
-    for row, (stage, stage_groups) in zip(axes, groups.items()):
-        whole, zoom = row[0], row[-1]
+    for row, stage in zip(axes, names):
+        whole, zoom = row
         _shade_window(whole, window)
-        for k, (var, kind, y, same) in enumerate(stage_groups):
+        groups = symmetric_groups(stages[stage])
+        for k, (var, kind, y, same) in enumerate(groups):
             label, style = _MESH_STYLE.get(kind, (kind, "-"))
             text = f"{var} ({label})"
             if same:
@@ -183,20 +179,18 @@ def plot_contact_forces(outcome: RunOutcome, gearbox: ComponentRole, window, pat
             # the envelope of the samples in N, drawn in kN (the same points as the envelope of y / 1e3)
             te, ye = envelope(t, y, bins)
             ye = ye / 1e3
-            for ax in row:
+            for ax in (whole, zoom):
                 ax.plot(te, ye, lw=0.7, ls=style, color=f"C{k % 10}", label=text if ax is zoom else None)
-        for ax in row:
+        limits = window_limits(t, [y for _, _, y, _ in groups], window, 0.08)
+        if limits is not None:
+            zoom.set_xlim(max(window[0], t[0]), min(window[1], t[-1]))
+            zoom.set_ylim(limits[0] / 1e3, limits[1] / 1e3)
+        for ax in (whole, zoom):
             ax.set_ylabel("force [kN]")
             ax.grid(True, lw=0.3)
-        if zoomed:
-            whole.set_title(f"{gearbox.component}.{stage}: whole run", fontsize=10, loc="left")
-            zoom.set_title(f"{gearbox.component}.{stage}: analysis window {window[0]:g}-{window[1]:g} s", fontsize=10,
-                           loc="left")
-            if limits[stage] is not None:
-                zoom.set_xlim(max(window[0], t[0]), min(window[1], t[-1]))
-                zoom.set_ylim(limits[stage][0] / 1e3, limits[stage][1] / 1e3)
-        else:
-            whole.set_title(f"{gearbox.component}.{stage}", fontsize=10, loc="left")
+        whole.set_title(f"{gearbox.component}.{stage}: whole run", fontsize=10, loc="left")
+        zoom.set_title(f"{gearbox.component}.{stage}: analysis window {window[0]:g}-{window[1]:g} s", fontsize=10,
+                       loc="left")
         # outside the axes: inside, it hid the peaks of load events and start-up swings
         legends.append(zoom.legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), fontsize=7, ncol=1,
                                    borderaxespad=0.0))

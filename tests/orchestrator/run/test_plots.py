@@ -108,24 +108,24 @@ def test_axis_labels_clear_the_tick_labels_and_legends_beside_the_axes_clear_the
                 assert not any(box.overlaps(o) for o in others), (legend, box)
 
 
-@pytest.mark.parametrize("start_peak, columns", [(0.0, 1), (0.2, 2)])
-def test_the_window_gets_its_own_column_only_where_the_start_up_sets_the_scale(figures, start_peak, columns):
+@pytest.mark.parametrize("start_peak", [0.0, 0.2])
+def test_every_stage_has_the_whole_run_and_the_window_scaled_to_it(figures, start_peak):
     outcome, gearbox = _outcome(start_peak)
     plots.plot_contact_forces(outcome, gearbox, WINDOW, "contact_forces.png")
     (fig,) = figures
-    assert len(fig.axes) == 3 * columns
-    stage1 = fig.axes[0]
+    assert len(fig.axes) == 6
+    stage1, zoom = fig.axes[0], fig.axes[1]
     # every sample's extremes are drawn: the envelope of stage 1's first curve spans the data
     first = stage1.get_lines()[0].get_ydata()
     assert first.max() == pytest.approx(outcome.values[:, 0].max() / 1e3)
     assert first.min() == pytest.approx(outcome.values[:, 0].min() / 1e3)
-    if columns == 2:
-        zoom = fig.axes[1]
-        inside = outcome.values[(T >= WINDOW[0]) & (T <= WINDOW[1]), 0] / 1e3
-        low, high = zoom.get_ylim()
-        assert low < inside.min() and inside.max() < high
-        assert high - low < 0.5 * (first.max() - first.min())  # scaled to the window, not to the start-up peak
-        assert zoom.get_xlim() == WINDOW
+    inside = outcome.values[(T >= WINDOW[0]) & (T <= WINDOW[1]), :6] / 1e3  # stage 1's six meshes
+    low, high = zoom.get_ylim()
+    pad = 0.08 * (inside.max() - inside.min())
+    assert (low, high) == pytest.approx((inside.min() - pad, inside.max() + pad))  # the window's range, padded
+    assert zoom.get_xlim() == WINDOW
+    if start_peak:
+        assert high - low < 0.5 * (first.max() - first.min())  # not squeezed by the start-up peak
 
 
 @pytest.mark.parametrize("start_peak", [0.0, 5.0])
