@@ -3,6 +3,7 @@ a study whose measured work is larger hands its remaining points to the cluster.
 
 from __future__ import annotations
 
+import json
 import os
 import signal
 
@@ -44,6 +45,8 @@ def test_a_small_study_runs_here_with_the_journal_and_table_of_a_cluster(write_s
         assert float(r["gearbox.stage3.F_mesh:mean [N]"]) == pytest.approx(STAGE3_FORCE_N, rel=0.01)
     records = read_journal(out / "journal.jsonl")
     assert {r["worker"].rsplit(":", 1)[1] for r in records} == {str(os.getpid())}
+    last = json.loads((out / "study.json").read_text())["last_sweep"]
+    assert (last["in_process"], last["workers"]) == (4, 0)
     second = run_sweep(prepared, out, workers=2, executor=executor)
     assert (second.submitted, second.skipped) == (0, 4) and len(read_journal(out / "journal.jsonl")) == 4
     third = run_sweep(prepared, out, workers=1, retry_failed=True, executor=executor)
