@@ -54,9 +54,9 @@ WAIT_FOR_WORKERS_S = 60.0
 EXECUTORS = ("auto", "process", "dask")
 #: a study whose pending points add up to less wall time than this [s] runs in the sweep's own process: twice what
 #: starting a LocalCluster of 2 workers and loading the study's code and FMUs in them costs before its first point
-#: (10.4 s, ``bench_sweep.py --overhead`` on the shared 2-core machine), the least work that 2 workers finish sooner
-#: than 1 process
-MIN_CLUSTER_WORK_S = 20.0
+#: (4.3 s, ``bench_sweep.py --overhead`` on the shared 2-core machine; 10.4 s while it was busier), rounded up: about
+#: the least work that 2 workers finish sooner than 1 process
+MIN_CLUSTER_WORK_S = 10.0
 
 
 # --------------------------------------------------------------------- sweep
