@@ -11,14 +11,22 @@ One process (libcosim in a child process with libpython preloaded; only its
    the same scenario on the same output grid: CPU time of the integration and in total
    (with the evaluation of the recorded variables); and the accuracy of (1) against it
    (largest relative difference of the Table 7 statistics, generator-speed RMS error);
-3. the same FMUs, exported as SSP, stepped by libcosim (libcosimpy) at the same H.
+3. the same FMUs, exported as SSP, stepped by libcosim (libcosimpy) at the same H;
+4. **at equal accuracy**: the Table 7 error of the co-simulation and of the monolithic solver at
+   relative tolerances from 1e-3 to 1e-7 (the largest relative difference of the three Table 7
+   forces' means and standard deviations over [5, 60] s from a monolithic solution at rtol 1e-10),
+   and the co-simulation's CPU time against that of the monolithic solver at the loosest tolerance
+   whose error is no larger than the co-simulation's (median of ``--repeat`` solves at each
+   tolerance). The default rtol 1e-7 is a reference: it solves the same equations far more
+   accurately than the co-simulation, so comparing times with it alone favours the co-simulation.
 
 The Gearbox kernel is the one ``$DTCOSIM_KERNEL`` selects (default: compiled where
 numba imports). Each run is warmed up once (FMU extraction, numba cache load) and
 measured ``--repeat`` times (co-simulation and reference taking turns); medians are printed.
 
 Targets (issue 14): co-simulation CPU <= 1.0 x the monolithic reference's total; <= 0.5 s
-with the compiled kernel (moonshot 0.3 s); libcosim >= 3 x slower than dtcosim.
+with the compiled kernel (moonshot 0.3 s); libcosim >= 3 x slower than dtcosim. Issue 34 asks for
+the ratio at equal accuracy (4) to be printed and quoted.
 
 Run: ``python benchmarks/bench_cosim.py [--fmu-dir DIR] [--stop T] [--repeat N] [--no-libcosim]``.
 """
@@ -140,6 +148,60 @@ def main() -> None:
     if kernel == "compiled":
         print(f"  co-simulation CPU {co_cpu:.3f} s (target <= 0.5 s, moonshot 0.3 s): "
               f"{'met' if co_cpu <= 0.5 else 'NOT met'}")
+    equal_accuracy(system, setup, runs, co_cpu, args.repeat)
+
+
+#: the forces of the paper's Table 7 (stage 1 and 2 sun-planet, stage 3 mesh)
+TABLE7_FORCES = ("stage1.F_sp[1]", "stage2.F_sp[1]", "stage3.F_mesh")
+#: the monolithic solver's relative tolerances tried at equal accuracy
+TOLERANCES = (1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 3e-6, 1e-6, 1e-7)
+
+
+def table7_error(time_s, column, truth, window) -> float:
+    """Largest relative difference of the Table 7 forces' mean and std from ``truth`` (mean relative to the mean)."""
+    from components.reference.results import window_statistics
+
+    worst = 0.0
+    for name in TABLE7_FORCES:
+        got, ref = window_statistics(time_s, column(name), window), window_statistics(truth.time_s, truth[name], window)
+        worst = max(worst, abs(got["mean"] - ref["mean"]) / abs(ref["mean"]), abs(got["std"] - ref["std"]) / ref["std"])
+    return worst
+
+
+def equal_accuracy(system, setup, runs, co_cpu: float, repeat: int) -> None:
+    """Part 4 of the module docstring."""
+    from components.reference.solver import SolverSettings
+    from orchestrator.run.comparison import run_reference
+
+    window = system.scenario.simulation.window_s
+    gearbox = next(c for c, r in system.roles.items() if r.role == "gearbox")
+    truth = run_reference(system, setup, SolverSettings(rtol=1e-10, atol_angle_rad=1e-13, atol_speed_rad_s=1e-10))
+    co_error = statistics.median(table7_error(r.time_s, lambda n, r=r: r.column(f"{gearbox}.{n}"), truth, window)
+                                 for r in runs)
+    print(f"at equal accuracy: Table 7 error (forces' mean and std over [{window[0]:g}, {window[1]:g}] s, from the "
+          f"monolithic solver at rtol 1e-10)")
+    print(f"  co-simulation at H = {system.scenario.simulation.step_s * 1e3:g} ms      error {co_error:.1e}   "
+          f"{co_cpu:.3f} s CPU")
+    chosen = None
+    for rtol in TOLERANCES:
+        settings = SolverSettings(rtol=rtol)
+        times = []
+        for _ in range(repeat):
+            cpu0 = time.process_time()
+            result = run_reference(system, setup, settings)
+            times.append(time.process_time() - cpu0)
+        assert result.complete, result.message
+        error = table7_error(result.time_s, lambda n: result[n], truth, window)
+        cpu = statistics.median(times)
+        print(f"  monolithic at rtol {rtol:.0e}          error {error:.1e}   {cpu:.3f} s CPU")
+        if chosen is None and error <= co_error:
+            chosen = (rtol, cpu)
+    if chosen is None:
+        print("  no tried tolerance reaches the co-simulation's error")
+        return
+    rtol, cpu = chosen
+    print(f"ratio at equal accuracy: co-simulation CPU / monolithic CPU at rtol {rtol:.0e} (the loosest tolerance as "
+          f"accurate as the co-simulation)  {co_cpu / cpu:6.2f}")
 
 
 if __name__ == "__main__":

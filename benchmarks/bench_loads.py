@@ -54,7 +54,8 @@ def reduced_set(length_s: float, transient_s: float, step_s: float | None) -> di
 
 def run_once(plc, workers: int, out: Path) -> dict:
     t0 = time.perf_counter()
-    report = run_sweep(plc.prepared, out, workers=workers, plots=False, on_result=store_run_data(plc, out))
+    report = run_sweep(plc.prepared, out, workers=workers, executor="dask", plots=False,
+                       on_result=store_run_data(plc, out))
     sweep_s = time.perf_counter() - t0
     t1 = time.perf_counter()
     write_lifetime_outputs(plc, out)

@@ -32,8 +32,10 @@ checked with ``fmpy.validation``.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import hashlib
 import importlib
+import importlib.util
 import json
 import os
 import re
@@ -41,6 +43,7 @@ import shutil
 import sys
 import tempfile
 import warnings
+import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Sequence
@@ -162,7 +165,16 @@ def embedded_modules(name: str, source: SourceTree | None = None) -> dict[str, S
 
 
 def _embedded_files(name: str, source: SourceTree) -> list[tuple[str, Path]]:
-    """(path inside the embedded package, source file) of every module FMU ``name`` carries."""
+    """(path inside the embedded package, source file) of every module FMU ``name`` carries.
+
+    Found by parsing the modules (:func:`embedded_modules`), once per FMU and state of the sources
+    (:func:`sources_stamp`) in a process: a build needs it three times.
+    """
+    return list(_embedded_files_of(name, source, sources_stamp(source)))
+
+
+@functools.lru_cache(maxsize=64)
+def _embedded_files_of(name: str, source: SourceTree, stamp: str) -> tuple[tuple[str, Path], ...]:
     out = []
     for mod in embedded_modules(name, source).values():
         if mod.name.startswith("fmus.slaves"):
@@ -171,13 +183,38 @@ def _embedded_files(name: str, source: SourceTree) -> list[tuple[str, Path]]:
             rel = "components/" + mod.path.relative_to(source.components_dir).as_posix()
         out.append((rel, mod.path))
     out.append((runtime_files.GUARD_FILE, runtime_files.GUARD_SOURCE))  # the requirement check the FMU runs first
-    return out
+    return tuple(out)
 
 
 def build_config(name: str, model: dict) -> dict:
     """Configuration that, together with the code, determines an FMU: its name and record ``model``."""
     return {"format": BUILD_FORMAT, "fmu": name, "model": model, "pythonfmu": pythonfmu.__version__,
             "dtcosim": components.__version__, "binary": binary.source_digest()}
+
+
+def stamped_files(source: SourceTree | None = None) -> list[Path]:
+    """Every file :func:`code_hash` may read, for any FMU: the ``.py`` files of ``components`` and ``fmus/slaves``,
+    the FMU binary's C sources and the runtime guard."""
+    source = source or SourceTree.installed()
+    files = [path for folder in (source.components_dir, source.slaves_dir) for path in sorted(Path(folder).rglob("*.py"))
+             if "__pycache__" not in path.parts]
+    files += [binary.NATIVE_DIR / name for name in (*binary.SOURCES, binary.HEADER)]
+    return files + [runtime_files.GUARD_SOURCE]
+
+
+def sources_stamp(source: SourceTree | None = None) -> str:
+    """A stamp of everything :func:`code_hash` reads, by file stats: equal stamps, equal hashes.
+
+    The path, size and modification time of each of :func:`stamped_files`, and the versions
+    in :func:`build_config`. Nothing is read or hashed: a check that remembers its verdict
+    under this stamp (and the FMU file's stats) repeats it in milliseconds
+    (:mod:`orchestrator.provision.staleness`).
+    """
+    entries = [f"{BUILD_FORMAT} {pythonfmu.__version__} {components.__version__}"]
+    for path in stamped_files(source):
+        st = path.stat()
+        entries.append(f"{path} {st.st_size} {st.st_mtime_ns}")
+    return hashlib.sha256("\n".join(entries).encode()).hexdigest()[:16]
 
 
 def code_hash(name: str, model: dict, source: SourceTree | None = None) -> str:
@@ -409,6 +446,7 @@ def _build_archive(name, kind, model, origin, source, part_dir: Path, resources,
         members.update(binary.native_members(name, name))
     except binary.NativeBuildError as exc:  # the FMU keeps pythonfmu's binary: C hosts must preload libpython
         warnings.warn(f"{name}.fmu keeps pythonfmu's linux64 binary: {exc}", stacklevel=2)
+    members.update(bytecode_members(fmu_path))
     model_description.rewrite_archive(fmu_path, members)
     if validate:
         from .validation import check_fmu
@@ -420,6 +458,33 @@ def _build_archive(name, kind, model, origin, source, part_dir: Path, resources,
     if case is not None:
         _add_cross_check(name, fmu_path, case)
     return BuiltFmu(name, fmu_path, build_id, package, script.stem)
+
+
+def bytecode_members(fmu_path: Path) -> dict[str, bytes]:
+    """The bytecode of every Python module in the FMU's ``resources/``, as archive members beside the sources.
+
+    An FMU is extracted into a new folder for each run, where Python would compile its ~45
+    modules again every time (~0.05 s per FMU). Each ``<module>.py`` therefore gets its
+    ``__pycache__/<module>.<python tag>.pyc`` compiled by this interpreter as an *unchecked-hash* pyc
+    (PEP 552): the same Python uses it without looking at the source's time stamp (the
+    extraction sets new ones), another version ignores it and compiles the source. Derived
+    from the sources like the compiled kernels, they leave the build id alone.
+    """
+    import py_compile
+
+    out = {}
+    with zipfile.ZipFile(fmu_path) as archive, tempfile.TemporaryDirectory(prefix="dtcosim_pyc_") as tmp:
+        for member in archive.namelist():
+            if not (member.startswith("resources/") and member.endswith(".py")):
+                continue
+            source = Path(tmp) / member
+            source.parent.mkdir(parents=True, exist_ok=True)
+            source.write_bytes(archive.read(member))
+            cached = importlib.util.cache_from_source(member)
+            py_compile.compile(str(source), cfile=str(Path(tmp) / cached), dfile=member, doraise=True,
+                               invalidation_mode=py_compile.PycInvalidationMode.UNCHECKED_HASH)
+            out[cached] = (Path(tmp) / cached).read_bytes()
+    return out
 
 
 def _add_cross_check(name: str, fmu_path: Path, case) -> None:

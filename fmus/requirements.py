@@ -34,13 +34,14 @@ instantiation live in :mod:`fmus.runtime_guard` (which the FMU carries).
 from __future__ import annotations
 
 import ast
+import functools
 import importlib.util
 import sys
 import zipfile
 from dataclasses import dataclass
 from importlib import metadata
 from pathlib import Path
-from typing import Callable, Iterable
+from typing import Callable, Iterable, Mapping
 
 from .runtime_guard import (
     REQUIREMENTS_FILE,
@@ -102,8 +103,15 @@ def third_party_modules(sources: Iterable[Path]) -> tuple[str, ...]:
 
 def distribution_of(module: str) -> str:
     """The installed distribution providing top-level ``module`` (the module name if none is known)."""
-    names = metadata.packages_distributions().get(module) or [module]
+    names = _distributions().get(module) or [module]
     return names[0]
+
+
+@functools.lru_cache(maxsize=1)
+def _distributions() -> Mapping[str, list[str]]:
+    """``importlib.metadata.packages_distributions()`` once per process (it reads every installed
+    distribution's file list: ~0.5 s, twice per FMU build)."""
+    return metadata.packages_distributions()
 
 
 def tested_range(version: str) -> tuple[tuple[int, ...], tuple[int, ...]]:

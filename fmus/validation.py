@@ -7,6 +7,7 @@ truncated is one problem with a message, never a traceback.
 from __future__ import annotations
 
 import os
+import re
 import zipfile
 from pathlib import Path
 from typing import Iterable
@@ -19,6 +20,43 @@ from .requirements import ARCHIVE_MEMBER, read_from_fmu
 from .runtime_guard import RequirementsFormatError
 
 DOCUMENTATION_MEMBER = "documentation/index.html"
+
+#: a structured variable name (FMI 2.0, section 2.2.9) of plain identifiers with array subscripts: the grammar accepts
+#: every such name (quoted names and ``der(...)`` are the grammar's other forms)
+_PLAIN_STRUCTURED_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*(?:\[[0-9]+(?:,[0-9]+)*\])?"
+                                    r"(?:\.[A-Za-z_][A-Za-z0-9_]*(?:\[[0-9]+(?:,[0-9]+)*\])?)*")
+
+
+def fmpy_problems(fmu_path: Path | str) -> list[str]:
+    """The problems ``fmpy.validation.validate_fmu`` finds in an FMU, found faster for the usual variable names.
+
+    fmpy checks each name of the structured naming convention with an Earley parser of the
+    grammar, built anew for every FMU: most of the time of a build's validation (~0.2 s for the
+    Gearbox's 160 names). Where every name is of :data:`_PLAIN_STRUCTURED_NAME`, which the
+    grammar accepts, fmpy validates everything else and the names are not parsed again; any
+    other name (quoted, ``der(...)``, an illegal one) has fmpy validate all of it.
+    """
+    from fmpy.model_description import ValidationError
+    from lxml import etree
+
+    try:
+        with zipfile.ZipFile(fmu_path) as archive:
+            root = etree.fromstring(archive.read("modelDescription.xml"))
+            backslashes = [f'The file path "{i.orig_filename}" contains a backslash.' for i in archive.filelist
+                           if "\\" in i.orig_filename]
+    except Exception:  # noqa: BLE001 - what fmpy says about it (it reads the archive itself)
+        return validate_fmu(str(fmu_path))
+    names = [v.get("name", "") for v in root.iterfind("ModelVariables/ScalarVariable")]
+    if root.get("variableNamingConvention") != "structured" or not all(map(_PLAIN_STRUCTURED_NAME.fullmatch, names)):
+        return validate_fmu(str(fmu_path))
+    try:  # as validate_fmu, without parsing the names again
+        read_model_description(str(fmu_path), validate=True, validate_variable_names=False,
+                               validate_model_structure=True)
+    except ValidationError as exc:
+        return list(exc.problems)
+    except Exception as exc:  # noqa: BLE001 - as validate_fmu: its message is the problem
+        return [str(exc)]
+    return backslashes
 
 
 def convention_problems(fmu_path: Path | str) -> list[str]:
@@ -91,7 +129,7 @@ def check_fmu(fmu_path: Path | str) -> list[str]:
     if problem is not None:
         return [problem]
     try:
-        problems = validate_fmu(str(fmu_path))
+        problems = fmpy_problems(fmu_path)
     except Exception as exc:  # noqa: BLE001 - fmpy raises plain exceptions for XML it cannot parse at all
         return [f"modelDescription.xml cannot be read ({exc})"]
     try:

@@ -20,6 +20,17 @@ import pytest
 from tests.helpers.scenarios import TOY_SCENARIO, dtcosim, write_scenario
 
 
+@pytest.hookimpl(tryfirst=True)
+def pytest_sessionstart(session):
+    """In a parallel run (``-n 2``), the controller compiles the kernels once before its workers start
+    (:mod:`tests.helpers.kernels`); a serial run compiles them as its tests first need them."""
+    if hasattr(session.config, "workerinput") or not getattr(session.config.option, "numprocesses", None):
+        return
+    from tests.helpers.kernels import compile_once
+
+    compile_once()
+
+
 @pytest.fixture(scope="session")
 def built_fmus(tmp_path_factory):
     """The project's three FMUs (preset table6) built once for the whole suite: ``{name: BuiltFmu}``.

@@ -6,6 +6,10 @@
 * :func:`modal_analysis` - both, matched mode by mode (mass-weighted MAC between the
   undamped shape and the displacement part of each complex pair), with damping
   ratios, damped frequencies and an overdamped flag per mode.
+
+scipy (``scipy.linalg``, ``scipy.optimize``: ~0.3 s of imports) is imported by the
+functions that use it, so :func:`state_space_matrix` (what a run's settling time needs,
+:func:`components.analysis.settling.drivetrain_settling`) costs numpy alone.
 """
 
 from __future__ import annotations
@@ -14,8 +18,6 @@ import math
 from dataclasses import dataclass, replace
 
 import numpy as np
-import scipy.linalg as sla
-from scipy.optimize import linear_sum_assignment
 
 from ..errors import ParameterError
 
@@ -76,13 +78,15 @@ def undamped_modes(mass: np.ndarray, stiffness: np.ndarray) -> UndampedModes:
         If the matrices are not square/symmetric of one size, ``M`` is not positive
         definite or ``K`` has a clearly negative eigenvalue (unstable equilibrium).
     """
+    import scipy.linalg
+
     m = _as_matrix("mass", mass)
     k = _as_matrix("stiffness", stiffness, m.shape[0])
     for name, x in (("mass", m), ("stiffness", k)):
         if np.abs(x - x.T).max() > 1e-9 * max(np.abs(x).max(), 1e-300):
             raise ParameterError(name, "asymmetric", "a symmetric matrix")
     try:
-        w2, u = sla.eigh(0.5 * (k + k.T), 0.5 * (m + m.T))
+        w2, u = scipy.linalg.eigh(0.5 * (k + k.T), 0.5 * (m + m.T))
     except np.linalg.LinAlgError:
         raise ParameterError("mass", "not positive definite", "a positive definite mass matrix") from None
     tol = 1e-9 * max(abs(w2).max(), 1e-300)
@@ -143,8 +147,10 @@ def state_space_modes(mass: np.ndarray, damping: np.ndarray, stiffness: np.ndarr
         eigenvalues, e.g. the planet-mode pairs); a rigid-body mode makes ``A``
         defective and the left eigenvectors meaningless (``ParameterError``).
     """
+    import scipy.linalg
+
     a = state_space_matrix(mass, damping, stiffness)
-    lam, right = sla.eig(a)
+    lam, right = scipy.linalg.eig(a)
     order = np.lexsort((lam.imag, np.abs(lam)))
     lam, right = lam[order], right[:, order]
     right = right / np.linalg.norm(right, axis=0)
@@ -274,6 +280,8 @@ def modal_analysis(mass: np.ndarray, damping: np.ndarray, stiffness: np.ndarray)
         with np.errstate(divide="ignore"):
             distance = np.abs(np.log(magnitude[None, :] / und.omega_rad_s[:, None]))
         distance[~np.isfinite(distance)] = 1e6  # a rigid-body mode takes no oscillating eigenvalue
+        from scipy.optimize import linear_sum_assignment
+
         rows, cols = linear_sum_assignment(distance - mac)
         assigned = {int(r): (int(osc[cidx]), float(mac[r, cidx])) for r, cidx in zip(rows, cols)}
     modes = []

@@ -11,16 +11,28 @@ time constants ``tau = 1 / sigma`` of the slowest one every start-up contributio
 
 Rigid-body eigenvalues (``|lambda|`` below :data:`RIGID_FRACTION` of the largest; there are none
 with the rotor held or with the free rotor's rigid rotation removed) are left out.
+
+:func:`settling_time` takes a whole modal analysis (``dtcosim modes``); :func:`drivetrain_settling`
+needs only the eigenvalues and computes nothing else (every run states its settling time: no mode
+matching, no scipy).
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .modes import DrivetrainModalAnalysis
+from ..model.drivetrain import Drivetrain
+from ..model.rotor import RotorParameters
+from .eigen import state_space_matrix
+from .equilibrium import OperatingPoint, linearise
+from .rotor_coupling import coupled
+
+if TYPE_CHECKING:
+    from .modes import DrivetrainModalAnalysis
 
 #: time constants of the slowest mode a window starts after (exp(-5) = 0.7 % of the start-up amplitude)
 N_TIME_CONSTANTS = 5.0
@@ -79,7 +91,31 @@ def settling_time(analysis: DrivetrainModalAnalysis, n_time_constants: float = N
     ValueError
         When no eigenvalue decays (an undamped or unstable drivetrain has no settling time).
     """
-    lam = np.asarray(analysis.state_space.eigenvalues, dtype=complex)
+    return settling_of_eigenvalues(analysis.state_space.eigenvalues, analysis.rotor_held, n_time_constants)
+
+
+def drivetrain_settling(drivetrain: Drivetrain, operating_point: OperatingPoint, stiffness_factor=1.0,
+                        rotor: RotorParameters | None = None,
+                        n_time_constants: float = N_TIME_CONSTANTS) -> Settling:
+    """The settling time of a drivetrain at an operating point, from the eigenvalues of its linearisation alone.
+
+    The same linear model as :func:`components.analysis.modes.drivetrain_modes` (rotor held, or
+    torque-driven with ``rotor``), so the same eigenvalues, and :func:`settling_time` of them.
+
+    Raises
+    ------
+    ValueError
+        As :func:`settling_time`.
+    """
+    model = coupled(linearise(drivetrain, operating_point, stiffness_factor), rotor)
+    eigenvalues = np.linalg.eigvals(state_space_matrix(model.mass, model.damping, model.stiffness))
+    return settling_of_eigenvalues(eigenvalues, rotor is None, n_time_constants)
+
+
+def settling_of_eigenvalues(eigenvalues: np.ndarray, rotor_held: bool,
+                            n_time_constants: float = N_TIME_CONSTANTS) -> Settling:
+    """:class:`Settling` from the eigenvalues of a drivetrain's state-space model (see the module docstring)."""
+    lam = np.asarray(eigenvalues, dtype=complex)
     size = np.abs(lam)
     lam = lam[size > RIGID_FRACTION * float(size.max())]
     sigma = -lam.real
@@ -92,4 +128,4 @@ def settling_time(analysis: DrivetrainModalAnalysis, n_time_constants: float = N
     return Settling(time_s=n_time_constants * tau, time_constant_s=tau, n_time_constants=float(n_time_constants),
                     frequency_hz=abs(slowest) / (2.0 * math.pi) if oscillatory else float("nan"),
                     damping_ratio=s / abs(slowest) if oscillatory else 1.0, oscillatory=bool(oscillatory),
-                    rotor="held" if analysis.rotor_held else "free")
+                    rotor="held" if rotor_held else "free")

@@ -14,8 +14,12 @@ source: the tests compare its results with the just-in-time functions bit for bi
   sources is never loaded; the directory (:func:`aot_directory`) is keyed by the Python ABI and
   the numpy version it was built against.
 * **Building** needs numba and a C compiler (setuptools' compiler: gcc or clang, MSVC on
-  Windows): ~10 s and ~1 MB per kernel, once per machine and source version. It runs in a
-  child process (:func:`build_in_subprocess`), so the builder's numba stays out of the run.
+  Windows) and ~1 MB per kernel, once per machine and source version; it takes tens of seconds
+  of CPU per kernel (numba's optimising compile; ``benchmarks/bench_commands.py --first-run``
+  measures it). It runs in child processes (:func:`build_in_subprocess`), so the builder's numba
+  stays out of the run; or in one detached, low-priority process that outlives the command
+  (:func:`build_in_background`), which the first ``dtcosim run`` of a machine starts so that it
+  does not wait.
 * **Loading** (:func:`load_module`) needs only the file, carried by an FMU beside its copy of
   the kernel's sources or found in the user cache: where it is missing, cannot be imported or
   ``DTCOSIM_AOT=0``, the kernel's owner uses the just-in-time module as before.
@@ -27,6 +31,7 @@ when such a name is asked for.
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import importlib.machinery
 import importlib.util
@@ -37,7 +42,7 @@ import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
-from typing import Callable, Sequence
+from typing import Callable, Iterator, Sequence
 
 from .numba_cache import user_cache_root
 from .sources import KernelSource
@@ -291,8 +296,134 @@ def build_in_subprocess(kernels: Sequence[AotKernel], timeout_s: float = 600.0) 
     return problems[0] if problems else None
 
 
+def build_lock_file() -> Path:
+    """The file that marks a background build in progress: it holds the builder's pid (:func:`build_in_background`)."""
+    return aot_directory() / ".building"
+
+
+def background_builder() -> int | None:
+    """The pid of the background build in progress on this machine (None: none; a dead builder's mark is removed)."""
+    lock = build_lock_file()
+    try:
+        pid = int(lock.read_text(encoding="utf-8").split()[0])
+    except (OSError, ValueError, IndexError):
+        return None
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:  # killed before it could remove its mark
+        lock.unlink(missing_ok=True)
+        return None
+    except PermissionError:  # alive, another user's
+        pass
+    return pid
+
+
+def build_log() -> Path:
+    """Where the background build writes what it did (kernels built, how long, or why not)."""
+    return aot_directory() / "build.log"
+
+
+def build_in_background(kernels: Sequence[AotKernel]) -> int | None:
+    """Build ``kernels`` in one detached process at low priority, one after the other; returns its pid.
+
+    The process outlives the command that starts it (a session of its own, so a Ctrl-C of the
+    command does not reach it), holds :func:`build_lock_file` while it builds (a second builder
+    started meanwhile leaves at once: the first one's pid is returned where it is known) and
+    writes :func:`build_log`. None where nothing can be started (numba missing, an unwritable cache).
+    """
+    if not kernels or importlib.util.find_spec("numba") is None:
+        return None
+    running = background_builder()
+    if running is not None:
+        return running
+    try:
+        build_log().parent.mkdir(parents=True, exist_ok=True)
+        env = {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in sys.path if p)}
+        with open(build_log(), "a", encoding="utf-8") as log:
+            child = subprocess.Popen([sys.executable, "-m", __name__, "--background", str(build_lock_file()),
+                                      *(f"{k.shared}={k.provider}" for k in kernels)],
+                                     stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT, env=env,
+                                     start_new_session=True, close_fds=True)
+    except OSError:
+        return None
+    return child.pid
+
+
+@contextlib.contextmanager
+def build_lock(timeout_s: float = 900.0) -> Iterator[None]:
+    """Be the one builder of this machine's kernels for the block: after a builder in progress has ended (another
+    process's ``dtcosim build``, a background build, a parallel test worker), so that nothing is compiled twice."""
+    import time
+
+    lock = build_lock_file()
+    lock.parent.mkdir(parents=True, exist_ok=True)
+    deadline = time.monotonic() + timeout_s
+    while not _take(lock):
+        if time.monotonic() > deadline:
+            raise TimeoutError(f"the build of pid {background_builder()} ({lock}) did not end in {timeout_s:g} s")
+        time.sleep(0.2)
+    try:
+        yield
+    finally:
+        lock.unlink(missing_ok=True)
+
+
+def _take(lock: Path) -> bool:
+    """Mark this process as the builder (the mark appears whole, with its pid); False if another builder has it."""
+    mine = lock.with_name(f".building.{os.getpid()}")
+    mine.write_text(f"{os.getpid()}\n", encoding="utf-8")
+    try:
+        for _ in range(2):  # once more after removing a dead builder's mark
+            try:
+                os.link(mine, lock)
+                return True
+            except FileExistsError:
+                if background_builder() is not None:
+                    return False
+        return False
+    finally:
+        mine.unlink(missing_ok=True)
+
+
+def _background(lock: Path, items: Sequence[str]) -> int:
+    """The detached builder: each kernel in turn, remembering failures, then its mark removed."""
+    import time
+
+    if not _take(lock):
+        print(f"another build is in progress (pid {background_builder()}): nothing to do", flush=True)
+        return 0
+    try:
+        if hasattr(os, "nice"):
+            os.nice(10)  # the runs of the user go first
+        start = time.perf_counter()
+        for item in items:
+            shared, _, provider = item.partition("=")
+            kernel = AotKernel(shared, provider)
+            if kernel.file().is_file() or failed_before(kernel) is not None:  # built, or failed, by a builder before
+                continue
+            t0 = time.perf_counter()
+            try:
+                path = build_module(kernel)
+            except Exception as exc:  # noqa: BLE001 - recorded: later runs do not retry it each time
+                _remember(kernel, f"{type(exc).__name__}: {exc}")
+                print(f"{kernel.module_name}: not built ({type(exc).__name__}: {exc})", flush=True)
+                continue
+            _remember(kernel, None)
+            print(f"{path}: built in {time.perf_counter() - t0:.1f} s", flush=True)
+        print(f"done in {time.perf_counter() - start:.1f} s (process CPU {time.process_time():.1f} s)", flush=True)
+    finally:
+        lock.unlink(missing_ok=True)
+    return 0
+
+
 def main(argv: Sequence[str]) -> int:
-    """``python -m components.compile.aot SHARED=PROVIDER ...``: build each kernel (providers: see :class:`AotKernel`)."""
+    """``python -m components.compile.aot [--background LOCK] SHARED=PROVIDER ...``: build each kernel.
+
+    Providers: see :class:`AotKernel`. ``--background``: the detached builder of
+    :func:`build_in_background`, which removes ``LOCK`` when it ends.
+    """
+    if argv[:1] == ["--background"]:
+        return _background(Path(argv[1]), argv[2:])
     for item in argv:
         shared, _, provider = item.partition("=")
         path = build_module(AotKernel(shared, provider))

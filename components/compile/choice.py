@@ -21,7 +21,7 @@ from typing import Callable
 
 from ..errors import ParameterError
 from .aot import AotKernel, compiled_or_jit
-from .jit import try_compiled
+from .jit import already_compiled, try_compiled
 from .sources import KernelSource
 
 KERNELS = ("auto", "numpy", "compiled")
@@ -92,7 +92,8 @@ def compiled_module(source: KernelSource, interpreted: ModuleType | None = None,
 
 
 def kernel_module(source: KernelSource, interpreted: ModuleType, kernel: str | None = None,
-                  what: str = "compiled kernel", ahead_of_time: bool = True) -> tuple[ModuleType, str, str | None]:
+                  what: str = "compiled kernel", ahead_of_time: bool = True,
+                  brief: bool = False) -> tuple[ModuleType, str, str | None]:
     """The form of ``source`` to run.
 
     Parameters
@@ -106,6 +107,12 @@ def kernel_module(source: KernelSource, interpreted: ModuleType, kernel: str | N
         What the kernel is, for the note (``"compiled gearbox kernel"``).
     ahead_of_time : bool
         See :func:`compiled_module`.
+    brief : bool
+        For a short evaluation (a static deflection, one Jacobian): with ``auto``, a kernel that is
+        compiled just in time only (``ahead_of_time=False``) runs compiled only where this process has
+        loaded it already, else interpreted: importing numba and loading the machine code from its
+        cache costs about 0.25 s, the interpreted evaluation milliseconds (and compiling it, on a
+        machine's first run, much more).
 
     Returns
     -------
@@ -121,5 +128,7 @@ def kernel_module(source: KernelSource, interpreted: ModuleType, kernel: str | N
     ParameterError
         Unknown name, or ``compiled`` requested where it cannot load.
     """
+    if brief and not ahead_of_time and requested_kernel(kernel) == "auto" and already_compiled(source) is None:
+        return interpreted, "numpy", None
     module, note = compiled_or_numpy(kernel, lambda: compiled_module(source, interpreted, ahead_of_time), what)
     return (interpreted, "numpy", note) if module is None else (module, "compiled", note)

@@ -23,6 +23,7 @@ the interpreted kernel, which is the same files imported normally.
 from __future__ import annotations
 
 import importlib.util
+import os
 import sys
 from types import FunctionType, ModuleType
 
@@ -86,20 +87,38 @@ def load_compiled(source: KernelSource) -> ModuleType:
 #: results of :func:`try_compiled` per kernel version: a module or the reason it could not load
 _attempts: dict[str, tuple[ModuleType | None, str | None]] = {}
 
+#: ``DTCOSIM_JIT=0``: nothing is compiled just in time in this process (a kernel runs from its ahead-of-time module
+#: where one loads, else interpreted); ``dtcosim run`` sets it while the ahead-of-time modules are being built in the
+#: background (:mod:`orchestrator.cosim.compiled_kernels`): compiling just in time costs as much as building them
+JIT_VARIABLE = "DTCOSIM_JIT"
+
+
+def jit_enabled() -> bool:
+    """False where ``DTCOSIM_JIT=0``."""
+    return os.environ.get(JIT_VARIABLE, "1").strip() != "0"
+
 
 def try_compiled(source: KernelSource) -> tuple[ModuleType | None, str | None]:
     """:func:`load_compiled`, tried once per process: the module and None, or None and why it failed.
 
     A failure (numba missing or broken) is remembered, not retried: the caller runs the
-    interpreted kernel instead and says why.
+    interpreted kernel instead and says why. With just-in-time compilation off
+    (:data:`JIT_VARIABLE`) only a module loaded already is returned.
     """
     key = source.shared_name
+    if key not in _attempts and not jit_enabled():
+        return None, f"no module compiled ahead of time, and just-in-time compilation is off ({JIT_VARIABLE}=0)"
     if key not in _attempts:
         try:
             _attempts[key] = (load_compiled(source), None)
         except Exception as exc:  # noqa: BLE001 - the caller runs the interpreted kernel instead and says why
             _attempts[key] = (None, f"{type(exc).__name__}: {exc}")
     return _attempts[key]
+
+
+def already_compiled(source: KernelSource) -> ModuleType | None:
+    """The just-in-time module of ``source`` if this process has loaded it already (nothing is loaded here)."""
+    return _attempts.get(source.shared_name, (None, None))[0]
 
 
 def entry_point(function, argument_types: tuple):

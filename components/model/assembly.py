@@ -500,7 +500,8 @@ class Assembly:
         stiffness_factor : ndarray or float
             Mesh stiffness multiplier.
         kernel : {"auto", "numpy", "compiled"}, optional
-            Form of the kernel.
+            Form of the kernel (``auto``: the interpreted one unless numba's is loaded already: a short
+            evaluation, :func:`components.model.kernel.monolithic`).
 
         Returns
         -------
@@ -516,7 +517,7 @@ class Assembly:
         dq, dv, port_jac = np.zeros((n, n)), np.zeros((n, n)), np.zeros((2, n))
         stks_port = self.STkS_port[:, 0].copy() if self.ports.size else np.zeros(n)
         stcs_port = self.STcS_port[:, 0].copy() if self.ports.size else np.zeros(n)
-        model_kernel.monolithic(kernel)[0].jacobian(
+        model_kernel.monolithic(kernel, brief=True)[0].jacobian(
             y, port, port_rate, factor, self.port_deflection, self.mesh_offset, self.law.table,
             np.zeros((2, m)), self.nz_index, self.nz_value, self.cos_alpha, self.STkS, self.STcS, stks_port, stcs_port, self.inv_inertia, np.zeros(m),
             np.zeros(m), dq, dv, port_jac)
@@ -540,7 +541,8 @@ class Assembly:
         stiffness_factor : float or ndarray, shape (n_mesh,)
             Mesh stiffness multiplier (time-varying stiffness frozen at one phase); 1 = mean.
         kernel : {"auto", "numpy", "compiled"}, optional
-            Form of the kernel.
+            Form of the kernel (``auto``: the interpreted one unless numba's is loaded already: a short
+            evaluation, :func:`components.model.kernel.monolithic`).
         rtol : float
             Converged when the largest generalised-force imbalance is below ``rtol`` times the largest sum of
             generalised-force magnitudes on one body.
@@ -572,7 +574,7 @@ class Assembly:
         n_ext = self.load_matrix.shape[0]
         z = np.zeros(m + 2 * n + 4 + n_ext)
         z[m + 2 * n + 3:m + 2 * n + 3 + n_ext] = self.external_terms(driver_angle_rad, driver_speed_rad_s)
-        status, iterations, imbalance = model_kernel.monolithic(kernel)[0].static_deflection(
+        status, iterations, imbalance = model_kernel.monolithic(kernel, brief=True)[0].static_deflection(
             y, n, float(load_nm), factor, math.copysign(1.0, load_nm), self.A_T, self.port_deflection, self.mesh_offset,
             self.fast_matrix, self.fast_index, self.fast_value, self.law.table, self.nz_index, self.nz_value, self.cos_alpha, self.STkS, self.STcS,
             np.zeros(n), np.zeros(n), self.inv_inertia, z, np.zeros((2, m)), np.zeros(n),

@@ -230,8 +230,8 @@ class ContactLaw:
         """Number of meshes."""
         return len(self.meshes)
 
-    def _many(self) -> object:
-        return kernel.monolithic(self._kernel)[0]
+    def _many(self, evaluations: int) -> object:
+        return kernel.monolithic(self._kernel, brief=evaluations <= kernel.BRIEF_EVALUATIONS)[0]
 
     def evaluate(self, deflection: np.ndarray, rate: np.ndarray,
                  stiffness_factor: np.ndarray | float = 1.0) -> ContactForces:
@@ -252,7 +252,7 @@ class ContactLaw:
         shape = d.shape
         flat = [np.ascontiguousarray(x, dtype=float).reshape(-1, self.size) for x in (d, r, f)]
         out = [np.empty_like(flat[0]) for _ in range(4)]
-        self._many().contact_forces_many(*flat, self.table, *out)
+        self._many(flat[0].size).contact_forces_many(*flat, self.table, *out)
         return ContactForces(*(o.reshape(shape) for o in out))
 
     def force_and_elastic(self, deflection: np.ndarray, rate: np.ndarray,
@@ -266,7 +266,7 @@ class ContactLaw:
         d = np.ascontiguousarray(np.broadcast_to(np.asarray(deflection, dtype=float), np.shape(deflection)))
         flat = d.reshape(-1, self.size)
         out = [np.empty_like(flat) for _ in range(3)]
-        self._many().regularised_many(flat, self.table, *out)
+        self._many(flat.size).regularised_many(flat, self.table, *out)
         return tuple(o.reshape(d.shape) for o in out)
 
     def potential_energy(self, deflection: np.ndarray, nodes: int = 64) -> np.ndarray:

@@ -149,9 +149,11 @@ def _factor_by_phase(phase_rad, contact_ratio, variation, transition: float, all
     out = np.empty(phase.shape)
     flat_phase = phase.reshape(-1, m)
     flat_out = out.reshape(-1, m)
-    for i in range(m):
-        one = MeshPhasing([1.0], [0.0], [columns[0][i]], [columns[1][i]], transition, allow_unit_variation)
-        flat_out[:, i] = one.factors(flat_phase[:, i])[0][:, 0]
+    pairs = np.column_stack(columns)
+    for eps, v in np.unique(pairs, axis=0):  # the meshes of one contact ratio and variation in one evaluation
+        same = np.flatnonzero((pairs[:, 0] == eps) & (pairs[:, 1] == v))
+        one = MeshPhasing([1.0], [0.0], [eps], [v], transition, allow_unit_variation)
+        flat_out[:, same] = one.factors(flat_phase[:, same].ravel())[0][:, 0].reshape(-1, same.size)
     return out.reshape(np.shape(phase_rad)) if np.ndim(phase_rad) else out[0]
 
 
@@ -213,7 +215,8 @@ class MeshPhasing:
         angles = np.ascontiguousarray(np.atleast_1d(np.asarray(driver_angles_rad, dtype=float)))
         factor = np.empty((angles.size, self.table.shape[1]))
         slope = np.empty_like(factor)
-        model_kernel.monolithic(kernel)[0].stiffness_factors_many(angles, self.table, factor, slope)
+        brief = factor.size <= model_kernel.BRIEF_EVALUATIONS
+        model_kernel.monolithic(kernel, brief=brief)[0].stiffness_factors_many(angles, self.table, factor, slope)
         return factor, slope
 
     def factor(self, driver_angle_rad: float) -> np.ndarray:

@@ -14,6 +14,7 @@ from components.model.presets import PRESETS
 from fmus.registry import PRESET, names_built_from
 
 from ..provision.folders import default_fmu_dir
+from .catalogue import help_line
 
 #: the FMUs built from a preset, in the registry's order
 PRESET_FMUS = names_built_from(PRESET)
@@ -24,7 +25,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     fmus = ", ".join(PRESET_FMUS)
     p = sub.add_parser(
         "build",
-        help=f"build the FMUs {fmus}",
+        help=help_line("build"),
         description=(f"Build the self-contained pythonfmu FMUs {fmus} into the FMU folder `dtcosim run` searches "
                      f"({default_fmu_dir()}; $DTCOSIM_FMU_DIR sets it) or into --out. With --drivetrain FILE: the "
                      "FMUs of that drivetrain file, by default into the FMU folder's folder of the file's content "

@@ -22,6 +22,7 @@ from components.compile.user_cache import user_cache_root
 from components.model.kernel import KERNELS
 
 from ..cosim.compiled_kernels import aot_kernels
+from .catalogue import help_line
 
 
 @dataclass(frozen=True)
@@ -69,7 +70,7 @@ def cache_entries(root: Path | None = None) -> list[CacheEntry]:
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``cache`` subcommand."""
-    p = sub.add_parser("cache", help="list the per-user cache of compiled kernels; --prune removes stale entries",
+    p = sub.add_parser("cache", help=help_line("cache"),
                        description=__doc__.splitlines()[0].split(": ", 1)[1])
     p.add_argument("--prune", action="store_true",
                    help="delete every entry the installed dtcosim, Python, numpy and numba would not load")

@@ -2,7 +2,9 @@
 
 Each subcommand lives in its own module exposing ``register(subparsers)``,
 which adds an argparse sub-parser whose ``func`` attribute runs the command
-and returns the process exit code.
+and returns the process exit code. Only the module of the command that runs is
+imported; the others are listed by name and help line
+(:mod:`orchestrator.commands.catalogue`).
 """
 
 from __future__ import annotations
@@ -14,29 +16,16 @@ import importlib
 import os
 import signal
 import sys
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 
 from components.errors import DtcosimError
 
 from ..cosim.stop_requests import STOP_SIGNALS
 from ..import_safe_signals import install, restore
+from .catalogue import COMMANDS
 
 #: set (to anything) to see the traceback of an unexpected error instead of its one line
 DEBUG_VARIABLE = "DTCOSIM_DEBUG"
-
-#: modules providing subcommands, in help order
-COMMAND_MODULES = (
-    "orchestrator.commands.run",
-    "orchestrator.commands.export_ssp",
-    "orchestrator.commands.reference",
-    "orchestrator.commands.build",
-    "orchestrator.commands.validate",
-    "orchestrator.commands.modes",
-    "orchestrator.commands.cache",
-    "orchestrator.commands.drivetrain",
-    "orchestrator.commands.sweep",
-    "orchestrator.commands.loads",
-)
 
 
 def _version_text() -> str:
@@ -57,8 +46,21 @@ class _VersionAction(argparse.Action):
         parser.exit()
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The ``dtcosim`` argument parser with every registered subcommand."""
+def command_named(argv: Sequence[str]) -> str | None:
+    """The subcommand ``argv`` runs: its first word, unless help is asked for before it (None: no command)."""
+    for word in argv:
+        if word in ("-h", "--help"):
+            return None
+        if not word.startswith("-"):
+            return word
+    return None
+
+
+def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
+    """The ``dtcosim`` argument parser: every subcommand listed, the one ``argv`` names registered by its module.
+
+    Without ``argv`` every command's module registers its sub-parser (all imported).
+    """
     parser = argparse.ArgumentParser(
         prog="dtcosim",
         description="Wind-turbine drivetrain torsional vibration as an FMI 2.0 co-simulation.",
@@ -66,8 +68,12 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action=_VersionAction, nargs=0,
                         help="print the versions of dtcosim and of what its results depend on, and exit")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    for name in COMMAND_MODULES:
-        importlib.import_module(name).register(sub)
+    wanted = None if argv is None else command_named(argv)
+    for command in COMMANDS:
+        if argv is None or command.name == wanted:
+            importlib.import_module(command.module).register(sub)
+        else:  # listed with its help line; its module is not imported
+            sub.add_parser(command.name, help=command.help, add_help=False)
     return parser
 
 
@@ -115,8 +121,9 @@ def main(argv: list[str] | None = None) -> int:
     """
     with _command_signals():
         args = argparse.Namespace(command=None)
+        argv = sys.argv[1:] if argv is None else list(argv)
         try:
-            parser = build_parser()
+            parser = build_parser(argv)
             args = parser.parse_args(argv)
             if not getattr(args, "func", None):
                 parser.print_help()

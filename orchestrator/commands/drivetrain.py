@@ -5,10 +5,13 @@ from __future__ import annotations
 import argparse
 import json
 
+from .catalogue import help_line
+
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``drivetrain`` subcommand (``show``)."""
-    p = sub.add_parser("drivetrain", help="drivetrain description files: show the derived design table",
+    p = sub.add_parser("drivetrain", help=help_line("drivetrain"),
                        description="Work with drivetrain description files (TOML; see docs/drivetrains.md).")
     actions = p.add_subparsers(dest="action", metavar="ACTION")
     show = actions.add_parser(

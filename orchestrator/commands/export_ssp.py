@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 from . import scenario_options
+from .catalogue import help_line
 from .fmu_options import add_fmu_arguments
 
 
@@ -14,7 +15,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``export-ssp`` subcommand."""
     p = sub.add_parser(
         "export-ssp",
-        help="export a scenario with its FMUs as an SSP 1.0 archive (.ssp)",
+        help=help_line("export-ssp"),
         description=(
             "Write SCENARIO (TOML, SSP or packaged name; default paper-60s) as an SSP 1.0 archive: "
             "SystemStructure.ssd with components, connectors, parameter values, connections, the fixed-step "

@@ -9,12 +9,13 @@ continues).
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 from dataclasses import replace
 from pathlib import Path
 
-from .cluster_options import add_cluster_arguments, check_cluster_arguments, check_workers
+from .catalogue import help_line
+from .cluster_options import add_cluster_arguments, check_cluster_arguments, check_workers, ran
+from .cluster_options import where as cluster_where
 from .fmu_options import add_fmu_arguments
 from .scenario_options import add_allow_argument, allow_implausible
 
@@ -23,7 +24,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``loads`` subcommand."""
     p = sub.add_parser(
         "loads",
-        help="run a load-case set (wind-speed bins x seeds) and write lifetime DELs, Miner damage, LDD and LRD",
+        help=help_line("loads"),
         description=(
             "Run every case of a load-case set (each wind-speed bin at its operating point, with several seeds) "
             "on Dask workers (a LocalCluster by default, or an existing cluster), then weight the runs by the wind "
@@ -190,7 +191,7 @@ def run(args: argparse.Namespace) -> int:
         say(f"{lcs.name}: some finished runs have lost their run files in {out_dir}/runs: they run again")
     prepared = replace(prepared, payload=replace(prepared.payload, progress_topic=f"dtcosim-loads-{uuid.uuid4().hex[:8]}"))
     plc = replace(plc, prepared=prepared)
-    where = f"scheduler {args.scheduler}" if args.scheduler else f"a LocalCluster of {args.workers or os.cpu_count()} workers"
+    where = cluster_where(args)
     labels = {c.index: f"run {c.index} {plc.bins[c.bin].label} seed {c.seed}" for c in plc.cases}
     bars: dict[str, _Progress] = {}
 
@@ -213,7 +214,8 @@ def run(args: argparse.Namespace) -> int:
     try:
         report = run_sweep(prepared, out_dir, workers=args.workers, scheduler=args.scheduler,
                            retry_failed=args.retry_failed, progress=finished, on_start=on_start, plots=False,
-                           dashboard=args.dashboard, on_result=store_run_data(plc, out_dir), case_progress=case)
+                           dashboard=args.dashboard, executor=args.executor, on_result=store_run_data(plc, out_dir),
+                           case_progress=case)
     finally:
         if "p" in bars:
             bars["p"].close()
@@ -234,7 +236,7 @@ def run(args: argparse.Namespace) -> int:
         if report.submitted:
             finished_n = report.ok + report.failed + report.errors
             print(f"{lcs.name}: {finished_n} of {report.submitted} submitted runs finished ({report.ok} ok, "
-                  f"{report.failed} failed, {report.errors} errors) on {report.workers} workers in "
+                  f"{report.failed} failed, {report.errors} errors) {ran(report)} in "
                   f"{report.compute_time_s:.2f} s; {report.skipped} skipped (already in the journal)")
         else:
             print(f"{lcs.name}: nothing to run, all {report.skipped} runs are in the journal")

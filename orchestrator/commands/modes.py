@@ -28,6 +28,7 @@ from components.errors import ParameterError
 from components.model.presets import PRESETS, preset
 from components.units import rpm
 
+from .catalogue import help_line
 from .fmu_options import add_fmu_arguments
 
 
@@ -35,7 +36,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``modes`` subcommand."""
     p = sub.add_parser(
         "modes",
-        help="natural frequencies, damping and mode shapes at an operating point; Campbell diagram",
+        help=help_line("modes"),
         description=(
             "Linearise the drivetrain about its static equilibrium at a rotor speed and generator "
             "torque (same matrices as the simulation), print the modal table and write modes.csv, "

@@ -9,12 +9,14 @@ from pathlib import Path
 
 from components.reference.cases import CASES, TABLE7_PAPER
 
+from .catalogue import help_line
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``reference`` subcommand."""
     p = sub.add_parser(
         "reference",
-        help="run a paper case (Table 2, Table 4, Fig. 10-11, Table 7) with the monolithic solver",
+        help=help_line("reference"),
         description="Run one of the paper's cases with the monolithic (LSODA) reference solver and print its statistics.",
     )
     p.add_argument("--case", choices=sorted(CASES), default=None, help="paper case (default: table7)")

@@ -15,6 +15,7 @@ from pathlib import Path
 
 from ..inputs.results_format import RESULTS_FORMATS
 from . import scenario_options
+from .catalogue import help_line
 from .fmu_options import add_fmu_arguments
 
 
@@ -22,7 +23,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``run`` subcommand."""
     p = sub.add_parser(
         "run",
-        help="run a co-simulation scenario (default: the paper's 60 s scenario) and write results and plots",
+        help=help_line("run"),
         description=(
             "Run a co-simulation scenario through its FMUs with the fixed-step master and write "
             "timeseries.csv (or timeseries.parquet for long runs, see --results), summary.json and PNG plots. SCENARIO is a TOML file, an .ssp/.ssd file, or the "
@@ -84,7 +85,7 @@ def checked_system(scenario, fmu_dir, build: bool, command: str, say):
     from ..provision.project_fmus import ensure_fmus
     from ..provision.staleness import stale_project_fmus
 
-    paths = ensure_fmus(scenario, fmu_dir, build=build, report=say)
+    paths = ensure_fmus(scenario, fmu_dir, build=build, report=say, kernels_in_background=True)
     for warning in stale_project_fmus(paths):
         print(f"dtcosim {command}: warning: {warning}", file=sys.stderr)
     system = resolve_system(scenario, fmu_paths=paths)

@@ -14,7 +14,9 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
-from .cluster_options import add_cluster_arguments, check_cluster_arguments, check_workers
+from .catalogue import help_line
+from .cluster_options import add_cluster_arguments, check_cluster_arguments, check_workers, ran
+from .cluster_options import where as cluster_where
 from .fmu_options import add_fmu_arguments
 from .scenario_options import add_allow_argument, allow_implausible
 
@@ -23,7 +25,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``sweep`` subcommand."""
     p = sub.add_parser(
         "sweep",
-        help="run a parameter study (grid, explicit points, seeds) on Dask workers and write a table and plots",
+        help=help_line("sweep"),
         description=(
             "Run every point of a study on Dask workers (a LocalCluster by default, or an existing cluster) "
             "with the co-simulation or the monolithic engine, and write journal.jsonl (one line per finished "
@@ -110,7 +112,7 @@ def run(args: argparse.Namespace) -> int:
         return 0
 
     check_cluster_arguments(args, "sweep")
-    where = f"scheduler {args.scheduler}" if args.scheduler else f"a LocalCluster of {args.workers or os.cpu_count()} workers"
+    where = cluster_where(args)
     bar = None
     progress = None
 
@@ -129,7 +131,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         report = run_sweep(prepared, out_dir, workers=args.workers, scheduler=args.scheduler,
                            retry_failed=args.retry_failed, progress=forward, on_start=on_start,
-                           plots=not args.no_plots, dashboard=args.dashboard)
+                           plots=not args.no_plots, dashboard=args.dashboard, executor=args.executor)
     finally:
         if bar is not None:
             bar.close()
@@ -138,7 +140,7 @@ def run(args: argparse.Namespace) -> int:
         finished = report.ok + report.failed + report.errors
         if report.submitted:
             print(f"{study.name}: {finished} of {report.submitted} submitted points finished ({report.ok} ok, "
-                  f"{report.failed} failed, {report.errors} errors) on {report.workers} workers in "
+                  f"{report.failed} failed, {report.errors} errors) {ran(report)} in "
                   f"{report.compute_time_s:.2f} s (whole command {report.wall_time_s:.2f} s); "
                   f"{report.skipped} skipped (already in the journal)")
         else:

@@ -25,13 +25,14 @@ from fmus.validation import check_fmu, fmu_files, is_dtcosim_fmu
 
 from ..archive_members import shown_path
 from ..provision.folders import default_fmu_dir
+from .catalogue import help_line
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``validate`` subcommand."""
     p = sub.add_parser(
         "validate",
-        help="validate FMUs (fmpy validation, conventions, declared requirements against this environment)",
+        help=help_line("validate"),
         description=("Validate FMU files, or every *.fmu in the given directories, and check this environment "
                      "against each FMU's declared requirements; exit code 1 on any problem."),
     )

@@ -3,19 +3,39 @@
 :mod:`components.compile.aot` compiles each kernel's entry points into an extension module
 that imports without numba, so a run's process (host and in-process FMUs) carries no numba
 and llvmlite (~75 MB less resident memory, ~0.5 s less start-up: ``bench_long_run.py``).
-:func:`ensure_compiled_kernels` builds the missing ones in a child process; ``dtcosim
-build`` and ``dtcosim run`` (whenever it may build FMUs) call it. Where it cannot build (no
-numba, no C compiler) it says so once and the kernels run just in time, as before.
+:func:`ensure_compiled_kernels` builds the missing ones: ``dtcosim build`` waits for them;
+``dtcosim run`` (whenever it may build FMUs) starts their build in the background and steps
+this run's kernels interpreted meanwhile (compiling them just in time would cost as much as
+the build), so that the first run of a machine does not wait for a compiler. Where they
+cannot be built (no numba, no C compiler) it says so once and the kernels run just in time,
+as before.
 """
 
 from __future__ import annotations
 
+import os
+import time
 from typing import Callable
 
-from components.compile.aot import AotKernel, aot_directory, build_in_subprocess, enabled, failed_before, missing
+from components.compile.aot import (
+    AotKernel,
+    aot_directory,
+    background_builder,
+    build_in_background,
+    build_in_subprocess,
+    build_lock,
+    build_log,
+    enabled,
+    failed_before,
+    missing,
+)
+from components.compile.jit import JIT_VARIABLE
 from components.model.kernel import AHEAD_OF_TIME
 
 from .stepping.compiled_loop import aot_loop_kernel
+
+#: how long a build waits for another process's build of the kernels to end [s]
+WAIT_FOR_BACKGROUND_S = 900.0
 
 
 def aot_kernels() -> tuple[AotKernel, ...]:
@@ -23,17 +43,31 @@ def aot_kernels() -> tuple[AotKernel, ...]:
     return (*(AotKernel.of(source) for source in AHEAD_OF_TIME), aot_loop_kernel())
 
 
-def ensure_compiled_kernels(report: Callable[[str], None] | None = None, retry: bool = False) -> str | None:
+def ensure_compiled_kernels(report: Callable[[str], None] | None = None, retry: bool = False,
+                            background: bool = False) -> str | None:
     """Build the kernels missing in :func:`~components.compile.aot.aot_directory`.
 
     A kernel version whose build failed on this machine before (no C compiler, say) is not
     retried on every run, only with ``retry`` (``dtcosim build``) or once its sources change.
 
+    Parameters
+    ----------
+    report : callable(str), optional
+        Receives what happens, in one line each.
+    retry : bool
+        Build also the kernels whose build failed before.
+    background : bool
+        Start the build in a detached process (:func:`~components.compile.aot.build_in_background`;
+        one already running is not started again) and return at once; until the modules are there,
+        this process compiles nothing just in time (``DTCOSIM_JIT=0`` for it and its FMUs and
+        workers): its kernels run interpreted. False: build now (after a build in the background,
+        if one runs) and return when done.
+
     Returns
     -------
     str or None
-        None when every kernel is there (or ``DTCOSIM_AOT=0``); else why they could not be built
-        (also given to ``report``; the run goes on with numba's just-in-time kernels).
+        None when every kernel is there (or ``DTCOSIM_AOT=0``); else why they are not (being built
+        in the background, or could not be built: the run goes on with numba's just-in-time kernels).
     """
     if not enabled():
         return None
@@ -51,10 +85,38 @@ def ensure_compiled_kernels(report: Callable[[str], None] | None = None, retry: 
                 return problem
     if not todo:
         return None
+    if background:
+        return _in_background(todo, report)
+    running = background_builder()
+    if running is not None and report:
+        report(f"waiting for the kernels being compiled ahead of time by another process (pid {running}) ...")
+    try:
+        with build_lock(WAIT_FOR_BACKGROUND_S):  # one builder at a time: what another built is not built again
+            todo = [k for k in missing(aot_kernels()) if retry or failed_before(k) is None]
+            if not todo:
+                return None
+            if report:
+                report(f"compiling {len(todo)} kernel(s) ahead of time into {aot_directory()} (once per machine and "
+                       "version) ...")
+            start = time.perf_counter()
+            problem = build_in_subprocess(todo)
+    except (OSError, TimeoutError) as exc:  # an unwritable cache, a builder that never ends: just in time instead
+        problem = f"{type(exc).__name__}: {exc}"
     if report:
-        report(f"compiling {len(todo)} kernel(s) ahead of time into {aot_directory()} (once per machine and "
-               "version, ~15 s) ...")
-    problem = build_in_subprocess(todo)
-    if problem and report:
-        report(f"kernels not compiled ahead of time ({problem}); numba compiles them just in time instead")
+        report(f"kernels not compiled ahead of time ({problem}); numba compiles them just in time instead" if problem
+               else f"compiled {len(todo)} kernel(s) ahead of time in {time.perf_counter() - start:.0f} s")
     return problem
+
+
+def _in_background(todo: list[AotKernel], report: Callable[[str], None] | None) -> str:
+    """The build of ``todo`` in the background (started, or already running), and this process's kernels interpreted."""
+    running = background_builder()
+    pid = running if running is not None else build_in_background(todo)
+    if pid is None:  # numba missing or an unwritable cache: numba compiles them just in time, as before
+        return "the kernels could not be compiled in the background"
+    os.environ[JIT_VARIABLE] = "0"  # compiling them just in time now would cost as much as the build
+    if report:
+        what = (f"the kernels are still being compiled ahead of time in the background (pid {pid}" if running is not None
+                else f"compiling {len(todo)} kernel(s) ahead of time in the background for later runs (pid {pid}")
+        report(f"{what}, log {build_log()}); until they are built, runs step them interpreted, which takes longer")
+    return f"being compiled in the background (pid {pid})"

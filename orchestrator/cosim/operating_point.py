@@ -17,8 +17,7 @@ from dataclasses import dataclass, replace
 from typing import Any, Mapping
 
 from components.analysis.equilibrium import OperatingPoint
-from components.analysis.modes import drivetrain_modes
-from components.analysis.settling import Settling, settling_time
+from components.analysis.settling import Settling, drivetrain_settling
 from components.model.drivetrain import Drivetrain
 from components.model.generator import GeneratorParameters
 from components.model.rotor import RotorParameters
@@ -92,7 +91,7 @@ def settling_of(system: ResolvedSystem, start_values: Mapping[str, Any] | None =
     """
     try:
         start = drivetrain_at_start(system, start_values)
-        return settling_time(drivetrain_modes(start.drivetrain, start.operating_point, rotor=start.rotor))
+        return drivetrain_settling(start.drivetrain, start.operating_point, rotor=start.rotor)
     except PhysicsUnavailable:
         return None
     except (ValueError, ArithmeticError, KeyError):

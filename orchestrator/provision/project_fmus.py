@@ -27,12 +27,12 @@ from ..inputs.scenario import Scenario
 from .drivetrain_fmus import ensure_drivetrain_fmus
 from .folders import default_fmu_dir
 from .locate import missing_fmus, resolve_fmu_paths
-from .staleness import broken_fmu
+from .staleness import broken_fmu, stale_project_fmus
 from .series_fmus import ensure_series_fmu
 
 
 def ensure_fmus(scenario: Scenario, fmu_dir: str | Path | None = None, build: bool = True,
-                report: Callable[[str], None] | None = None) -> dict[str, Path]:
+                report: Callable[[str], None] | None = None, kernels_in_background: bool = False) -> dict[str, Path]:
     """Resolve every FMU path, building the project's missing FMUs first.
 
     Parameters
@@ -44,6 +44,11 @@ def ensure_fmus(scenario: Scenario, fmu_dir: str | Path | None = None, build: bo
         Build missing project FMUs into ``fmu_dir``; if False a missing FMU is an error.
     report : callable(str), optional
         Receives progress messages ("building Gearbox.fmu ...").
+    kernels_in_background : bool
+        Missing compiled kernels: built in the background while this process runs them
+        interpreted (``dtcosim run``: one run does not pay for a machine's compile), instead of
+        built before anything else (studies, whose many points would all run interpreted);
+        see :func:`~orchestrator.cosim.compiled_kernels.ensure_compiled_kernels`.
 
     Returns
     -------
@@ -55,9 +60,11 @@ def ensure_fmus(scenario: Scenario, fmu_dir: str | Path | None = None, build: bo
     ScenarioError
         ``components.<name>.fmu`` for a missing FMU that cannot be built.
     """
+    managed = fmu_dir is None  # the project's own FMU folder: what is stale there is rebuilt, not only reported
     fmu_dir = default_fmu_dir() if fmu_dir is None else Path(fmu_dir)
     if build:
-        ensure_compiled_kernels(report)  # the kernels the FMUs and the master step, once per machine
+        # the kernels the FMUs and the master step, once per machine
+        ensure_compiled_kernels(report, background=kernels_in_background)
         wanted: dict[str, tuple[DrivetrainSpec, list[str]]] = {}
         for comp in scenario.components:
             if comp.drivetrain is not None:
@@ -68,9 +75,9 @@ def ensure_fmus(scenario: Scenario, fmu_dir: str | Path | None = None, build: bo
         for comp in scenario.components:
             if comp.series is not None:
                 ensure_series_fmu(comp.series, fmu_dir, report)
-        if _missing_preset_fmus(scenario, fmu_dir):
+        if _missing_preset_fmus(scenario, fmu_dir, managed):
             with build_lock(fmu_dir, report):  # decided again and built by one process at a time
-                names = _missing_preset_fmus(scenario, fmu_dir)  # another process may have built them meanwhile
+                names = _missing_preset_fmus(scenario, fmu_dir, managed)  # another process may have built them
                 if names:
                     if report:
                         report(f"building {', '.join(n + '.fmu' for n in names)} into {fmu_dir} ...")
@@ -78,11 +85,16 @@ def ensure_fmus(scenario: Scenario, fmu_dir: str | Path | None = None, build: bo
     return resolve_fmu_paths(scenario, fmu_dir)
 
 
-def _missing_preset_fmus(scenario: Scenario, fmu_dir: Path) -> list[str]:
+def _missing_preset_fmus(scenario: Scenario, fmu_dir: Path, rebuild_stale: bool) -> list[str]:
     """The project FMUs built from a preset that ``fmu_dir`` lacks or holds broken (an interrupted build of an
-    older version), by model name."""
+    older version) or, with ``rebuild_stale`` (the project's own folder), built from other code than the
+    installed dtcosim (after an upgrade), by model name. In a folder the user names a stale FMU is kept and
+    reported (:func:`~orchestrator.provision.staleness.stale_project_fmus`)."""
+    def replaced(path: Path) -> bool:
+        return bool(broken_fmu(path) or (rebuild_stale and stale_project_fmus({path.stem: path})))
+
     broken = [comp.name for comp in scenario.components if (fmu_dir / comp.fmu.name).is_file()
-              and _preset_fmu(scenario, comp.name) is not None and broken_fmu(fmu_dir / comp.fmu.name)]
+              and _preset_fmu(scenario, comp.name) is not None and replaced(fmu_dir / comp.fmu.name)]
     return sorted({_preset_fmu(scenario, comp) for comp in [*missing_fmus(scenario, fmu_dir), *broken]} - {None})
 
 

@@ -435,9 +435,9 @@ def format_analyses(summary: dict[str, Any]) -> str:
             lines += fit_table(["mesh", "separations", "flank changes", "in backlash", "longest"], rows)
     sharing = summary.get("load_sharing")
     if sharing:
-        lines.append("planet load sharing (largest planet sun-mesh force / mean, max over the window): " + ", ".join(
-            f"{stage.partition('.')[2] or stage} {s['factor']:.4f} (planet {s['most_loaded_planet']})"
-            for stage, s in sharing["stages"].items()))
+        lines.append("planet load sharing (largest planet sun-mesh force / mean, max over the window):")
+        lines += [f"  {stage.partition('.')[2] or stage} {s['factor']:.4f} (planet {s['most_loaded_planet']})"
+                  for stage, s in sharing["stages"].items()]
     fat = summary.get("fatigue")
     if fat:
         exps = [f"m={m:g}" for m in fat["wohler_exponents"]]

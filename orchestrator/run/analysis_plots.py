@@ -1,6 +1,7 @@
 """PNG plots of a run's analyses: contact-force spectra, load duration distributions, load events.
 
-matplotlib with the Agg backend (no display needed). Every function takes the
+matplotlib's figure API on the Agg canvas (no display, no pyplot), each figure in a
+fixed layout drawn once (:mod:`orchestrator.plotting`). Every function takes the
 plain result objects of :mod:`components.analysis.fatigue` and
 :mod:`components.analysis.spectrum` (or arrays) and a path, writes one PNG and returns the path.
 """
@@ -10,16 +11,17 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Mapping, Sequence
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+from components.analysis.load_duration import LoadDurationDistribution
+from components.analysis.spectrum import amplitude_spectrum
 
-from components.analysis.load_duration import LoadDurationDistribution  # noqa: E402
-from components.analysis.spectrum import amplitude_spectrum  # noqa: E402
+from ..plotting import Margins, axes_pixels, envelope, new_figure, save_figure, shade_inside_backlash
 
-from ..plotting import close_figure, envelope, shade_inside_backlash  # noqa: E402
+#: a title above and an x label below every panel
+_PANEL_MARGINS = Margins(top=0.35, hspace=0.75)
+#: panels sharing the time axis under one title
+_STACK_MARGINS = Margins(top=0.4, hspace=0.15)
 
 
 def plot_force_spectra(
@@ -49,26 +51,24 @@ def plot_force_spectra(
     t = np.asarray(time_s, dtype=float)
     sel = np.ones(t.size, bool) if window is None else (t >= window[0]) & (t <= window[1])
     dt = float(np.median(np.diff(t[sel])))
-    fig, axes = plt.subplots(len(series), 1, figsize=(10, 2.6 * len(series)), squeeze=False)
-    cmap = plt.get_cmap("tab10")
-    for ax, (name, x) in zip(axes[:, 0], series.items()):
+    fig, axes = new_figure(len(series), height=2.6 * len(series) + 0.4, sharex=False, margins=_PANEL_MARGINS)
+    for ax, (name, x) in zip(axes, series.items()):
         f, amp = amplitude_spectrum(np.asarray(x)[sel], dt)
         if max_frequency_hz:  # only the shown band, drawn as its envelope (every peak kept)
             band = f <= max_frequency_hz * 1.001
             f, amp = f[band], amp[band]
-        ax.semilogy(*envelope(f[1:], np.maximum(amp[1:], 1e-12)), lw=0.8, color="black")
+        ax.semilogy(*envelope(f[1:], np.maximum(amp[1:], 1e-12), axes_pixels(ax)), lw=0.8, color="black")
         for k, (label, fm) in enumerate((mesh_frequencies_hz or {}).items()):
-            ax.axvline(fm, ls="--", lw=1.0, color=cmap(k % 10), label=f"{label} {fm:.4g} Hz")
+            ax.axvline(fm, ls="--", lw=1.0, color=f"C{k % 10}", label=f"{label} {fm:.4g} Hz")
         ax.set_ylabel(f"|{name}| [N]")
         ax.set_xlim(0.0, max_frequency_hz or f[-1])
         ax.grid(True, which="both", alpha=0.25)
         if mesh_frequencies_hz:
             ax.legend(fontsize=7, loc="upper right")
-    axes[-1, 0].set_xlabel("frequency [Hz]")
+    axes[-1].set_xlabel("frequency [Hz]")
     fig.suptitle(f"Contact-force amplitude spectra (Hann window, {t[sel][-1] - t[sel][0]:.3g} s, "
                  f"resolution {1.0 / (t[sel][-1] - t[sel][0]):.3g} Hz)", fontsize=10)
-    fig.tight_layout()
-    return close_figure(fig, path)
+    return save_figure(fig, Path(path))
 
 
 def plot_load_duration(ldds: Sequence[LoadDurationDistribution], path: str | Path) -> Path:
@@ -77,14 +77,30 @@ def plot_load_duration(ldds: Sequence[LoadDurationDistribution], path: str | Pat
     Torques are drawn in kN m (forces in kN); the log time axis shows the rare extreme
     loads (e.g. of a load event) next to the hours-equivalent of normal operation.
     """
-    fig, axes = plt.subplots(len(ldds), 1, figsize=(9, 2.5 * len(ldds)), squeeze=False)
-    for ax, ld in zip(axes[:, 0], ldds):
+    from matplotlib.collections import PolyCollection
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+    fig, axes = new_figure(len(ldds), height=2.5 * len(ldds) + 0.2, sharex=False, margins=_PANEL_MARGINS)
+    for ax, ld in zip(axes, ldds):
         scale, unit = (1e-3, "kN m") if ld.unit in ("N.m", "N m") else (1e-3, "kN") if ld.unit == "N" else (1.0, ld.unit)
         edges = ld.edges * scale
-        centres = 0.5 * (edges[1:] + edges[:-1])
         keep = ld.time_s > 0.0
-        ax.bar(centres[keep], ld.time_s[keep], width=np.diff(edges)[keep], color="tab:blue", edgecolor="none")
         ax.set_yscale("log")
+        # decades labelled as plain numbers, minor lines at 2 and 5 (mathematical text and eight unlabelled
+        # minor ticks per decade cost half of each panel's drawing)
+        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.yaxis.set_minor_locator(LogLocator(subs=(2.0, 5.0)))
+        ax.yaxis.set_minor_formatter(NullFormatter())
+        if keep.any():  # one bar per non-empty bin, drawn as one collection, from below the axis up
+            time_s = ld.time_s[keep]
+            low, high = float(time_s.min()), float(time_s.max())
+            bottom = 10.0 ** np.floor(np.log10(low) - 0.05)
+            left, right = edges[:-1][keep], edges[1:][keep]
+            bars = np.stack([np.column_stack([left, np.full_like(left, bottom * 1e-3)]),
+                             np.column_stack([left, time_s]), np.column_stack([right, time_s]),
+                             np.column_stack([right, np.full_like(left, bottom * 1e-3)])], axis=1)
+            ax.add_collection(PolyCollection(bars, facecolors="tab:blue", edgecolors="none", linewidths=0.0))
+            ax.set_ylim(bottom, high * 10.0 ** 0.1)
         ax.set_xlim(edges[0], edges[-1])
         ax.set_xlabel(f"{ld.name} [{unit}]")
         ax.set_ylabel("time in bin [s]")
@@ -92,8 +108,7 @@ def plot_load_duration(ldds: Sequence[LoadDurationDistribution], path: str | Pat
         ax.set_title(f"{ld.name}: load duration distribution ({ld.analysed_time_s:.4g} s analysed, "
                      f"{edges.size - 1} bins of {np.diff(edges).mean():.3g} {unit}{extra})", fontsize=9)
         ax.grid(True, which="both", alpha=0.25)
-    fig.tight_layout()
-    return close_figure(fig, path)
+    return save_figure(fig, Path(path))
 
 
 def plot_event_response(
@@ -132,15 +147,13 @@ def plot_event_response(
     sel = (t >= span[0]) & (t <= span[1])
     ts = t[sel]
     n = 1 + len(forces)
-    fig, axes = plt.subplots(n, 1, figsize=(10, 2.3 * n + 0.6), sharex=True, squeeze=False)
-    axes = axes[:, 0]
+    fig, axes = new_figure(n, height=2.3 * n + 0.6, margins=_STACK_MARGINS)
     for ax in axes:
         for k, (label, a, b) in enumerate(events):
             ax.axvspan(a, min(b, span[1]), color="gold", alpha=0.25, lw=0, label=label if ax is axes[0] else None)
         ax.grid(True, alpha=0.3)
-    cmap = plt.get_cmap("tab10")
     for k, (name, y) in enumerate(torques.items()):
-        axes[0].plot(ts, np.asarray(y)[sel] * 1e-3, lw=1.2, color=cmap(k), label=name)
+        axes[0].plot(ts, np.asarray(y)[sel] * 1e-3, lw=1.2, color=f"C{k % 10}", label=name)
     axes[0].axhline(0.0, color="black", lw=0.6)
     axes[0].set_ylabel("torque [kN m]")
     axes[0].legend(fontsize=7.5, loc="upper right", ncol=2)
@@ -154,5 +167,4 @@ def plot_event_response(
     axes[-1].set_xlabel("time [s]")
     axes[-1].set_xlim(*span)
     fig.suptitle("Response to generator load events (torques and one contact force per stage)", fontsize=10)
-    fig.tight_layout()
-    return close_figure(fig, path)
+    return save_figure(fig, Path(path))

@@ -59,8 +59,10 @@ def reference_name(column: str, system: ResolvedSystem, view: PhysicsView,
     return name if name in series else None
 
 
-def run_reference(system: ResolvedSystem, view: PhysicsView | None = None) -> SimulationResult:
+def run_reference(system: ResolvedSystem, view: PhysicsView | None = None, settings=None) -> SimulationResult:
     """The monolithic solution on the scenario's time grid (start, stop, output interval), started where the Gearbox is.
+
+    ``settings``: the solver's tolerances (:class:`components.reference.solver.SolverSettings`; default its own).
 
     Raises
     ------
@@ -74,7 +76,7 @@ def run_reference(system: ResolvedSystem, view: PhysicsView | None = None) -> Si
     sim = system.scenario.simulation
     return simulate_monolithic(
         setup.drivetrain, RotorSpeedProcess(setup.wind), sim.stop_s,
-        output_interval_s=sim.output_interval_s, t_start_s=sim.start_s, start=setup.start,
+        output_interval_s=sim.output_interval_s, t_start_s=sim.start_s, start=setup.start, settings=settings,
     )
 
 

@@ -23,7 +23,10 @@ from ..cosim.resolved import ResolvedSystem
 from ..plotting import (
     MESH_KIND_STYLES,
     RPM_PER_RAD_S,
+    Margins,
+    axes_pixels,
     envelope,
+    legend_room,
     new_figure,
     new_grid,
     plot_envelope,
@@ -32,6 +35,11 @@ from ..plotting import (
 from .derived import Skipped, generator_vs_ideal, single_role
 from .memory import release_between_phases
 
+
+#: the layouts of the figures (fixed: each is drawn once, see :class:`~orchestrator.plotting.Margins`)
+_SPEED_MARGINS = Margins()
+#: contact forces: a title above every row, the window's axes with their own tick labels
+_FORCE_MARGINS = Margins(top=0.75, hspace=0.4, wspace=0.9)
 
 
 def _shade_window(ax, window) -> None:
@@ -42,7 +50,7 @@ def plot_rotor_speed(outcome: RunOutcome, column: str, window, path: Path, title
     """Rotor speed [rpm] over time (Fig. 15)."""
     t = outcome.time_s
     w = outcome.column(column) * RPM_PER_RAD_S
-    fig, (ax,) = new_figure()
+    fig, (ax,) = new_figure(margins=_SPEED_MARGINS)
     _shade_window(ax, window)
     plot_envelope(ax, t, w, lw=0.8, color="C0", label=f"rotor speed {column}")
     sel = (t >= window[0]) & (t <= window[1])
@@ -63,7 +71,7 @@ def plot_generator_speed(outcome: RunOutcome, rotor_column: str, gen_column: str
     t = outcome.time_s
     gen = outcome.column(gen_column) * RPM_PER_RAD_S
     ideal = ratio * outcome.column(rotor_column) * RPM_PER_RAD_S
-    fig, (ax, ax2) = new_figure(2, height=6.0)
+    fig, (ax, ax2) = new_figure(2, height=6.0, margins=_SPEED_MARGINS)
     _shade_window(ax, window)
     plot_envelope(ax, t, ideal, lw=1.6, color="C1", label=f"ideal gearbox: {ratio:.6g} x rotor speed")
     plot_envelope(ax, t, gen, lw=0.8, color="C0", label=f"simulated generator speed {gen_column}")
@@ -82,18 +90,12 @@ def plot_generator_speed(outcome: RunOutcome, rotor_column: str, gen_column: str
     ax2.legend(loc="best", fontsize=8)
     ax2.set_xlim(t[0], t[-1])
     # scale both panels to the analysis window; a larger start-up transient is clipped
-    sel = (t >= window[0]) & (t <= window[1]) & np.isfinite(dev)
-    if sel.any():
-        for axis, curves in ((ax, (gen, ideal)), (ax2, (dev,))):
-            lo = min(float(np.min(c[sel])) for c in curves)
-            hi = max(float(np.max(c[sel])) for c in curves)
-            pad = 0.15 * (hi - lo) if hi > lo else max(abs(hi), 1e-9) * 0.01
-            full_lo = min(float(np.nanmin(c)) for c in curves)
-            full_hi = max(float(np.nanmax(c)) for c in curves)
-            if full_lo < lo - pad or full_hi > hi + pad:
-                axis.set_ylim(lo - pad, hi + pad)
-                axis.text(0.005, 0.02, "scaled to the analysis window (start-up transient clipped)",
-                          transform=axis.transAxes, fontsize=7, color="0.35")
+    for axis, curves in ((ax, (gen, ideal)), (ax2, (dev,))):
+        limits = window_limits(t, curves, window, 0.15)
+        if limits is not None and limits[2]:
+            axis.set_ylim(limits[0], limits[1])
+            axis.text(0.005, 0.02, "scaled to the analysis window (start-up transient clipped)",
+                      transform=axis.transAxes, fontsize=7, color="0.35")
     return save_figure(fig, path)
 
 
@@ -118,16 +120,25 @@ def symmetric_groups(series: list[tuple[str, str, np.ndarray]]) -> list[tuple[st
     return groups
 
 
-def _scale_to_window(ax, t, curves, window, divisor: float = 1.0) -> None:
-    """Axis limits to the window; ``curves`` are drawn divided by ``divisor`` (> 0)."""
+def window_limits(t: np.ndarray, curves, window, pad_share: float) -> tuple[float, float, bool] | None:
+    """y limits that show ``curves`` inside the analysis window, and whether that clips them elsewhere.
+
+    The window's range widened by ``pad_share`` of it on both sides; ``clipped`` is True
+    where a curve leaves those limits outside the window (a start-up transient, an
+    event before it), so that scaling to the whole run would squeeze the window's
+    fluctuation. Non-finite samples are left out; None where no finite sample is inside the window.
+    """
     sel = (t >= window[0]) & (t <= window[1])
-    if not sel.any():
-        return
-    lo = min(float(np.nanmin(c[sel])) for c in curves) / divisor
-    hi = max(float(np.nanmax(c[sel])) for c in curves) / divisor
-    pad = 0.08 * (hi - lo) if hi > lo else max(abs(hi), 1e-9) * 0.01
-    ax.set_xlim(max(window[0], t[0]), min(window[1], t[-1]))
-    ax.set_ylim(lo - pad, hi + pad)
+    inside = [v for v in (c[sel] for c in curves) if v.size]
+    inside = [v[np.isfinite(v)] for v in inside]
+    inside = [v for v in inside if v.size]
+    if not inside:
+        return None
+    lo, hi = min(float(v.min()) for v in inside), max(float(v.max()) for v in inside)
+    everywhere = [v for v in (c[np.isfinite(c)] for c in curves) if v.size]
+    full_lo, full_hi = min(float(v.min()) for v in everywhere), max(float(v.max()) for v in everywhere)
+    pad = pad_share * (hi - lo) if hi > lo else max(abs(hi), 1e-9) * 0.01
+    return lo - pad, hi + pad, bool(full_lo < lo - pad or full_hi > hi + pad)
 
 
 def plot_contact_forces(outcome: RunOutcome, gearbox: ComponentRole, window, path: Path,
@@ -135,8 +146,8 @@ def plot_contact_forces(outcome: RunOutcome, gearbox: ComponentRole, window, pat
     """Every recorded contact force the gearbox declares [kN], one row per stage (Fig. 17).
 
     Left: the whole run (the analysis window shaded), where the start-up peak
-    sets the scale; right: the analysis window alone, scaled to it, where the
-    fluctuation the statistics describe is visible. Planet meshes that carry the
+    sets the scale; right: the analysis window alone, scaled to it (:func:`window_limits`),
+    where the fluctuation the statistics describe is visible. Planet meshes that carry the
     same force (by symmetry) are drawn once (:func:`symmetric_groups`).
     """
     recorded = {c.column: i for i, c in enumerate(outcome.columns)}
@@ -149,8 +160,10 @@ def plot_contact_forces(outcome: RunOutcome, gearbox: ComponentRole, window, pat
     if not stages:
         return None
     names = list(stages)
-    fig, axes = new_grid(len(names), 2, height=2.6 * len(names) + 1.0, width=15.0)
+    fig, axes = new_grid(len(names), 2, height=2.6 * len(names) + 1.0, width=15.0, margins=_FORCE_MARGINS)
     t = outcome.time_s
+    bins = axes_pixels(axes[0][0])
+    legends = []
     merged = False
     for row, stage in zip(axes, names):
         whole, zoom = row
@@ -163,11 +176,14 @@ def plot_contact_forces(outcome: RunOutcome, gearbox: ComponentRole, window, pat
                 merged = True
                 text += " = " + ", ".join(v[v.rfind("["):] if v.endswith("]") else v for v in same)
             # the envelope of the samples in N, drawn in kN (the same points as the envelope of y / 1e3)
-            te, ye = envelope(t, y)
+            te, ye = envelope(t, y, bins)
             ye = ye / 1e3
             for ax in (whole, zoom):
                 ax.plot(te, ye, lw=0.7, ls=style, color=f"C{k % 10}", label=text if ax is zoom else None)
-        _scale_to_window(zoom, t, [y for _, _, y, _ in groups], window, divisor=1e3)
+        limits = window_limits(t, [y for _, _, y, _ in groups], window, 0.08)
+        if limits is not None:
+            zoom.set_xlim(max(window[0], t[0]), min(window[1], t[-1]))
+            zoom.set_ylim(limits[0] / 1e3, limits[1] / 1e3)
         for ax in (whole, zoom):
             ax.set_ylabel("force [kN]")
             ax.grid(True, lw=0.3)
@@ -175,11 +191,13 @@ def plot_contact_forces(outcome: RunOutcome, gearbox: ComponentRole, window, pat
         zoom.set_title(f"{gearbox.component}.{stage}: analysis window {window[0]:g}-{window[1]:g} s", fontsize=10,
                        loc="left")
         # outside the axes: inside, it hid the peaks of load events and start-up swings
-        zoom.legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), fontsize=7, ncol=1, borderaxespad=0.0)
+        legends.append(zoom.legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), fontsize=7, ncol=1,
+                                   borderaxespad=0.0))
+    legend_room(fig, legends, _FORCE_MARGINS)
     for ax in axes[-1]:
         ax.set_xlabel("time [s]")
     axes[-1][0].set_xlim(t[0], t[-1])
-    note = ("; the planets' meshes carry identical forces by symmetry (evenly spaced planets, one parameter set): "
+    note = ("\nthe planets' meshes carry identical forces by symmetry (evenly spaced planets, one parameter set): "
             "each drawn once") if merged else ""
     fig.suptitle("Gear contact forces of all stages (paper Fig. 17)" + title_suffix + note, fontsize=10)
     return save_figure(fig, path)

@@ -40,7 +40,7 @@ import tempfile
 import time
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Callable, Mapping
 
 from components.errors import DtcosimError, WallTimeLimitError
 
@@ -262,16 +262,24 @@ def _monolithic(payload: StudyPayload, task: PointTask) -> tuple[dict[str, float
     return out, None
 
 
-def _progress_publisher(topic: str | None, task: PointTask):
-    """A master progress callback publishing on ``topic`` from this Dask worker (None outside a worker)."""
-    if not topic:
-        return None
-    try:
-        from distributed import get_worker
+def _progress_publisher(topic: str | None, task: PointTask, here: Callable[[dict], None] | None = None):
+    """A master progress callback: to ``here`` (a point run in the sweep's own process), else published on
+    ``topic`` from this Dask worker (None outside a worker); at most twice a second."""
+    if here is not None:
+        send = here
+    else:
+        if not topic:
+            return None
+        try:
+            from distributed import get_worker
 
-        worker = get_worker()
-    except (ImportError, ValueError):
-        return None
+            worker = get_worker()
+        except (ImportError, ValueError):
+            return None
+
+        def send(event: dict) -> None:
+            worker.log_event(topic, event)
+
     last = [0.0]
 
     def publish(done: int, total: int) -> None:
@@ -279,19 +287,21 @@ def _progress_publisher(topic: str | None, task: PointTask):
         if done < total and now - last[0] < 0.5:
             return
         last[0] = now
-        worker.log_event(topic, {"key": task.key, "index": task.index, "done": int(done), "total": int(total)})
+        send({"key": task.key, "index": task.index, "done": int(done), "total": int(total)})
 
     return publish
 
 
-def _cosim(payload: StudyPayload, task: PointTask) -> tuple[dict[str, float], dict | None]:
+def _cosim(payload: StudyPayload, task: PointTask, progress=None, stop=None) -> tuple[dict[str, float], dict | None]:
     from ..cosim.master import CoSimulation
 
     system = _point_system(payload, task, local_files=True)
     cpu0 = time.process_time()
-    outcome = CoSimulation(system).run(progress=_progress_publisher(payload.progress_topic, task),
-                                       handle_sigint=False, wall_time_limit_s=payload.timeout_s)
+    outcome = CoSimulation(system).run(progress=_progress_publisher(payload.progress_topic, task, progress),
+                                       handle_sigint=False, wall_time_limit_s=payload.timeout_s, stop=stop)
     cpu = time.process_time() - cpu0
+    if outcome.interrupted:
+        raise PointInterrupted(outcome.error or "interrupted")
     if not outcome.complete:
         raise DtcosimError(outcome.error or "the co-simulation stopped early")
     out: dict[str, float] = {}
@@ -324,13 +334,24 @@ def _clean(value: float) -> float | None:
     return float(value) if value is not None and math.isfinite(value) else None
 
 
-def run_point(payload: StudyPayload, task: PointTask) -> dict[str, Any]:
-    """Run one point and compute its measures (in a Dask worker).
+class PointInterrupted(Exception):
+    """A point run in the sweep's own process stopped by a stop request: neither done nor failed."""
+
+
+def run_point(payload: StudyPayload, task: PointTask, progress: Callable[[dict], None] | None = None,
+              stop=None) -> dict[str, Any]:
+    """Run one point and compute its measures (in a Dask worker, or in the sweep's own process).
 
     Parameters
     ----------
     payload : StudyPayload
     task : PointTask
+    progress : callable(event), optional
+        In the sweep's own process: receives the progress events a worker publishes on the
+        payload's ``progress_topic``.
+    stop : orchestrator.cosim.stop_requests.StopRequests, optional
+        In the sweep's own process: the sweep's stop requests; a co-simulation checks them
+        between blocks of steps and a stopped point raises :class:`PointInterrupted`.
 
     Returns
     -------
@@ -344,7 +365,8 @@ def run_point(payload: StudyPayload, task: PointTask) -> dict[str, Any]:
     record: dict[str, Any] = {"key": task.key, "index": task.index, "status": OK, "measures": {}, "error": None,
                               "error_type": None}
     try:
-        values, data = _monolithic(payload, task) if payload.engine == "monolithic" else _cosim(payload, task)
+        values, data = (_monolithic(payload, task) if payload.engine == "monolithic"
+                        else _cosim(payload, task, progress, stop))
         record["measures"] = {k: _clean(v) for k, v in values.items()}
         if data is not None:
             record["data"] = data

@@ -119,7 +119,7 @@ def summary(prepared, recs: list[dict | None], report=None, files: Mapping[str, 
         doc["last_sweep"] = {
             "submitted": report.submitted, "skipped": report.skipped, "ok": report.ok, "failed": report.failed,
             "errors": report.errors, "interrupted": report.interrupted, "workers": report.workers,
-            "compute_time_s": report.compute_time_s,
+            "in_process": report.in_process, "compute_time_s": report.compute_time_s,
         }
     if files:
         doc["files"] = {k: Path(p).name for k, p in files.items()}

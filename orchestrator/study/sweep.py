@@ -27,7 +27,9 @@ from __future__ import annotations
 import contextlib
 import datetime as _dt
 import math
+import os
 import signal
+import socket
 import time
 import uuid
 from dataclasses import dataclass, field
@@ -35,17 +37,26 @@ from pathlib import Path
 from typing import Any, Callable
 
 from ..atomic_files import describe_os_error
-from ..cosim.stop_requests import STOP_SIGNALS
+from ..cosim.stop_requests import STOP_SIGNALS, StopRequests
 from ..import_safe_signals import install, restore
 from ..inputs.study import StudyError
 from ..output_folders import check_for_study
-from .engine import FAILED, OK, PointTask, run_point
+from .engine import FAILED, OK, PointInterrupted, PointTask, run_point
 from .journal import JOURNAL_FILE, Journal, latest_by_key, read_journal
 from .prepare import PreparedStudy
 
 ERROR = "error"
 #: how long a sweep waits for the first worker of an existing cluster [s]
 WAIT_FOR_WORKERS_S = 60.0
+#: where a sweep without ``scheduler`` runs its points: ``auto`` (in this process while the pending points add up
+#: to less work than :data:`MIN_CLUSTER_WORK_S`, else on a LocalCluster), ``process`` (always here, one point at a
+#: time), ``dask`` (always on a LocalCluster)
+EXECUTORS = ("auto", "process", "dask")
+#: a study whose pending points add up to less wall time than this [s] runs in the sweep's own process: twice what
+#: starting a LocalCluster of 2 workers and loading the study's code and FMUs in them costs before its first point
+#: (4.3 s, ``bench_sweep.py --overhead`` on the shared 2-core machine; 10.4 s while it was busier), rounded up: about
+#: the least work that 2 workers finish sooner than 1 process
+MIN_CLUSTER_WORK_S = 10.0
 
 
 # --------------------------------------------------------------------- sweep
@@ -71,9 +82,12 @@ class SweepReport:
     wall_time_s : float
         The whole call [s] (cluster start-up and output files included).
     compute_time_s : float
-        First submission to last result [s].
+        First point started (here) or submitted (to the cluster) to the last result [s].
     workers : int
         Workers of the cluster when the sweep started (0 if none ran).
+    in_process : int
+        Points run in the sweep's own process (``executor``: small studies, and the first points of
+        any study without a ``scheduler`` while their cost is measured).
     out_dir : pathlib.Path
     files : dict of str -> pathlib.Path
         Written files by role (``journal``, ``table``, ``summary``, ``plot:<name>``).
@@ -96,6 +110,7 @@ class SweepReport:
     wall_time_s: float = 0.0
     compute_time_s: float = 0.0
     workers: int = 0
+    in_process: int = 0
     out_dir: Path = Path(".")
     files: dict[str, Path] = field(default_factory=dict)
     problems: list[str] = field(default_factory=list)
@@ -120,11 +135,14 @@ class _Interrupts:
     (:func:`~orchestrator.import_safe_signals.install`).
     """
 
-    def __init__(self) -> None:
+    def __init__(self, stop: StopRequests | None = None) -> None:
         self.critical = False
         self.pending = False
         self.previous: dict[int, object] = {}
         self.signum: int | None = None
+        #: points run in this process: every signal is only noted and passed on to these stop requests, which
+        #: the running point checks between its blocks of steps (nothing is raised inside an FMU's code)
+        self.stop = stop
 
     def __enter__(self) -> "_Interrupts":
         self.previous = install(dict.fromkeys(STOP_SIGNALS, self._handler))
@@ -135,7 +153,10 @@ class _Interrupts:
 
     def _handler(self, signum, frame) -> None:
         self.signum = self.signum or signum
-        if self.critical:
+        if self.stop is not None:
+            self.stop.request(signum)
+            self.pending = True
+        elif self.critical:
             self.pending = True
         else:
             raise KeyboardInterrupt
@@ -246,8 +267,9 @@ def run_sweep(
     dashboard: str | None = None,
     on_result: Callable[[int, dict[str, Any]], dict[str, Any]] | None = None,
     case_progress: Callable[[dict[str, Any]], None] | None = None,
+    executor: str = "auto",
 ) -> SweepReport:
-    """Run the study's pending points on Dask and write the journal, the table and the plots.
+    """Run the study's pending points, in this process or on Dask, and write the journal, the table and the plots.
 
     Parameters
     ----------
@@ -279,6 +301,12 @@ def run_sweep(
     case_progress : callable(event), optional
         Called with the progress events the workers publish while a point runs
         (``{"key", "index", "done", "total"}``; the payload's ``progress_topic``).
+    executor : {"auto", "process", "dask"}
+        Without ``scheduler``: ``auto`` runs the points in this process, one at a time, for as long
+        as the pending ones add up to less than :data:`MIN_CLUSTER_WORK_S` of work, measured on the
+        points run so far (the first as a whole, then the cheapest), and hands the rest to a
+        LocalCluster as soon as they do not; a small study so pays no cluster. ``process``: all
+        here; ``dask``: all on the cluster. With ``scheduler`` the points run there.
 
     Returns
     -------
@@ -298,7 +326,12 @@ def run_sweep(
         report.skipped = report.total - len(todo)
         if on_start is not None:
             on_start(len(todo), report.skipped)
-        if todo:
+        if executor not in EXECUTORS:
+            raise StudyError("executor", executor, f"one of {', '.join(EXECUTORS)}")
+        if todo and scheduler is None and executor != "dask":
+            todo = _run_here(prepared, todo, journal, report, progress, on_result, case_progress,
+                             None if executor == "process" else MIN_CLUSTER_WORK_S)
+        if todo and not report.interrupted and not report.stopped_at:
             _execute(prepared, todo, journal, report, workers, scheduler, progress, dashboard, on_result,
                      case_progress)
     unwritten = ""
@@ -319,13 +352,104 @@ def run_sweep(
     return report
 
 
+def _error_result(prepared: PreparedStudy, i: int, exc: Exception) -> dict[str, Any]:
+    """The result of a point that raised (a lost worker, a bug): recorded as an error, run again next time."""
+    return {"key": prepared.keys[i], "index": prepared.points[i].index, "status": ERROR, "measures": {},
+            "error": f"{type(exc).__name__}: {exc}", "error_type": type(exc).__name__}
+
+
+def _keep(prepared: PreparedStudy, i: int, result: dict[str, Any], journal: Journal, report: SweepReport,
+          interrupts: _Interrupts, on_result, progress) -> bool:
+    """Journal a finished point (with what ``on_result`` adds) and count it.
+
+    Returns False when the journal or the run's file cannot be written (a full disk): nothing more can
+    be kept, so the sweep stops. A signal during the write is raised after it (a KeyboardInterrupt).
+    """
+    point = prepared.points[i]
+    study = prepared.study
+    record = {
+        "key": prepared.keys[i], "index": point.index, "study": study.name, "engine": study.engine,
+        "status": result["status"],
+        "parameters": {k: _json_value(v) for k, v in point.parameters.items()},
+        "measures": result.get("measures", {}), "error": result.get("error"),
+        "error_type": result.get("error_type"), "worker": result.get("worker"),
+        "task_wall_time_s": result.get("task_wall_time_s"), "code_version": prepared.identity["code"],
+        "finished_at": _now(),
+    }
+    try:
+        # storing a run's data, journaling it and counting it is one step: a signal during it is raised after all
+        # three (raised between journal and count, the sweep would say one point fewer was kept)
+        with interrupts.critical_section():
+            if on_result is not None and record["status"] == OK:
+                record.update(on_result(i, result))
+            journal.append(record)
+            _count(report, record["status"])
+    except OSError as exc:  # a full disk: nothing more can be kept, so nothing more is run
+        report.stopped_at = describe_os_error(exc)  # told once by run_sweep, with the table
+        return False
+    if progress is not None:
+        progress(record)
+    return True
+
+
+def _run_here(prepared: PreparedStudy, todo: list[int], journal: Journal, report: SweepReport, progress,
+              on_result, case_progress, limit_s: float | None) -> list[int]:
+    """Run points in this process, one at a time; returns the points left for a cluster (see ``executor``).
+
+    With ``limit_s`` (``auto``): after each point, the pending ones' work is estimated from the
+    points run here (after the first, which also loads the code and FMUs: only whether it took the
+    limit by itself; then the cheapest point after it times the pending ones); once it reaches
+    ``limit_s`` the rest is returned. Stop signals are only noted and
+    passed to the running point (a co-simulation stops between blocks of steps): a point cut short
+    is not journaled, the sweep ends as interrupted after the point in progress.
+    """
+    stop = StopRequests(enabled=False)  # the requests of _Interrupts' handler, checked by the running point
+    times: list[float] = []
+    left = list(todo)
+    t0 = time.perf_counter()
+    with _Interrupts(stop) as interrupts:
+        try:
+            while left:
+                if limit_s is not None and times:
+                    # the first point also loads the code and the FMUs: alone it decides only when it took the
+                    # limit by itself; from the second on, the cheapest point after it gives the cost of the rest
+                    left_s = times[0] if len(times) == 1 else min(times[1:]) * len(left)
+                    if left_s >= limit_s:
+                        return left
+                i = left[0]
+                task = PointTask(prepared.keys[i], prepared.points[i].index, dict(prepared.points[i].parameters))
+                wall0 = time.perf_counter()
+                try:
+                    result = run_point(prepared.payload, task, case_progress, stop)
+                except PointInterrupted:
+                    raise KeyboardInterrupt from None
+                except Exception as exc:  # a bug: recorded as an error, re-tried next time
+                    result = _error_result(prepared, i, exc)
+                    result["worker"] = f"{socket.gethostname()}:{os.getpid()}"
+                    result["task_wall_time_s"] = time.perf_counter() - wall0
+                times.append(result["task_wall_time_s"])
+                left.pop(0)
+                report.submitted += 1
+                report.in_process += 1
+                if not _keep(prepared, i, result, journal, report, interrupts, on_result, progress):
+                    return []
+                if stop.requested:  # noted while the point ran: it finished anyway and is kept
+                    raise KeyboardInterrupt
+        except KeyboardInterrupt:
+            report.interrupted = True
+            report.signal = interrupts.signum or signal.SIGINT
+            return []
+        finally:
+            report.compute_time_s += time.perf_counter() - t0
+    return []
+
+
 def _execute(prepared: PreparedStudy, todo: list[int], journal: Journal, report: SweepReport,
              workers: int | None, scheduler: str | None, progress, dashboard: str | None = None, on_result=None,
              case_progress=None) -> None:
     from distributed import as_completed
 
     study = prepared.study
-    code = prepared.identity["code"]
     futures: dict = {}
     t0 = None
     with _Interrupts() as interrupts:
@@ -355,39 +479,18 @@ def _execute(prepared: PreparedStudy, todo: list[int], journal: Journal, report:
                 task = PointTask(prepared.keys[i], point.index, dict(point.parameters))
                 fut = client.submit(run_point, payload, task, key=f"{study.name}-{point.index}-{run_id}", pure=False)
                 futures[fut] = i
-            report.submitted = len(futures)
+            report.submitted += len(futures)
             for fut in as_completed(list(futures)):
                 i = futures.pop(fut)
-                point = prepared.points[i]
                 try:
                     result = fut.result()
                 except Exception as exc:  # a lost worker, KilledWorker, a bug: re-tried next time
-                    result = {"key": prepared.keys[i], "index": point.index, "status": ERROR, "measures": {},
-                              "error": f"{type(exc).__name__}: {exc}", "error_type": type(exc).__name__}
+                    result = _error_result(prepared, i, exc)
                 fut.release()
-                record = {
-                    "key": prepared.keys[i], "index": point.index, "study": study.name, "engine": study.engine,
-                    "status": result["status"],
-                    "parameters": {k: _json_value(v) for k, v in point.parameters.items()},
-                    "measures": result.get("measures", {}), "error": result.get("error"),
-                    "error_type": result.get("error_type"), "worker": result.get("worker"),
-                    "task_wall_time_s": result.get("task_wall_time_s"), "code_version": code, "finished_at": _now(),
-                }
-                try:
-                    # storing a run's data, journaling it and counting it is one step: a signal during it is raised
-                    # after all three (raised between journal and count, the sweep said one point fewer was kept)
-                    with interrupts.critical_section():
-                        if on_result is not None and record["status"] == OK:
-                            record.update(on_result(i, result))
-                        journal.append(record)
-                        _count(report, record["status"])
-                except OSError as exc:  # a full disk: nothing more can be kept, so nothing more is run
-                    report.stopped_at = describe_os_error(exc)  # told once by run_sweep, with the table
+                if not _keep(prepared, i, result, journal, report, interrupts, on_result, progress):
                     with interrupts.shielded(), contextlib.suppress(Exception):
                         client.cancel(list(futures))
                     break
-                if progress is not None:
-                    progress(record)
         except KeyboardInterrupt:
             report.interrupted = True
             report.signal = interrupts.signum or signal.SIGINT
@@ -397,7 +500,7 @@ def _execute(prepared: PreparedStudy, todo: list[int], journal: Journal, report:
                     client.cancel(list(futures))
         finally:
             if t0 is not None:
-                report.compute_time_s = time.perf_counter() - t0
+                report.compute_time_s += time.perf_counter() - t0
             with interrupts.shielded(), quiet:  # a signal while the cluster closes is noted, never raised
                 if interrupts.pending:
                     quiet.enter_context(_quiet_dask_logs())

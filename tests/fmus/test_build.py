@@ -43,6 +43,27 @@ def test_fmpy_validation_reports_no_problem(fmu_path, name):
     assert check_fmu(fmu_path(name)) == []
 
 
+@pytest.mark.parametrize("old, new", [
+    (None, None),  # as built: plain structured names
+    ('name="stage1.k0"', 'name="stage1..k0"'),  # illegal
+    ('name="stage1.k0"', 'name="stage1.\'k 0\'"'),  # quoted: legal, parsed by fmpy
+    ('name="stage1.k0"', 'name="shaft1.torque"'),  # a duplicate
+    ('<Unknown index=', '<Unknown index="9999" x='),  # a model structure entry of no variable
+])
+def test_the_build_finds_what_fmpys_validation_finds(fmu_path, tmp_path, old, new):
+    from fmus.validation import fmpy_problems
+
+    fmu = tmp_path / "Gearbox.fmu"
+    shutil.copy(fmu_path("Gearbox"), fmu)
+    if old is not None:
+        xml = read_member(fmu).decode()
+        assert old in xml
+        rewrite_archive(fmu, {"modelDescription.xml": xml.replace(old, new, 1).encode()})
+    expected = validate_fmu(str(fmu))
+    assert fmpy_problems(fmu) == expected
+    assert (expected == []) == (old is None or "'" in new)
+
+
 @pytest.mark.parametrize("name, causality, expected", [
     ("WindSource", "output", {"omega": "rad/s", "phi": "rad"}),
     ("WindSource", "parameter", {"omega0": "rad/s", "a": "rad/s", "sigma": "rad/s", "n_harmonics": None,
@@ -128,7 +149,8 @@ def test_archive_carries_its_code_under_private_names(built_fmus, name):
     with zipfile.ZipFile(built.path) as archive:
         files = archive.namelist()
         assert archive.read("resources/slavemodule.txt").decode().strip() == built.slave_module
-        slave_sources = [archive.read(f).decode() for f in files if f.startswith(f"resources/{built.package}/slaves/")]
+        slave_sources = [archive.read(f).decode() for f in files
+                         if f.startswith(f"resources/{built.package}/slaves/") and f.endswith(".py")]
     assert f"resources/{built.package}/components/model/wind.py" in files
     assert (f"resources/{built.package}/components/model/gearbox_model.py" in files) == (name == "Gearbox")
     assert f"resources/{built.slave_module}.py" in files
@@ -252,6 +274,31 @@ def test_an_fmu_carries_only_its_slaves_import_closure(built_fmus, name):
     assert not any(f.startswith(("components/analysis/", "components/reference/")) for f in code)
     # exactly the closure: one file per module, plus the embedding package's own __init__.py and the runtime guard
     assert len(code) == len(embedded_modules(name)) + 2 and {"__init__.py", GUARD_FILE} <= code
+
+
+@pytest.mark.parametrize("name", FMU_NAMES)
+def test_every_module_an_fmu_carries_has_its_bytecode_which_python_loads_without_compiling(built_fmus, name, tmp_path):
+    import importlib.util
+    import subprocess
+    import sys
+
+    with zipfile.ZipFile(built_fmus[name].path) as archive:
+        files = set(archive.namelist())
+        sources = sorted(f for f in files if f.startswith("resources/") and f.endswith(".py"))
+        pycs = {f: archive.read(importlib.util.cache_from_source(f)) for f in sources}
+        archive.extractall(tmp_path)
+    assert len(sources) > 20
+    assert {f for f in files if f.endswith(".pyc")} == {importlib.util.cache_from_source(f) for f in sources}
+    for source, pyc in pycs.items():  # PEP 552: hash-based (bit 0), unchecked (bit 1 clear), this Python's magic
+        assert pyc[:4] == importlib.util.MAGIC_NUMBER and int.from_bytes(pyc[4:8], "little") == 0b01, source
+    # the slave imported from the extracted folder (new time stamps, as every run extracts it): nothing compiled
+    code = (f"import sys, importlib._bootstrap_external as be\nsys.path.insert(0, {str(tmp_path / 'resources')!r})\n"
+            "compiled = []\nreal = be.SourceLoader.source_to_code\n"
+            "be.SourceLoader.source_to_code = lambda self, data, path, **k: compiled.append(path) or real(self, data, path, **k)\n"
+            f"import {built_fmus[name].slave_module}\nprint(compiled)")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip().splitlines()[-1] == "[]"
 
 
 @pytest.mark.parametrize("name, role, signals", [

@@ -74,7 +74,7 @@ def test_a_signal_during_an_import_is_delivered_after_it(tmp_path, wrapped, expe
     assert proc.stdout.strip() == expected
 
 
-# a subcommand whose module is imported while the parser is built and receives the signal there
+# a subcommand whose module is imported (only when it runs) while the parser is built and receives the signal there
 SLEEP_COMMAND = textwrap.dedent("""
     import time
     import signalled  # the stop signal lands in this import
@@ -94,7 +94,8 @@ def test_a_stop_signal_during_start_up_is_one_line_and_its_status(tmp_path, sign
     (tmp_path / "sleep_command.py").write_text(SLEEP_COMMAND)
     proc = _python("""
         from orchestrator.commands import cli
-        cli.COMMAND_MODULES = cli.COMMAND_MODULES + ("sleep_command",)
+        from orchestrator.commands.catalogue import Command
+        cli.COMMANDS = cli.COMMANDS + (Command("sleep", "sleep_command", "sleep a minute"),)
         cli.end_process(cli.main(["sleep"]))
     """, tmp_path, signame)
     assert proc.returncode == status, proc.stderr
@@ -103,6 +104,7 @@ def test_a_stop_signal_during_start_up_is_one_line_and_its_status(tmp_path, sign
 
 def test_a_signal_the_process_ignores_stays_ignored_during_a_command(monkeypatch):
     from orchestrator.commands import cli
+    from orchestrator.commands.catalogue import Command as Entry
 
     seen = {}
 
@@ -113,7 +115,7 @@ def test_a_signal_the_process_ignores_stays_ignored_during_a_command(monkeypatch
             p.set_defaults(func=lambda args: seen.update(hup=signal.getsignal(signal.SIGHUP),
                                                          term=signal.getsignal(signal.SIGTERM)) or 0)
 
-    monkeypatch.setattr(cli, "COMMAND_MODULES", ("probe_command",))
+    monkeypatch.setattr(cli, "COMMANDS", (Entry("probe", "probe_command", "probe the signal handlers"),))
     monkeypatch.setitem(sys.modules, "probe_command", Command)
     before_term = signal.getsignal(signal.SIGTERM)
     previous = signal.signal(signal.SIGHUP, signal.SIG_IGN)  # as under nohup

@@ -40,12 +40,16 @@ MONOLITHIC = KernelSource("monolithic", _HERE / "monolithic.py")
 #: the rotor-speed process's phasor step (compiled ahead of time)
 WIND = KernelSource("wind", _HERE / "wind.py")
 
+#: at most this many evaluations of a mesh (contact law, stiffness) are brief (:func:`monolithic`): interpreted they
+#: cost ~50 ms, less than importing numba and loading the compiled form from its cache (~0.25 s)
+BRIEF_EVALUATIONS = 10_000
+
 #: the kernels compiled ahead of time (an FMU carries their modules beside its copy of the sources)
 AHEAD_OF_TIME = (GEARBOX, WIND)
 #: every kernel
 KERNELS = (GEARBOX, MONOLITHIC, WIND)
 
-__all__ = ["AHEAD_OF_TIME", "ENVIRONMENT_VARIABLE", "GEARBOX", "KERNELS", "MONOLITHIC", "WIND", "choose_kernel",
+__all__ = ["AHEAD_OF_TIME", "BRIEF_EVALUATIONS", "ENVIRONMENT_VARIABLE", "GEARBOX", "KERNELS", "MONOLITHIC", "WIND", "choose_kernel",
            "gearbox", "jit_gearbox", "monolithic", "wind"]
 
 
@@ -57,9 +61,14 @@ def gearbox(kernel: str | None = None) -> tuple[ModuleType, str, str | None]:
     return kernel_module(GEARBOX, _step, kernel, "compiled gearbox kernel")
 
 
-def monolithic(kernel: str | None = None) -> tuple[ModuleType, str, str | None]:
-    """The monolithic kernel's entry module to run (numba's just-in-time form, or interpreted)."""
-    return kernel_module(MONOLITHIC, _monolithic, kernel, "compiled monolithic kernel", ahead_of_time=False)
+def monolithic(kernel: str | None = None, brief: bool = False) -> tuple[ModuleType, str, str | None]:
+    """The monolithic kernel's entry module to run (numba's just-in-time form, or interpreted).
+
+    ``brief``: a short evaluation, interpreted unless numba's form is loaded already
+    (:func:`components.compile.choice.kernel_module`).
+    """
+    return kernel_module(MONOLITHIC, _monolithic, kernel, "compiled monolithic kernel", ahead_of_time=False,
+                         brief=brief)
 
 
 def wind(kernel: str | None = None) -> tuple[ModuleType, str, str | None]:

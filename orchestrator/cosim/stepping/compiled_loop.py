@@ -35,6 +35,7 @@ from types import ModuleType
 import numpy as np
 
 from components.compile.aot import AotKernel, compiled_or_jit
+from components.compile.jit import JIT_VARIABLE, jit_enabled
 from components.compile.sources import KernelSource
 
 from ..fmi_runtime import runs_python
@@ -83,6 +84,8 @@ def aot_loop_kernel() -> AotKernel:
 
 
 def _jit_module() -> tuple[ModuleType | None, str | None]:
+    if not jit_enabled():
+        return None, f"no module compiled ahead of time, and just-in-time compilation is off ({JIT_VARIABLE}=0)"
     try:
         return _jit_kernel_module(), None
     except Exception as exc:  # noqa: BLE001 - numba missing or broken: the Python loop runs
@@ -108,7 +111,7 @@ def unavailable_reason(plan: StepPlan, profiling: bool = False, iterating_loops:
     if not all(runs_python(fmu.instance.interface) for fmu in plan.fmus):
         return "an FMU is not a PythonFMU (its functions are called with the GIL released)"
     if _load() is None:
-        return f"numba unavailable ({_import_error})"
+        return f"the compiled loop is unavailable ({_import_error})"
     return None
 
 

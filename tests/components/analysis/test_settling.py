@@ -57,3 +57,34 @@ def test_the_paper_drivetrain_settles_with_its_0_95_hz_mode():
     assert s.frequency_hz == pytest.approx(first.mode.undamped_frequency_hz, rel=1e-6)
     assert s.damping_ratio == pytest.approx(first.mode.damping_ratio, rel=1e-6)
     assert s.frequency_hz == pytest.approx(0.953, abs=5e-4) and s.time_s == pytest.approx(2.82, abs=0.01)
+
+
+@pytest.mark.parametrize("rotor", [None, "rigid shaft", "main shaft"])
+def test_the_settling_from_the_eigenvalues_alone_is_the_modal_analysis_one(rotor):
+    from components.analysis.settling import drivetrain_settling
+    from components.model.rotor import RotorParameters
+
+    drivetrain, op = table6_gearbox(), OperatingPoint.from_rpm(16.0, 25.4e3)
+    parameters = {None: None, "rigid shaft": RotorParameters(inertia_kgm2=3.8e7),
+                  "main shaft": RotorParameters(inertia_kgm2=3.8e7, shaft_stiffness_nm_rad=8.7e8,
+                                                shaft_damping_nms_rad=6.2e6, carrier_inertia_kgm2=2.0e3)}[rotor]
+    full = settling_time(drivetrain_modes(drivetrain, op, rotor=parameters))
+    alone = drivetrain_settling(drivetrain, op, rotor=parameters)
+    assert alone.rotor == full.rotor == ("held" if rotor is None else "free")
+    assert alone.time_s == pytest.approx(full.time_s, rel=1e-9)
+    assert alone.frequency_hz == pytest.approx(full.frequency_hz, rel=1e-9, nan_ok=True)
+    assert alone.damping_ratio == pytest.approx(full.damping_ratio, rel=1e-9)
+
+
+def test_a_runs_settling_time_imports_no_scipy():
+    import subprocess
+    import sys
+
+    code = ("import sys\nfrom components.analysis.settling import drivetrain_settling\n"
+            "from components.analysis.equilibrium import OperatingPoint\n"
+            "from components.model.presets import table6_gearbox\n"
+            "drivetrain_settling(table6_gearbox(), OperatingPoint.from_rpm(16.0, 25.4e3))\n"
+            "print(sorted(m for m in sys.modules if m.startswith('scipy')))")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip() == "[]"

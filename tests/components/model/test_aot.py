@@ -194,3 +194,68 @@ def test_a_failing_build_says_why_in_one_line_and_is_not_retried_on_every_run(tm
     assert len(said) == 1 and problem in said[0] and "`dtcosim build` tries again" in said[0]
     with pytest.raises(AssertionError, match="rebuilt"):
         compiled_kernels.ensure_compiled_kernels(said.append, retry=True)  # dtcosim build tries again
+
+
+def test_a_background_build_is_one_detached_builder_that_records_what_it_did(tmp_path, monkeypatch):
+    """The builder of a kernel that cannot be built (a provider that does not exist) records why and removes its mark;
+    a second request while it runs gets its pid instead of a second builder."""
+    monkeypatch.setenv("DTCOSIM_CACHE_DIR", str(tmp_path))
+    fake = AotKernel("_dtcosim_test_kernel_fedcba9876543210", "components.model.kernel:no_such_provider")
+    import os
+
+    first = aot.build_in_background([fake])
+    second = aot.build_in_background([fake])  # before the first has its mark, or after it: one builds, one leaves
+    assert first is not None and second is not None
+    for pid in {first, second}:
+        os.waitpid(pid, 0)
+    assert not aot.build_lock_file().exists() and aot.background_builder() is None
+    assert "no_such_provider" in (aot.failed_before(fake) or "")
+    log = aot.build_log().read_text()
+    assert log.count("not built") == 1 and "no_such_provider" in log and "done in" in log
+
+
+def test_a_dead_builders_mark_is_cleared(tmp_path, monkeypatch):
+    monkeypatch.setenv("DTCOSIM_CACHE_DIR", str(tmp_path))
+    lock = aot.build_lock_file()
+    lock.parent.mkdir(parents=True)
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    lock.write_text(f"{dead.pid}\n")
+    assert aot.background_builder() is None and not lock.exists()
+
+
+def test_the_first_run_does_not_wait_for_the_compiler(tmp_path, monkeypatch):
+    """ensure_compiled_kernels(background=True): the build starts detached, this process compiles nothing just in
+    time (DTCOSIM_JIT=0: its kernels run interpreted) and the message says what happens, without a duration."""
+    import orchestrator.cosim.compiled_kernels as compiled_kernels
+    from components.compile.jit import JIT_VARIABLE
+
+    monkeypatch.setenv("DTCOSIM_CACHE_DIR", str(tmp_path))
+    monkeypatch.delenv(JIT_VARIABLE, raising=False)
+    fake = AotKernel("_dtcosim_test_kernel_0011223344556677", "components.model.kernel:no_such_provider")
+    monkeypatch.setattr(compiled_kernels, "aot_kernels", lambda: (fake,))
+    started = []
+    monkeypatch.setattr(compiled_kernels, "build_in_background", lambda todo: started.append(todo) or 4242)
+    said = []
+    problem = compiled_kernels.ensure_compiled_kernels(said.append, background=True)
+    assert started == [[fake]] and problem == "being compiled in the background (pid 4242)"
+    import os
+
+    assert os.environ[JIT_VARIABLE] == "0"
+    (line,) = said
+    assert line.startswith("compiling 1 kernel(s) ahead of time in the background for later runs (pid 4242, log ")
+    assert line.endswith("until they are built, runs step them interpreted, which takes longer")
+    assert not any(c.isdigit() for c in line.split("log ")[0].replace("4242", "").replace("1 kernel", ""))
+
+
+def test_without_just_in_time_compilation_a_kernel_runs_from_its_module_or_interpreted(tmp_path, monkeypatch):
+    from components.compile.jit import JIT_VARIABLE
+
+    monkeypatch.setenv("DTCOSIM_CACHE_DIR", str(tmp_path))  # no ahead-of-time modules here
+    monkeypatch.setenv(JIT_VARIABLE, "0")
+    source = KernelSource("wind", kernel.WIND.entry)
+    module, reason = try_compiled(KernelSource("nojit", kernel.WIND.entry.with_name("contact.py")))
+    assert module is None and f"{JIT_VARIABLE}=0" in reason
+    form = kernel.wind()
+    if aot.load_module(AotKernel.of(source)) is None and try_compiled(source)[0] is None:
+        assert form[1] == "numpy" and f"{JIT_VARIABLE}=0" in form[2]

@@ -78,3 +78,36 @@ def test_compiled_forms_replace_the_numpy_forms(packages):
     import numpy as np
 
     assert module.total(np.array([1.0, 2.0])) == 3.0  # the loop, not the numpy form (+ 0.5)
+
+
+BRIEF = """
+import json, sys
+import numpy as np
+from components.model import kernel
+from components.model.presets import preset
+from components.model.assembly import Assembly
+a = Assembly(preset("table6"))
+a.static_deflection(25400.0)
+a.law.evaluate(np.zeros((2, a.n_mesh)), np.zeros((2, a.n_mesh)))
+brief = "numba" in sys.modules
+a.law.evaluate(np.zeros((kernel.BRIEF_EVALUATIONS // a.n_mesh + 1, a.n_mesh)), np.zeros(1))
+many = "numba" in sys.modules
+a.static_deflection(25400.0)
+print(json.dumps([brief, many, kernel.monolithic(brief=True)[1]]))
+"""
+
+
+@pytest.mark.parametrize("requested, expected", [
+    ("auto", [False, True, "compiled"]),  # brief ones interpreted until numba's form is loaded, then compiled
+    ("numpy", [False, False, "numpy"]),
+    ("compiled", [True, True, "compiled"]),  # asked for: compiled even when brief
+])
+def test_brief_evaluations_do_not_load_numba_unless_it_is_loaded_or_asked_for(tmp_path, requested, expected):
+    import json
+    import os
+    import subprocess
+
+    env = {**os.environ, "DTCOSIM_KERNEL": requested}
+    proc = subprocess.run([sys.executable, "-c", BRIEF], capture_output=True, text=True, env=env, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    assert json.loads(proc.stdout) == expected

@@ -21,7 +21,7 @@ def test_a_run_and_a_load_set_of_one_name_go_to_different_folders():
     from orchestrator.inputs.scenario_file import find_scenario, load_scenario
 
     scenario = load_scenario(find_scenario("openfast-dlc11"))
-    args = cli.build_parser().parse_args(["run", "openfast-dlc11"])
+    args = cli.build_parser(["run", "openfast-dlc11"]).parse_args(["run", "openfast-dlc11"])
     run_dir, _ = run_out_dir(scenario, args)
     assert run_dir == Path("results/openfast-dlc11")
     assert default_out_dir("openfast-dlc11") == Path("results/loads/openfast-dlc11")

@@ -66,7 +66,8 @@ def killed_and_resumed(tmp_path_factory, fmu_dir):
     (work / "set.toml").write_text(SET)
     out = work / "out"
     exe = Path(sys.executable).parent / "dtcosim"
-    cmd = [str(exe), "loads", "set.toml", "--workers", "2", "--out", str(out), "--fmu-dir", str(fmu_dir), "-q"]
+    cmd = [str(exe), "loads", "set.toml", "--workers", "2", "--out", str(out), "--fmu-dir", str(fmu_dir), "-q",
+           "--executor", "dask"]
     proc = subprocess.Popen(cmd, cwd=work, start_new_session=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     deadline = time.monotonic() + 600
     try:

@@ -25,7 +25,7 @@ def paper_sweep(tmp_path_factory):
     """The full 49-point study, once, on a LocalCluster of 2 workers: (output dir, completed process)."""
     work = tmp_path_factory.mktemp("paper-sensitivity")
     out = work / "results" / "paper-sensitivity"
-    proc = run_cli("sweep", "paper-sensitivity", "--workers", "2", cwd=work, timeout=600)
+    proc = run_cli("sweep", "paper-sensitivity", "--workers", "2", "--executor", "dask", cwd=work, timeout=600)
     assert proc.returncode == 0, proc.stderr
     return out, proc
 

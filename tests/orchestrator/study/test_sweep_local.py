@@ -1,4 +1,5 @@
-"""Sweeps on a LocalCluster: a failing point is recorded, completed points are never run twice, Ctrl-C loses nothing."""
+"""Sweeps on a LocalCluster and in the sweep's own process: a failing point is recorded, completed points are never
+run twice, Ctrl-C loses nothing."""
 
 from __future__ import annotations
 
@@ -32,7 +33,7 @@ def test_two_by_two_with_an_invalid_point_on_two_workers(write_study, tmp_path):
     prepared = prepare_study(load_study(write_study(SMALL_STUDY)))
     out = tmp_path / "out"
     seen = []
-    first = run_sweep(prepared, out, workers=2, progress=seen.append)
+    first = run_sweep(prepared, out, workers=2, progress=seen.append, executor="dask")
     assert (first.total, first.submitted, first.skipped, first.workers) == (4, 4, 0, 2)
     assert (first.ok, first.failed, first.errors, first.interrupted) == (3, 1, 0, False)
     assert sorted(r["index"] for r in seen) == [0, 1, 2, 3]  # one journal record per point, as each finished
@@ -49,7 +50,7 @@ def test_two_by_two_with_an_invalid_point_on_two_workers(write_study, tmp_path):
 
     journal = (out / "journal.jsonl").read_bytes()
     table = (out / "results.csv").read_text()
-    second = run_sweep(prepared, out, workers=2)
+    second = run_sweep(prepared, out, workers=2, executor="dask")
     assert (second.submitted, second.skipped, second.workers) == (0, 4, 0)  # nothing run, no cluster started
     assert (out / "journal.jsonl").read_bytes() == journal  # not one record added
     assert (out / "results.csv").read_text() == table
@@ -60,7 +61,8 @@ def test_two_by_two_with_an_invalid_point_on_two_workers(write_study, tmp_path):
     assert [r["index"] for r in records[4:]] == [3] and records[4]["error"] == SMALL_FAILURE
 
 
-def test_ctrl_c_keeps_every_finished_point_and_the_next_run_completes_the_rest(write_study, tmp_path):
+@pytest.mark.parametrize("executor", ["dask", "auto"])  # auto: this small study runs in the command's own process
+def test_ctrl_c_keeps_every_finished_point_and_the_next_run_completes_the_rest(write_study, tmp_path, executor):
     # R1 below 7.4 makes Table 6's stage-1 planets implausible (paper-sensitivity allows it the same way)
     text = SMALL_HEAD + SMALL_TABLES.replace("stop = 0.02", "stop = 0.3") + (
         '[plausibility]\nallow = ["gearbox.stage1.planet_inertia"]\n'
@@ -69,7 +71,8 @@ def test_ctrl_c_keeps_every_finished_point_and_the_next_run_completes_the_rest(w
     out = tmp_path / "out"
     exe = Path(sys.executable).parent / "dtcosim"
     # a new session: Ctrl-C on a terminal signals the whole foreground process group, workers included
-    proc = subprocess.Popen([str(exe), "sweep", str(path), "--workers", "1", "--out", str(out), "--no-plots"],
+    proc = subprocess.Popen([str(exe), "sweep", str(path), "--workers", "1", "--out", str(out), "--no-plots",
+                             "--executor", executor],
                             cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             start_new_session=True)
     journal = out / "journal.jsonl"

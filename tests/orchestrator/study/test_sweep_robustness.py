@@ -183,7 +183,8 @@ async def signalled_start(self):
     return await start(self)
 
 nanny.Nanny.start_unsafe = signalled_start
-cli.end_process(cli.main(["sweep", {study!r}, "--workers", "1", "--out", {out!r}, "-q", "--no-plots"]))
+cli.end_process(cli.main(["sweep", {study!r}, "--workers", "1", "--out", {out!r}, "-q", "--no-plots",
+                          "--executor", "dask"]))
 """
 
 
@@ -239,7 +240,8 @@ def test_a_sweep_stopped_by_a_full_disk_is_one_line_whether_its_table_is_written
     monkeypatch.setattr(sweep, "_execute", stopped_at_the_journal)
     if not table_fits:
         monkeypatch.setattr(os, "replace", FullAt("results.csv"))
-    assert cli.main(["sweep", str(path), "--out", str(out), "-q", "--no-plots"]) == 1
+    # on the cluster's path (_execute): a study this small would run in the command's own process
+    assert cli.main(["sweep", str(path), "--out", str(out), "-q", "--no-plots", "--executor", "dask"]) == 1
     either = "" if table_fits else "; the table, plots and study.json are not all written either"
     assert capsys.readouterr().err.strip().splitlines() == [
         f"dtcosim sweep: error: cannot write {journal}: No space left on device; the sweep stopped, the points "

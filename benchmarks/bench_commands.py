@@ -1,0 +1,122 @@
+"""What the user waits for: whole ``dtcosim`` commands, each in a fresh process, against the monolithic reference.
+
+1. **Warm runs** (default): ``dtcosim run`` (the paper's 60 s scenario, plots included: what a
+   user types first) and ``dtcosim reference --case table7 --json`` (the monolithic solver on the
+   same case) taking turns, ``--repeat`` times each after one warm-up of each, into a temporary
+   folder; printed: the median CPU time (user + system, of the command's process and its
+   children) and wall time of each, and the ratio run / reference (target, issue 34: <= 1).
+   ``--no-plots`` adds ``dtcosim run --no-plots``.
+2. **The first run after install** (``--first-run``): ``dtcosim run`` with an empty per-user cache
+   (``DTCOSIM_CACHE_DIR`` and ``MPLCONFIGDIR`` in a new temporary folder: no FMUs, no compiled
+   kernels, no matplotlib font list), its wall and CPU time, then, once the kernels compiled in the
+   background are there, warm runs with that cache; printed: the ratio of the first run's wall time
+   to the median warm run's (target, issue 34: <= 3) and how long the background compile took.
+
+The commands run with ``PYTHONDONTWRITEBYTECODE`` removed from their environment, as in a user's
+shell: with it set every command compiles dtcosim's modules again. The machine's other work
+changes the absolute times; the ratios are measured in the same run.
+
+Run: ``python benchmarks/bench_commands.py [--repeat N] [--no-plots] [--first-run]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+DTCOSIM = [sys.executable, "-m", "orchestrator.commands.cli"]
+
+
+def environment(**changes: str) -> dict[str, str]:
+    """This process's environment without ``PYTHONDONTWRITEBYTECODE``, with ``changes``."""
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+    return {**env, **changes}
+
+
+def timed(argv: list[str], env: dict[str, str], cwd: Path | None = None) -> tuple[float, float]:
+    """(wall, CPU) seconds of one command; CPU is user + system of the process and the children it waited for."""
+    wall0 = time.perf_counter()
+    proc = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=env, cwd=cwd)
+    _, status, usage = os.wait4(proc.pid, 0)
+    wall = time.perf_counter() - wall0
+    err = proc.stderr.read().decode(errors="replace") if proc.stderr else ""
+    proc.returncode = os.waitstatus_to_exitcode(status)
+    if proc.returncode != 0:
+        raise SystemExit(f"{' '.join(argv)} failed ({proc.returncode}):\n{err}")
+    return wall, usage.ru_utime + usage.ru_stime
+
+
+def warm(repeat: int, no_plots: bool, env: dict[str, str]) -> dict[str, list[tuple[float, float]]]:
+    """Each command once to warm up, then ``repeat`` times taking turns."""
+    with tempfile.TemporaryDirectory(prefix="dtcosim-bench-commands-") as tmp:
+        commands = {"dtcosim run": DTCOSIM + ["run", "--out", str(Path(tmp) / "run")],
+                    "dtcosim reference --case table7 --json": DTCOSIM + ["reference", "--case", "table7", "--json"]}
+        if no_plots:
+            commands["dtcosim run --no-plots"] = DTCOSIM + ["run", "--no-plots", "--out", str(Path(tmp) / "bare")]
+        for argv in commands.values():
+            timed(argv, env, Path(tmp))
+        times: dict[str, list[tuple[float, float]]] = {name: [] for name in commands}
+        for _ in range(repeat):
+            for name, argv in commands.items():
+                times[name].append(timed(argv, env, Path(tmp)))
+    return times
+
+
+def report(times: dict[str, list[tuple[float, float]]]) -> dict[str, tuple[float, float]]:
+    medians = {}
+    for name, values in times.items():
+        wall = statistics.median(w for w, _ in values)
+        cpu = statistics.median(c for _, c in values)
+        medians[name] = (wall, cpu)
+        print(f"  {name:42s} {cpu:6.2f} s CPU  {wall:6.2f} s wall")
+    return medians
+
+
+def first_run(repeat: int) -> None:
+    from components.compile.aot import build_lock_file
+
+    with tempfile.TemporaryDirectory(prefix="dtcosim-bench-first-") as tmp:
+        cache = Path(tmp) / "cache"
+        env = environment(DTCOSIM_CACHE_DIR=str(cache), MPLCONFIGDIR=str(Path(tmp) / "matplotlib"))
+        env.pop("DTCOSIM_FMU_DIR", None)
+        wall, cpu = timed(DTCOSIM + ["run", "--out", str(Path(tmp) / "first")], env, Path(tmp))
+        print(f"  first dtcosim run, empty caches              {cpu:6.2f} s CPU  {wall:6.2f} s wall")
+        waited = time.perf_counter()
+        os.environ["DTCOSIM_CACHE_DIR"] = str(cache)  # where build_lock_file looks
+        while build_lock_file().exists():  # the kernels compiling in the background, for later runs
+            time.sleep(0.5)
+        print(f"  (the background compile ended {time.perf_counter() - waited:.1f} s after the first run)")
+        times = warm(repeat, no_plots=False, env=env)
+        medians = report({"dtcosim run": times["dtcosim run"]})
+        print(f"ratio: first run wall / warm run wall  {wall / medians['dtcosim run'][0]:.2f}   (target <= 3)")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeat", type=int, default=5, help="measured runs of each command (default 5)")
+    parser.add_argument("--no-plots", action="store_true", help="also time `dtcosim run --no-plots`")
+    parser.add_argument("--first-run", action="store_true", help="time the first run with empty caches instead")
+    args = parser.parse_args()
+    if args.first_run:
+        print(f"the first `dtcosim run` with empty caches against warm runs (median of {args.repeat})")
+        first_run(args.repeat)
+        return
+    print(f"whole commands in fresh processes, median of {args.repeat} (taking turns, after one warm-up each)")
+    medians = report(warm(args.repeat, args.no_plots, environment()))
+    run_cpu = medians["dtcosim run"][1]
+    ref_cpu = medians["dtcosim reference --case table7 --json"][1]
+    print(f"ratio: dtcosim run CPU / dtcosim reference --case table7 --json CPU  {run_cpu / ref_cpu:.2f}   "
+          "(target <= 1)")
+    if "dtcosim run --no-plots" in medians:
+        print(f"       the four figures and matplotlib: {run_cpu - medians['dtcosim run --no-plots'][1]:.2f} s CPU "
+              "(run - run --no-plots)")
+
+
+if __name__ == "__main__":
+    main()
