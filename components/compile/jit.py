@@ -118,6 +118,8 @@ def try_compiled(source: KernelSource) -> tuple[ModuleType | None, str | None]:
 
 def already_compiled(source: KernelSource) -> ModuleType | None:
     """The just-in-time module of ``source`` if this process has loaded it already (nothing is loaded here)."""
+    if not _attempts:  # nothing compiled just in time here: no need to name the sources' version
+        return None
     return _attempts.get(source.shared_name, (None, None))[0]
 
 
