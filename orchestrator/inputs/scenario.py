@@ -30,6 +30,7 @@ from .analysis_settings import AnalysisSettings
 from .drivetrain_file import DrivetrainSpec
 from .limits import MAX_LOOP_ITERATIONS, MIN_RELATIVE_STEP
 from .load_events import ScenarioEvent, check_events_in_run
+from .origins import Origin
 from .master_options import ALGEBRAIC_LOOPS, ALGORITHMS, EXTRAPOLATIONS
 from .results_format import RESULTS_FORMATS
 from .series_spec import SeriesSpec
@@ -104,6 +105,9 @@ class Component:
         description does not say (no ``dependencies`` attribute: FMI 2 then means
         "depends on all inputs"); a loop through them is not algebraic. ``"*"``:
         every output of the FMU without declared dependencies (``--no-feedthrough COMPONENT``).
+    origins : mapping of str -> Origin
+        Where parameter values were given, in the order they were set (:mod:`orchestrator.inputs.origins`);
+        a value without one is the scenario's own entry.
     """
 
     name: str
@@ -114,15 +118,18 @@ class Component:
     drivetrain: DrivetrainSpec | None = None
     no_feedthrough: tuple[str, ...] = ()
     series: SeriesSpec | None = None
+    origins: Mapping[str, Origin] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not NAME_PATTERN.match(self.name):
             raise ScenarioError("components", self.name, "a component name of letters, digits, '_' or '-' (no dots)")
         object.__setattr__(self, "fmu", Path(self.fmu))
         params = dict(self.parameters)
+        object.__setattr__(self, "origins", FrozenMap(self.origins))
         for pname, value in params.items():
             if not isinstance(value, (int, float, bool, str)):
-                raise ScenarioError(f"components.{self.name}.parameters.{pname}", value, "a number, boolean or string")
+                raise self.origins.get(pname, Origin(None)).refusal(f"components.{self.name}.parameters.{pname}",
+                                                                    value, "a number, boolean or string")
         object.__setattr__(self, "parameters", FrozenMap(params))
         if self.role is not None and self.role not in ROLES:
             raise ScenarioError(f"components.{self.name}.role", self.role, "one of " + ", ".join(ROLES))
@@ -512,11 +519,11 @@ class Scenario:
             for pname, value in comp.parameters.items():
                 key = f"{comp.name}.{pname}"
                 if key in bound:
-                    raise ScenarioError(
+                    raise comp.origins.get(pname, Origin(src)).refusal(
                         f"components.{comp.name}.parameters.{pname}", value,
                         f"no value: {key} takes its value from {bound[key]} ([[bindings]]: one source for a value "
                         f"two FMUs need; a value here would break the link); set {bound[key]} instead (--set "
-                        f"{bound[key]}=...), or remove the binding", src)
+                        f"{bound[key]}=...), or remove the binding")
 
     def bound_source(self, ref: "VariableRef | str") -> str | None:
         """``"component.parameter"`` whose value ``ref`` takes through the bindings (the chain's start), or None."""
@@ -555,18 +562,25 @@ class Scenario:
             return self.with_simulation(algorithm=algorithm, **changes)
         coupling, scenario = self.jacobi, self
         for comp, values in coupling.parameters.items():
-            scenario = scenario.with_parameters(comp, **values)
+            scenario = scenario.with_values(comp, values, {p: Origin(self.source, f"jacobi.parameters.{comp}.{p}")
+                                                           for p in values})
         step = {} if coupling.step_s is None else {"step_s": coupling.step_s}
         return replace(scenario, connections=scenario.connections + coupling.connections, jacobi=None,
                        simulation=replace(scenario.simulation, algorithm="jacobi", **{**step, **changes}))
 
     def with_parameters(self, component: str, **values: ParameterValue) -> "Scenario":
-        """Copy with parameter values of one component added or replaced."""
-        comps = tuple(
-            replace(c, parameters={**c.parameters, **values}) if c.name == component else c for c in self.components
-        )
+        """Copy with parameter values of one component added or replaced, each where its value was given before."""
+        return self.with_values(component, values, {})
+
+    def with_values(self, component: str, values: Mapping[str, ParameterValue],
+                    origins: Mapping[str, Origin]) -> "Scenario":
+        """Copy with values of one component set, given at ``origins`` (a value without one keeps its origin)."""
         if component not in self.component_names:
-            raise ScenarioError("components", component, "a declared component: " + ", ".join(self.component_names), self.source)
+            raise next(iter(origins.values()), Origin(self.source)).refusal(
+                "components", component, "a declared component: " + ", ".join(self.component_names))
+        comps = tuple(replace(c, parameters={**c.parameters, **values},
+                              origins={**{k: o for k, o in c.origins.items() if k not in origins}, **origins})
+                      if c.name == component else c for c in self.components)
         return replace(self, components=comps)
 
     def with_allowed(self, *keys: str) -> "Scenario":
