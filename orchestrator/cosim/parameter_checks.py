@@ -161,9 +161,9 @@ def model_problem(system) -> EntryError | None:
             if not isinstance(cause, ParameterError):
                 continue
             variables = system.interfaces[name].variables
-            key = f"components.{name}.parameters"
-            if cause.name in variables:
-                key += f".{cause.name}"
+            if cause.name not in variables:  # no value of a parameter: the FMU with this scenario
+                return ScenarioError(f"components.{name}.parameters", cause.value, cause.expected,
+                                     system.scenario.source)
             origin, own = responsible(system.scenario, name, cause.name)
-            return origin.refusal(key, cause.value, cause.expected, own)
+            return origin.refusal(f"components.{name}.parameters.{cause.name}", cause.value, cause.expected, own)
     return record_speed_ratio(system)

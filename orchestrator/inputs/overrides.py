@@ -168,6 +168,7 @@ def apply_assignments(scenario, items: Sequence[str], option: str = "--set"):
     """The scenario with ``--set COMPONENT.PARAMETER=VALUE`` items set, each given by that option as typed."""
     values, origins = {}, {}
     for item in items:
-        name, values[name] = parse_assignment(item, option)
-        origins[name] = command_line(f"{option} {item.strip()}", scenario.source)
+        name, value = parse_assignment(item, option)
+        values.pop(name, None)  # the last typed is the last set
+        values[name], origins[name] = value, command_line(f"{option} {item.strip()}", scenario.source)
     return apply_parameters(scenario, values, origins)
