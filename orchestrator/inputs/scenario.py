@@ -577,7 +577,7 @@ class Scenario:
         """Copy with values of one component set, given at ``origins`` (a value without one keeps its origin)."""
         if component not in self.component_names:
             raise next(iter(origins.values()), Origin(self.source)).refusal(
-                "components", component, "a declared component: " + ", ".join(self.component_names))
+                "components", component, "a declared component: " + ", ".join(self.component_names), own=False)
         comps = tuple(replace(c, parameters={**c.parameters, **values},
                               origins={**{k: o for k, o in c.origins.items() if k not in origins}, **origins})
                       if c.name == component else c for c in self.components)

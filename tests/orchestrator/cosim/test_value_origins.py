@@ -138,6 +138,9 @@ stop = 0.1
     ("", '[base.parameters]\n"gearbox.stage1.backlash" = 0.3', "",
      r"study\.toml: invalid study entry base\.parameters\.gearbox\.stage1\.backlash = 0\.3: " + BACKLASH
      + r".* in the study or --allow-implausible gearbox\.stage1\.backlash$"),
+    ("", '[base.parameters]\n"turbine.seed" = 2', "",
+     r"study\.toml: invalid study entry components = 'turbine': expected a declared component: wind, gearbox, "
+     r"generator \(given with base\.parameters\.turbine\.seed\)$"),
     # a value the FMU keeps, implausible with an axis value: named with that axis value and its point
     ("", "", '[[axes]]\nparameter = "gearbox.stage3.module"\nvalues = [0.0015]\n',
      r"study\.toml: invalid study entry components\.gearbox\.parameters\.stage3\.backlash = '0\.00056 \(as built\)'"
