@@ -328,8 +328,9 @@ class Scenario:
             if tgt in set_initially:
                 raise ScenarioError(f"initial[{i}].to", tgt, f"a variable set once (already by initial[{set_initially[tgt]}])", src)
             comp = next(c for c in self.components if c.name == b.target.component)
-            if b.target.variable in comp.parameters:
-                raise ScenarioError(f"initial[{i}].to", tgt, f"a variable without a value in components.{comp.name}.parameters", src)
+            if b.target.variable in comp.parameters:  # named where that value was given
+                raise comp.origins.get(b.target.variable, Origin(src)).refusal(
+                    f"initial[{i}].to", tgt, f"a variable without a value in components.{comp.name}.parameters", own=False)
             set_initially[tgt] = i
         object.__setattr__(self, "bindings", tuple(self.bindings))
         self._check_bindings(known, names, driven, set_initially)

@@ -67,6 +67,9 @@ SET_REFUSED = [
     (["gearbox.generator_inertia=100"], rf"^--set gearbox\.generator_inertia=100 {ON_TOP}.*generator_inertia = 100: "
                                         r"expected no value: gearbox\.generator_inertia takes its value from "
                                         r"generator\.inertia"),
+    (["generator.initial_speed=5"], rf"^--set generator\.initial_speed=5 {ON_TOP}initial\[0\]\.to = "
+                                    r"'generator\.initial_speed': expected a variable without a value in "
+                                    r"components\.generator\.parameters$"),
     # a value the FMU keeps, refused by the model or by physics with the one given: named by the one given
     (["gearbox.stage1.sun_radius=2.0"], rf"^--set gearbox\.stage1\.sun_radius=2\.0 {ON_TOP}components\.gearbox\."
                                         r"parameters\.stage1\.ring_radius = 0\.9: expected > sun radius"),
