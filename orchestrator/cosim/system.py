@@ -21,7 +21,8 @@ values given with a unit (``"0.56 mm"``) converted to the unit the FMU declares
 dtcosim model's own validation: :mod:`orchestrator.cosim.parameter_checks`); values plausible by physics
 (:mod:`orchestrator.cosim.plausibility_checks`); the
 results within the size limits (:func:`check_sizes`). The first problem raises
-:class:`~orchestrator.errors.ScenarioError` naming the scenario key. The result,
+:class:`~orchestrator.errors.ScenarioError` naming the scenario key (for a parameter value, the error of the
+place it was given: :mod:`orchestrator.inputs.origins`). The result,
 a :class:`~orchestrator.cosim.resolved.ResolvedSystem`, is what the master runs.
 """
 
@@ -36,6 +37,7 @@ from components.validation import is_number
 from ..errors import AlgebraicLoopError, ScenarioError, suggestion
 from ..frozen_map import FrozenMap
 from ..inputs.limits import MAX_RESULT_VALUES
+from ..inputs.origins import origin_of
 from ..inputs.scenario import Component, Scenario, VariableRef
 from .declared_units import quantities_as_values
 from .event_slots import assign_events
@@ -195,17 +197,16 @@ def resolve_system(scenario: Scenario, fmu_paths: Mapping[str, Path] | None = No
         iface = interfaces[comp.name]
         for pname, value in comp.parameters.items():
             key = f"components.{comp.name}.parameters.{pname}"
+            var = iface.variables.get(pname)
             problem = parameter_problem(iface, pname)
-            if problem is not None:
-                raise ScenarioError(key, value, problem, src)
-            var = iface.variables[pname]
-            if f"{comp.name}.{pname}" in connected_inputs:
-                raise ScenarioError(key, value, "no value for an input that a connection drives", src)
-            if not _value_matches(var, value):
-                raise ScenarioError(key, value, f"a {var.type} value for {pname}", src)
-            problem = value_problem(iface, var, value)
-            if problem is not None:
-                raise ScenarioError(key, value, problem, src)
+            if problem is None and f"{comp.name}.{pname}" in connected_inputs:
+                problem = "no value for an input that a connection drives"
+            elif problem is None and not _value_matches(var, value):
+                problem = f"a {var.type} value for {pname}"
+            elif problem is None:
+                problem = value_problem(iface, var, value)
+            if problem is not None:  # named where the value was given (the scenario, --set, a study, an SSP)
+                raise origin_of(scenario, comp.name, pname).refusal(key, value, problem)
 
     for i, con in enumerate(scenario.connections):
         a = _lookup(interfaces[con.source.component], con.source, f"connections[{i}].from", src, READABLE_CAUSALITIES, "an output")
@@ -281,7 +282,7 @@ def resolve_system(scenario: Scenario, fmu_paths: Mapping[str, Path] | None = No
     )
     problem = model_problem(system) or plausibility_problem(system)
     if problem is not None:
-        raise ScenarioError(*problem, src)
+        raise problem
     check_sizes(system)
     return system
 
@@ -315,9 +316,9 @@ def _enumeration_items_as_values(scenario: Scenario, interfaces: Mapping[str, Fm
             if var is not None and var.type == "Enumeration" and isinstance(value, str):
                 items = iface.enumerations.get(var.declared_type, {})
                 if value not in items:
-                    raise ScenarioError(f"components.{comp.name}.parameters.{pname}", value,
-                                        f"an item of {var.declared_type}: {', '.join(items) or 'none'}",
-                                        scenario.source)
+                    raise origin_of(scenario, comp.name, pname).refusal(
+                        f"components.{comp.name}.parameters.{pname}", value,
+                        f"an item of {var.declared_type}: {', '.join(items) or 'none'}")
                 changed[pname] = items[value]
         if changed:
             scenario = scenario.with_parameters(comp.name, **changed)
