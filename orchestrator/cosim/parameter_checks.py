@@ -28,7 +28,7 @@ import math
 from typing import Any
 
 from components.errors import ParameterError
-from components.validation import INT32_MAX, INT32_MIN, Bounds
+from components.validation import INT32_MAX, INT32_MIN, Bounds, is_number
 
 from ..errors import EntryError, ScenarioError
 from ..inputs.origins import responsible
@@ -53,6 +53,20 @@ def declared_bounds(iface: FmuInterface, var: FmuVariable) -> Bounds | None:
     low = var.minimum if var.minimum is not None else (INT32_MIN if integer else -math.inf)
     high = var.maximum if var.maximum is not None else (INT32_MAX if integer else math.inf)
     return Bounds(low, high, integer, f"within [{low:g}, {high:g}] (the FMU's declared min and max)")
+
+
+def type_problem(var: FmuVariable, value: Any, name: str) -> str | None:
+    """'an Integer value for NAME' if ``value`` is not of ``var``'s FMI type, else None."""
+    if var.type == "Real":
+        matches = is_number(value)
+    elif var.type in ("Integer", "Enumeration"):
+        matches = isinstance(value, int) and not isinstance(value, bool)
+    elif var.type == "Boolean":
+        matches = isinstance(value, bool)
+    else:
+        matches = isinstance(value, str)
+    article = "an" if var.type[0] in "AEIOU" else "a"
+    return None if matches else f"{article} {var.type} value for {name}"
 
 
 def value_problem(iface: FmuInterface, var: FmuVariable, value: Any) -> str | None:

@@ -32,7 +32,6 @@ import re
 from pathlib import Path
 from typing import Mapping, Sequence
 
-from components.validation import is_number
 
 from ..errors import AlgebraicLoopError, ScenarioError, suggestion
 from ..frozen_map import FrozenMap
@@ -44,7 +43,7 @@ from .event_slots import assign_events
 from .fmu_interface import FmuInterface, FmuVariable, read_fmu_interface
 from .coupling_delays import FEEDTHROUGH, coupling_delays
 from .graph import algebraic_loop_groups, dependency_order, find_algebraic_loop, initialization_order
-from .parameter_checks import model_problem, value_problem
+from .parameter_checks import model_problem, type_problem, value_problem
 from .plausibility_checks import plausibility_problem
 from .resolved import RecordedVariable, ResolvedSystem
 from .roles import declared_roles
@@ -135,16 +134,6 @@ def parameter_problem(iface: FmuInterface, pname: str) -> str | None:
     return None
 
 
-def _value_matches(var: FmuVariable, value) -> bool:
-    if var.type == "Real":
-        return is_number(value)
-    if var.type in ("Integer", "Enumeration"):
-        return isinstance(value, int) and not isinstance(value, bool)
-    if var.type == "Boolean":
-        return isinstance(value, bool)
-    return isinstance(value, str)
-
-
 def _pattern_regex(pattern: str) -> re.Pattern:
     """``*`` and ``?`` are wildcards; everything else (dots, brackets) is literal."""
     return re.compile("".join(".*" if ch == "*" else "." if ch == "?" else re.escape(ch) for ch in pattern) + r"\Z")
@@ -201,10 +190,8 @@ def resolve_system(scenario: Scenario, fmu_paths: Mapping[str, Path] | None = No
             problem = parameter_problem(iface, pname)
             if problem is None and f"{comp.name}.{pname}" in connected_inputs:
                 problem = "no value for an input that a connection drives"
-            elif problem is None and not _value_matches(var, value):
-                problem = f"a {var.type} value for {pname}"
             elif problem is None:
-                problem = value_problem(iface, var, value)
+                problem = type_problem(var, value, pname) or value_problem(iface, var, value)
             if problem is not None:  # named where the value was given (the scenario, --set, a study, an SSP)
                 raise origin_of(scenario, comp.name, pname).refusal(key, value, problem)
 

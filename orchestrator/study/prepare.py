@@ -167,8 +167,7 @@ def _check_values(study: Study, system, skip) -> None:
     with the FMU's own message; combinations of values are the model's to refuse
     (that point fails).
     """
-    from ..cosim.parameter_checks import value_problem
-    from ..cosim.system import _value_matches
+    from ..cosim.parameter_checks import type_problem, value_problem
 
     seen: set = set()
     for point in study.expand():
@@ -179,9 +178,11 @@ def _check_values(study: Study, system, skip) -> None:
             comp, param = split_parameter(name)
             iface = system.interfaces[comp]
             var = iface.variables[param]
-            problem = f"a {var.type} value" if not _value_matches(var, value) else value_problem(iface, var, value)
+            problem = type_problem(var, value, name)
+            if problem is None and (problem := value_problem(iface, var, value)) is not None:
+                problem = f"{problem} for {name}"
             if problem is not None:
-                raise study.origins(point)[name].refusal(name, value, f"{problem} for {name}")
+                raise study.origins(point)[name].refusal(name, value, problem)
 
 
 def _solver_settings(study: Study):
