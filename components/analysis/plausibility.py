@@ -155,6 +155,11 @@ class Judgement:
         """The bound and its reason, for an error message."""
         return f"a plausible value {self.bound} ({self.reason})"
 
+    @property
+    def in_si(self) -> str:
+        """The value with its SI unit for a message: ``"0.3 m"``, ``"1e+30"`` (dimensionless)."""
+        return f"{self.value:.6g} {self.unit}".rstrip()
+
 
 def _judgement(rule: str, key: str, value: float, low: float | None, high: float | None, reason: str) -> Judgement:
     return Judgement(rule, key, float(value), low, high, _UNITS.get(key.rsplit(".", 1)[-1].split("_")[-1], ""),

@@ -65,11 +65,7 @@ def load(spec, args: argparse.Namespace, command: str):
 
 def apply(scenario, args: argparse.Namespace, command: str):
     """The scenario with the options applied; notes of what else changed go to stderr as warnings."""
-    from ..inputs.overrides import (
-        SimulationOverrides,
-        apply_parameters,
-        parse_assignment,
-    )
+    from ..inputs.overrides import SimulationOverrides, apply_assignments
 
     overrides = SimulationOverrides(stop_s=args.stop, step_s=args.step, output_interval_s=args.output_interval,
                                     window_s=args.window, algorithm=args.algorithm, extrapolation=args.extrapolation)
@@ -81,7 +77,7 @@ def apply(scenario, args: argparse.Namespace, command: str):
     for item in args.no_feedthrough:
         scenario = scenario.with_no_feedthrough(item.strip())
     scenario = allow_implausible(scenario, args.allow_implausible)
-    return apply_parameters(scenario, dict(parse_assignment(item) for item in args.set))
+    return apply_assignments(scenario, args.set)
 
 
 def allow_implausible(target, keys: list[str]):

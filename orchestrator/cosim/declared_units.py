@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from typing import Any, Mapping
 
-from ..errors import ScenarioError
+from ..inputs.origins import origin_of
 from ..inputs.quantities import UnitError, is_quantity_text, to_declared
 from .fmu_interface import FmuInterface, FmuVariable
 
@@ -48,8 +48,9 @@ def quantities_as_values(scenario, interfaces: Mapping[str, FmuInterface]):
 
     Raises
     ------
-    ScenarioError
-        Naming ``components.<name>.parameters.<parameter>``, the value, the declared unit and dimension.
+    EntryError
+        Naming where the value was given (:mod:`orchestrator.inputs.origins`),
+        ``components.<name>.parameters.<parameter>``, the value, the declared unit and dimension.
     """
     for comp in scenario.components:
         iface = interfaces[comp.name]
@@ -61,9 +62,9 @@ def quantities_as_values(scenario, interfaces: Mapping[str, FmuInterface]):
             try:
                 new = declared_value(iface, var, value, comp.parameters)
             except UnitError as exc:
-                raise ScenarioError(f"components.{comp.name}.parameters.{pname}", value,
-                                    f"{exc.expected} ({pname} is declared in {var.unit or '1'} by "
-                                    f"{iface.path.name})", scenario.source) from None
+                raise origin_of(scenario, comp.name, pname).refusal(
+                    f"components.{comp.name}.parameters.{pname}", value,
+                    f"{exc.expected} ({pname} is declared in {var.unit or '1'} by {iface.path.name})") from None
             if new is not value:
                 changed[pname] = new
         if changed:

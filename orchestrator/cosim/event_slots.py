@@ -16,6 +16,7 @@ from typing import Any, Mapping
 
 from ..errors import ScenarioError
 from ..inputs.load_events import EVENT_KIND_CODES, SLOT_FIELDS, ScenarioEvent
+from ..inputs.origins import origin_of, responsible
 from .fmu_interface import FmuInterface
 
 
@@ -65,15 +66,16 @@ def _events_in_slot_parameters(scenario, interfaces: Mapping[str, FmuInterface],
                      if f"event{slot}.{f}" in variables else None for f in SLOT_FIELDS[1:]}
             prefix = f"components.{comp.name}.parameters.event{slot}"
             if code not in kinds:
-                raise ScenarioError(f"{prefix}.kind", code, "0 (none) or an event code: "
-                                    + ", ".join(f"{c} {k}" for c, k in kinds.items()), scenario.source)
+                raise origin_of(scenario, comp.name, f"event{slot}.kind").refusal(
+                    f"{prefix}.kind", code, "0 (none) or an event code: " + ", ".join(f"{c} {k}" for c, k in kinds.items()))
             kind = kinds[code]
             try:
                 event = ScenarioEvent(kind, value["start"], value["duration"],
                                       None if kind == "grid_fault" else value["factor"], comp.name)
-            except ScenarioError as exc:
-                raise ScenarioError(exc.key.replace("event.", f"{prefix}.", 1), exc.value, exc.expected,
-                                    scenario.source) from None
+            except ScenarioError as exc:  # named where the slot's value was given (or its kind, for the FMU's own)
+                origin, own = responsible(scenario, comp.name, exc.key.replace("event.", f"event{slot}.", 1),
+                                          [f"event{slot}.kind"])
+                raise origin.refusal(exc.key.replace("event.", f"{prefix}.", 1), exc.value, exc.expected, own) from None
             found.append(AssignedEvent(event, comp.name, slot))
     return tuple(found)
 
@@ -141,9 +143,9 @@ def assign_events(scenario, interfaces: Mapping[str, FmuInterface]):
         for pname in comp.parameters:
             head, dot, tail = pname.partition(".")
             if dot and head.startswith("event") and head[5:].isdigit() and tail in SLOT_FIELDS:
-                raise ScenarioError(f"components.{comp.name}.parameters.{pname}", comp.parameters[pname],
-                                    "no event-slot parameter on a component that [[events]] fill (give the event "
-                                    "as [[events]] only)", src)
+                raise origin_of(scenario, comp.name, pname).refusal(
+                    f"components.{comp.name}.parameters.{pname}", comp.parameters[pname],
+                    "no event-slot parameter on a component that [[events]] fill (give the event as [[events]] only)")
         values = dict(comp.parameters)
         for a in assigned:
             if a.component == comp.name:

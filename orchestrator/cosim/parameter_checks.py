@@ -28,8 +28,10 @@ import math
 from typing import Any
 
 from components.errors import ParameterError
-from components.validation import INT32_MAX, INT32_MIN, Bounds
+from components.validation import INT32_MAX, INT32_MIN, Bounds, is_number
 
+from ..errors import EntryError, ScenarioError
+from ..inputs.origins import responsible
 from .fmu_interface import FmuInterface, FmuVariable
 
 INTEGER_TYPES = ("Integer", "Enumeration")
@@ -51,6 +53,20 @@ def declared_bounds(iface: FmuInterface, var: FmuVariable) -> Bounds | None:
     low = var.minimum if var.minimum is not None else (INT32_MIN if integer else -math.inf)
     high = var.maximum if var.maximum is not None else (INT32_MAX if integer else math.inf)
     return Bounds(low, high, integer, f"within [{low:g}, {high:g}] (the FMU's declared min and max)")
+
+
+def type_problem(var: FmuVariable, value: Any, name: str) -> str | None:
+    """'an Integer value for NAME' if ``value`` is not of ``var``'s FMI type, else None."""
+    if var.type == "Real":
+        matches = is_number(value)
+    elif var.type in ("Integer", "Enumeration"):
+        matches = isinstance(value, int) and not isinstance(value, bool)
+    elif var.type == "Boolean":
+        matches = isinstance(value, bool)
+    else:
+        matches = isinstance(value, str)
+    article = "an" if var.type[0] in "AEIOU" else "a"
+    return None if matches else f"{article} {var.type} value for {name}"
 
 
 def value_problem(iface: FmuInterface, var: FmuVariable, value: Any) -> str | None:
@@ -89,8 +105,8 @@ def record_coverage(system, component: str) -> None:
             f"[{t0:g}, {t1:g}] s (record time = simulation time + time_offset; or out_of_record = 0, hold)"))
 
 
-def record_speed_ratio(system) -> tuple[str, Any, str] | None:
-    """A load record whose generator/rotor speed ratio is not its drivetrain's, as ``(key, value, expectation)``.
+def record_speed_ratio(system) -> ScenarioError | None:
+    """The error for a load record whose generator/rotor speed ratio is not its drivetrain's, else None.
 
     A record that carries both speeds (OpenFAST's RotSpeed and GenSpeed or HSShftV) measured a drivetrain
     of that ratio; played through another (a record of another turbine), its speeds and loads run
@@ -119,20 +135,23 @@ def record_speed_ratio(system) -> tuple[str, Any, str] | None:
     for name, recorded in sources:
         for record, value in zip(recorded.get("records", []), recorded.get("ratios", [recorded["ratio"]])):
             if not abs(abs(value) / ratio - 1.0) <= SPEED_RATIO_TOLERANCE:
-                return (f"components.{name}.series", f"{record}: {recorded['generator']} / {recorded['rotor']} = "
-                        f"{abs(value):.4g}",
-                        f"the generator/rotor speed ratio of the drivetrain of {gear}, {ratio:.4g}, within "
-                        f"{SPEED_RATIO_TOLERANCE:.0%} (a record of another drivetrain runs through the wrong gearbox; "
-                        "check_speed_ratio = false in the series table runs it anyway)")
+                return ScenarioError(
+                    f"components.{name}.series", f"{record}: {recorded['generator']} / {recorded['rotor']} = "
+                    f"{abs(value):.4g}",
+                    f"the generator/rotor speed ratio of the drivetrain of {gear}, {ratio:.4g}, within "
+                    f"{SPEED_RATIO_TOLERANCE:.0%} (a record of another drivetrain runs through the wrong gearbox; "
+                    "check_speed_ratio = false in the series table runs it anyway)", system.scenario.source)
     return None
 
 
-def model_problem(system) -> tuple[str, Any, str] | None:
-    """``(scenario key, value, expectation)`` of the first dtcosim model that rejects the values, else None.
+def model_problem(system) -> EntryError | None:
+    """The error of the first dtcosim model that rejects the values (scenario key, value, expectation), else None.
 
     Builds each dtcosim component's parameter set from its record and the
     effective parameter values (:mod:`orchestrator.cosim.physics_view`), exactly as
-    the FMU does at initialisation. Foreign FMUs are skipped.
+    the FMU does at initialisation. Foreign FMUs are skipped. The error is named where the
+    refused value was given, or for a value of the FMU's own where the last value of the
+    component was (:func:`orchestrator.inputs.origins.responsible`).
     """
     from .physics_view import (
         PhysicsUnavailable,
@@ -156,8 +175,9 @@ def model_problem(system) -> tuple[str, Any, str] | None:
             if not isinstance(cause, ParameterError):
                 continue
             variables = system.interfaces[name].variables
-            key = f"components.{name}.parameters"
-            if cause.name in variables:
-                key += f".{cause.name}"
-            return key, cause.value, cause.expected
+            if cause.name not in variables:  # no value of a parameter: the FMU with this scenario
+                return ScenarioError(f"components.{name}.parameters", cause.value, cause.expected,
+                                     system.scenario.source)
+            origin, own = responsible(system.scenario, name, cause.name)
+            return origin.refusal(f"components.{name}.parameters.{cause.name}", cause.value, cause.expected, own)
     return record_speed_ratio(system)

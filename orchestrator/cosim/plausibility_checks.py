@@ -25,7 +25,8 @@ from components.model.description import build
 from components.model.parameter_map import GENERATOR_FIELDS, WIND_FIELDS, flatten
 from components.model.torque_controller import CONTROLLER_FIELDS
 
-from ..errors import ScenarioError, suggestion
+from ..errors import EntryError, ScenarioError, suggestion
+from ..inputs.origins import responsible
 from .physics_view import (
     PhysicsUnavailable,
     controller_parameters,
@@ -97,10 +98,13 @@ def _operation_findings(system, rating: Rating) -> tuple[Judgement, ...]:
     return implausible(judge_operation(rating, speeds, torques, factors), system.scenario.allow_implausible)
 
 
-def plausibility_problem(system) -> tuple[str, Any, str] | None:
-    """``(scenario key, value, expectation)`` of the first implausible value the scenario introduces, else None.
+def plausibility_problem(system) -> EntryError | None:
+    """The error for the first implausible value the scenario introduces (scenario key, value, bound), else None.
 
-    Scenarios without exactly one dtcosim Gearbox FMU have no rating: nothing is judged.
+    Named where the value was given (the scenario, ``--set``, a study's point, a load-case entry, an SSP);
+    a value of the FMU's own, implausible with the values given around it, where the last of those was
+    (:func:`orchestrator.inputs.origins.responsible`). Scenarios without exactly one dtcosim Gearbox FMU
+    have no rating: nothing is judged.
     """
     check_allowed(system)
     try:
@@ -116,8 +120,11 @@ def plausibility_problem(system) -> tuple[str, Any, str] | None:
     given = system.scenario.component(comp).parameters
     value = given.get(param, f"{j.value:.6g} (as built)")
     stage = param.split(".", 1)[0]
+    around = sorted(k for k in given if k.split(".", 1)[0] == stage)
     note = "" if param in given else (" (the FMU's own value, implausible with the values this scenario gives: "
-                                      + ", ".join(sorted(k for k in given if k.split(".", 1)[0] == stage)) + ")")
-    return (f"components.{comp}.parameters.{param}", value,
-            f"{j.expected}; it is {j.value:.6g} {j.unit} in SI{note}; a deliberate value is kept by [plausibility] "
-            f'allow = ["{comp}.{param}"] in the scenario or --allow-implausible {comp}.{param}')
+                                      + ", ".join(around) + ")")
+    origin, own = responsible(system.scenario, comp, param, around)
+    return origin.refusal(f"components.{comp}.parameters.{param}", value,
+                          f"{j.expected}; it is {j.in_si} in SI{note}; a deliberate value is kept by [plausibility] "
+                          f'allow = ["{comp}.{param}"] in the {origin.holder} or --allow-implausible {comp}.{param}',
+                          own)

@@ -21,7 +21,8 @@ values given with a unit (``"0.56 mm"``) converted to the unit the FMU declares
 dtcosim model's own validation: :mod:`orchestrator.cosim.parameter_checks`); values plausible by physics
 (:mod:`orchestrator.cosim.plausibility_checks`); the
 results within the size limits (:func:`check_sizes`). The first problem raises
-:class:`~orchestrator.errors.ScenarioError` naming the scenario key. The result,
+:class:`~orchestrator.errors.ScenarioError` naming the scenario key (for a parameter value, the error of the
+place it was given: :mod:`orchestrator.inputs.origins`). The result,
 a :class:`~orchestrator.cosim.resolved.ResolvedSystem`, is what the master runs.
 """
 
@@ -31,18 +32,18 @@ import re
 from pathlib import Path
 from typing import Mapping, Sequence
 
-from components.validation import is_number
 
 from ..errors import AlgebraicLoopError, ScenarioError, suggestion
 from ..frozen_map import FrozenMap
 from ..inputs.limits import MAX_RESULT_VALUES
+from ..inputs.origins import origin_of
 from ..inputs.scenario import Component, Scenario, VariableRef
 from .declared_units import quantities_as_values
 from .event_slots import assign_events
 from .fmu_interface import FmuInterface, FmuVariable, read_fmu_interface
 from .coupling_delays import FEEDTHROUGH, coupling_delays
 from .graph import algebraic_loop_groups, dependency_order, find_algebraic_loop, initialization_order
-from .parameter_checks import model_problem, value_problem
+from .parameter_checks import model_problem, type_problem, value_problem
 from .plausibility_checks import plausibility_problem
 from .resolved import RecordedVariable, ResolvedSystem
 from .roles import declared_roles
@@ -133,16 +134,6 @@ def parameter_problem(iface: FmuInterface, pname: str) -> str | None:
     return None
 
 
-def _value_matches(var: FmuVariable, value) -> bool:
-    if var.type == "Real":
-        return is_number(value)
-    if var.type in ("Integer", "Enumeration"):
-        return isinstance(value, int) and not isinstance(value, bool)
-    if var.type == "Boolean":
-        return isinstance(value, bool)
-    return isinstance(value, str)
-
-
 def _pattern_regex(pattern: str) -> re.Pattern:
     """``*`` and ``?`` are wildcards; everything else (dots, brackets) is literal."""
     return re.compile("".join(".*" if ch == "*" else "." if ch == "?" else re.escape(ch) for ch in pattern) + r"\Z")
@@ -195,17 +186,14 @@ def resolve_system(scenario: Scenario, fmu_paths: Mapping[str, Path] | None = No
         iface = interfaces[comp.name]
         for pname, value in comp.parameters.items():
             key = f"components.{comp.name}.parameters.{pname}"
+            var = iface.variables.get(pname)
             problem = parameter_problem(iface, pname)
-            if problem is not None:
-                raise ScenarioError(key, value, problem, src)
-            var = iface.variables[pname]
-            if f"{comp.name}.{pname}" in connected_inputs:
-                raise ScenarioError(key, value, "no value for an input that a connection drives", src)
-            if not _value_matches(var, value):
-                raise ScenarioError(key, value, f"a {var.type} value for {pname}", src)
-            problem = value_problem(iface, var, value)
-            if problem is not None:
-                raise ScenarioError(key, value, problem, src)
+            if problem is None and f"{comp.name}.{pname}" in connected_inputs:
+                problem = "no value for an input that a connection drives"
+            elif problem is None:
+                problem = type_problem(var, value, pname) or value_problem(iface, var, value)
+            if problem is not None:  # named where the value was given (the scenario, --set, a study, an SSP)
+                raise origin_of(scenario, comp.name, pname).refusal(key, value, problem)
 
     for i, con in enumerate(scenario.connections):
         a = _lookup(interfaces[con.source.component], con.source, f"connections[{i}].from", src, READABLE_CAUSALITIES, "an output")
@@ -281,7 +269,7 @@ def resolve_system(scenario: Scenario, fmu_paths: Mapping[str, Path] | None = No
     )
     problem = model_problem(system) or plausibility_problem(system)
     if problem is not None:
-        raise ScenarioError(*problem, src)
+        raise problem
     check_sizes(system)
     return system
 
@@ -315,9 +303,9 @@ def _enumeration_items_as_values(scenario: Scenario, interfaces: Mapping[str, Fm
             if var is not None and var.type == "Enumeration" and isinstance(value, str):
                 items = iface.enumerations.get(var.declared_type, {})
                 if value not in items:
-                    raise ScenarioError(f"components.{comp.name}.parameters.{pname}", value,
-                                        f"an item of {var.declared_type}: {', '.join(items) or 'none'}",
-                                        scenario.source)
+                    raise origin_of(scenario, comp.name, pname).refusal(
+                        f"components.{comp.name}.parameters.{pname}", value,
+                        f"an item of {var.declared_type}: {', '.join(items) or 'none'}")
                 changed[pname] = items[value]
         if changed:
             scenario = scenario.with_parameters(comp.name, **changed)

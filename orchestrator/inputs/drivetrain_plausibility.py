@@ -92,8 +92,8 @@ def check_file(drivetrain: Drivetrain, rotor_speed_rad_s: float, allow: Sequence
         key = file_keys.get(j.key, j.key)
         written = entry_at(data, key)
         shown = written if isinstance(written, (int, float, str)) and not isinstance(written, bool) \
-            else f"{j.value:.6g} {j.unit} (derived)"
-        raise DrivetrainFileError(key, shown, f"{j.expected}; it is {j.value:.6g} {j.unit} in SI ({j.key}); "
+            else f"{j.in_si} (derived)"
+        raise DrivetrainFileError(key, shown, f"{j.expected}; it is {j.in_si} in SI ({j.key}); "
                                   + allow_hint(j.key, "in this file"), source)
     return judgements
 

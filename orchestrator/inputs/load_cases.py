@@ -57,6 +57,7 @@ from components.analysis.wind_distribution import WindDistribution, bin_probabil
 
 from ..errors import EntryError
 from ..frozen_map import FrozenMap
+from .origins import Origin
 from .overrides import SimulationOverrides
 from .rating_options import BearingLifeOptions, GearRatingOptions
 from .schema import NAME_PATTERN, ParameterValue
@@ -130,6 +131,8 @@ class LoadBin:
         At the bin centre (from the law, a row, or both).
     parameters : mapping of str -> value
         The row's extra parameters.
+    row : int or None
+        Index of the bin's ``[[operating_points]]`` row (None: the law alone).
     """
 
     index: int
@@ -138,6 +141,7 @@ class LoadBin:
     probability: float
     point: OperatingPoint
     parameters: Mapping[str, ParameterValue] = field(default_factory=dict)
+    row: int | None = None
 
     @property
     def centre_m_s(self) -> float:
@@ -312,11 +316,11 @@ class LoadCaseSet:
         """Every bin with its probability and operating point."""
         edges = np.asarray(self.edges_m_s, dtype=float)
         probs = bin_probabilities(self.wind, edges)
-        rows = {self.bin_of(r.wind_speed_m_s): r for r in self.rows}
+        rows = {self.bin_of(r.wind_speed_m_s): i for i, r in enumerate(self.rows)}
         out = []
         for b in range(edges.size - 1):
             centre = 0.5 * (edges[b] + edges[b + 1])
-            row = rows.get(b)
+            row = self.rows[rows[b]] if b in rows else None
             if self.law is not None:
                 point = self.law.at(centre) if centre > 0 else OperatingPoint(centre)
             elif row is not None:
@@ -332,8 +336,25 @@ class LoadCaseSet:
                                        "generator_torque_nm", "sigma_rad_s", "spectrum_level")} | given,
                                        region="table" if self.law is None or given else point.region)
                 params = row.parameters
-            out.append(LoadBin(b, float(edges[b]), float(edges[b + 1]), float(probs[b]), point, params))
+            out.append(LoadBin(b, float(edges[b]), float(edges[b + 1]), float(probs[b]), point, params, rows.get(b)))
         return tuple(out)
+
+    def base_origins(self) -> dict[str, Origin]:
+        """Where each fixed value of the base was given (``base.parameters.<name>``)."""
+        return {p: Origin(self.source, f"base.parameters.{p}", error=LoadCaseError) for p in self.base_parameters}
+
+    def row_origin(self, b: LoadBin, name: str, run: str, field: tuple[str, str] | None = None) -> Origin:
+        """Where bin ``b``'s value of ``name`` was given for ``run``: its ``[[operating_points]]`` row, else the law.
+
+        ``field``: the operating-point value's attribute (``generator_torque_nm``) and key in the file
+        (``generator_torque``); None: one of the row's ``parameters``.
+        """
+        if field is None:
+            return Origin(self.source, f"operating_points[{b.row}].parameters.{name}", run, LoadCaseError)
+        attr, key = field
+        if b.row is not None and getattr(self.rows[b.row], attr) is not None:
+            return Origin(self.source, f"operating_points[{b.row}].{key} ({name})", run, LoadCaseError)
+        return Origin(self.source, f"operating_law ({name} at {b.centre_m_s:g} m/s)", run, LoadCaseError)
 
     @property
     def operating_share(self) -> float:

@@ -14,7 +14,9 @@ and parameter values) change a scenario the same way:
   [5, 600] s, not [5, 60] s). The change is reported as a note, which the commands
   print as a warning;
 * parameter values are set by ``component.parameter`` and checked against the
-  FMUs like the scenario's own.
+  FMUs like the scenario's own; a message about one names where it was given
+  (``--set gearbox.stage1.backlash=0.3 (on top of paper-60s.toml)``, a study's axis:
+  :mod:`orchestrator.inputs.origins`).
 """
 
 from __future__ import annotations
@@ -22,9 +24,10 @@ from __future__ import annotations
 import math
 
 from dataclasses import dataclass, fields
-from typing import Any, Mapping
+from typing import Any, Mapping, Sequence
 
 from ..errors import ScenarioError
+from .origins import Origin, command_line
 from .schema import ParameterValue
 
 #: TOML / command-line key -> SimulationSettings field
@@ -148,9 +151,24 @@ def parse_assignment(text: str, key: str = "--set") -> tuple[str, ParameterValue
     return f"{comp.strip()}.{param.strip()}", parse_value(value)
 
 
-def apply_parameters(scenario, values: Mapping[str, ParameterValue]):
-    """The scenario with ``component.parameter`` values set (checked against the FMUs when resolved)."""
+def apply_parameters(scenario, values: Mapping[str, ParameterValue], origins: Mapping[str, Origin] | None = None):
+    """The scenario with ``component.parameter`` values set (checked against the FMUs when resolved).
+
+    ``origins``: where each value was given (a study's axis, a load-case entry; :mod:`orchestrator.inputs.origins`),
+    which every message about the value names; without one, ``component.parameter = value`` on top of the scenario.
+    """
     for name, value in values.items():
         comp, _, param = name.partition(".")
-        scenario = scenario.with_parameters(comp, **{param: value})
+        origin = (origins or {}).get(name) or command_line(f"{name} = {value!r}", scenario.source)
+        scenario = scenario.with_values(comp, {param: value}, {param: origin})
     return scenario
+
+
+def apply_assignments(scenario, items: Sequence[str], option: str = "--set"):
+    """The scenario with ``--set COMPONENT.PARAMETER=VALUE`` items set, each given by that option as typed."""
+    values, origins = {}, {}
+    for item in items:
+        name, value = parse_assignment(item, option)
+        values.pop(name, None)  # the last typed is the last set
+        values[name], origins[name] = value, command_line(f"{option} {item.strip()}", scenario.source)
+    return apply_parameters(scenario, values, origins)

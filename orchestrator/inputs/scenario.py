@@ -15,12 +15,10 @@ The TOML file format and its reading are :mod:`orchestrator.inputs.scenario_file
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Mapping
 
-from components.validation import is_number
 from fmus import registry
 from fmus.slaves.record import ROLES
 
@@ -28,27 +26,16 @@ from ..errors import ScenarioError
 from ..frozen_map import FrozenMap
 from .analysis_settings import AnalysisSettings
 from .drivetrain_file import DrivetrainSpec
-from .limits import MAX_LOOP_ITERATIONS, MIN_RELATIVE_STEP
 from .load_events import ScenarioEvent, check_events_in_run
-from .master_options import ALGEBRAIC_LOOPS, ALGORITHMS, EXTRAPOLATIONS
+from .origins import Origin
 from .results_format import RESULTS_FORMATS
 from .series_spec import SeriesSpec
 from .schema import NAME_PATTERN, ParameterValue
+from .simulation_settings import SimulationSettings, steps_between
 from .transformations import Transformation
 
-#: relative tolerance when checking that times are whole multiples of the step
-_MULTIPLE_RTOL = 1e-9
-
-
-def steps_between(duration_s: float, step_s: float) -> int | None:
-    """``duration / step`` if it is a whole number (relative tolerance 1e-9), else None (also when not finite)."""
-    ratio = duration_s / step_s
-    if not math.isfinite(ratio):
-        return None
-    n = round(ratio)
-    if n >= 0 and abs(ratio - n) <= _MULTIPLE_RTOL * max(1.0, abs(ratio)):
-        return int(n)
-    return None
+__all__ = ["Component", "Connection", "InitialBinding", "JacobiCoupling", "ParameterBinding", "Scenario",
+           "SimulationSettings", "VariableRef", "steps_between"]
 
 
 @dataclass(frozen=True)
@@ -104,6 +91,9 @@ class Component:
         description does not say (no ``dependencies`` attribute: FMI 2 then means
         "depends on all inputs"); a loop through them is not algebraic. ``"*"``:
         every output of the FMU without declared dependencies (``--no-feedthrough COMPONENT``).
+    origins : mapping of str -> Origin
+        Where parameter values were given, in the order they were set (:mod:`orchestrator.inputs.origins`);
+        a value without one is the scenario's own entry.
     """
 
     name: str
@@ -114,15 +104,18 @@ class Component:
     drivetrain: DrivetrainSpec | None = None
     no_feedthrough: tuple[str, ...] = ()
     series: SeriesSpec | None = None
+    origins: Mapping[str, Origin] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not NAME_PATTERN.match(self.name):
             raise ScenarioError("components", self.name, "a component name of letters, digits, '_' or '-' (no dots)")
         object.__setattr__(self, "fmu", Path(self.fmu))
         params = dict(self.parameters)
+        object.__setattr__(self, "origins", FrozenMap(self.origins))
         for pname, value in params.items():
             if not isinstance(value, (int, float, bool, str)):
-                raise ScenarioError(f"components.{self.name}.parameters.{pname}", value, "a number, boolean or string")
+                raise self.origins.get(pname, Origin(None)).refusal(f"components.{self.name}.parameters.{pname}",
+                                                                    value, "a number, boolean or string")
         object.__setattr__(self, "parameters", FrozenMap(params))
         if self.role is not None and self.role not in ROLES:
             raise ScenarioError(f"components.{self.name}.role", self.role, "one of " + ", ".join(ROLES))
@@ -237,123 +230,6 @@ class JacobiCoupling:
 
 
 @dataclass(frozen=True)
-class SimulationSettings:
-    """Time grid and master algorithm.
-
-    Parameters
-    ----------
-    stop_s : float
-        Stop time [s] (> start, a whole number of steps after it).
-    step_s : float
-        Communication step H [s] (> 0).
-    start_s : float
-        Start time [s].
-    output_interval_s : float, optional
-        Sampling interval of the recorded variables [s], a whole multiple of the
-        step; default: the step.
-    window_s : (float, float), optional
-        Analysis window of the statistics [s]; default ``(start, stop)``.
-    algorithm : {"gauss-seidel", "jacobi"}
-        Master algorithm.
-    extrapolation : {"hold", "linear"}
-        How coupled inputs are formed from the sources' samples (see
-        :mod:`orchestrator.cosim.master`).
-    order : tuple of str, optional
-        Stepping order of the components; default from the connection graph.
-    algebraic_loops : {"refuse", "iterate"}
-        A cycle of direct-feedthrough dependencies is refused when the system is
-        checked, or solved at every communication point by fixed-point iteration
-        (:mod:`orchestrator.cosim.algebraic_loops`).
-    loop_tolerance : float
-        Convergence of that iteration: every loop input moves by at most
-        ``loop_tolerance * max(1, |u|)`` in the last sweep (> 0, < 1).
-    loop_max_iterations : int
-        Sweeps per communication point before the run fails there (>= 1).
-    """
-
-    stop_s: float
-    step_s: float
-    start_s: float = 0.0
-    output_interval_s: float | None = None
-    window_s: tuple[float, float] | None = None
-    algorithm: str = "gauss-seidel"
-    extrapolation: str = "hold"
-    order: tuple[str, ...] | None = None
-    algebraic_loops: str = "refuse"
-    loop_tolerance: float = 1e-10
-    loop_max_iterations: int = 100
-
-    def __post_init__(self) -> None:
-        for key, value in (("simulation.start", self.start_s), ("simulation.stop", self.stop_s), ("simulation.step", self.step_s)):
-            if not is_number(value) or not math.isfinite(value):
-                raise ScenarioError(key, value, "a finite number [s]")
-        start, stop, step = float(self.start_s), float(self.stop_s), float(self.step_s)
-        if not step > 0.0:
-            raise ScenarioError("simulation.step", self.step_s, "> 0 s")
-        if not stop > start:
-            raise ScenarioError("simulation.stop", self.stop_s, f"> simulation.start = {start:g} s")
-        length = stop - start
-        if not math.isfinite(length):
-            raise ScenarioError("simulation.stop", self.stop_s, f"a run whose length stop - start is a finite number "
-                                f"(start = {start:g} s)")
-        if step > length:
-            raise ScenarioError("simulation.step", self.step_s, f"a step no longer than the run, stop - start = {length:g} s")
-        finest = MIN_RELATIVE_STEP * max(abs(start), abs(stop))
-        if step < finest:
-            raise ScenarioError("simulation.step", self.step_s,
-                                f"a step of at least {MIN_RELATIVE_STEP:g} x max(|start|, |stop|) = {finest:g} s (finer "
-                                "communication points are not distinct in double precision)")
-        if steps_between(length, step) is None:
-            raise ScenarioError("simulation.step", self.step_s, f"a step that divides stop - start = {length:g} s into whole steps")
-        out = step if self.output_interval_s is None else self.output_interval_s
-        if not is_number(out) or not math.isfinite(out) or not out > 0:
-            raise ScenarioError("simulation.output_interval", self.output_interval_s, "a number > 0 [s]")
-        if out > length * (1.0 + _MULTIPLE_RTOL):
-            raise ScenarioError("simulation.output_interval", self.output_interval_s,
-                                f"an interval no longer than the run, stop - start = {length:g} s")
-        if steps_between(float(out), step) in (None, 0):
-            raise ScenarioError("simulation.output_interval", self.output_interval_s, f"a whole multiple of the step {step:g} s")
-        window = (start, stop) if self.window_s is None else self.window_s
-        if (not isinstance(window, (tuple, list)) or len(window) != 2 or not all(is_number(w) for w in window)):
-            raise ScenarioError("simulation.window", self.window_s, "[begin, end] in seconds")
-        w0, w1 = float(window[0]), float(window[1])
-        if not (start <= w0 < w1 <= stop):
-            raise ScenarioError("simulation.window", list(window), f"start <= begin < end <= stop, i.e. within [{start:g}, {stop:g}] s")
-        if self.algorithm not in ALGORITHMS:
-            raise ScenarioError("simulation.algorithm", self.algorithm, "one of " + ", ".join(ALGORITHMS))
-        if self.extrapolation not in EXTRAPOLATIONS:
-            raise ScenarioError("simulation.extrapolation", self.extrapolation, "one of " + ", ".join(EXTRAPOLATIONS))
-        if self.algebraic_loops not in ALGEBRAIC_LOOPS:
-            raise ScenarioError("simulation.algebraic_loops", self.algebraic_loops, "one of " + ", ".join(ALGEBRAIC_LOOPS))
-        if not is_number(self.loop_tolerance) or not 0.0 < float(self.loop_tolerance) < 1.0:
-            raise ScenarioError("simulation.loop_tolerance", self.loop_tolerance, "a number > 0 and < 1")
-        if isinstance(self.loop_max_iterations, bool) or not isinstance(self.loop_max_iterations, int) \
-                or not 1 <= self.loop_max_iterations <= MAX_LOOP_ITERATIONS:
-            raise ScenarioError("simulation.loop_max_iterations", self.loop_max_iterations,
-                                f"a whole number from 1 to {MAX_LOOP_ITERATIONS}")
-        object.__setattr__(self, "loop_tolerance", float(self.loop_tolerance))
-        order = None if self.order is None else tuple(self.order)
-        if order is not None and not all(isinstance(o, str) for o in order):
-            raise ScenarioError("simulation.order", self.order, "a list of component names")
-        object.__setattr__(self, "start_s", start)
-        object.__setattr__(self, "stop_s", stop)
-        object.__setattr__(self, "step_s", step)
-        object.__setattr__(self, "output_interval_s", float(out))
-        object.__setattr__(self, "window_s", (w0, w1))
-        object.__setattr__(self, "order", order)
-
-    @property
-    def n_steps(self) -> int:
-        """Number of communication steps from start to stop."""
-        return steps_between(self.stop_s - self.start_s, self.step_s)
-
-    @property
-    def output_stride(self) -> int:
-        """Communication steps per recorded sample."""
-        return steps_between(self.output_interval_s, self.step_s)
-
-
-@dataclass(frozen=True)
 class Scenario:
     """A complete, structurally valid co-simulation scenario.
 
@@ -452,8 +328,9 @@ class Scenario:
             if tgt in set_initially:
                 raise ScenarioError(f"initial[{i}].to", tgt, f"a variable set once (already by initial[{set_initially[tgt]}])", src)
             comp = next(c for c in self.components if c.name == b.target.component)
-            if b.target.variable in comp.parameters:
-                raise ScenarioError(f"initial[{i}].to", tgt, f"a variable without a value in components.{comp.name}.parameters", src)
+            if b.target.variable in comp.parameters:  # named where that value was given
+                raise comp.origins.get(b.target.variable, Origin(src)).refusal(
+                    f"initial[{i}].to", tgt, f"a variable without a value in components.{comp.name}.parameters", own=False)
             set_initially[tgt] = i
         object.__setattr__(self, "bindings", tuple(self.bindings))
         self._check_bindings(known, names, driven, set_initially)
@@ -512,11 +389,11 @@ class Scenario:
             for pname, value in comp.parameters.items():
                 key = f"{comp.name}.{pname}"
                 if key in bound:
-                    raise ScenarioError(
+                    raise comp.origins.get(pname, Origin(src)).refusal(
                         f"components.{comp.name}.parameters.{pname}", value,
                         f"no value: {key} takes its value from {bound[key]} ([[bindings]]: one source for a value "
                         f"two FMUs need; a value here would break the link); set {bound[key]} instead (--set "
-                        f"{bound[key]}=...), or remove the binding", src)
+                        f"{bound[key]}=...), or remove the binding")
 
     def bound_source(self, ref: "VariableRef | str") -> str | None:
         """``"component.parameter"`` whose value ``ref`` takes through the bindings (the chain's start), or None."""
@@ -555,18 +432,25 @@ class Scenario:
             return self.with_simulation(algorithm=algorithm, **changes)
         coupling, scenario = self.jacobi, self
         for comp, values in coupling.parameters.items():
-            scenario = scenario.with_parameters(comp, **values)
+            scenario = scenario.with_values(comp, values, {p: Origin(self.source, f"jacobi.parameters.{comp}.{p}")
+                                                           for p in values})
         step = {} if coupling.step_s is None else {"step_s": coupling.step_s}
         return replace(scenario, connections=scenario.connections + coupling.connections, jacobi=None,
                        simulation=replace(scenario.simulation, algorithm="jacobi", **{**step, **changes}))
 
     def with_parameters(self, component: str, **values: ParameterValue) -> "Scenario":
-        """Copy with parameter values of one component added or replaced."""
-        comps = tuple(
-            replace(c, parameters={**c.parameters, **values}) if c.name == component else c for c in self.components
-        )
+        """Copy with parameter values of one component added or replaced, each where its value was given before."""
+        return self.with_values(component, values, {})
+
+    def with_values(self, component: str, values: Mapping[str, ParameterValue],
+                    origins: Mapping[str, Origin]) -> "Scenario":
+        """Copy with values of one component set, given at ``origins`` (a value without one keeps its origin)."""
         if component not in self.component_names:
-            raise ScenarioError("components", component, "a declared component: " + ", ".join(self.component_names), self.source)
+            raise next(iter(origins.values()), Origin(self.source)).refusal(
+                "components", component, "a declared component: " + ", ".join(self.component_names), own=False)
+        comps = tuple(replace(c, parameters={**c.parameters, **values},
+                              origins={**{k: o for k, o in c.origins.items() if k not in origins}, **origins})
+                      if c.name == component else c for c in self.components)
         return replace(self, components=comps)
 
     def with_allowed(self, *keys: str) -> "Scenario":

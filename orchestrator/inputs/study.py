@@ -49,6 +49,7 @@ from ..errors import EntryError
 from ..frozen_map import FrozenMap
 from .limits import MAX_STUDY_POINTS
 from .measures import Measure
+from .origins import Origin
 from .overrides import SimulationOverrides
 from .schema import NAME_PATTERN, ParameterValue
 
@@ -258,6 +259,9 @@ class Study:
     allow_implausible : tuple of str
         ``"component.parameter"`` values kept although implausible by physics (``[plausibility] allow``,
         ``--allow-implausible``), for every point.
+    point_origins : tuple of mapping of str -> Origin
+        Where the values of each explicit point were given, by whoever made the points (a load-case
+        set's entries); default the study's ``points[i]`` (:meth:`origins`).
     """
 
     name: str
@@ -276,10 +280,11 @@ class Study:
     base_dir: Path | None = None
     source: str | None = None
     allow_implausible: tuple[str, ...] = ()
+    point_origins: tuple[Mapping[str, Origin], ...] = ()
 
     def __post_init__(self) -> None:
         src = self.source
-        for attr in ("measures", "axes", "points", "seeds", "plots", "allow_implausible"):
+        for attr in ("measures", "axes", "points", "seeds", "plots", "allow_implausible", "point_origins"):
             object.__setattr__(self, attr, tuple(getattr(self, attr)))
         object.__setattr__(self, "points", tuple(FrozenMap(dict(p)) for p in self.points))
         if isinstance(self.simulation, Mapping):
@@ -363,6 +368,27 @@ class Study:
                 params[self.seed_parameter] = self.seeds[coords[-1]]
             out.append(Point(index, params, tuple(int(c) for c in coords)))
         return out
+
+    def origins(self, point: Point) -> dict[str, Origin]:
+        """Where each value of ``point`` was given: ``axes[0].values[3] (gearbox.R1)``, ``points[1].wind.omega0``, a seed.
+
+        Made when a point's values are applied (:mod:`orchestrator.inputs.origins`), not kept per point.
+        """
+        src, note, out = self.source, f"point {point.index}", {}
+        if self.points:
+            i = point.coords[0]
+            given = self.point_origins[i] if self.point_origins else {}
+            out.update({p: given.get(p) or Origin(src, f"points[{i}].{p}", note, StudyError) for p in self.points[i]})
+        for j, (axis, k) in enumerate(zip(self.axes, point.coords[1:-1])):
+            out.update({p: Origin(src, f"axes[{j}].values[{k}] ({p})", note, StudyError) for p in axis.parameters})
+        if self.seeds:
+            k = point.coords[-1]
+            out[self.seed_parameter] = Origin(src, f"seeds[{k}] ({self.seed_parameter})", note, StudyError)
+        return out
+
+    def base_origins(self) -> dict[str, Origin]:
+        """Where each fixed value of the base was given (``base.parameters.<name>``)."""
+        return {p: Origin(self.source, f"base.parameters.{p}", error=StudyError) for p in self.base.parameters}
 
     @property
     def varied_parameters(self) -> list[str]:

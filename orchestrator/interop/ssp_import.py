@@ -50,6 +50,7 @@ from ..archive_members import record_extraction
 from ..errors import ScenarioError, SspError
 from ..inputs.analysis_settings import AnalysisSettings
 from ..inputs.limits import MAX_SSP_BYTES, MAX_SSP_MEMBERS, MAX_SSP_RATIO
+from ..inputs.origins import Origin
 from ..inputs.scenario import (
     Component,
     Connection,
@@ -374,10 +375,12 @@ def import_ssp(path: str | Path, step_s: float | None = None, stop_s: float | No
         initial.append(InitialBinding(VariableRef(*src), VariableRef(*dst)))
         bound.add(f"{dst[0]}.{dst[1]}")
     params: dict[str, dict[str, Any]] = {c: {} for c in flat.components}
+    origins: dict[str, dict[str, Origin]] = {c: {} for c in flat.components}
     for (comp, var), (value, origin) in flat.values.items():
         if f"{comp}.{var}" not in bound:  # the binding sets it at initialisation
             params[comp][var] = value
-    components = tuple(Component(c, Path(src), params[c]) for c, src in flat.components.items())
+            origins[comp][var] = Origin(origin)  # the ssv:Parameter's file and line: what a message names
+    components = tuple(Component(c, Path(src), params[c], origins=origins[c]) for c, src in flat.components.items())
     connections = tuple(Connection(VariableRef(*src), VariableRef(*dst), transform)
                         for src, dst, transform, _ in flat.connections)
     for note in notes:

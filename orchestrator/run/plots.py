@@ -197,8 +197,8 @@ def plot_contact_forces(outcome: RunOutcome, gearbox: ComponentRole, window, pat
     for ax in axes[-1]:
         ax.set_xlabel("time [s]")
     axes[-1][0].set_xlim(t[0], t[-1])
-    note = ("\nthe planets' meshes carry identical forces by symmetry (evenly spaced planets, one parameter set): "
-            "each drawn once") if merged else ""
+    note = ("\nplanet meshes that carry identical forces (by symmetry) are drawn once, named '= [2], [3]' in the "
+            "legend") if merged else ""
     fig.suptitle("Gear contact forces of all stages (paper Fig. 17)" + title_suffix + note, fontsize=10)
     return save_figure(fig, path)
 

@@ -17,7 +17,8 @@ Plausibility
 Every point's values are judged by :mod:`components.analysis.plausibility` as a run would
 judge them (:func:`orchestrator.cosim.plausibility_checks.plausibility_problem`; a built-in model's
 drivetrain against the model as defined), with the study's ``[plausibility] allow``; the first
-implausible point is an error naming the study key that set the value, the point and the bound.
+implausible point is an error naming where the value was given (the study's axis value or point, a
+load-case set's entry: :meth:`orchestrator.inputs.study.Study.origins`), the point and the bound.
 """
 
 from __future__ import annotations
@@ -27,6 +28,8 @@ from typing import Any, Callable, Mapping
 
 from components.validation import is_number
 
+from ..errors import EntryError
+from ..inputs.origins import Origin, last_given
 from ..inputs.quantities import UnitError, is_quantity_text, to_unit
 from ..inputs.study import Point, Study, StudyError, split_parameter
 
@@ -106,22 +109,13 @@ def model_converter(units: Mapping[str, str], exponents: Callable[[str], float |
     return convert
 
 
-def point_key(study: Study, point: Point, name: str) -> str:
-    """The study key that set ``name`` at ``point``, or the point itself."""
-    if study.points and name in study.points[point.coords[0]]:
-        return f"points[{point.coords[0]}].{name}"
-    for i, axis in enumerate(study.axes):
-        if name in axis.parameters:
-            return f"axes[{i}].values[{point.coords[1 + i]}] ({name})"
-    if name in study.base.parameters:
-        return f"base.parameters.{name}"
-    shown = ", ".join(f"{k} = {v!r}" for k, v in point.parameters.items())
-    return f"{name} at point {point.index} ({shown})"
+#: ``problem(point values, their origins) -> the error refusing the first implausible value, or None``
+Problem = Callable[[Mapping[str, Any], Mapping[str, Origin]], "EntryError | None"]
 
 
-def check_points(study: Study, points: list[Point], problem: Callable[[Mapping[str, Any]], tuple | None],
+def check_points(study: Study, points: list[Point], problem: Problem,
                  skip: Callable[[str], bool] = lambda name: False) -> None:
-    """Each point's ``problem(values) -> (component.parameter, value, expectation) or None``, first one raised.
+    """Each point's ``problem(values, origins)``, the first error raised (named where its value was given).
 
     Points that differ only in parameters ``skip`` leaves out (a seed) are judged once.
     """
@@ -132,24 +126,36 @@ def check_points(study: Study, points: list[Point], problem: Callable[[Mapping[s
         if marker in seen:
             continue
         seen.add(marker)
-        found = problem(values)
+        origins = study.origins(point)
+        found = problem(values, {k: origins[k] for k in values})
         if found is not None:
-            name, value, expected = found
-            raise StudyError(point_key(study, point, name), value, f"{expected} (point {point.index})", study.source)
+            raise found
 
 
-def scenario_problem(system) -> Callable[[Mapping[str, Any]], tuple | None]:
-    """``problem(point values)`` of :func:`check_points` for a scenario base: the run's own plausibility check."""
+def model_problem(study: Study, judge: Callable[[Mapping[str, Any]], tuple | None]) -> Problem:
+    """``problem`` of :func:`check_points` for a built-in model: ``judge(values) -> (parameter, value, expectation)``.
+
+    A value the model builds itself, implausible with the point's values, is named with the last of those.
+    """
+    def problem(values: Mapping[str, Any], origins: Mapping[str, Origin]) -> EntryError | None:
+        found = judge(values)
+        if found is None:
+            return None
+        name, value, expected = found
+        if name in origins:
+            return origins[name].refusal(name, value, expected)
+        return last_given(origins, origins, Origin(study.source, error=StudyError)).refusal(name, value, expected,
+                                                                                            own=False)
+
+    return problem
+
+
+def scenario_problem(system) -> Problem:
+    """``problem`` of :func:`check_points` for a scenario base: the run's own plausibility check, values at their origins."""
     from ..cosim.plausibility_checks import plausibility_problem
     from ..inputs.overrides import apply_parameters
 
-    def problem(values: Mapping[str, Any]) -> tuple | None:
-        found = plausibility_problem(replace(system, scenario=apply_parameters(system.scenario, values)))
-        if found is None:
-            return None
-        key, value, expected = found  # components.<comp>.parameters.<param>
-        _, comp, _, param = key.split(".", 3)
-        return f"{comp}.{param}", value, expected.replace("in the scenario or --allow-implausible",
-                                                          "in the study or load-case set or --allow-implausible")
+    def problem(values: Mapping[str, Any], origins: Mapping[str, Origin]) -> EntryError | None:
+        return plausibility_problem(replace(system, scenario=apply_parameters(system.scenario, values, origins)))
 
     return problem

@@ -135,9 +135,9 @@ def drivetrain_variants(study: Study, scenario, points: list[Point], fmu_dir: Pa
                 original, {FILE_ENTRY.match(n)["path"]: v for n, v in changes.items()}, allow)
         except EntryError as exc:
             culprit = next((n for n in changes if FILE_ENTRY.match(n)["path"] == exc.key), next(iter(changes)))
-            raise StudyError(_study_key(study, culprit, point), changes.get(culprit),
-                             f"a drivetrain file entry that gives a valid drivetrain at point {point.index} "
-                             f"({exc.key} = {exc.value!r}: expected {exc.expected})", src) from None
+            origin = {**study.base_origins(), **study.origins(point)}[culprit]  # where the study gives it
+            raise origin.refusal(culprit, changes.get(culprit), f"a drivetrain file entry that gives a valid "
+                                 f"drivetrain ({exc.key} = {exc.value!r}: expected {exc.expected})") from None
         dt = spec.cosim_drivetrain()
         values = flatten(dt)
         structure = None

@@ -48,7 +48,8 @@ from typing import Any, Mapping
 
 from ..errors import EntryError, ScenarioError, suggestion
 from ..inputs.load_cases import SEED_PLACEHOLDER, LoadBin, LoadCaseError, LoadCaseSet
-from ..inputs.study import Base, Study, StudyError
+from ..inputs.origins import Origin
+from ..inputs.study import Base, Study
 from .prepare import PreparedStudy, point_key, prepare_study
 from .rating_plan import RatingPlan, bearing_channels, mesh_channel, plan_ratings
 from .run_data import Channel, RunDataSpec
@@ -136,7 +137,8 @@ def _settled(lcs: LoadCaseSet, fmu_dir, build: bool) -> tuple[LoadCaseSet, dict 
     from ..run.runner import load_any
 
     try:
-        scenario = apply_parameters(load_any(lcs.base_path), lcs.base_parameters).with_allowed(*lcs.allow_implausible)
+        scenario = apply_parameters(load_any(lcs.base_path), lcs.base_parameters,
+                                    lcs.base_origins()).with_allowed(*lcs.allow_implausible)
         system = resolve_system(scenario, fmu_paths=ensure_fmus(scenario, fmu_dir, build=build))
     except ScenarioError as exc:
         raise LoadCaseError("base.scenario", lcs.base_scenario, f"a valid scenario with its FMUs ({exc})",
@@ -159,7 +161,8 @@ def _base_system(lcs: LoadCaseSet, fmu_dir, build: bool):
         scenario = load_any(lcs.base_path)
         scenario, _ = lcs.time_grid().apply(scenario)
         paths = ensure_fmus(scenario, fmu_dir, build=build)
-        return resolve_system(apply_parameters(scenario, lcs.base_parameters).with_allowed(*lcs.allow_implausible),
+        return resolve_system(apply_parameters(scenario, lcs.base_parameters,
+                                               lcs.base_origins()).with_allowed(*lcs.allow_implausible),
                               fmu_paths=paths)
     except ScenarioError as exc:
         raise LoadCaseError("base.scenario", lcs.base_scenario, f"a valid scenario with its FMUs ({exc})", src) from None
@@ -280,6 +283,18 @@ def _cases(lcs: LoadCaseSet, bins, targets: Mapping[str, str], seed_parameter: s
     return tuple(out)
 
 
+def _case_origins(lcs: LoadCaseSet, bins, case: Case, targets: Mapping[str, str],
+                  seed_parameter: str | None) -> dict[str, Origin]:
+    """Where each value of a run was given: the bin's row or the law, the row's parameters, the seeds."""
+    b = bins[case.bin]
+    run = f"run {case.index}, bin {b.label}, seed {case.seed}"
+    out = {target: lcs.row_origin(b, target, run, (f, TARGETS[f][2])) for f, target in targets.items()}
+    out.update({name: lcs.row_origin(b, name, run) for name in b.parameters})
+    if seed_parameter is not None:
+        out[seed_parameter] = Origin(lcs.source, f"runs.seeds ({seed_parameter})", run, LoadCaseError)
+    return {name: origin for name, origin in out.items() if name in case.parameters}
+
+
 def _measures(channels: tuple[Channel, ...]):
     from ..inputs.measures import parse_measure
 
@@ -288,16 +303,6 @@ def _measures(channels: tuple[Channel, ...]):
         names += [f"{ch.column}:mean", f"{ch.column}:max"]
         names += [f"{speed}:mean" for _, speed in ch.gears]
     return tuple(parse_measure(n) for n in dict.fromkeys(names))
-
-
-def _case_label(cases: tuple[Case, ...], bins, key: str) -> str:
-    """``points[7].wind.omega0`` -> ``run 7 (bin [9, 11) m/s, seed 2): wind.omega0``."""
-    if key.startswith("points["):
-        idx, _, rest = key[len("points["):].partition("]")
-        if idx.isdigit() and int(idx) < len(cases):
-            c = cases[int(idx)]
-            return f"run {c.index} (bin {bins[c.bin].label}, seed {c.seed}){': ' + rest.lstrip('.') if rest else ''}"
-    return key
 
 
 def prepare_load_cases(lcs: LoadCaseSet, fmu_dir: str | Path | None = None, build: bool = True) -> PreparedLoadCases:
@@ -322,10 +327,11 @@ def prepare_load_cases(lcs: LoadCaseSet, fmu_dir: str | Path | None = None, buil
                       measures=_measures(channels), points=tuple(c.parameters for c in cases),
                       simulation=lcs.time_grid(), timeout_s=lcs.timeout_s, description=lcs.description,
                       base_dir=None if src is None else Path(src).resolve().parent, source=src,
-                      allow_implausible=lcs.allow_implausible)
+                      allow_implausible=lcs.allow_implausible,
+                      point_origins=tuple(_case_origins(lcs, bins, c, targets, seed_parameter) for c in cases))
         prepared = prepare_study(study, fmu_dir=fmu_dir, build=build)
-    except StudyError as exc:
-        raise LoadCaseError(_case_label(cases, bins, exc.key), exc.value, exc.expected, src) from None
+    except LoadCaseError:
+        raise  # a run's value, named where the set gives it
     except EntryError as exc:
         raise LoadCaseError(exc.key, exc.value, exc.expected, src) from None
     spec = RunDataSpec(channels, lcs.time_grid().window_s, lcs.fatigue.gate_fraction, lcs.fatigue.residue)

@@ -100,7 +100,7 @@ class BuiltinModel:
                 return None
             name, j = bad[0]
             return (name, values.get(name, f"{j.value:.6g} (as the model builds it)"),
-                    f'{j.expected}; it is {j.value:.6g} {j.unit} in SI; a deliberate value is kept by [plausibility] '
+                    f'{j.expected}; it is {j.in_si} in SI; a deliberate value is kept by [plausibility] '
                     f'allow = ["{name}"] in the study or --allow-implausible {name}')
 
         return problem

@@ -123,48 +123,32 @@ class PreparedStudy:
     notes: tuple[str, ...] = ()
 
 
-def _origins(study: Study) -> list[tuple[str, str, list]]:
-    """(study key, parameter, values) of every varied parameter, for error messages."""
+def _varied(study: Study) -> list[tuple[str, str, list]]:
+    """(study key naming the parameter, parameter, values) of every varied parameter, for error messages."""
     out = []
     for i, axis in enumerate(study.axes):
         for j, p in enumerate(axis.parameters):
             key = f"axes[{i}].parameter" if len(axis.parameters) == 1 else f"axes[{i}].parameters[{j}]"
             out.append((key, p, list(axis.values)))
     for i, pt in enumerate(study.points):
-        for p, v in pt.items():
-            out.append((f"points[{i}].{p}", p, [v]))
+        given = study.point_origins[i] if study.point_origins else {}
+        for p, v in pt.items():  # a load-case set's point: its own entry
+            out.append((given[p].key if p in given else f"points[{i}].{p}", p, [v]))
     if study.seeds:
         out.append(("seeds", study.seed_parameter, list(study.seeds)))
     return out
 
 
-def _study_key_of(exc: ScenarioError) -> str:
-    """``components.gearbox.parameters.stage1.k0`` -> ``base.parameters.gearbox.stage1.k0``."""
-    parts = exc.key.split(".", 3)
-    if len(parts) == 4 and parts[0] == "components" and parts[2] == "parameters":
-        return f"base.parameters.{parts[1]}.{parts[3]}"
-    return f"base.scenario ({exc.key})"
-
-
-def _check_value(system, name: str, value: Any, key: str, source: str | None) -> None:
-    """A varied scenario parameter exists, is settable, not connected, and the value has its type and range.
-
-    The range is what the FMU declares (an FMI Integer's 32 bits, a dtcosim FMU's
-    bounds, ``min``/``max``: :func:`orchestrator.cosim.parameter_checks.value_problem`),
-    with the FMU's own message; combinations of values are the model's to refuse
-    (that point fails).
-    """
-    from ..cosim.parameter_checks import value_problem
-    from ..cosim.system import _value_matches, parameter_problem
+def _check_name(system, name: str, key: str, source: str | None) -> None:
+    """A varied scenario parameter exists, is settable, not connected, set at initialisation or bound."""
+    from ..cosim.system import parameter_problem
 
     comp, param = split_parameter(name)
     if comp not in system.interfaces:
         raise StudyError(key, name, "a parameter of a component of the base scenario: " + ", ".join(system.interfaces), source)
-    iface = system.interfaces[comp]
-    problem = parameter_problem(iface, param)
+    problem = parameter_problem(system.interfaces[comp], param)
     if problem is not None:
         raise StudyError(key, name, problem, source)
-    var = iface.variables[param]
     if any(str(c.target) == name for c in system.scenario.connections):
         raise StudyError(key, name, "a parameter, not an input a connection drives", source)
     if any(str(b.target) == name for b in system.scenario.initial):
@@ -173,11 +157,32 @@ def _check_value(system, name: str, value: Any, key: str, source: str | None) ->
     if bound is not None:
         raise StudyError(key, name, f"a parameter the scenario does not bind: {name} takes its value from {bound} "
                          f"([[bindings]]); vary {bound} instead", source)
-    if not _value_matches(var, value):
-        raise StudyError(key, value, f"a {var.type} value for {name}", source)
-    problem = value_problem(iface, var, value)
-    if problem is not None:
-        raise StudyError(key, value, f"{problem} for {name}", source)
+
+
+def _check_values(study: Study, system, skip) -> None:
+    """Every value a point sets has its parameter's type and range, each refused where it was given.
+
+    The range is what the FMU declares (an FMI Integer's 32 bits, a dtcosim FMU's
+    bounds, ``min``/``max``: :func:`orchestrator.cosim.parameter_checks.value_problem`),
+    with the FMU's own message; combinations of values are the model's to refuse
+    (that point fails).
+    """
+    from ..cosim.parameter_checks import type_problem, value_problem
+
+    seen: set = set()
+    for point in study.expand():
+        for name, value in point.parameters.items():
+            if skip(name) or (name, repr(value)) in seen:
+                continue
+            seen.add((name, repr(value)))
+            comp, param = split_parameter(name)
+            iface = system.interfaces[comp]
+            var = iface.variables[param]
+            problem = type_problem(var, value, name)
+            if problem is None and (problem := value_problem(iface, var, value)) is not None:
+                problem = f"{problem} for {name}"
+            if problem is not None:
+                raise study.origins(point)[name].refusal(name, value, problem)
 
 
 def _solver_settings(study: Study):
@@ -212,7 +217,7 @@ def _check_measure_engines(study: Study) -> None:
 def _prepare_model(study: Study) -> tuple[Study, StudyPayload, dict[str, Any]]:
     from components.errors import ParameterError
 
-    from .declared_values import check_points, in_declared_units, model_converter
+    from .declared_values import check_points, in_declared_units, model_converter, model_problem
     from .models import MODEL_COMPONENT, MODELS
 
     src = study.source
@@ -221,7 +226,7 @@ def _prepare_model(study: Study) -> tuple[Study, StudyPayload, dict[str, Any]]:
     model = MODELS[study.base.name]
     defaults = model.defaults()
     study = in_declared_units(study, model_converter(model.units(), model.exponent), base_too=True)
-    checks = [(f"base.parameters.{p}", p, [v]) for p, v in study.base.parameters.items()] + _origins(study)
+    checks = [(f"base.parameters.{p}", p, [v]) for p, v in study.base.parameters.items()] + _varied(study)
     for key, name, values in checks:
         if name not in defaults:
             raise StudyError(key, name, f"a parameter of the built-in model {model.name}{suggestion(name, defaults)}", src)
@@ -232,7 +237,8 @@ def _prepare_model(study: Study) -> tuple[Study, StudyPayload, dict[str, Any]]:
         drivetrain, driver = model.build(dict(study.base.parameters))
     except ParameterError as exc:
         raise StudyError(f"base.parameters ({exc.name})", exc.value, exc.expected, src) from None
-    check_points(study, study.expand(), model.plausibility(dict(study.base.parameters), study.allow_implausible))
+    check_points(study, study.expand(),
+                 model_problem(study, model.plausibility(dict(study.base.parameters), study.allow_implausible)))
     sim = study.simulation
     start = 0.0 if sim.start_s is None else float(sim.start_s)
     stop = float(sim.stop_s)
@@ -281,6 +287,7 @@ def _prepare_scenario(study: Study, fmu_dir,
                       build: bool) -> tuple[Study, StudyPayload, dict[str, Any], dict[str, Path], tuple[str, ...]]:
     from ..cosim.roles import GEARBOX
     from ..cosim.system import resolve_system
+    from ..inputs.overrides import apply_parameters
     from ..provision.project_fmus import ensure_fmus
     from ..run.runner import load_any
 
@@ -301,23 +308,18 @@ def _prepare_scenario(study: Study, fmu_dir,
     from .declared_values import check_points, in_declared_units, scenario_converter, scenario_problem
     from .drivetrain_variants import is_file_entry
 
-    by_comp: dict[str, dict[str, Any]] = {}
-    for name, value in study.base.parameters.items():
-        if is_file_entry(name):  # drivetrain file entries: see drivetrain_variants
-            continue
-        comp, param = split_parameter(name)
-        by_comp.setdefault(comp, {})[param] = value
+    fixed = {name: value for name, value in study.base.parameters.items() if not is_file_entry(name)}
+    # drivetrain file entries: see drivetrain_variants; a base value refused is a StudyError naming base.parameters
+    scenario = apply_parameters(scenario, fixed, study.base_origins()).with_allowed(*study.allow_implausible)
     try:
-        for comp, values in by_comp.items():
-            scenario = scenario.with_parameters(comp, **values)
-        scenario = scenario.with_allowed(*study.allow_implausible)
         system = resolve_system(scenario, fmu_paths=paths)
-    except ScenarioError as exc:
-        raise StudyError(_study_key_of(exc), exc.value, exc.expected, src) from None
+    except ScenarioError as exc:  # the scenario's own entries (its file in the message)
+        raise StudyError("base.scenario", study.base.name, f"a valid scenario ({exc})", src) from None
     study = in_declared_units(study, scenario_converter(system, is_file_entry))
-    for key, name, values in _origins(study):
-        for value in values if not is_file_entry(name) else ():
-            _check_value(system, name, value, key, src)
+    for key, name, values in _varied(study):
+        if not is_file_entry(name):
+            _check_name(system, name, key, src)
+    _check_values(study, system, is_file_entry)
     seed = study.seed_parameter if study.seeds else None  # a seed changes no value physics bounds
     # drivetrain file entries are judged when each point's file is read again (drivetrain_variants)
     check_points(study, study.expand(), scenario_problem(system),

@@ -114,7 +114,7 @@ def test_measure_variables_are_checked_against_the_model(write_study):
     ("cosim", "seeds = [1]\n", "", '["steps"]', r"measures\[0\] = 'steps'.*needs the monolithic engine"),
     ("cosim", "", "", '["generator.omeg:std"]', r"measures\[0\] = 'generator.omeg:std'.*did you mean generator.omega"),
     ("cosim", "", '[[axes]]\nparameter = "wind.seed"\nvalues = [1, 2.5]\n', '["cpu_time"]',
-     r"axes\[0\]\.parameter = 2\.5: expected a Integer value for wind.seed"),
+     r"axes\[0\]\.values\[1\] \(wind\.seed\) = 2\.5: expected an Integer value for wind\.seed \(point 1\)"),
     ("cosim", "", '[[axes]]\nparameter = "gearbox.omega_gen"\nvalues = [1.0]\n', '["cpu_time"]',
      r"not an input a connection drives"),
     ("monolithic", "", "", '["gearbox.shaft_torque_mode:mean"]', r"measures\[0\] = .*counterpart in the monolithic model"),

@@ -95,8 +95,9 @@ def test_cosim_builds_one_fmu_set_per_structure(fmu_home, write_study):
 
 
 @pytest.mark.parametrize("axis, values, pattern", [
-    ("gearbox.drivetrain.stages[0].planets", "[5]", r"axes\[0\]\.parameter = 5: .*at point 0 \(stages\[0\]\.planets = 5: "
-                                                   r"expected planets that do not overlap"),
+    ("gearbox.drivetrain.stages[0].planets", "[5]", r"axes\[0\]\.values\[0\] \(gearbox\.drivetrain\.stages\[0\]\.planets\) "
+                                                   r"= 5: .*\(stages\[0\]\.planets = 5: expected planets that do not "
+                                                   r"overlap.*\(point 0\)$"),
     ("gearbox.drivetrain.stages[0].teeth.sunn", "[3]", r"an entry the drivetrain file has"),
     ("wind.drivetrain.stages[0].planets", "[3]", r"wind names none"),
 ])

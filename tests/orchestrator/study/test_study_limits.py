@@ -63,8 +63,8 @@ def test_seeds_beyond_an_fmi_integer_are_refused_at_check(fmu_dir, write_study, 
     path = write_study(COSIM_SEEDS.format(seeds="[1, 4294967297, 8589934593]"))
     assert main(["sweep", str(path), "--check", "--fmu-dir", str(fmu_dir)]) == 1
     err = capsys.readouterr().err.strip().splitlines()[-1]
-    assert err.endswith("invalid study entry seeds = 4294967297: expected an FMI Integer within "
-                        "[-2147483648, 2147483647] (32 bits) for wind.seed")
+    assert err.endswith("invalid study entry seeds[1] (wind.seed) = 4294967297: expected an FMI Integer within "
+                        "[-2147483648, 2147483647] (32 bits) for wind.seed (point 1)")
 
 
 def test_a_value_outside_the_fmus_bounds_is_refused_at_check(fmu_dir, write_study, capsys):
@@ -72,7 +72,8 @@ def test_a_value_outside_the_fmus_bounds_is_refused_at_check(fmu_dir, write_stud
                                                         'values = [-1.0, 1.58e10]\n')
     assert main(["sweep", str(path), "--check", "--fmu-dir", str(fmu_dir)]) == 1
     assert capsys.readouterr().err.strip().endswith(
-        "axes[0].parameter = -1.0: expected > 0 (within [1e-30, 1e+30]) for gearbox.stage1.k0")
+        "axes[0].values[0] (gearbox.stage1.k0) = -1.0: expected > 0 (within [1e-30, 1e+30]) for gearbox.stage1.k0 "
+        "(point 0)")
 
 
 @pytest.mark.parametrize("address", ["not a url", "tcp://127.0.0.1:1"])
