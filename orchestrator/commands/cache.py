@@ -9,7 +9,7 @@ kernel's sources adds entries and nothing removes the old ones: ``--prune`` dele
 installed dtcosim, Python, numpy and numba would not load (FMUs carry their own compiled
 modules, so an older FMU keeps running; a later run rebuilds what it needs), and every unpacked
 FMU that is not one of the FMU folder's (:func:`orchestrator.provision.folders.default_fmu_dir`;
-a later run of it unpacks it again).
+a later run of it unpacks it again) unless used within the hour (a run may be loading it).
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ from components.model.kernel import KERNELS
 from ..cosim.compiled_kernels import aot_kernels
 from ..cosim.fmu_interface import file_sha256
 from ..cosim.unpacked_fmus import FOLDER as UNPACKED_FOLDER
-from ..cosim.unpacked_fmus import folder_name
+from ..cosim.unpacked_fmus import folder_name, in_use
 from ..provision.folders import default_fmu_dir
 from .catalogue import help_line
 
@@ -75,7 +75,7 @@ def cache_entries(root: Path | None = None) -> list[CacheEntry]:
     unpacked = sorted(p for p in (root / UNPACKED_FOLDER).glob("*") if p.is_dir())
     if unpacked:
         built = {folder_name(file_sha256(p)) for p in default_fmu_dir().rglob("*.fmu") if p.is_file()}
-        entries += [CacheEntry(p, _size(p), p.name in built) for p in unpacked]
+        entries += [CacheEntry(p, _size(p), p.name in built or in_use(p)) for p in unpacked]
     return entries
 
 

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import hashlib
+import os
+import time
 
 import pytest
 
@@ -10,7 +12,7 @@ from components.compile.aot import aot_directory
 from components.compile.numba_cache import source_hash
 from orchestrator.commands.cli import main
 from orchestrator.cosim.compiled_kernels import aot_kernels
-from orchestrator.cosim.unpacked_fmus import folder_name
+from orchestrator.cosim.unpacked_fmus import IN_USE_S, folder_name
 
 
 @pytest.fixture
@@ -40,6 +42,9 @@ def cache(tmp_path, monkeypatch):
     (unpacked / "resources" / "x.py").write_bytes(b"u" * 100)
     current.append(unpacked)
     stale.append(tmp_path / "unpacked" / folder_name("0" * 64))  # an FMU run from elsewhere (or rebuilt since)
+    running = tmp_path / "unpacked" / folder_name("1" * 64)  # one from elsewhere that a run may be loading
+    running.mkdir()
+    current.append(running)
     for path in stale:
         if path.suffix == ".so":
             path.parent.mkdir(parents=True, exist_ok=True)
@@ -47,6 +52,8 @@ def cache(tmp_path, monkeypatch):
         else:
             path.mkdir(parents=True)
             (path / "index.nbi").write_bytes(b"z")
+    long_ago = time.time() - 2 * IN_USE_S
+    os.utime(stale[-1], (long_ago, long_ago))  # last used more than an hour ago
     return tmp_path, current, stale
 
 

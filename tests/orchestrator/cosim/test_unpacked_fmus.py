@@ -142,3 +142,28 @@ def test_loading_and_stepping_an_unpacked_fmu_writes_nothing_into_its_folder(cac
     finally:
         instance.close()
     assert _snapshot(_extract(iface)) == before  # no bytecode, no log: concurrent runs load it as it is
+
+
+@pytest.mark.parametrize("damage", ["deleted", "truncated", "no manifest"])
+def test_a_folder_changed_since_it_was_unpacked_is_set_aside_and_unpacked_anew(cache, tmp_path, damage):
+    calls: list = []
+    folder = unpacked(tmp_path / "A.fmu", SHA, _extractor(calls))
+    member = folder / "resources" / "member.txt"
+    if damage == "deleted":
+        member.unlink()
+    elif damage == "truncated":
+        member.write_text("")
+    else:
+        (folder / unpacked_fmus.MANIFEST).unlink()
+    again = unpacked(tmp_path / "A.fmu", SHA, _extractor(calls))
+    assert again == folder and len(calls) == 2 and member.read_text() == "A.fmu"
+    aside = [p.name for p in store().iterdir() if p.name.startswith(unpacked_fmus.PARTIAL_PREFIX)]
+    assert len(aside) == 1 and "-damaged-" in aside[0]  # removed by a later unpacking once unused for an hour
+    assert unpacked(tmp_path / "A.fmu", SHA, _extractor(calls)) == folder and len(calls) == 2  # whole again
+
+
+def test_the_manifest_lists_every_file_with_its_size(cache, tmp_path):
+    import json
+
+    folder = unpacked(tmp_path / "A.fmu", SHA, _extractor([]))
+    assert json.loads((folder / unpacked_fmus.MANIFEST).read_text()) == {"resources/member.txt": len("A.fmu")}
