@@ -61,11 +61,10 @@ def child(out: Path) -> dict[str, float]:
     generator = single_role(system, GENERATOR).column("generator_speed")
     ratio = generator_vs_ideal(system, outcome)["ratio"]
 
-    cpu0 = time.process_time()
-    from matplotlib.backends import backend_agg  # noqa: F401 - what the first figure imports
-    from matplotlib import figure  # noqa: F401
-
     from orchestrator import plotting
+
+    cpu0 = time.process_time()
+    plotting.import_matplotlib()  # what the first figure imports
     from orchestrator.run import plots
     from orchestrator.run.analysis_plots import plot_load_duration
 

@@ -42,6 +42,7 @@ import re
 import shutil
 import sys
 import tempfile
+import types
 import warnings
 import zipfile
 from dataclasses import dataclass
@@ -470,21 +471,35 @@ def bytecode_members(fmu_path: Path) -> dict[str, bytes]:
     extraction sets new ones), another version ignores it and compiles the source. Derived
     from the sources like the compiled kernels, they leave the build id alone.
     """
-    import py_compile
-
     out = {}
-    with zipfile.ZipFile(fmu_path) as archive, tempfile.TemporaryDirectory(prefix="dtcosim_pyc_") as tmp:
+    with zipfile.ZipFile(fmu_path) as archive:
         for member in archive.namelist():
-            if not (member.startswith("resources/") and member.endswith(".py")):
-                continue
-            source = Path(tmp) / member
-            source.parent.mkdir(parents=True, exist_ok=True)
-            source.write_bytes(archive.read(member))
-            cached = importlib.util.cache_from_source(member)
-            py_compile.compile(str(source), cfile=str(Path(tmp) / cached), dfile=member, doraise=True,
-                               invalidation_mode=py_compile.PycInvalidationMode.UNCHECKED_HASH)
-            out[cached] = (Path(tmp) / cached).read_bytes()
+            if member.startswith("resources/") and member.endswith(".py"):
+                out[importlib.util.cache_from_source(member)] = _unchecked_pyc(archive.read(member), member)
     return out
+
+
+def _unchecked_pyc(source: bytes, filename: str) -> bytes:
+    """What ``py_compile`` writes for ``source`` as an unchecked-hash pyc whose code names ``filename``.
+
+    The FMUs of one build embed mostly the same modules (under their own package names): each
+    distinct source is compiled once per process (:func:`_compiled`) and its code objects renamed.
+    """
+    from importlib._bootstrap_external import _code_to_hash_pyc  # what py_compile itself writes with
+
+    code = _renamed(_compiled(source), filename)
+    return bytes(_code_to_hash_pyc(code, importlib.util.source_hash(source), checked=False))
+
+
+@functools.lru_cache(maxsize=512)
+def _compiled(source: bytes):
+    return compile(source, "<embedded>", "exec", dont_inherit=True)
+
+
+def _renamed(code, filename: str):
+    """``code`` and every code object in it with ``co_filename`` = ``filename`` (as compiled under that name)."""
+    consts = tuple(_renamed(c, filename) if isinstance(c, types.CodeType) else c for c in code.co_consts)
+    return code.replace(co_filename=filename, co_consts=consts)
 
 
 def _add_cross_check(name: str, fmu_path: Path, case) -> None:

@@ -74,26 +74,35 @@ def imported_modules(sources: Iterable[Path]) -> tuple[dict[str, None], dict[str
     required: dict[str, None] = {}
     optional: dict[str, str] = {}
     for path in sources:
-        text = Path(path).read_text(encoding="utf-8")
-        lines = text.splitlines()
-        for node in ast.walk(ast.parse(text, filename=str(path))):
-            if isinstance(node, ast.Import):
-                names = [alias.name.split(".")[0] for alias in node.names]
-            elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
-                names = [node.module.split(".")[0]]
+        for name, note in _imports_of(str(path), Path(path).read_text(encoding="utf-8")):
+            if note is None:
+                required[name] = None
             else:
-                continue
-            line = lines[node.lineno - 1]
-            note = line.partition(OPTIONAL_NOTE)[2].strip() if OPTIONAL_NOTE in line else None
-            for name in names:
-                if note is None:
-                    required[name] = None
-                else:
-                    optional.setdefault(name, note)
+                optional.setdefault(name, note)
     ignored = set(sys.stdlib_module_names) | {"__future__"} | EMBEDDED_PACKAGES
     required = {m: None for m in sorted(required) if m not in ignored}
     optional = {m: p for m, p in sorted(optional.items()) if m not in ignored and m not in required}
     return required, optional
+
+
+@functools.lru_cache(maxsize=1024)
+def _imports_of(path: str, text: str) -> tuple[tuple[str, str | None], ...]:
+    """The top-level modules of every absolute import in ``text`` (the file ``path``), each with the note of its
+    line after :data:`OPTIONAL_NOTE` (None: required). Parsed once per process and content: the FMUs of one
+    build embed mostly the same modules."""
+    lines = text.splitlines()
+    found = []
+    for node in ast.walk(ast.parse(text, filename=path)):
+        if isinstance(node, ast.Import):
+            names = [alias.name.split(".")[0] for alias in node.names]
+        elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            names = [node.module.split(".")[0]]
+        else:
+            continue
+        line = lines[node.lineno - 1]
+        note = line.partition(OPTIONAL_NOTE)[2].strip() if OPTIONAL_NOTE in line else None
+        found += [(name, note) for name in names]
+    return tuple(found)
 
 
 def third_party_modules(sources: Iterable[Path]) -> tuple[str, ...]:

@@ -93,9 +93,23 @@ _attempts: dict[str, tuple[ModuleType | None, str | None]] = {}
 JIT_VARIABLE = "DTCOSIM_JIT"
 
 
+#: why just-in-time compilation is off, set beside :data:`JIT_VARIABLE` by the process that turned it off for
+#: itself, its FMUs and its workers (``dtcosim run`` while the kernels compile in the background)
+JIT_OFF_REASON_VARIABLE = "DTCOSIM_JIT_OFF_REASON"
+
+
 def jit_enabled() -> bool:
     """False where ``DTCOSIM_JIT=0``."""
     return os.environ.get(JIT_VARIABLE, "1").strip() != "0"
+
+
+def jit_off_reason() -> str:
+    """Why a kernel has no compiled form where just-in-time compilation is off: the reason the process that turned
+    it off gave (:data:`JIT_OFF_REASON_VARIABLE`), else that ``DTCOSIM_JIT=0`` is set."""
+    given = os.environ.get(JIT_OFF_REASON_VARIABLE, "").strip()
+    if given:
+        return f"no module compiled ahead of time yet: {given}"
+    return f"no module compiled ahead of time, and just-in-time compilation is off ({JIT_VARIABLE}=0)"
 
 
 def try_compiled(source: KernelSource) -> tuple[ModuleType | None, str | None]:
@@ -107,7 +121,7 @@ def try_compiled(source: KernelSource) -> tuple[ModuleType | None, str | None]:
     """
     key = source.shared_name
     if key not in _attempts and not jit_enabled():
-        return None, f"no module compiled ahead of time, and just-in-time compilation is off ({JIT_VARIABLE}=0)"
+        return None, jit_off_reason()
     if key not in _attempts:
         try:
             _attempts[key] = (load_compiled(source), None)
@@ -118,6 +132,8 @@ def try_compiled(source: KernelSource) -> tuple[ModuleType | None, str | None]:
 
 def already_compiled(source: KernelSource) -> ModuleType | None:
     """The just-in-time module of ``source`` if this process has loaded it already (nothing is loaded here)."""
+    if not _attempts:  # nothing compiled just in time here: no need to name the sources' version
+        return None
     return _attempts.get(source.shared_name, (None, None))[0]
 
 

@@ -2,11 +2,14 @@
 
 The cache (:func:`components.compile.user_cache.user_cache_root`, ``~/.cache/dtcosim``) keeps
 the kernels compiled ahead of time (``aot/<python tag>-numpy<version>/``, one module per
-kernel version: :mod:`components.compile.aot`) and numba's just-in-time machine code
-(``numba-<numba version>/<source hash>/``). Every new version of a kernel's sources adds
-entries and nothing removes the old ones: ``--prune`` deletes every entry that the
+kernel version: :mod:`components.compile.aot`), numba's just-in-time machine code
+(``numba-<numba version>/<source hash>/``) and the FMUs runs have unpacked
+(``unpacked/<content hash>-<Python tag>/``: :mod:`orchestrator.cosim.unpacked_fmus`). Every new version of a
+kernel's sources adds entries and nothing removes the old ones: ``--prune`` deletes every entry that the
 installed dtcosim, Python, numpy and numba would not load (FMUs carry their own compiled
-modules, so an older FMU keeps running; a later run rebuilds what it needs).
+modules, so an older FMU keeps running; a later run rebuilds what it needs), and every unpacked
+FMU that is not one of the FMU folder's (:func:`orchestrator.provision.folders.default_fmu_dir`;
+a later run of it unpacks it again) unless used within the hour (a run may be loading it).
 """
 
 from __future__ import annotations
@@ -22,6 +25,10 @@ from components.compile.user_cache import user_cache_root
 from components.model.kernel import KERNELS
 
 from ..cosim.compiled_kernels import aot_kernels
+from ..cosim.fmu_interface import file_sha256
+from ..cosim.unpacked_fmus import FOLDER as UNPACKED_FOLDER
+from ..cosim.unpacked_fmus import folder_name, in_use
+from ..provision.folders import default_fmu_dir
 from .catalogue import help_line
 
 
@@ -51,7 +58,7 @@ def _jit_keys() -> tuple[str | None, set[str]]:
 
 
 def cache_entries(root: Path | None = None) -> list[CacheEntry]:
-    """Every module of ``aot/`` and every kernel folder of ``numba-*/``, marked current or stale."""
+    """Every module of ``aot/``, every kernel folder of ``numba-*/`` and every unpacked FMU, marked current or stale."""
     root = Path(root or user_cache_root())
     entries = []
     current_aot_dir = aot_directory()
@@ -65,6 +72,10 @@ def cache_entries(root: Path | None = None) -> list[CacheEntry]:
         for kernel_dir in sorted(p for p in folder.iterdir() if p.is_dir()):
             current = folder.name == numba_dir and kernel_dir.name in hashes
             entries.append(CacheEntry(kernel_dir, _size(kernel_dir), current))
+    unpacked = sorted(p for p in (root / UNPACKED_FOLDER).glob("*") if p.is_dir())
+    if unpacked:
+        built = {folder_name(file_sha256(p)) for p in default_fmu_dir().rglob("*.fmu") if p.is_file()}
+        entries += [CacheEntry(p, _size(p), p.name in built or in_use(p)) for p in unpacked]
     return entries
 
 
@@ -96,7 +107,7 @@ def run(args: argparse.Namespace) -> int:
                 shutil.rmtree(e.path, ignore_errors=True)
             else:
                 e.path.unlink(missing_ok=True)
-        for folder in [*(root / "aot").glob("*"), *root.glob("numba-*")]:
+        for folder in [*(root / "aot").glob("*"), *root.glob("numba-*"), root / UNPACKED_FOLDER]:
             if folder.is_dir() and not any(folder.iterdir()):
                 folder.rmdir()
         print(f"pruned {len(stale)} stale entries")

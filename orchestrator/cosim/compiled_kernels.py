@@ -29,7 +29,7 @@ from components.compile.aot import (
     failed_before,
     missing,
 )
-from components.compile.jit import JIT_VARIABLE
+from components.compile.jit import JIT_OFF_REASON_VARIABLE, JIT_VARIABLE
 from components.model.kernel import AHEAD_OF_TIME
 
 from .stepping.compiled_loop import aot_loop_kernel
@@ -115,6 +115,7 @@ def _in_background(todo: list[AotKernel], report: Callable[[str], None] | None) 
     if pid is None:  # numba missing or an unwritable cache: numba compiles them just in time, as before
         return "the kernels could not be compiled in the background"
     os.environ[JIT_VARIABLE] = "0"  # compiling them just in time now would cost as much as the build
+    os.environ[JIT_OFF_REASON_VARIABLE] = f"being compiled in the background for later runs (pid {pid})"
     if report:
         what = (f"the kernels are still being compiled ahead of time in the background (pid {pid}" if running is not None
                 else f"compiling {len(todo)} kernel(s) ahead of time in the background for later runs (pid {pid}")

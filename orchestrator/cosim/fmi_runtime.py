@@ -17,9 +17,6 @@ unloaded and loaded again in one process.
 
 from __future__ import annotations
 
-import atexit
-import shutil
-import tempfile
 from collections import deque
 from ctypes import (
     CFUNCTYPE,
@@ -39,6 +36,7 @@ from typing import Any, Iterable
 from ..archive_members import shown_path
 from ..errors import FmuStepError, InitializationError, status_label
 from .fmu_interface import FmuInterface
+from .unpacked_fmus import unpacked
 
 FMI_OK, FMI_WARNING, FMI_ERROR, FMI_FATAL = 0, 1, 3, 4
 
@@ -72,33 +70,23 @@ def hot_prototypes(iface: FmuInterface) -> tuple:
         return DO_STEP_HOLDING_GIL, REAL_VALUES_HOLDING_GIL
     return DO_STEP, REAL_VALUES
 
-_EXTRACTED: dict[str, Path] = {}
+
 #: log message lists of the live instances by instance name (see FmuInstance)
 _LOG_SINKS: dict[str, deque] = {}
-_EXTRACT_ROOT: Path | None = None
 
 
 def _extract(iface: FmuInterface) -> Path:
-    """Directory with the FMU's contents, extracted once per process."""
-    global _EXTRACT_ROOT
+    """Directory with the FMU's contents: unpacked once per content into the user cache (:mod:`.unpacked_fmus`)."""
     from fmus.archive_checks import FmuArchiveError, extract_fmu
 
-    if iface.sha256 in _EXTRACTED:
-        return _EXTRACTED[iface.sha256]
-    if _EXTRACT_ROOT is None:
-        _EXTRACT_ROOT = Path(tempfile.mkdtemp(prefix="dtcosim-fmus-"))
-        atexit.register(shutil.rmtree, _EXTRACT_ROOT, True)
-    target = _EXTRACT_ROOT / iface.sha256[:16]
     try:
-        extract_fmu(iface.path, target)  # bounded: the archive limits hold whatever its directory says
-    except FmuArchiveError as exc:  # a damaged member, a zip bomb, a member outside the folder
-        shutil.rmtree(target, ignore_errors=True)
+        target = unpacked(iface.path, iface.sha256, extract_fmu)  # bounded: the archive limits hold whatever its
+    except FmuArchiveError as exc:  # directory says; a damaged member, a zip bomb, a member outside the folder
         raise InitializationError(f"cannot extract the FMU: {exc}") from None
     except OSError as exc:  # a full disk, a file-size limit, a read-only temporary folder
-        shutil.rmtree(target, ignore_errors=True)
         reason = exc.strerror or str(exc) or type(exc).__name__
-        raise InitializationError(f"cannot extract the FMU {shown_path(iface.path)} into {target}: {reason}") from None
-    _EXTRACTED[iface.sha256] = target
+        where = f" into {exc.filename}" if exc.filename else ""
+        raise InitializationError(f"cannot extract the FMU {shown_path(iface.path)}{where}: {reason}") from None
     return target
 
 

@@ -23,6 +23,7 @@ from typing import Any, Mapping
 from ..archive_members import shown_path
 from ..errors import ScenarioError
 from ..frozen_map import FrozenMap
+from .unpacked_fmus import is_unpacked
 
 
 @dataclass(frozen=True)
@@ -246,7 +247,9 @@ def read_fmu_interface(path: str | Path, key: str = "fmu") -> FmuInterface:
     from fmus.archive_checks import corrupt_member, layout_problems
 
     problems = layout_problems(p)  # before anything is decompressed: a pipe, a zip bomb, a zip-slip name
-    damaged = None if problems else corrupt_member(p)
+    sha256 = None if problems else file_sha256(p)
+    # every member is read (CRC checked) unless an archive of this content was unpacked whole before
+    damaged = None if problems or is_unpacked(sha256) else corrupt_member(p)
     if problems or damaged:
         raise ScenarioError(key, shown, f"a readable FMU ({'; '.join(problems) or damaged})")
     try:
@@ -316,7 +319,7 @@ def read_fmu_interface(path: str | Path, key: str = "fmu") -> FmuInterface:
         output_dependencies=FrozenMap(deps),
         can_handle_variable_step=bool(cs.canHandleVariableCommunicationStepSize),
         can_get_and_set_state=bool(cs.canGetAndSetFMUstate),
-        sha256=file_sha256(p),
+        sha256=sha256,
         default_step_s=default_step,
         unit_definitions=FrozenMap(units),
         record=read_fmu_record(p, key),

@@ -77,10 +77,10 @@ def plot_load_duration(ldds: Sequence[LoadDurationDistribution], path: str | Pat
     Torques are drawn in kN m (forces in kN); the log time axis shows the rare extreme
     loads (e.g. of a load event) next to the hours-equivalent of normal operation.
     """
-    from matplotlib.collections import PolyCollection
+    fig, axes = new_figure(len(ldds), height=2.5 * len(ldds) + 0.2, sharex=False, margins=_PANEL_MARGINS)
+    from matplotlib.collections import PolyCollection  # imported with the figure (orchestrator.plotting)
     from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
-    fig, axes = new_figure(len(ldds), height=2.5 * len(ldds) + 0.2, sharex=False, margins=_PANEL_MARGINS)
     for ax, ld in zip(axes, ldds):
         scale, unit = (1e-3, "kN m") if ld.unit in ("N.m", "N m") else (1e-3, "kN") if ld.unit == "N" else (1.0, ld.unit)
         edges = ld.edges * scale

@@ -344,3 +344,31 @@ def test_an_interrupted_build_leaves_the_previous_fmu_whole_and_nothing_half_wri
     built = fmu_build.build_fmu("WindSource", out)
     assert built.path == out / "WindSource.fmu" and check_fmu(built.path) == []
     assert sorted(p.name for p in out.iterdir()) == ["WindSource.fmu"]
+
+
+def test_bytecode_of_a_source_two_fmus_embed_is_compiled_once_and_names_each_file(tmp_path):
+    """fmus.build._unchecked_pyc: the code py_compile writes (same header and code), under each member's name."""
+    import importlib.util
+    import marshal
+    import py_compile
+
+    source = b"def outer():\n    def inner():\n        return 1\n    return inner\n\nclass K:\n    def m(self):\n        pass\n"
+    (tmp_path / "mod.py").write_bytes(source)
+    py_compile.compile(str(tmp_path / "mod.py"), cfile=str(tmp_path / "mod.pyc"), dfile="resources/a/mod.py",
+                       doraise=True, invalidation_mode=py_compile.PycInvalidationMode.UNCHECKED_HASH)
+    expected = (tmp_path / "mod.pyc").read_bytes()
+    fmu_build._compiled.cache_clear()
+    first = fmu_build._unchecked_pyc(source, "resources/a/mod.py")
+    second = fmu_build._unchecked_pyc(source, "resources/b/mod.py")
+    assert fmu_build._compiled.cache_info().misses == 1 and fmu_build._compiled.cache_info().hits == 1
+    assert first[:16] == expected[:16] == second[:16] and expected[8:16] == importlib.util.source_hash(source)
+    assert marshal.loads(first[16:]) == marshal.loads(expected[16:])
+
+    def filenames(code):
+        return {code.co_filename}.union(*(filenames(c) for c in code.co_consts if hasattr(c, "co_filename")))
+
+    assert filenames(marshal.loads(first[16:])) == {"resources/a/mod.py"}
+    assert filenames(marshal.loads(second[16:])) == {"resources/b/mod.py"}
+    outer = {}
+    exec(marshal.loads(second[16:]), outer)
+    assert outer["outer"]().__code__.co_filename == "resources/b/mod.py" and outer["outer"]()() == 1

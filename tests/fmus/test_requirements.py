@@ -69,6 +69,17 @@ def test_third_party_modules_are_the_absolute_non_stdlib_non_embedded_imports(tm
     assert third_party_modules([tmp_path / "a.py", tmp_path / "b.py"]) == ("numpy", "scipy")
 
 
+def test_imports_are_parsed_once_per_content_and_a_changed_file_again(tmp_path):
+    from fmus import requirements
+
+    (tmp_path / "a.py").write_text("import numpy\nimport scipy  # optional requirement: faster solves\n")
+    requirements._imports_of.cache_clear()
+    assert imported_modules([tmp_path / "a.py"]) == ({"numpy": None}, {"scipy": "faster solves"})
+    assert imported_modules([tmp_path / "a.py"])[0] == {"numpy": None} and requirements._imports_of.cache_info().hits == 1
+    (tmp_path / "a.py").write_text("import pandas\n")
+    assert imported_modules([tmp_path / "a.py"]) == ({"pandas": None}, {})
+
+
 def test_requirements_come_from_the_installed_versions():
     req = from_environment("X", ["sklearn", "numpy"], python=(3, 12, 4),
                            version_of={"numpy": "2.4.6", "scikit-learn": "1.5.2"}.__getitem__,

@@ -35,7 +35,7 @@ from types import ModuleType
 import numpy as np
 
 from components.compile.aot import AotKernel, compiled_or_jit
-from components.compile.jit import JIT_VARIABLE, jit_enabled
+from components.compile.jit import jit_enabled, jit_off_reason
 from components.compile.sources import KernelSource
 
 from ..fmi_runtime import runs_python
@@ -85,7 +85,7 @@ def aot_loop_kernel() -> AotKernel:
 
 def _jit_module() -> tuple[ModuleType | None, str | None]:
     if not jit_enabled():
-        return None, f"no module compiled ahead of time, and just-in-time compilation is off ({JIT_VARIABLE}=0)"
+        return None, jit_off_reason()
     try:
         return _jit_kernel_module(), None
     except Exception as exc:  # noqa: BLE001 - numba missing or broken: the Python loop runs

@@ -228,10 +228,11 @@ def test_the_first_run_does_not_wait_for_the_compiler(tmp_path, monkeypatch):
     """ensure_compiled_kernels(background=True): the build starts detached, this process compiles nothing just in
     time (DTCOSIM_JIT=0: its kernels run interpreted) and the message says what happens, without a duration."""
     import orchestrator.cosim.compiled_kernels as compiled_kernels
-    from components.compile.jit import JIT_VARIABLE
+    from components.compile.jit import JIT_OFF_REASON_VARIABLE, JIT_VARIABLE
 
     monkeypatch.setenv("DTCOSIM_CACHE_DIR", str(tmp_path))
-    monkeypatch.delenv(JIT_VARIABLE, raising=False)
+    monkeypatch.setenv(JIT_VARIABLE, "1")  # restored after the test, as the reason below
+    monkeypatch.setenv(JIT_OFF_REASON_VARIABLE, "")
     fake = AotKernel("_dtcosim_test_kernel_0011223344556677", "components.model.kernel:no_such_provider")
     monkeypatch.setattr(compiled_kernels, "aot_kernels", lambda: (fake,))
     started = []
@@ -242,6 +243,9 @@ def test_the_first_run_does_not_wait_for_the_compiler(tmp_path, monkeypatch):
     import os
 
     assert os.environ[JIT_VARIABLE] == "0"
+    # what the kernels of this process and its FMUs say when they run interpreted: why, with the builder's pid
+    assert try_compiled(KernelSource("nojit", kernel.WIND.entry.with_name("contact.py"))) == (
+        None, "no module compiled ahead of time yet: being compiled in the background for later runs (pid 4242)")
     (line,) = said
     assert line.startswith("compiling 1 kernel(s) ahead of time in the background for later runs (pid 4242, log ")
     assert line.endswith("until they are built, runs step them interpreted, which takes longer")
@@ -252,7 +256,8 @@ def test_without_just_in_time_compilation_a_kernel_runs_from_its_module_or_inter
     from components.compile.jit import JIT_VARIABLE
 
     monkeypatch.setenv("DTCOSIM_CACHE_DIR", str(tmp_path))  # no ahead-of-time modules here
-    monkeypatch.setenv(JIT_VARIABLE, "0")
+    monkeypatch.setenv(JIT_VARIABLE, "0")  # set by the user: no reason given
+    monkeypatch.delenv("DTCOSIM_JIT_OFF_REASON", raising=False)
     source = KernelSource("wind", kernel.WIND.entry)
     module, reason = try_compiled(KernelSource("nojit", kernel.WIND.entry.with_name("contact.py")))
     assert module is None and f"{JIT_VARIABLE}=0" in reason

@@ -2,12 +2,17 @@
 
 from __future__ import annotations
 
+import hashlib
+import os
+import time
+
 import pytest
 
 from components.compile.aot import aot_directory
 from components.compile.numba_cache import source_hash
 from orchestrator.commands.cli import main
 from orchestrator.cosim.compiled_kernels import aot_kernels
+from orchestrator.cosim.unpacked_fmus import IN_USE_S, folder_name
 
 
 @pytest.fixture
@@ -28,6 +33,18 @@ def cache(tmp_path, monkeypatch):
              tmp_path / "aot" / "cpython-310-numpy1.26" / "_dtcosim_compiled_wind_0000000000000000_aot.so",
              tmp_path / f"numba-{numba.__version__}" / "0000000000000000",
              tmp_path / "numba-0.60.0" / source_hash(aot_kernels()[0].source)[:16]]
+    monkeypatch.delenv("DTCOSIM_FMU_DIR", raising=False)
+    built = tmp_path / "fmus" / "drivetrains" / "x-0123" / "Gearbox.fmu"  # an FMU of the FMU folder
+    built.parent.mkdir(parents=True)
+    built.write_bytes(b"an FMU")
+    unpacked = tmp_path / "unpacked" / folder_name(hashlib.sha256(b"an FMU").hexdigest())
+    (unpacked / "resources").mkdir(parents=True)
+    (unpacked / "resources" / "x.py").write_bytes(b"u" * 100)
+    current.append(unpacked)
+    stale.append(tmp_path / "unpacked" / folder_name("0" * 64))  # an FMU run from elsewhere (or rebuilt since)
+    running = tmp_path / "unpacked" / folder_name("1" * 64)  # one from elsewhere that a run may be loading
+    running.mkdir()
+    current.append(running)
     for path in stale:
         if path.suffix == ".so":
             path.parent.mkdir(parents=True, exist_ok=True)
@@ -35,6 +52,8 @@ def cache(tmp_path, monkeypatch):
         else:
             path.mkdir(parents=True)
             (path / "index.nbi").write_bytes(b"z")
+    long_ago = time.time() - 2 * IN_USE_S
+    os.utime(stale[-1], (long_ago, long_ago))  # last used more than an hour ago
     return tmp_path, current, stale
 
 
@@ -58,6 +77,7 @@ def test_prune_removes_only_the_stale_entries(cache, capsys):
     assert f"pruned {len(stale)} stale entries" in capsys.readouterr().out
     assert all(p.exists() for p in current) and not any(p.exists() for p in stale)
     assert not (root / "aot" / "cpython-310-numpy1.26").exists() and not (root / "numba-0.60.0").exists()
+    assert (root / "unpacked").is_dir()  # still holds the current one
 
 
 def test_an_empty_cache_says_so(tmp_path, monkeypatch, capsys):

@@ -68,3 +68,18 @@ def test_an_unknown_command_is_refused_naming_every_command(capsys):
                                         (["export-ssp", "--out", "a.ssp"], "export-ssp")])
 def test_the_command_is_the_first_word_unless_help_comes_first(argv, name):
     assert cli.command_named(argv) == name
+
+
+def test_the_console_script_collects_cycles_less_often_than_python_by_default(monkeypatch):
+    import gc
+
+    seen = {}
+    monkeypatch.setattr(cli, "main", lambda: seen.setdefault("thresholds", gc.get_threshold()) and 0)
+    monkeypatch.setattr(cli, "end_process", lambda status: seen.setdefault("status", status))
+    before = gc.get_threshold()
+    try:
+        cli.console_main()
+    finally:
+        gc.set_threshold(*before)
+    assert seen == {"thresholds": cli.COLLECTOR_THRESHOLDS, "status": 0}
+    assert cli.COLLECTOR_THRESHOLDS[0] > 700 and gc.isenabled()

@@ -10,10 +10,12 @@ from __future__ import annotations
 import json
 import re
 import resource
+import shutil
 import signal
 import subprocess
 import sys
 import time
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -140,11 +142,24 @@ def test_a_file_size_limit_keeps_what_was_written_and_says_so(fmu_dir, tmp_path)
     _check_disk_full(proc, out, "File too large")
 
 
+def _never_unpacked(fmu_dir: Path, folder: Path) -> Path:
+    """Copies of the FMUs of ``fmu_dir`` in ``folder``, each with a zip comment of its own: content no run has
+    unpacked into the user cache yet (orchestrator.cosim.unpacked_fmus), the same FMUs otherwise."""
+    folder.mkdir()
+    for fmu in fmu_dir.glob("*.fmu"):
+        copy = folder / fmu.name
+        shutil.copyfile(fmu, copy)
+        with zipfile.ZipFile(copy, "a") as archive:
+            archive.comment = f"{folder} {time.time_ns()}".encode()
+    return folder
+
+
 def test_an_fmu_that_cannot_be_extracted_is_a_named_error_before_stepping(fmu_dir, tmp_path):
     """A file-size limit below the Gearbox's compiled module (0.85 MB): the extraction fails, one clear line."""
     out = tmp_path / "limited"
     out.mkdir()
-    proc = start(fmu_dir, out, "--stop", "1", preexec_fn=_file_size_limit(300_000))
+    fmus = _never_unpacked(fmu_dir, tmp_path / "fmus")
+    proc = start(fmus, out, "--stop", "1", preexec_fn=_file_size_limit(300_000))
     _, stderr = proc.communicate(timeout=300)
     assert proc.returncode == 1, stderr
     assert "cannot extract the FMU" in stderr and "File too large" in stderr and "Traceback" not in stderr, stderr
