@@ -9,8 +9,13 @@ pydantic, lxml, the FMU slaves), so a stop signal can land in an import at
 almost any stage.
 
 :func:`outside_imports` wraps a handler: a signal that arrives while an
-import is running is delivered again :data:`REDELIVERY_S` later, until it
+import is running is delivered again every :data:`REDELIVERY_S` until it
 lands outside every import, where the wrapped handler runs (and may raise).
+It is sent again until the handler has run, not once: a signal that arrives
+just before the main thread enters a blocking call (``time.sleep``, a wait)
+is noted by CPython but wakes nothing, and would otherwise wait for the call
+to end. One redelivery is pending per signal at a time, so a signal handled
+inside an import starts no further thread.
 :func:`install` puts such handlers in place for the signals a process does
 not ignore, and :func:`restore` puts the previous ones back.
 """
@@ -19,6 +24,7 @@ from __future__ import annotations
 
 import signal
 import threading
+import time
 from collections.abc import Callable, Mapping
 from types import FrameType
 
@@ -48,8 +54,22 @@ def _to_main_thread(signum: int) -> None:
         signal.raise_signal(signum)
 
 
+#: signals deferred out of an import whose handler has not run yet (changed under the GIL only)
+_pending: set[int] = set()
+
+
+def _redeliver(signum: int) -> None:
+    """Send ``signum`` to the main thread every :data:`REDELIVERY_S` until its handler has run."""
+    while signum in _pending:
+        _to_main_thread(signum)
+        time.sleep(REDELIVERY_S)
+
+
 def _deliver_again(signum: int) -> None:
-    timer = threading.Timer(REDELIVERY_S, _to_main_thread, (signum,))
+    if signum in _pending:  # a redelivery is under way: it sends this one too
+        return
+    _pending.add(signum)
+    timer = threading.Timer(REDELIVERY_S, _redeliver, (signum,))
     timer.daemon = True
     timer.start()
 
@@ -73,6 +93,7 @@ def outside_imports(handler: Handler) -> Handler:
         if inside_import(frame):
             _deliver_again(signum)
             return None
+        _pending.discard(signum)
         return handler(signum, frame)
 
     deferring.wrapped = handler  # type: ignore[attr-defined]

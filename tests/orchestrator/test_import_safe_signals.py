@@ -127,3 +127,30 @@ def test_a_signal_the_process_ignores_stays_ignored_during_a_command(monkeypatch
     assert seen["hup"] is signal.SIG_IGN
     assert seen["term"].wrapped is cli._raise_interrupt  # a handler that ends the command, kept out of imports
     assert signal.getsignal(signal.SIGTERM) is before_term  # restored afterwards
+
+
+def test_a_deferred_signal_is_sent_again_until_its_handler_has_run(monkeypatch):
+    """One send can be lost (it lands just before the main thread blocks in a sleep or a wait): repeat until
+    handled, and a signal deferred again while one redelivery is under way starts no second one."""
+    import threading
+    import time
+
+    from orchestrator import import_safe_signals as iss
+
+    sent = []
+    monkeypatch.setattr(iss, "REDELIVERY_S", 0.005)
+    monkeypatch.setattr(iss, "_to_main_thread", sent.append)
+    starts, timer = [], threading.Timer
+    monkeypatch.setattr(iss.threading, "Timer", lambda *a: starts.append(a) or timer(*a))
+    iss._deliver_again(signal.SIGUSR1)
+    iss._deliver_again(signal.SIGUSR1)  # deferred again inside the import: no second redelivery
+    deadline = time.monotonic() + 10
+    while len(sent) < 3 and time.monotonic() < deadline:  # the first sends "lost": the handler never ran
+        time.sleep(0.005)
+    assert len(sent) >= 3 and set(sent) == {signal.SIGUSR1} and len(starts) == 1
+    handled = []
+    iss.outside_imports(lambda signum, frame: handled.append(signum))(signal.SIGUSR1, None)  # finally outside
+    count = len(sent)
+    time.sleep(0.05)
+    assert handled == [signal.SIGUSR1] and len(sent) <= count + 1  # at most the send under way
+    assert signal.SIGUSR1 not in iss._pending
