@@ -16,6 +16,7 @@ import pytest
 
 from orchestrator.commands import cli
 from orchestrator.run import run_folder
+from tests.helpers.stop_signals import ignored_stop_signals_at_defaults
 from orchestrator.run.run_folder import OutputFolderError, RunFolder
 from tests.helpers.failing_files import FullAt, FullDisk
 
@@ -46,7 +47,8 @@ def test_a_signal_just_after_the_folder_is_prepared_ends_with_a_stopped_summary(
                                                                                  signal_after_prepare, signum, status):
     signal_after_prepare(signum)
     out = tmp_path / "out"
-    assert cli.main(["run", str(toy_scenario()), "--out", str(out), "--no-build", "-q"]) == status
+    with ignored_stop_signals_at_defaults():  # a suite under nohup ignores SIGHUP, and so would the command
+        assert cli.main(["run", str(toy_scenario()), "--out", str(out), "--no-build", "-q"]) == status
     summary = summary_of(out)
     assert summary["status"] == "stopped" and summary["complete"] is False and summary["interrupted"] is True
     assert summary["signal"] == signal.Signals(signum).name and summary["samples"] == 0

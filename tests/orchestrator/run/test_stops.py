@@ -23,22 +23,11 @@ import pytest
 
 from orchestrator.result_files import read_timeseries
 from tests.helpers.scenarios import dtcosim
+from tests.helpers.stop_signals import as_from_a_terminal
 
 pytestmark = pytest.mark.slow
 
 EXE = str(Path(sys.executable).parent / "dtcosim")
-
-
-def _as_from_a_terminal(then=None):
-    """The child's stop signals at their defaults, as a shell's job has them (CI may run under nohup)."""
-
-    def preexec():
-        for signum in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
-            signal.signal(signum, signal.SIG_DFL)
-        if then is not None:
-            then()
-
-    return preexec
 
 
 def start(fmu_dir, out, *extra, preexec_fn=None) -> subprocess.Popen:
@@ -47,7 +36,7 @@ def start(fmu_dir, out, *extra, preexec_fn=None) -> subprocess.Popen:
     return subprocess.Popen([EXE, "run", "--fmu-dir", str(fmu_dir), "--out", str(out), "--no-plots", "-q",
                              "--step", "0.001", "--output-interval", "0.001", *extra],
                             cwd=out.parent, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            preexec_fn=_as_from_a_terminal(preexec_fn))
+                            preexec_fn=as_from_a_terminal(preexec_fn))
 
 
 def wait_until_stepping(proc: subprocess.Popen, out: Path, rows: int = 600, timeout: float = 300.0) -> None:
@@ -240,7 +229,7 @@ def test_ctrl_c_at_any_stage_exits_130_with_one_line(fmu_dir, tmp_path, delay_s)
     # under 4 s once the start-up got faster)
     proc = subprocess.Popen([EXE, "run", "--fmu-dir", str(fmu_dir), "--out", str(out), "-q", "--step", "0.001",
                              "--output-interval", "0.001", "--stop", "300", "--window", "5", "60"], cwd=tmp_path,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, preexec_fn=_as_from_a_terminal())
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, preexec_fn=as_from_a_terminal())
     time.sleep(delay_s)  # start-up, imports, FMU loading, instantiation, stepping: wherever it is
     proc.send_signal(signal.SIGINT)
     _, stderr = proc.communicate(timeout=120)

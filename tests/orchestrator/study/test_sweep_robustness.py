@@ -27,6 +27,7 @@ from orchestrator.study.engine import PointTask, run_point
 from orchestrator.study.journal import Journal
 from orchestrator.study.prepare import prepare_study
 from tests.helpers.failing_files import FullAt
+from tests.helpers.stop_signals import as_from_a_terminal
 from tests.helpers.studies import SMALL_HEAD, SMALL_TABLES
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -196,7 +197,7 @@ def test_a_signal_during_the_cluster_start_up_is_one_line(write_study, tmp_path,
     out = tmp_path / "out"
     code = SIGNAL_IN_START_UP.format(root=str(ROOT), signame=signame, study=str(path), out=str(out))
     proc = subprocess.run([sys.executable, "-c", textwrap.dedent(code)], capture_output=True, text=True, timeout=300,
-                          cwd=tmp_path, start_new_session=True)
+                          cwd=tmp_path, start_new_session=True, preexec_fn=as_from_a_terminal())
     assert proc.returncode == status, proc.stderr
     assert proc.stderr.strip().splitlines() == [
         f"dtcosim sweep: interrupted; 0 finished points kept in {out / 'journal.jsonl'}; run the same command again "
