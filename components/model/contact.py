@@ -250,7 +250,8 @@ class ContactLaw:
         d, r, f = np.broadcast_arrays(np.asarray(deflection, dtype=float), np.asarray(rate, dtype=float),
                                       np.asarray(stiffness_factor, dtype=float))
         shape = d.shape
-        flat = [np.ascontiguousarray(x, dtype=float).reshape(-1, self.size) for x in (d, r, f)]
+        # copies: a broadcast view is read-only in future numpy, and numba warns about it when it compiles
+        flat = [np.array(x, dtype=float, order="C").reshape(-1, self.size) for x in (d, r, f)]
         out = [np.empty_like(flat[0]) for _ in range(4)]
         self._many(flat[0].size).contact_forces_many(*flat, self.table, *out)
         return ContactForces(*(o.reshape(shape) for o in out))
