@@ -59,8 +59,14 @@ _pending: set[int] = set()
 
 
 def _redeliver(signum: int) -> None:
-    """Send ``signum`` to the main thread every :data:`REDELIVERY_S` until its handler has run."""
+    """Send ``signum`` to the main thread every :data:`REDELIVERY_S` until its handler has run.
+
+    Where the deferring handler is gone by then (:func:`restore` put the previous one back),
+    the signal is sent once more, to the handler in place, and no longer.
+    """
     while signum in _pending:
+        if not hasattr(signal.getsignal(signum), "wrapped"):
+            _pending.discard(signum)
         _to_main_thread(signum)
         time.sleep(REDELIVERY_S)
 

@@ -142,15 +142,42 @@ def test_a_deferred_signal_is_sent_again_until_its_handler_has_run(monkeypatch):
     monkeypatch.setattr(iss, "_to_main_thread", sent.append)
     starts, timer = [], threading.Timer
     monkeypatch.setattr(iss.threading, "Timer", lambda *a: starts.append(a) or timer(*a))
-    iss._deliver_again(signal.SIGUSR1)
-    iss._deliver_again(signal.SIGUSR1)  # deferred again inside the import: no second redelivery
-    deadline = time.monotonic() + 10
-    while len(sent) < 3 and time.monotonic() < deadline:  # the first sends "lost": the handler never ran
-        time.sleep(0.005)
-    assert len(sent) >= 3 and set(sent) == {signal.SIGUSR1} and len(starts) == 1
     handled = []
-    iss.outside_imports(lambda signum, frame: handled.append(signum))(signal.SIGUSR1, None)  # finally outside
-    count = len(sent)
-    time.sleep(0.05)
+    deferring = iss.outside_imports(lambda signum, frame: handled.append(signum))
+    previous = signal.signal(signal.SIGUSR1, deferring)
+    try:
+        iss._deliver_again(signal.SIGUSR1)
+        iss._deliver_again(signal.SIGUSR1)  # deferred again inside the import: no second redelivery
+        deadline = time.monotonic() + 10
+        while len(sent) < 3 and time.monotonic() < deadline:  # the first sends "lost": the handler never ran
+            time.sleep(0.005)
+        assert len(sent) >= 3 and set(sent) == {signal.SIGUSR1} and len(starts) == 1
+        deferring(signal.SIGUSR1, None)  # finally outside any import
+        count = len(sent)
+        time.sleep(0.05)
+    finally:
+        signal.signal(signal.SIGUSR1, previous)
     assert handled == [signal.SIGUSR1] and len(sent) <= count + 1  # at most the send under way
     assert signal.SIGUSR1 not in iss._pending
+
+
+def test_a_signal_deferred_when_its_handler_is_restored_reaches_the_restored_one_once(monkeypatch):
+    """The command ended (its handlers restored) before the deferred signal was handled: it goes, once, to the
+    handler in place, as it would have without the deferral; no stream of signals to a handler that never clears it."""
+    import time
+
+    from orchestrator import import_safe_signals as iss
+
+    sent = []
+    monkeypatch.setattr(iss, "REDELIVERY_S", 0.005)
+    monkeypatch.setattr(iss, "_to_main_thread", sent.append)
+    previous = signal.signal(signal.SIGUSR1, lambda signum, frame: None)  # no deferring handler in place
+    try:
+        iss._deliver_again(signal.SIGUSR1)
+        deadline = time.monotonic() + 10
+        while signal.SIGUSR1 in iss._pending and time.monotonic() < deadline:
+            time.sleep(0.005)
+        time.sleep(0.05)
+    finally:
+        signal.signal(signal.SIGUSR1, previous)
+    assert sent == [signal.SIGUSR1] and signal.SIGUSR1 not in iss._pending
