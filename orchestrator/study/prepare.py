@@ -179,8 +179,9 @@ def _check_values(study: Study, system, skip) -> None:
             iface = system.interfaces[comp]
             var = iface.variables[param]
             problem = type_problem(var, value, name)
-            if problem is None and (problem := value_problem(iface, var, value)) is not None:
-                problem = f"{problem} for {name}"
+            if problem is None:
+                bound = value_problem(iface, var, value)
+                problem = None if bound is None else f"{bound} for {name}"
             if problem is not None:
                 raise study.origins(point)[name].refusal(name, value, problem)
 
