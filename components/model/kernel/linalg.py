@@ -3,11 +3,18 @@
 Each is written once with numpy calls (what the interpreted kernel runs) and once as the loop
 numba compiles without BLAS or LAPACK (``COMPILED``; :mod:`components.compile.jit` swaps them
 in). Both perform the same floating-point operations in the same order - the products summed
-from the first term on, as the loops do (``np.cumsum``, not BLAS, whose blocked sums differ in
-the last bits) - so the interpreted and the compiled kernel compute the same numbers.
+from the first term on, as the loops do (``np.add.accumulate``, not BLAS nor ``np.sum``, whose
+blocked or pairwise sums differ in the last bits) - so the interpreted and the compiled kernel
+compute the same numbers. A loop's sum starts from ``0.0`` and is never ``-0.0``; the numpy forms
+store their sums plus ``0.0`` (:func:`_sums`), so an all-zero sum has the loop's sign too. A numpy
+form may add terms that the loop skips because they are exactly zero (a product over a pattern
+summed densely, the padding of a sparse row): adding ``+-0`` changes a sum at most in the sign of
+a zero, which the stored ``+ 0.0`` settles.
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 
@@ -17,25 +24,31 @@ def copy(src, dst):
     dst[:] = src
 
 
+def _sums(terms, out):
+    """``out = sum of terms`` along the last axis, from the first term on (numpy's ``add.accumulate`` adds in
+    order, unlike ``sum``), stored plus ``0.0``: with the sign a loop's sum has (never ``-0.0``)."""
+    np.add(np.add.accumulate(terms, -1)[..., -1], 0.0, out=out)
+
+
 def matvec(w, x, out):
     """``out = w @ x``."""
-    out[:] = np.cumsum(w * x, axis=1)[:, -1]
+    _sums(w * x, out)
 
 
 def vecmat(x, w, out):
     """``out = x @ w``."""
-    out[:] = np.cumsum(x[:, None] * w, axis=0)[-1]
+    _sums((x[:, None] * w).T, out)
 
 
 def matmul(a, b, out):
     """``out = a @ b``."""
-    out[:] = np.cumsum(a[:, :, None] * b[None, :, :], axis=1)[:, -1, :]
+    _sums(a[:, None, :] * b.T[None, :, :], out)
 
 
 def vecmat_sum(a, wa, b, wb, tail, wt, out):
     """``out = a @ wa + b @ wb + tail @ wt``: the product of ``[a, b, tail] @ [wa; wb; wt]`` without joining them,
     summed from the first term of ``a`` to the last of ``tail``."""
-    out[:] = np.cumsum(np.concatenate((a[:, None] * wa, b[:, None] * wb, tail[:, None] * wt)), axis=0)[-1]
+    _sums(np.concatenate((a[:, None] * wa, b[:, None] * wb, tail[:, None] * wt)).T, out)
 
 
 def axpy(alpha, x, y):
@@ -43,45 +56,64 @@ def axpy(alpha, x, y):
     y += alpha * x
 
 
+def subtract(a, b, out):
+    """``out = a - b``."""
+    np.subtract(a, b, out=out)
+
+
+def negate(x):
+    """``x = -x``."""
+    np.negative(x, out=x)
+
+
 def matvec_pattern(w, index, x, out):
     """``out = w @ x`` over the nonzero pattern of ``w`` only: ``out[i] = sum_p w[i, index[i, p]] x[index[i, p]]``
-    (``index < 0``: padding), summed from the first."""
-    idx = index.astype(np.int64)
-    valid = idx >= 0
-    safe = np.where(valid, idx, 0)
-    terms = np.where(valid, np.take_along_axis(w, safe, axis=1) * x[safe], 0.0)
-    out[:] = np.cumsum(terms, axis=1)[:, -1] if terms.shape[1] else 0.0
+    (``index``: ascending, ``< 0`` padding), summed from the first; ``w`` is zero outside the pattern.
+
+    The numpy form sums whole rows (:func:`matvec`) where ``x`` is finite: the terms outside the pattern are zero.
+    """
+    if all(map(math.isfinite, x.tolist())):
+        matvec(w, x, out)
+        return
+    valid = index >= 0.0
+    safe = np.where(valid, index, 0.0).astype(np.intp)
+    _sums(np.where(valid, np.take_along_axis(w, safe, 1) * x[safe], 0.0), out)
 
 
 def sparse_vecmat(x, index, value, out):
     """``out = x @ w`` for a sparse ``w`` held by columns: ``out[j] = sum_p x[index[j, p]] value[j, p]`` over the
-    nonzero rows of column ``j`` in ascending order (``index < 0``: padding), summed from the first."""
-    idx = index.astype(np.int64)
-    valid = idx >= 0
-    terms = np.where(valid, x[np.where(valid, idx, 0)] * value, 0.0)
-    out[:] = np.cumsum(terms, axis=1)[:, -1] if terms.shape[1] else 0.0
+    nonzero rows of column ``j`` in ascending order (``index < 0``: padding, its ``value`` 0), summed from the
+    first.
+
+    The numpy form also takes a stack of vectors, ``x`` of shape (k, len) and ``out`` (k, columns).
+    """
+    terms = x[..., index.astype(np.intp)] * value  # a padding term is x[..., -1] * 0: zero where that is finite
+    if not all(map(math.isfinite, x[..., -1:].ravel().tolist())):
+        terms = np.where(index >= 0.0, terms, 0.0)
+    _sums(terms, out)
 
 
 def invert(g, out):
-    """``out = g^-1`` by Gauss-Jordan elimination with partial pivoting (``g`` is overwritten)."""
+    """``out = g^-1`` by Gauss-Jordan elimination with partial pivoting (``g`` is overwritten).
+
+    The numpy form eliminates on ``[g, I]`` (each row operation once on both halves, the rows whose
+    factor is zero left alone, as the loop does).
+    """
     n = g.shape[0]
-    out[:] = 0.0
-    for i in range(n):
-        out[i, i] = 1.0
+    aug = np.zeros((n, 2 * n))
+    aug[:, :n] = g
+    aug.reshape(-1)[n::2 * n + 1] = 1.0  # the identity on the right
     for col in range(n):
-        pivot = col + int(np.argmax(np.abs(g[col:, col])))
+        pivot = col + int(np.abs(aug[col:, col]).argmax())
         if pivot != col:
-            g[[col, pivot]] = g[[pivot, col]]
-            out[[col, pivot]] = out[[pivot, col]]
-        inv_p = 1.0 / float(g[col, col])  # a zero pivot raises ZeroDivisionError, as in the compiled form
-        g[col] *= inv_p
-        out[col] *= inv_p
-        f = g[:, col].copy()
+            aug[[col, pivot]] = aug[[pivot, col]]
+        row = aug[col]
+        row *= 1.0 / float(row[col])  # a zero pivot raises ZeroDivisionError, as in the compiled form
+        f = aug[:, col].copy()
         f[col] = 0.0
-        rows = np.flatnonzero(f)
-        if rows.size:
-            g[rows] -= np.outer(f[rows], g[col])
-            out[rows] -= np.outer(f[rows], out[col])
+        np.subtract(aug, f[:, None] * row, out=aug, where=(f != 0.0)[:, None])
+    g[:] = aug[:, :n]
+    out[:] = aug[:, n:]
     return out
 
 
@@ -180,6 +212,16 @@ def _vecmat_sum_loop(a, wa, b, wb, tail, wt, out):
 def _axpy_loop(alpha, x, y):
     for i in range(x.shape[0]):
         y[i] += alpha * x[i]
+
+
+def _subtract_loop(a, b, out):
+    for i in range(out.shape[0]):
+        out[i] = a[i] - b[i]
+
+
+def _negate_loop(x):
+    for i in range(x.shape[0]):
+        x[i] = -x[i]
 
 
 def _matvec_pattern_loop(w, index, x, out):
@@ -311,8 +353,9 @@ def _lu_solve_loop(lu, piv, lower, upper, b, out):
 
 #: the loops numba compiles in place of the numpy forms (see :mod:`components.compile.jit`)
 COMPILED = {"copy": _copy_loop, "matvec": _matvec_loop, "vecmat": _vecmat_loop, "axpy": _axpy_loop,
+            "subtract": _subtract_loop, "negate": _negate_loop,
             "vecmat_sum": _vecmat_sum_loop, "matmul": _matmul_loop, "invert": _invert_loop,
             "lu_factor": _lu_factor_loop, "lu_solve": _lu_solve_loop, "lu_pattern": _lu_pattern_loop, "sparse_vecmat": _sparse_vecmat_loop,
             "matvec_pattern": _matvec_pattern_loop}
 #: inlined into their callers by numba (no call boundary on the hot path)
-INLINE = ("copy", "matvec", "vecmat", "vecmat_sum", "axpy", "sparse_vecmat", "matvec_pattern")
+INLINE = ("copy", "matvec", "vecmat", "vecmat_sum", "axpy", "subtract", "negate", "sparse_vecmat", "matvec_pattern")
