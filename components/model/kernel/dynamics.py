@@ -18,7 +18,7 @@ import math
 import numpy as np
 
 from .contact import force_slopes, forces, stiffness_sensitivity
-from .linalg import axpy, copy, sparse_vecmat
+from .linalg import copy, sparse_vecmat
 from .stiffness import stiffness_factors
 
 
@@ -26,9 +26,8 @@ def deflections(y, n, nz_index, nz_value, a_port, offset, port, port_rate, out):
     """Mesh deflections [m] (row 0) and their rates [m/s] (row 1) of ``y = [q, v, ...]``, the port input and
     the constant offsets; every mesh row ``A`` through its nonzero columns (``nz_index``, ``nz_value``)."""
     sparse_vecmat(y[:2 * n].reshape(2, n), nz_index, nz_value, out)  # both rows at once (the numpy form)
-    axpy(port, a_port, out[0])
-    axpy(port_rate, a_port, out[1])
-    axpy(1.0, offset, out[0])
+    out += np.multiply.outer((port, port_rate), a_port)
+    out[0] += offset
 
 
 def _deflections_loop(y, n, nz_index, nz_value, a_port, offset, port, port_rate, out):

@@ -269,12 +269,12 @@ def time_derivative_term(k, y, t, h, hd, angle0, driver, port, winv, piv, w_basi
     """``h d W^-1 [0, f_t]`` into ``k.w_hdt``: the prescribed motions' part of the stages at local time ``t``
     (and the external loads', which move with the driver angle and speed)."""
     n = k.dq.shape[0]
-    n2 = 2 * n
     w_hdt = k.w_hdt
     n_ext = k.n_ext
     ext = k.fast[k.fast.shape[0] - n_ext:]  # the external rows (none without external loads)
     rates = k.w_ext[:n_ext]  # the time derivatives of the external terms
-    external_term_rates(angle0 + value(driver, t), rate(driver, t), accel(driver, t), k.load_rates, rates)
+    if n_ext:
+        external_term_rates(angle0 + value(driver, t), rate(driver, t), accel(driver, t), k.load_rates, rates)
     if not k.tvs:  # f_t = [port speed, port accel, driver jerk, external rates] @ [pj0; pj1; -kappa; external
         # rows]: W^-1 of the rows once per factorisation
         ist = k.istate

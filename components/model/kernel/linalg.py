@@ -56,6 +56,18 @@ def axpy(alpha, x, y):
     y += alpha * x
 
 
+def axpy2(alpha, x, beta, w, y):
+    """``y += alpha x + beta w``."""
+    y += alpha * x + beta * w
+
+
+def dot(x, y):
+    """``x . y``, summed from the first term on."""
+    if x.shape[0] == 0:
+        return 0.0
+    return float(np.add.accumulate(x * y)[-1]) + 0.0
+
+
 def subtract(a, b, out):
     """``out = a - b``."""
     np.subtract(a, b, out=out)
@@ -87,7 +99,8 @@ def sparse_vecmat(x, index, value, out):
 
     The numpy form also takes a stack of vectors, ``x`` of shape (k, len) and ``out`` (k, columns).
     """
-    terms = x[..., index.astype(np.intp)] * value  # a padding term is x[..., -1] * 0: zero where that is finite
+    terms = x.take(index.astype(np.intp), -1)
+    terms *= value  # a padding term is x[..., -1] * 0: zero where that is finite
     if not all(map(math.isfinite, x[..., -1:].ravel().tolist())):
         terms = np.where(index >= 0.0, terms, 0.0)
     _sums(terms, out)
@@ -104,14 +117,15 @@ def invert(g, out):
     aug[:, :n] = g
     aug.reshape(-1)[n::2 * n + 1] = 1.0  # the identity on the right
     for col in range(n):
-        pivot = col + int(np.abs(aug[col:, col]).argmax())
+        f = aug[:, col]
+        pivot = col + int(np.abs(f[col:]).argmax())
         if pivot != col:
             aug[[col, pivot]] = aug[[pivot, col]]
         row = aug[col]
         row *= 1.0 / float(row[col])  # a zero pivot raises ZeroDivisionError, as in the compiled form
-        f = aug[:, col].copy()
-        f[col] = 0.0
-        np.subtract(aug, f[:, None] * row, out=aug, where=(f != 0.0)[:, None])
+        rows = f != 0.0
+        rows[col] = False
+        np.subtract(aug, f[:, None] * row, out=aug, where=rows[:, None])
     g[:] = aug[:, :n]
     out[:] = aug[:, n:]
     return out
@@ -212,6 +226,18 @@ def _vecmat_sum_loop(a, wa, b, wb, tail, wt, out):
 def _axpy_loop(alpha, x, y):
     for i in range(x.shape[0]):
         y[i] += alpha * x[i]
+
+
+def _axpy2_loop(alpha, x, beta, w, y):
+    for i in range(x.shape[0]):
+        y[i] += alpha * x[i] + beta * w[i]
+
+
+def _dot_loop(x, y):
+    s = 0.0
+    for i in range(x.shape[0]):
+        s += x[i] * y[i]
+    return s
 
 
 def _subtract_loop(a, b, out):
@@ -353,9 +379,10 @@ def _lu_solve_loop(lu, piv, lower, upper, b, out):
 
 #: the loops numba compiles in place of the numpy forms (see :mod:`components.compile.jit`)
 COMPILED = {"copy": _copy_loop, "matvec": _matvec_loop, "vecmat": _vecmat_loop, "axpy": _axpy_loop,
-            "subtract": _subtract_loop, "negate": _negate_loop,
+            "axpy2": _axpy2_loop, "dot": _dot_loop, "subtract": _subtract_loop, "negate": _negate_loop,
             "vecmat_sum": _vecmat_sum_loop, "matmul": _matmul_loop, "invert": _invert_loop,
             "lu_factor": _lu_factor_loop, "lu_solve": _lu_solve_loop, "lu_pattern": _lu_pattern_loop, "sparse_vecmat": _sparse_vecmat_loop,
             "matvec_pattern": _matvec_pattern_loop}
 #: inlined into their callers by numba (no call boundary on the hot path)
-INLINE = ("copy", "matvec", "vecmat", "vecmat_sum", "axpy", "subtract", "negate", "sparse_vecmat", "matvec_pattern")
+INLINE = ("copy", "matvec", "vecmat", "vecmat_sum", "axpy", "axpy2", "dot", "subtract", "negate", "sparse_vecmat",
+          "matvec_pattern")
