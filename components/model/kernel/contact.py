@@ -140,6 +140,13 @@ def forces(defl, factor, contact, out):
     out[:] = [law[0] for law in _every_mesh(defl, factor, contact)]
 
 
+def stiffness_force_rates(defl, factor, contact, slope, speed, out):
+    """dF/dt [N/s] of every mesh from its stiffness factor's rate ``slope speed`` (:func:`stiffness_sensitivity`)."""
+    d, rate = defl.tolist()
+    out[:] = list(map(stiffness_sensitivity, d, rate, factor.tolist(), contact.tolist()))
+    out *= slope * speed
+
+
 def force_slopes(defl, factor, contact, d_force_d_deflection, d_force_d_rate):
     """dF/dd [N/m] and dF/d(rate) [N s/m] of every mesh at deflections ``defl`` (rows: deflection, rate)."""
     laws = _every_mesh(defl, factor, contact)
@@ -160,11 +167,18 @@ def _forces_loop(defl, factor, contact, out):
         out[i] = contact_force(defl[0, i], defl[1, i], factor[i], contact[i])[0]
 
 
+def _stiffness_force_rates_loop(defl, factor, contact, slope, speed, out):
+    for i in range(out.shape[0]):
+        out[i] = stiffness_sensitivity(defl[0, i], defl[1, i], factor[i], contact[i]) * (slope[i] * speed)
+
+
 def _force_slopes_loop(defl, factor, contact, d_force_d_deflection, d_force_d_rate):
     for i in range(d_force_d_deflection.shape[0]):
         _, d_force_d_deflection[i], d_force_d_rate[i], _ = contact_force(defl[0, i], defl[1, i], factor[i], contact[i])
 
 
 #: the loops numba compiles in place of the numpy forms (see :mod:`components.compile.jit`)
-COMPILED = {"mesh_forces": _mesh_forces_loop, "forces": _forces_loop, "force_slopes": _force_slopes_loop}
-INLINE = ("sign", "_power_minus_one", "regularised", "contact_force", "forces", "force_slopes")
+COMPILED = {"mesh_forces": _mesh_forces_loop, "forces": _forces_loop, "force_slopes": _force_slopes_loop,
+            "stiffness_force_rates": _stiffness_force_rates_loop}
+INLINE = ("sign", "_power_minus_one", "regularised", "contact_force", "forces", "force_slopes",
+          "stiffness_force_rates")

@@ -17,8 +17,8 @@ import math
 
 import numpy as np
 
-from .contact import force_slopes, forces, stiffness_sensitivity
-from .linalg import copy, sparse_vecmat
+from .contact import force_slopes, forces, stiffness_force_rates
+from .linalg import copy, sparse_vecmat, vecmat_add
 from .stiffness import stiffness_factors
 
 
@@ -173,13 +173,8 @@ def stiffness_rate(y, n, angle, speed, port, port_rate, nz_index, nz_value, a_po
     with the driver angle). Leaves the factors at ``angle`` in ``factor``."""
     stiffness_factors(angle, phasing, factor, slope)
     deflections(y, n, nz_index, nz_value, a_port, offset, port, port_rate, defl)
-    for i in range(sens.shape[0]):
-        sens[i] = stiffness_sensitivity(defl[0, i], defl[1, i], factor[i], contact[i]) * (slope[i] * speed)
-    for j in range(out.shape[0]):
-        s = 0.0
-        for i in range(sens.shape[0]):
-            s += sens[i] * force_rows[i, j]
-        out[j] += s
+    stiffness_force_rates(defl, factor, contact, slope, speed, sens)
+    vecmat_add(sens, force_rows, out)
 
 
 #: the loops numba compiles in place of the numpy forms (see :mod:`components.compile.jit`)

@@ -208,6 +208,19 @@ def _basis_terms_loop(w_basis, c0, c1, c2, out):
         out[i] = w_basis[0, i] * c0 + w_basis[1, i] * c1 + w_basis[2, i] * c2
 
 
+def motion_terms(port_jac, kappa, port_rate, port_accel, jerk_, out):
+    """``out = port_jac[0] port_rate + port_jac[1] port_accel - kappa jerk_``: the prescribed motions' part of ``f_t``
+    (accelerations; :func:`time_derivative_term` with a time-varying mesh stiffness)."""
+    np.multiply(port_jac[0], port_rate, out=out)
+    out += port_jac[1] * port_accel
+    out -= kappa * jerk_
+
+
+def _motion_terms_loop(port_jac, kappa, port_rate, port_accel, jerk_, out):
+    for j in range(out.shape[0]):
+        out[j] = port_jac[0, j] * port_rate + port_jac[1, j] * port_accel - kappa[j] * jerk_
+
+
 def use_factorisation(hd, dq, dv, winvs, pivots, istate):
     """Make the factorisation for ``hd`` the active one of the ``N_SLOTS`` kept (same Jacobian), factorising it into
     the least recently used slot where none is kept; returns its slot."""
@@ -297,13 +310,11 @@ def time_derivative_term(k, y, t, h, hd, angle0, driver, port, winv, piv, w_basi
     pa = accel(port, t)
     jk = jerk(driver)
     da = k.da
-    for j in range(n):
-        da[j] = k.port_jac[0, j] * pr + k.port_jac[1, j] * pa - k.kappa[j] * jk
+    motion_terms(k.port_jac, k.kappa, pr, pa, jk, da)
     stiffness_rate(y, n, angle0 + value(driver, t), rate(driver, t), value(port, t), pr, k.nz_index, k.nz_value,
                    k.a_port, k.offset, k.contact, k.phasing, k.force_rows, k.factor, k.slope, k.defl, k.sens, da)
     for r in range(n_ext):
-        for j in range(n):
-            da[j] += rates[r] * ext[r, j]
+        axpy(rates[r], ext[r], da)
     da *= hd
     solve_lower(winv, piv, hd, da, w_hdt)
 
@@ -481,6 +492,6 @@ def advance(k, y, t_end, alpha_shift, driver, port, angle0, twist_q, twist_port)
 #: the loops numba compiles in place of the numpy forms (see :mod:`components.compile.jit`)
 COMPILED = {"factor": _factor_loop, "solve": _solve_loop, "solve_lower": _solve_lower_loop,
             "twist_and_rate": _twist_and_rate_loop, "stage": _stage_loop, "third_rhs": _third_rhs_loop,
-            "error_norm": _error_norm_loop, "basis_terms": _basis_terms_loop}
+            "error_norm": _error_norm_loop, "basis_terms": _basis_terms_loop, "motion_terms": _motion_terms_loop}
 INLINE = ("twist_and_rate", "evaluate", "time_derivative_term", "refresh_jacobian", "advance", "stage", "third_rhs",
-          "error_norm", "basis_terms")
+          "error_norm", "basis_terms", "motion_terms")

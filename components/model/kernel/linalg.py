@@ -45,6 +45,11 @@ def matmul(a, b, out):
     _sums(a[:, None, :] * b.T[None, :, :], out)
 
 
+def vecmat_add(x, w, out):
+    """``out += x @ w`` (each column's sum from the first term on, then added)."""
+    out += np.add.accumulate((x[:, None] * w).T, -1)[..., -1] + 0.0
+
+
 def vecmat_sum(a, wa, b, wb, tail, wt, out):
     """``out = a @ wa + b @ wb + tail @ wt``: the product of ``[a, b, tail] @ [wa; wb; wt]`` without joining them,
     summed from the first term of ``a`` to the last of ``tail``."""
@@ -136,47 +141,45 @@ def lu_factor(a, piv):
     ``a``; ``U`` on and above it), the row swapped with row ``k`` in ``piv[k]`` (as a float)."""
     n = a.shape[0]
     for k in range(n):
-        p = k + int(np.argmax(np.abs(a[k:, k])))
+        p = k + int(np.abs(a[k:, k]).argmax())
         piv[k] = p
         if p != k:
             a[[k, p]] = a[[p, k]]
-        inv_p = 1.0 / float(a[k, k])  # a zero pivot raises ZeroDivisionError, as in the compiled form
-        a[k + 1:, k] *= inv_p
         f = a[k + 1:, k]
-        rows = np.flatnonzero(f)
-        if rows.size:
-            a[k + 1 + rows, k + 1:] -= np.outer(f[rows], a[k, k + 1:])
+        f *= 1.0 / float(a[k, k])  # a zero pivot raises ZeroDivisionError, as in the compiled form
+        rest = a[k + 1:, k + 1:]  # the rows whose factor is zero left alone, as the loop does
+        np.subtract(rest, f[:, None] * a[k, k + 1:], out=rest, where=(f != 0.0)[:, None])
 
 
 def lu_pattern(lu, lower, upper):
     """The nonzero rows of every column of ``L`` (below the diagonal, ascending) into ``lower`` and of ``U`` (above
     it, ascending) into ``upper``, padded with -1: what :func:`lu_solve` visits."""
     n = lu.shape[0]
-    lower[:] = -1.0
-    upper[:] = -1.0
-    for j in range(n):
-        below = np.flatnonzero(lu[j + 1:, j]) + j + 1
-        above = np.flatnonzero(lu[:j, j])
-        lower[j, :below.size] = below
-        upper[j, :above.size] = above
+    rows = np.arange(n)
+    nonzero = lu.T != 0.0  # [column, row]
+    for side, out in ((rows[None, :] > rows[:, None], lower), (rows[None, :] < rows[:, None], upper)):
+        found = np.where(nonzero & side, rows[None, :], n)
+        found.sort(axis=1)  # each column's rows to the front, ascending; n (none) behind them
+        out[:] = np.where(found < n, found, -1)
 
 
 def lu_solve(lu, piv, lower, upper, b, out):
     """``out = a^-1 b`` from :func:`lu_factor`'s ``lu`` and ``piv``: column-oriented substitutions over the nonzero
-    rows of each column (:func:`lu_pattern`'s ``lower`` and ``upper``)."""
+    rows of each column (:func:`lu_pattern`'s ``lower`` and ``upper``; the numpy form finds them in ``lu``)."""
     n = lu.shape[0]
     out[:] = b
-    for k in range(n):
-        p = int(piv[k])
+    for k, p in enumerate(piv.astype(np.intp).tolist()):
         if p != k:
             out[k], out[p] = out[p], out[k]
-    for j in range(n):
-        rows = lower[j][lower[j] >= 0.0].astype(np.int64)
-        out[rows] -= lu[rows, j] * out[j]
+    for j in range(n - 1):
+        column = lu[j + 1:, j]
+        below = out[j + 1:]
+        np.subtract(below, column * out[j], out=below, where=column != 0.0)
     for j in range(n - 1, -1, -1):
         out[j] = out[j] / lu[j, j]
-        rows = upper[j][upper[j] >= 0.0].astype(np.int64)
-        out[rows] -= lu[rows, j] * out[j]
+        column = lu[:j, j]
+        above = out[:j]
+        np.subtract(above, column * out[j], out=above, where=column != 0.0)
 
 
 # ---------------------------------------------------------------- the compiled forms
@@ -209,6 +212,14 @@ def _matmul_loop(a, b, out):
             for k in range(b.shape[0]):
                 s += a[i, k] * b[k, j]
             out[i, j] = s
+
+
+def _vecmat_add_loop(x, w, out):
+    for j in range(out.shape[0]):
+        s = 0.0
+        for i in range(x.shape[0]):
+            s += x[i] * w[i, j]
+        out[j] += s
 
 
 def _vecmat_sum_loop(a, wa, b, wb, tail, wt, out):
@@ -378,11 +389,12 @@ def _lu_solve_loop(lu, piv, lower, upper, b, out):
 
 
 #: the loops numba compiles in place of the numpy forms (see :mod:`components.compile.jit`)
-COMPILED = {"copy": _copy_loop, "matvec": _matvec_loop, "vecmat": _vecmat_loop, "axpy": _axpy_loop,
+COMPILED = {"copy": _copy_loop, "matvec": _matvec_loop, "vecmat": _vecmat_loop, "vecmat_add": _vecmat_add_loop,
+            "axpy": _axpy_loop,
             "axpy2": _axpy2_loop, "dot": _dot_loop, "subtract": _subtract_loop, "negate": _negate_loop,
             "vecmat_sum": _vecmat_sum_loop, "matmul": _matmul_loop, "invert": _invert_loop,
             "lu_factor": _lu_factor_loop, "lu_solve": _lu_solve_loop, "lu_pattern": _lu_pattern_loop, "sparse_vecmat": _sparse_vecmat_loop,
             "matvec_pattern": _matvec_pattern_loop}
 #: inlined into their callers by numba (no call boundary on the hot path)
-INLINE = ("copy", "matvec", "vecmat", "vecmat_sum", "axpy", "axpy2", "dot", "subtract", "negate", "sparse_vecmat",
+INLINE = ("copy", "matvec", "vecmat", "vecmat_add", "vecmat_sum", "axpy", "axpy2", "dot", "subtract", "negate", "sparse_vecmat",
           "matvec_pattern")
