@@ -173,7 +173,8 @@ def _third_rhs_loop(fn, k2, f1, k1, f0, out):
 def error_norm(k1, k2, k3, y, yn, n, atol_q, atol_v, rtol):
     """``max |k1 - 2 k2 + k3| / (atol + rtol max(|y|, |yn|))`` (``atol_q`` on the first ``n`` entries, ``atol_v`` on
     the rest); NaN where any entry is NaN."""
-    scale = np.maximum(np.abs(y), np.abs(yn))
+    a, b = np.abs(y), np.abs(yn)
+    scale = np.where(b > a, b, a)  # Python's max(a, b) (np.maximum differs where one of them is NaN)
     scale *= rtol
     scale[:n] += atol_q
     scale[n:] += atol_v

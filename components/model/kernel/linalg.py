@@ -106,7 +106,8 @@ def sparse_vecmat(x, index, value, out):
     """
     terms = x.take(index.astype(np.intp), -1)
     terms *= value  # a padding term is x[..., -1] * 0: zero where that is finite
-    if not all(map(math.isfinite, x[..., -1:].ravel().tolist())):
+    last = x[..., -1]
+    if not (math.isfinite(last) if x.ndim == 1 else all(map(math.isfinite, last.tolist()))):
         terms = np.where(index >= 0.0, terms, 0.0)
     _sums(terms, out)
 
