@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import partial
 
 import numpy as np
 
@@ -201,14 +200,12 @@ class GearboxModel:
         self._out_kinematic = float(a.kinematic_ratio[self._out_member])
         self._out_rate_index = a.n_dof + self._out_member  # its speed in [q, v], its acceleration in [v, a]
         self._allocate()
-        if self.kernel == "compiled":  # the buffer's offsets and sizes as int64 arrays, one call per step
-            self._lay, self._sizes = self._offsets, self._dims
-            self._step = entry_point(self._module.gearbox_step,
-                                     ("float64[::1]", "int64[::1]", "int64[::1]") + ("float64",) * 9)
-        else:  # interpreted: the offsets and sizes as lists (Python indexes a list several times faster than an
-            # array) and the buffer's views made once (~25 us of every step together)
-            self._lay, self._sizes = self._offsets.tolist(), self._dims.tolist()
-            self._step = partial(self._module.step_views, self._module.views(self._buffer, self._lay, self._sizes))
+        # the buffer's offsets and sizes as the kernel takes them: int64 arrays (compiled), or lists of ints
+        # (interpreted: Python indexes a list several times faster than an array, ~10 us of every step)
+        self._lay, self._sizes = ((self._offsets, self._dims) if self.kernel == "compiled"
+                                  else (self._offsets.tolist(), self._dims.tolist()))
+        self._step = entry_point(self._module.gearbox_step,
+                                 ("float64[::1]", "int64[::1]", "int64[::1]") + ("float64",) * 9)
         self.initialized = False
         #: Newton iterations of the static deflection at the last initialisation (0: started undeflected)
         self.static_iterations = 0

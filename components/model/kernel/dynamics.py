@@ -179,4 +179,5 @@ def stiffness_rate(y, n, angle, speed, port, port_rate, nz_index, nz_value, a_po
 
 #: the loops numba compiles in place of the numpy forms (see :mod:`components.compile.jit`)
 COMPILED = {"deflections": _deflections_loop, "assemble_jacobian": _assemble_jacobian_loop}
-INLINE = ("deflections", "acceleration", "assemble_jacobian")
+#: inlined into their callers by numba (the Jacobian's assembly is compiled once and called)
+INLINE = ("deflections", "acceleration")

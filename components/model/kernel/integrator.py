@@ -360,7 +360,6 @@ def advance(k, y, t_end, alpha_shift, driver, port, angle0, twist_q, twist_port)
         trapezoid per accepted step; 0 on failure). On failure the state is as it was.
     """
     n = k.dq.shape[0]
-    n2 = 2 * n
     m = k.last_force.shape[0]
     ist = k.istate
     control = k.control

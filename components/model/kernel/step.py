@@ -64,8 +64,29 @@ def matrix(buf, lay, slot, rows):
     return v.reshape((rows, v.shape[0] // rows))
 
 
+#: buffers whose views the interpreted :func:`views` keeps, at most (the least recently made dropped first)
+KEPT_VIEWS = 8
+_kept_views: dict = {}
+
+
 def views(buf, lay, dims):
-    """The :class:`Gearbox` views of a buffer."""
+    """The :class:`Gearbox` views of a buffer.
+
+    The numpy form keeps the views it made for the last :data:`KEPT_VIEWS` buffers, by the identity of the
+    buffer and its offset and size tables (a model steps one buffer with the same tables every time: making
+    the ~60 views costs ~15 us, 4 % of an interpreted step). A kept entry holds those objects, so the identity
+    of no other can be mistaken for theirs; the tables are never changed in place.
+    """
+    key = (id(buf), id(lay), id(dims))
+    kept = _kept_views.get(key)
+    if kept is None:
+        if len(_kept_views) >= KEPT_VIEWS:
+            del _kept_views[next(iter(_kept_views))]
+        kept = _kept_views[key] = (buf, lay, dims, _views_loop(buf, lay, dims))
+    return kept[3]
+
+
+def _views_loop(buf, lay, dims):
     n = dims[D_N]
     m = dims[D_M]
     n2 = 2 * n
@@ -190,17 +211,10 @@ def gearbox_step(buf, lay, dims, t, h, omega_rotor, phi_rotor, omega_gen, phi_ge
     Returns ``(status, local time, step size, error norm)`` (:func:`~.integrator.advance`), or
     ``NON_FINITE_INPUT``; on failure the buffer is as it was at ``t``.
     """
-    return step_views(views(buf, lay, dims), buf, lay, dims, t, h, omega_rotor, phi_rotor, omega_gen, phi_gen,
-                      counter_torque, alpha_rotor, jerk_rotor)
-
-
-def step_views(k, buf, lay, dims, t, h, omega_rotor, phi_rotor, omega_gen, phi_gen, counter_torque, alpha_rotor,
-               jerk_rotor):
-    """:func:`gearbox_step` with the buffer's :func:`views` ``k`` given: a caller that steps one buffer many times
-    interpreted keeps them (making them costs ~15 us, ~4 % of an interpreted step)."""
     n = dims[D_N]
     m = dims[D_M]
     gdof = dims[D_GEN_DOF]
+    k = views(buf, lay, dims)
     sc = vector(buf, lay, SCALARS)
     y = vector(buf, lay, Y)
     out_kin = k.control[OUT_KINEMATIC]
@@ -280,7 +294,9 @@ def step_views(k, buf, lay, dims, t, h, omega_rotor, phi_rotor, omega_gen, phi_g
     return OK, tau, h, 0.0
 
 
-INLINE = ("vector", "matrix", "views", "external", "step_views")
+#: the loop numba compiles in place of the numpy form (see :mod:`components.compile.jit`)
+COMPILED = {"views": _views_loop}
+INLINE = ("vector", "matrix", "views", "external")
 #: entry points of the ahead-of-time compiled module (:mod:`components.compile.aot`) and their signatures
 AOT_EXPORTS = {
     "gearbox_step": "Tuple((i8, f8, f8, f8))(f8[::1], i8[::1], i8[::1], f8, f8, f8, f8, f8, f8, f8, f8, f8)",

@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 
 from components.model.assembly import Assembly
+from components.model.gearbox_model import GearboxModel
 from components.model.kernel import GEARBOX, MONOLITHIC
 from components.model.presets import cosim_preset
 from components.model.sparse import column_sparsity
@@ -156,7 +157,13 @@ def _model_cases(rng, a: Assembly, nonfinite: bool) -> dict:
         "stiffness_factors": lambda: (rng.normal(0.0, 30.0), phasing, np.empty(m), np.empty(m)),
         "stiffness_factors_many": lambda: (np.concatenate(([0.0, -0.0], rng.normal(0.0, 30.0, 50))), phasing,
                                            np.empty((52, m)), np.empty((52, m))),
+        "views": lambda: _buffer_of(rng, GearboxModel(a.drivetrain, kernel="numpy")),
     }
+
+
+def _buffer_of(rng, model: GearboxModel) -> tuple:
+    """A buffer of ``model``'s layout (random contents), its offsets and sizes: the kernel step's tables."""
+    return rng.normal(size=model._buffer.size), model._offsets, model._dims
 
 
 MODULE_OF = {name: module for module in KERNEL_MODULES for name in getattr(_module(module), "COMPILED", {})}
@@ -218,3 +225,41 @@ def test_every_loop_of_the_kernel_has_a_case():
     cases = set(_cases(np.random.default_rng(0), ASSEMBLIES["table6"], False))
     assert set(MODULE_OF) <= cases, sorted(set(MODULE_OF) - cases)
     assert {"linalg", "contact", "dynamics", "integrator", "stiffness", "monolithic"} <= set(MODULE_OF.values())
+
+
+def test_the_interpreted_views_are_kept_per_buffer():
+    """The interpreted step keeps a buffer's views by the identity of the buffer and its tables: never another's."""
+    step = _module("step")
+    models = [GearboxModel(cosim_preset("table6"), kernel="numpy") for _ in range(step.KEPT_VIEWS + 2)]
+    tables = [(g._buffer, g._lay, g._sizes) for g in models]
+    kept = step.views(*tables[0])
+    assert step.views(*tables[0]) is kept
+    assert np.shares_memory(kept.state, tables[0][0])
+    others = [step.views(*t) for t in tables[1:]]
+    assert all(not np.shares_memory(k.state, tables[0][0]) for k in others)
+    again = step.views(*tables[0])  # dropped for the later ones, made anew from the same buffer
+    assert again is not kept and all(_same(a, b) for a, b in zip(again[:-2], kept[:-2]))
+    copy_of_tables = (tables[0][0], list(tables[0][1]), list(tables[0][2]))
+    assert step.views(*copy_of_tables) is not again  # equal tables in other objects: views made for them
+
+
+def test_models_stepped_in_turns_step_as_alone():
+    """Interpreted gearboxes stepped in turns (more than the views kept) compute what each computes alone."""
+    from components.model.kernel.step import KEPT_VIEWS
+
+    drivetrains = [cosim_preset("table6"), cosim_preset("table6").with_meshes(law="impact")] * (KEPT_VIEWS // 2 + 1)
+
+    def run(models, steps):
+        for model in models:
+            model.initialize(0.0, 1.6, 0.0, 1.6 * model.ratio, 0.0)
+        out = [[] for _ in models]
+        for k in range(steps):
+            for model, rows in zip(models, out):
+                model.step(k * 2e-3, 2e-3, 1.6, 1.6 * k * 2e-3, 1.6 * model.ratio, 1.6 * model.ratio * k * 2e-3)
+                rows.append(model.output_vector())
+        return [np.array(rows) for rows in out]
+
+    together = run([GearboxModel(dt, kernel="numpy") for dt in drivetrains], 4)
+    for dt, rows in zip(drivetrains[:2], together[:2]):
+        alone = run([GearboxModel(dt, kernel="numpy")], 4)[0]
+        assert _same(rows, alone)
