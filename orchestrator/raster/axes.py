@@ -87,6 +87,7 @@ class Axes:
         self.titles: dict[str, tuple[str, float]] = {}
         self.grid_style: tuple[float, paint.RGB, float, bool] | None = None
         self.legend_style: tuple[str, float] | None = None
+        self.legend_beside = False  # where the figure puts it (set_legend, Figure.lay_out)
         self.x_tick_labels = True
         self._labelled: list[Curve | Span] = []  # in the order added: the legend's order
         # the layout (lay_out)
@@ -132,10 +133,15 @@ class Axes:
         self.grid_style = (width_pt, paint.rgb(color), alpha, minor)
 
     def set_legend(self, loc: str = "best", size_pt: float = 8.0) -> None:
-        """A legend of the labelled content: inside at the ``best`` place, or ``beside`` the axes on the right."""
+        """A legend of the labelled content: ``beside`` the axes on the right, or inside at the ``best`` place.
+
+        The best place is the corner (or edge, or centre) that hides least (:meth:`Legend.place_best`);
+        where every place would hide some of the lines, the figure puts the legend beside the axes.
+        """
         if loc not in ("best", "beside"):
             raise ValueError(f"a legend goes 'best' or 'beside', not {loc!r}")
         self.legend_style = (loc, size_pt)
+        self.legend_beside = loc == "beside"
 
     def legend_entries(self) -> list[Entry]:
         """The labelled spans and lines, in the order added."""
@@ -266,12 +272,12 @@ class Axes:
         self.legend = None
         if self.legend_style is None or not self.legend_entries():
             return
-        loc, size = self.legend_style
-        self.legend = Legend(self.legend_entries(), size, outside=loc == "beside")
-        if loc == "beside":
+        self.legend = Legend(self.legend_entries(), self.legend_style[1])
+        if self.legend_beside:
             self.legend.place_beside(self.box)
         else:
-            self.legend.place_best(self.box, self.drawn_points())
+            spans = [(*sorted(self.x_pixels([s.x0, s.x1])), self.box[1], self.box[3]) for s in self.spans]
+            self.legend.place_best(self.box, self.drawn_points(), [(a, y0, b, y1) for a, b, y0, y1 in spans])
         self.texts += self.legend.texts
 
     def drawn_points(self) -> list[np.ndarray]:

@@ -15,6 +15,7 @@ from pathlib import Path
 from ..atomic_files import atomic_path
 from ..figure_files import DPI, Margins, axes_size, write_png
 from .axes import Axes
+from .legend import Legend
 from .text import Text
 
 #: text of a figure's title (matplotlib's "large")
@@ -121,16 +122,32 @@ class Figure:
                        bottom=max(m.bottom, bottom), wspace=max(m.wspace, wspace), hspace=max(m.hspace, hspace))
 
     def lay_out(self) -> None:
-        """Place every axes, tick, text and legend; widen the margins where the text needs it."""
-        self._share_limits()
-        margins = self.margins
-        beside = [ax for ax in self.flat() if ax.legend_style and ax.legend_style[0] == "beside" and
-                  ax.legend_entries()]
-        if beside:  # the right margin takes the widest legend beside the axes
-            from .legend import Legend
+        """Place every axes, tick, text and legend; widen the margins where the text needs it.
 
-            widest = max(Legend(ax.legend_entries(), ax.legend_style[1]).extent()[0] for ax in beside)
-            margins = replace(margins, right=margins.right + widest / DPI + LEGEND_ROOM)
+        A legend to go at the best place inside its axes goes beside them where every place
+        inside would hide some of the lines; the layout is then done again.
+        """
+        self._share_limits()
+        for ax in self.flat():
+            ax.legend_beside = bool(ax.legend_style) and ax.legend_style[0] == "beside"
+        while True:
+            self._lay_out_in(self._legend_room(self.margins))
+            hiding = [ax for ax in self.flat() if ax.legend is not None and ax.legend.hidden]
+            if not hiding:
+                return
+            for ax in hiding:
+                ax.legend_beside = True
+
+    def _legend_room(self, margins: Margins) -> Margins:
+        """``margins`` with the right one widened to the widest legend beside the axes."""
+        beside = [ax for ax in self.flat() if ax.legend_beside and ax.legend_entries()]
+        if not beside:
+            return margins
+        widest = max(Legend(ax.legend_entries(), ax.legend_style[1]).extent()[0] for ax in beside)
+        return replace(margins, right=margins.right + widest / DPI + LEGEND_ROOM)
+
+    def _lay_out_in(self, margins: Margins) -> None:
+        """Lay the axes out in ``margins``, widened (up to three times) where their text needs more."""
         self.used_margins = margins
         for attempt in range(4):  # a wider margin can change the ticks of the narrower axes: again
             for row, boxes in zip(self.axes, self._boxes(self.used_margins)):

@@ -44,9 +44,10 @@ class Legend:
 
     entries: list[Entry]
     size_pt: float
-    outside: bool = False
     box: tuple[float, float, float, float] | None = None
     place: str = ""
+    #: drawn points inside the box plus lines crossing it (:meth:`place_best`)
+    hidden: int = 0
     texts: list[Text] = field(default_factory=list)
 
     def _unit(self, key: str) -> float:
@@ -75,31 +76,32 @@ class Legend:
             boxes[name] = (left, top, left + width, top + height)
         return boxes
 
-    def place_best(self, axes_box, lines: list[np.ndarray]) -> None:
+    def place_best(self, axes_box, lines: list[np.ndarray], patches=()) -> None:
         """Put the legend where it hides least of ``lines`` (canvas points, each (n, 2)), as matplotlib's "best".
 
-        A place's cost is the number of drawn points inside it plus one for every line that
-        crosses it; the first place of :data:`PLACES` with the least cost wins (the first
-        with none at once).
+        A place's cost is the number of drawn points inside it, plus one for every line that
+        crosses it and for every one of ``patches`` (boxes: shaded spans) it overlaps; the first
+        place of :data:`PLACES` with the least cost wins (the first with none at once).
         """
         best = None
         for name, box in self.candidates(axes_box).items():
-            cost = 0
+            hidden = 0
             for pts in lines:
                 inside = ((pts[:, 0] >= box[0]) & (pts[:, 0] <= box[2]) & (pts[:, 1] >= box[1]) & (pts[:, 1] <= box[3]))
-                cost += int(np.count_nonzero(inside)) + (1 if paint.clip_polyline(pts[:, 0], pts[:, 1], box) else 0)
+                hidden += int(np.count_nonzero(inside)) + (1 if paint.clip_polyline(pts[:, 0], pts[:, 1], box) else 0)
+            cost = hidden + sum(1 for p in patches if p[0] < box[2] and box[0] < p[2] and p[1] < box[3] and box[1] < p[3])
             if best is None or cost < best[0]:
-                best = (cost, name, box)
+                best = (cost, name, box, hidden)
             if cost == 0:
                 break
-        _, self.place, self.box = best
+        _, self.place, self.box, self.hidden = best
         self._lay_out_texts()
 
     def place_beside(self, axes_box) -> None:
         """Put the legend beside the axes, its top left at their top right (half a percent of their width off)."""
         width, height = self.extent()
         left = axes_box[2] + 0.005 * (axes_box[2] - axes_box[0])
-        self.box, self.place = (left, axes_box[1], left + width, axes_box[1] + height), "beside"
+        self.box, self.place, self.hidden = (left, axes_box[1], left + width, axes_box[1] + height), "beside", 0
         self._lay_out_texts()
 
     def _rows(self):

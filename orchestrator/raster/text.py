@@ -2,7 +2,7 @@
 
 A text's box is what the layout keeps clear of other text: its advance width, and from the
 top of an ``l`` to the bottom of a ``p`` (the same height whatever the letters, as
-matplotlib's), lines 1.2 font line heights apart. Sizes are in points at :data:`~orchestrator.png_files.DPI`.
+matplotlib's); lines are a descent and 1.2 ascents apart. Sizes are in points at :data:`~orchestrator.png_files.DPI`.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from ..figure_files import DPI
 
 #: the font of every figure (matplotlib's default, so that the run figures read like the others)
 FAMILY = "DejaVu Sans"
-#: baseline to baseline of a text's lines, in its line height
+#: baseline to baseline of a text's lines: a descent and this many ascents
 LINE_SPACING = 1.2
 
 
@@ -73,15 +73,17 @@ def font(size_pt: float):
 def _metrics(size_pt: float) -> tuple[float, float, float]:
     """(ascent, descent, line pitch) of the font of ``size_pt`` [pixels].
 
-    A line's box reaches from the top of an ``l`` to the bottom of a ``p`` (as matplotlib's);
-    lines are :data:`LINE_SPACING` times the font's line height (ascender to descender) apart.
+    A line's box reaches from the top of an ``l`` to the bottom of a ``p``; from one baseline
+    to the next is a descent and :data:`LINE_SPACING` ascents (both as matplotlib's).
     """
     face = font(size_pt)
-    _, top, _, bottom = face.getbbox("lp", anchor="ls") if hasattr(face, "getmetrics") else face.getbbox("lp")
     if hasattr(face, "getmetrics"):
-        ascender, descender = face.getmetrics()
-        return float(-top), float(bottom), LINE_SPACING * (ascender + descender)
-    return float(bottom - top), 0.0, LINE_SPACING * float(bottom - top)  # a bitmap font (Pillow without FreeType)
+        _, top, _, bottom = face.getbbox("lp", anchor="ls")
+        ascent, descent = float(-top), float(bottom)
+    else:  # a bitmap font (Pillow without FreeType): no baseline known
+        _, top, _, bottom = face.getbbox("lp")
+        ascent, descent = float(bottom - top), 0.0
+    return ascent, descent, descent + LINE_SPACING * ascent
 
 
 @lru_cache(maxsize=4096)

@@ -44,15 +44,18 @@ def test_a_data_point_is_drawn_at_the_pixel_the_axes_predict(tmp_path):
     assert np.abs(pixels[150, 336] - blue).max() <= 8 and np.abs(pixels[150, 336 + 4] - 255).max() <= 8
 
 
-@pytest.mark.parametrize("ys, place", [
-    (np.full(50, 0.95), "lower left"),                    # data across the top: the first free place below
-    (np.linspace(0.0, 0.2, 50), "upper right"),           # data along the bottom: the first place
-    (np.where(np.linspace(0, 1, 50) > 0.5, 0.95, 0.05), "upper left"),  # top right and bottom left taken
+@pytest.mark.parametrize("ys, span, place", [
+    (np.full(50, 0.95), None, "lower left"),              # data across the top: the first free place below
+    (np.linspace(0.0, 0.2, 50), None, "upper right"),     # data along the bottom: the first place
+    (np.where(np.linspace(0, 1, 50) > 0.5, 0.95, 0.05), None, "upper left"),  # top right and bottom left taken
+    (np.linspace(0.0, 0.2, 50), (0.5, 1.0), "upper left"),  # the right half shaded: kept clear where it can be
 ])
-def test_the_best_legend_place_hides_the_fewest_points(ys, place):
+def test_the_best_legend_place_hides_the_fewest_points(ys, span, place):
     fig = Figure(6.0, 4.0)
     (ax,) = fig.axes[0]
     ax.xlim, ax.ylim = (0.0, 1.0), (0.0, 1.0)
+    if span:
+        ax.span(*span)
     ax.curve(np.linspace(0.0, 1.0, ys.size), ys, label="data")
     ax.set_legend("best")
     fig.lay_out()
@@ -60,6 +63,19 @@ def test_the_best_legend_place_hides_the_fewest_points(ys, place):
     points = ax.drawn_points()[0]
     x0, y0, x1, y1 = ax.legend.box
     assert not ((points[:, 0] >= x0) & (points[:, 0] <= x1) & (points[:, 1] >= y0) & (points[:, 1] <= y1)).any()
+
+
+def test_a_legend_that_would_hide_data_everywhere_inside_goes_beside_the_axes():
+    """A fast sine fills the axes: every place inside hides some of it; the legend goes beside, the axes narrower."""
+    fig = Figure(6.0, 4.0)
+    (ax,) = fig.axes[0]
+    x = np.linspace(0.0, 1.0, 2001)
+    ax.curve(x, np.sin(2 * np.pi * 40 * x), label="40 cycles")
+    ax.set_legend("best")
+    fig.lay_out()
+    assert ax.legend.place == "beside" and ax.legend.hidden == 0
+    assert ax.legend.box[0] > ax.box[2] and ax.legend.box[2] <= fig.size[0]
+    assert fig.used_margins.right == pytest.approx(0.2 + ax.legend.extent()[0] / 110.0 + 0.05)
 
 
 def test_a_legend_beside_the_axes_widens_the_right_margin_to_its_width():
