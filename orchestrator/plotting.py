@@ -163,7 +163,7 @@ TEXT_RENDERING = {"text.hinting": "no_hinting"}
 
 
 def encode_png(canvas, path: Path) -> None:
-    """Write a drawn Agg canvas as an 8-bit palette PNG (:func:`orchestrator.png_files.write_png`)."""
+    """Write a drawn Agg canvas as an 8-bit palette PNG (:func:`orchestrator.figure_files.write_png`)."""
     from PIL import Image
 
     width, height = canvas.get_width_height(physical=True)

@@ -6,7 +6,8 @@ figure then lays the axes out in a box of the canvas (:meth:`Axes.lay_out`): lim
 box (:attr:`Axes.texts`), the legend's place; and draws it (:meth:`Axes.draw`). The sizes
 are matplotlib's defaults: tick labels and axis labels 10 pt, ticks 3.5 pt long outwards
 (minor 2 pt), 3.5 pt from their labels, axis labels 4 pt beyond the tick labels, titles
-6 pt above the axes.
+6 pt above the axes; an offset or power of ten of the tick labels (:mod:`.ticks`) 3 pt above
+the y axis' top, or right below the x axis' tick labels.
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ MINOR_TICK = (2.0, 0.6)
 TICK_PAD_PT = 3.5
 LABEL_PAD_PT = 4.0
 TITLE_PAD_PT = 6.0
+OFFSET_PAD_PT = 3.0
 SPINE_PT = 0.8
 #: share of the data's range added on both sides where the limits are not given
 MARGIN = 0.05
@@ -206,7 +208,8 @@ class Axes:
         self._yl = tuple(float(v) for v in self._scale(np.array([ya, yb])))
         x0, y0, x1, y1 = box
         to_pt = 72.0 / pixels(72.0)
-        self.xticks = self._linear_ticks(xa, xb, ticks.tick_bins((x1 - x0) * to_pt, TICK_PT, True), self.x_pixels)
+        self.xticks, x_offset = self._linear_ticks(xa, xb, ticks.tick_bins((x1 - x0) * to_pt, TICK_PT, True),
+                                                   self.x_pixels)
         ybins = ticks.tick_bins((y1 - y0) * to_pt, TICK_PT, False)
         if self.yscale == "log":
             major, minor = ticks.log_ticks(ya, yb, ybins)
@@ -215,9 +218,9 @@ class Axes:
                                                                                  self.y_pixels)]
             y_offset = ""
         else:
-            self.yticks, y_offset = self._linear_ticks(ya, yb, ybins, self.y_pixels, with_offset=True)
+            self.yticks, y_offset = self._linear_ticks(ya, yb, ybins, self.y_pixels)
         self.texts = []
-        self._lay_out_ticks_and_labels(y_offset)
+        self._lay_out_ticks_and_labels(x_offset if self.x_tick_labels else "", y_offset)
         self._lay_out_titles()
         for n in self.notes:
             self.texts.append(Text(n.text, x0 + n.x * (x1 - x0), y1 - n.y * (y1 - y0), n.size_pt, color=n.color,
@@ -230,13 +233,14 @@ class Axes:
         return [Tick(float(v), float(to_pixels(v)), text, True) for v, text in zip(values, labels)
                 if low - slack <= v <= high + slack]
 
-    def _linear_ticks(self, low, high, bins, to_pixels, with_offset=False):
+    def _linear_ticks(self, low, high, bins, to_pixels) -> tuple[list[Tick], str]:
+        """The visible ticks of a linear axis and its offset text ('' if none)."""
         values = ticks.linear_ticks(low, high, bins)
         labels = ticks.linear_labels(values, low, high)
-        visible = self._visible(values, labels.labels, low, high, to_pixels)
-        return (visible, labels.offset_text) if with_offset else visible
+        return self._visible(values, labels.labels, low, high, to_pixels), labels.offset_text
 
-    def _lay_out_ticks_and_labels(self, y_offset: str) -> None:
+    def _lay_out_ticks_and_labels(self, x_offset: str, y_offset: str) -> None:
+        """Tick labels, the offset texts (x: right, below the tick labels; y: above the axes), axis labels."""
         x0, y0, x1, y1 = self.box
         reach = pixels(MAJOR_TICK[0] + TICK_PAD_PT)
         if self.x_tick_labels:
@@ -245,20 +249,27 @@ class Axes:
         self.texts += [Text(t.label, x0 - reach, t.at, TICK_PT, ha="right", va="center", role="ytick")
                        for t in self.yticks if t.label]
         below = max([t.box[3] for t in self.texts if t.role == "xtick"], default=y1 + pixels(MAJOR_TICK[0]))
+        if x_offset:
+            self.texts.append(Text(x_offset, x1, below + pixels(OFFSET_PAD_PT), TICK_PT, ha="right", va="top",
+                                   role="offset"))
         if self.xlabel:
-            self.texts.append(Text(self.xlabel, 0.5 * (x0 + x1), below + pixels(LABEL_PAD_PT), LABEL_PT, ha="center",
-                                   va="top", role="xlabel"))
+            label = Text(self.xlabel, 0.5 * (x0 + x1), below + pixels(LABEL_PAD_PT), LABEL_PT, ha="center", va="top",
+                         role="xlabel")
+            for o in [t.box for t in self.texts if t.role == "offset"]:  # below an x offset text it would cover
+                if label.box[2] > o[0] and label.box[1] < o[3]:
+                    label.y = o[3] + pixels(OFFSET_PAD_PT)
+            self.texts.append(label)
         left = min([t.box[0] for t in self.texts if t.role == "ytick"], default=x0 - pixels(MAJOR_TICK[0]))
         if self.ylabel:
             self.texts.append(Text(self.ylabel, left - pixels(LABEL_PAD_PT), 0.5 * (y0 + y1), LABEL_PT, ha="right",
                                    va="center", rotation=90, role="ylabel"))
         if y_offset:
-            self.texts.append(Text(y_offset, x0, y0 - pixels(TICK_PAD_PT), TICK_PT, ha="left", va="bottom",
+            self.texts.append(Text(y_offset, x0, y0 - pixels(OFFSET_PAD_PT), TICK_PT, ha="left", va="bottom",
                                    role="offset"))
 
     def _lay_out_titles(self) -> None:
         x0, y0, x1, _ = self.box
-        offsets = [t.box for t in self.texts if t.role == "offset"]
+        offsets = [t.box for t in self.texts if t.role == "offset" and t.va == "bottom"]  # the y axis'
         for loc, (text, size) in self.titles.items():
             x, ha = {"left": (x0, "left"), "center": (0.5 * (x0 + x1), "center"), "right": (x1, "right")}[loc]
             title = Text(text, x, y0 - pixels(TITLE_PAD_PT), size, ha=ha, va="baseline", role="title")

@@ -117,6 +117,25 @@ def test_margins_too_small_for_the_text_are_widened():
         assert all(ylabel[2] <= t.box[0] for t in ax.texts if t.role == "ytick")
 
 
+def test_an_x_offset_text_goes_right_below_the_tick_labels_and_the_x_label_clears_it():
+    """Times 100000.1-100001.9 s: labels 0.0 ... 2.0 (not 100000.0 ...), '+1e5' at the right, the long x label below it."""
+    fig = Figure(6.0, 3.0)
+    (ax,) = fig.axes[0]
+    ax.curve([100000.1, 100001.9], [0.0, 1.0])
+    ax.xlim = (100000.1, 100001.9)
+    ax.xlabel = "time since the start of the measurement campaign on the test bench [s]"
+    ax.ylabel = "force [kN]"
+    fig.lay_out()
+    labels = [t.text for t in ax.texts if t.role == "xtick"]
+    assert labels[0] in ("0.2", "0.5") and labels[-1] in ("1.5", "1.8")
+    (offset,) = [t for t in ax.texts if t.role == "offset"]
+    (xlabel,) = [t for t in ax.texts if t.role == "xlabel"]
+    ticks_bottom = max(t.box[3] for t in ax.texts if t.role == "xtick")
+    assert offset.text == "+1e5" and offset.box[2] == pytest.approx(ax.box[2]) and offset.box[1] > ticks_bottom
+    assert xlabel.box[2] > offset.box[0] and xlabel.box[1] >= offset.box[3]  # as wide as to reach it: below it
+    _inside(fig)
+
+
 def test_shared_x_axes_share_their_limits_and_only_the_bottom_row_is_labelled():
     fig = Figure(6.0, 4.0, rows=2, sharex="all")
     (top,), (bottom,) = fig.axes
