@@ -2,8 +2,10 @@
 
 The four figures of every ``dtcosim run`` (``rotor_speed.png``, ``generator_speed.png``,
 ``contact_forces.png``, ``load_duration.png``) are drawn here: importing matplotlib and
-drawing them with it cost about 0.7 s of a 1.4 s run, mostly matplotlib's per-artist
-machinery (every tick an object of lines, texts and transforms) and its import. This
+drawing them with it cost about 0.7 s of CPU, half of a whole run's (docs/performance.md:
+``python benchmarks/bench_plots.py`` and ``bench_commands.py`` on main at 1988d3f), mostly
+matplotlib's per-artist machinery (every tick an object of lines, texts and transforms) and
+its import. This
 package does only what those figures need: a grid of axes in fixed margins, linear and
 log y axes with matplotlib's tick rules, grid, curves (solid, dashed), horizontal lines,
 shaded spans, bars, notes, legends (the "best" corner or beside the axes), titles;

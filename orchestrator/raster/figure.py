@@ -3,7 +3,8 @@
 The margins (:class:`~orchestrator.figure_files.Margins`) are the least space around and
 between the axes; the layout measures every text (it costs microseconds here) and widens a
 margin where its text needs more: tick labels longer than planned, an offset text, a legend
-beside the axes (the right margin takes the widest). Axes sharing their x axis (``sharex``)
+beside the axes (the right margin takes the widest; a legend meant for the best place inside
+goes there where every place inside would hide data). Axes sharing their x axis (``sharex``)
 share its limits and show tick labels only on the bottom row.
 """
 
