@@ -114,7 +114,7 @@ def main() -> None:
     print(f"ratio: dtcosim run CPU / dtcosim reference --case table7 --json CPU  {run_cpu / ref_cpu:.2f}   "
           "(target <= 1)")
     if "dtcosim run --no-plots" in medians:
-        print(f"       the four figures and matplotlib: {run_cpu - medians['dtcosim run --no-plots'][1]:.2f} s CPU "
+        print(f"       the four figures and their renderer: {run_cpu - medians['dtcosim run --no-plots'][1]:.2f} s CPU "
               "(run - run --no-plots)")
 
 

@@ -26,6 +26,7 @@ import subprocess
 import sys
 import sysconfig
 import tempfile
+import threading
 from pathlib import Path
 
 from components.compile.user_cache import user_cache_root
@@ -39,6 +40,8 @@ PYTHON_FILE = "python.txt"
 CLASS_FILE = "slaveclass.txt"
 #: the FMU member the binary replaces
 BINARY_FOLDER = "binaries/linux64"
+#: one compile at a time in a process: a caller that comes while :func:`compile_in_background` compiles waits for it
+_COMPILING = threading.Lock()
 
 
 class NativeBuildError(RuntimeError):
@@ -105,8 +108,11 @@ def compiled_binary() -> Path:
                                "(Debian: apt install gcc), or the FMU keeps pythonfmu's binary")
     key = hashlib.sha256(source + cc.encode()).hexdigest()[:16]
     target = user_cache_root() / "native" / key / "dtcosim_fmi2.so"
-    if target.is_file():
-        return target
+    with _COMPILING:
+        return target if target.is_file() else _compile(cc, target)
+
+
+def _compile(cc: str, target: Path) -> Path:
     target.parent.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(dir=target.parent) as tmp:
         out = Path(tmp) / target.name
@@ -118,6 +124,21 @@ def compiled_binary() -> Path:
             raise NativeBuildError(f"{cc} could not compile {', '.join(SOURCES)}: {proc.stderr.strip()[-2000:]}")
         os.replace(out, target)  # atomic: a concurrent build finds either nothing or the whole file
     return target
+
+
+def compile_in_background() -> threading.Thread:
+    """Start :func:`compiled_binary` in a thread (the compiler is another process: it runs beside this one's
+    Python work); a later :func:`compiled_binary` waits for it, and raises what it would have raised."""
+
+    def compile_quietly() -> None:
+        try:
+            compiled_binary()
+        except Exception:  # noqa: BLE001 - a thread's traceback would reach the user: the caller that needs the
+            pass  # binary compiles again and reports what goes wrong (a missing compiler, a full disk) its own way
+
+    thread = threading.Thread(target=compile_quietly, name="dtcosim-fmu-binary", daemon=True)
+    thread.start()
+    return thread
 
 
 def native_members(model_identifier: str, class_name: str) -> dict[str, bytes]:

@@ -510,7 +510,7 @@ def _add_cross_check(name: str, fmu_path: Path, case) -> None:
         members = reference_members(fmu_path, case)
     except Exception as exc:  # the FMU's own run failed: the build must not ship it
         raise BuildError(f"{name}.fmu: its stand-alone cross-check run failed: {type(exc).__name__}: {exc}") from None
-    model_description.rewrite_archive(fmu_path, members)
+    model_description.add_members(fmu_path, members)  # the archive is still under its temporary name
 
 
 def _staged_resources(tmp: Path, resources: dict[str, Path] | None) -> list[Path]:
@@ -527,6 +527,11 @@ def _staged_resources(tmp: Path, resources: dict[str, Path] | None) -> list[Path
 def build_all(out_dir: Path | str, preset: str = "table6", source: SourceTree | None = None,
               names: Sequence[str] = PRESET_FMU_NAMES, validate: bool = True,
               report: Callable[[str], None] | None = None) -> list[BuiltFmu]:
-    """Build the FMUs ``names`` (default: every FMU of a preset) into ``out_dir`` (``report``: see :func:`build_fmu`)."""
+    """Build the FMUs ``names`` (default: every FMU of a preset) into ``out_dir`` (``report``: see :func:`build_fmu`).
+
+    The FMU binary, where it is not compiled yet (the first build of a machine), compiles beside the first FMU's
+    Python work."""
+    if names:
+        binary.compile_in_background()
     return [build_fmu(name, out_dir, preset, source, validate, report=report) for name in names]
 

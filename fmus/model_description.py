@@ -148,6 +148,28 @@ def read_member(fmu_path: Path, name: str = MODEL_DESCRIPTION) -> bytes:
         return archive.read(name)
 
 
+def _new_member(name: str) -> zipfile.ZipInfo:
+    info = zipfile.ZipInfo(name, date_time=(1980, 1, 1, 0, 0, 0))
+    info.compress_type = zipfile.ZIP_DEFLATED
+    info.external_attr = (0o755 if name.endswith(".so") else 0o644) << 16
+    return info
+
+
+def add_members(fmu_path: Path, members: dict[str, bytes]) -> None:
+    """Append new members to an FMU archive in place, without recompressing the others.
+
+    For an archive still being built (under a temporary name: an interrupted append leaves a damaged
+    file, which the build discards); a name already in the archive is an error (:func:`rewrite_archive`
+    replaces members).
+    """
+    with zipfile.ZipFile(fmu_path, "a") as archive:
+        present = set(archive.namelist()) & set(members)
+        if present:
+            raise ValueError(f"{fmu_path} already has {', '.join(sorted(present))}")
+        for name in sorted(members):
+            archive.writestr(_new_member(name), members[name])
+
+
 def rewrite_archive(fmu_path: Path, replacements: dict[str, bytes]) -> None:
     """Rewrite an FMU archive (deflate-compressed) with some members replaced; new names are added."""
     fmu_path = Path(fmu_path)
@@ -160,8 +182,5 @@ def rewrite_archive(fmu_path: Path, replacements: dict[str, bytes]) -> None:
             info.compress_type = zipfile.ZIP_DEFLATED
             archive.writestr(info, replacements.get(info.filename, data))
         for name in sorted(set(replacements) - present):
-            info = zipfile.ZipInfo(name, date_time=(1980, 1, 1, 0, 0, 0))
-            info.compress_type = zipfile.ZIP_DEFLATED
-            info.external_attr = (0o755 if name.endswith(".so") else 0o644) << 16
-            archive.writestr(info, replacements[name])
+            archive.writestr(_new_member(name), replacements[name])
     tmp.replace(fmu_path)

@@ -33,7 +33,6 @@ instantiation live in :mod:`fmus.runtime_guard` (which the FMU carries).
 
 from __future__ import annotations
 
-import ast
 import functools
 import importlib.util
 import sys
@@ -42,6 +41,8 @@ from dataclasses import dataclass
 from importlib import metadata
 from pathlib import Path
 from typing import Callable, Iterable, Mapping
+
+from components.compile.import_statements import import_statements
 
 from .runtime_guard import (
     REQUIREMENTS_FILE,
@@ -85,21 +86,19 @@ def imported_modules(sources: Iterable[Path]) -> tuple[dict[str, None], dict[str
     return required, optional
 
 
-@functools.lru_cache(maxsize=1024)
 def _imports_of(path: str, text: str) -> tuple[tuple[str, str | None], ...]:
     """The top-level modules of every absolute import in ``text`` (the file ``path``), each with the note of its
-    line after :data:`OPTIONAL_NOTE` (None: required). Parsed once per process and content: the FMUs of one
-    build embed mostly the same modules."""
+    line after :data:`OPTIONAL_NOTE` (None: required)."""
     lines = text.splitlines()
     found = []
-    for node in ast.walk(ast.parse(text, filename=path)):
-        if isinstance(node, ast.Import):
-            names = [alias.name.split(".")[0] for alias in node.names]
-        elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
-            names = [node.module.split(".")[0]]
+    for statement in import_statements(text, path):
+        if not statement.is_from:
+            names = [name.split(".")[0] for name in statement.names]
+        elif statement.level == 0 and statement.module:
+            names = [statement.module.split(".")[0]]
         else:
             continue
-        line = lines[node.lineno - 1]
+        line = lines[statement.line - 1]
         note = line.partition(OPTIONAL_NOTE)[2].strip() if OPTIONAL_NOTE in line else None
         found += [(name, note) for name in names]
     return tuple(found)
@@ -112,14 +111,40 @@ def third_party_modules(sources: Iterable[Path]) -> tuple[str, ...]:
 
 def distribution_of(module: str) -> str:
     """The installed distribution providing top-level ``module`` (the module name if none is known)."""
+    return _distribution_of(module)
+
+
+@functools.lru_cache(maxsize=64)
+def _distribution_of(module: str) -> str:
+    """:func:`distribution_of`, first by the distribution of the module's own name where that one provides it
+    (numpy, scipy, pythonfmu: one file list read), else from every installed distribution's file list
+    (``importlib.metadata.packages_distributions()``: ~0.5 s, once per process)."""
+    try:
+        same_name = metadata.distribution(module)
+    except metadata.PackageNotFoundError:
+        same_name = None
+    if same_name is not None and module in _top_level_names(same_name):
+        return same_name.metadata["Name"] or module
     names = _distributions().get(module) or [module]
     return names[0]
+
+
+def _top_level_names(dist: metadata.Distribution) -> set[str]:
+    """The top-level modules and packages ``dist`` installs (from its file list; empty if it has none)."""
+    out = set()
+    for file in dist.files or ():
+        first = file.parts[0] if file.parts else ""
+        if len(file.parts) > 1 and not first.endswith((".dist-info", ".egg-info", ".data")) and first != "..":
+            out.add(first)
+        elif len(file.parts) == 1 and first.endswith((".py", ".so", ".pyd")):
+            out.add(first.split(".")[0])
+    return out
 
 
 @functools.lru_cache(maxsize=1)
 def _distributions() -> Mapping[str, list[str]]:
     """``importlib.metadata.packages_distributions()`` once per process (it reads every installed
-    distribution's file list: ~0.5 s, twice per FMU build)."""
+    distribution's file list)."""
     return metadata.packages_distributions()
 
 

@@ -19,6 +19,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Iterable, Mapping
 
+from components.compile.import_statements import ImportStatement, import_statements
+
 
 @dataclass(frozen=True)
 class SourceModule:
@@ -51,49 +53,53 @@ def _locate(name: str, packages: Mapping[str, Path]) -> SourceModule | None:
     return None
 
 
-def _imported_names(module: SourceModule, tree: ast.AST) -> list[str]:
-    """Absolute names of every module an import statement of ``tree`` may refer to."""
+def _absolute(module: SourceModule, statement: ImportStatement) -> str:
+    """The absolute module a statement imports from (``from ..x import y`` in ``a.b.c``: ``a.x``); "" for ``import``."""
+    if not statement.is_from:
+        return ""
+    if not statement.level:
+        return statement.module or ""
     package = module.name if module.is_package else module.name.rpartition(".")[0]
+    parts = package.split(".")
+    parts = parts[: len(parts) - (statement.level - 1)] if statement.level > 1 else parts
+    return ".".join(parts + ([statement.module] if statement.module else []))
+
+
+def _statements_of(module: SourceModule) -> tuple[ImportStatement, ...]:
+    return import_statements(module.path.read_bytes(), str(module.path))
+
+
+def _imported_names(module: SourceModule) -> list[str]:
+    """Absolute names of every module an import statement of ``module`` may refer to."""
     out: list[str] = []
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Import):
-            for alias in node.names:
-                parts = alias.name.split(".")
+    for statement in _statements_of(module):
+        if not statement.is_from:
+            for name in statement.names:
+                parts = name.split(".")
                 out += [".".join(parts[:i]) for i in range(1, len(parts) + 1)]
-        elif isinstance(node, ast.ImportFrom):
-            if node.level:
-                parts = package.split(".")
-                parts = parts[: len(parts) - (node.level - 1)] if node.level > 1 else parts
-                base = ".".join(parts + ([node.module] if node.module else []))
-            else:
-                base = node.module or ""
-            pieces = base.split(".")
-            out += [".".join(pieces[:i]) for i in range(1, len(pieces) + 1)]
-            out += [f"{base}.{alias.name}" for alias in node.names if alias.name != "*"]
+            continue
+        base = _absolute(module, statement)
+        pieces = base.split(".")
+        out += [".".join(pieces[:i]) for i in range(1, len(pieces) + 1)]
+        out += [f"{base}.{name}" for name in statement.names if name != "*"]
     return out
 
 
-def _imports(module: SourceModule, tree: ast.AST) -> list[list[str]]:
-    """Per imported name of every import statement of ``tree``: the absolute names it may be, most specific first."""
-    package = module.name if module.is_package else module.name.rpartition(".")[0]
+def _imports(module: SourceModule) -> list[list[str]]:
+    """Per imported name of every import statement of ``module``: the absolute names it may be, most specific first."""
     out: list[list[str]] = []
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Import):
-            for alias in node.names:
-                parts = alias.name.split(".")
+    for statement in _statements_of(module):
+        if not statement.is_from:
+            for name in statement.names:
+                parts = name.split(".")
                 out.append([".".join(parts[:i]) for i in range(len(parts), 0, -1)])
-        elif isinstance(node, ast.ImportFrom):
-            if node.level:
-                parts = package.split(".")
-                parts = parts[: len(parts) - (node.level - 1)] if node.level > 1 else parts
-                base = ".".join(parts + ([node.module] if node.module else []))
-            else:
-                base = node.module or ""
-            pieces = base.split(".")
-            prefixes = [".".join(pieces[:i]) for i in range(len(pieces), 0, -1)]
-            out += [[f"{base}.{alias.name}", *prefixes] for alias in node.names if alias.name != "*"]
-            if any(alias.name == "*" for alias in node.names):
-                out.append(prefixes)
+            continue
+        base = _absolute(module, statement)
+        pieces = base.split(".")
+        prefixes = [".".join(pieces[:i]) for i in range(len(pieces), 0, -1)]
+        out += [[f"{base}.{name}", *prefixes] for name in statement.names if name != "*"]
+        if "*" in statement.names:
+            out.append(prefixes)
     return out
 
 
@@ -113,7 +119,7 @@ def direct_imports(name: str, packages: Mapping[str, Path]) -> set[str]:
     if mod is None:
         raise LookupError(f"module {name!r} is not in the packages {', '.join(packages)}")
     out = set()
-    for names in _imports(mod, ast.parse(mod.path.read_bytes(), filename=str(mod.path))):
+    for names in _imports(mod):
         found = next((dep for dep in (_locate(n, packages) for n in names) if dep is not None), None)
         if found is not None and found.name != name:
             out.add(found.name)
@@ -154,7 +160,7 @@ def import_closure(roots: Iterable[str], packages: Mapping[str, Path]) -> dict[s
         found[mod.name] = mod
         parts = mod.name.split(".")
         candidates = [".".join(parts[:i]) for i in range(1, len(parts))]
-        candidates += _imported_names(mod, ast.parse(mod.path.read_bytes(), filename=str(mod.path)))
+        candidates += _imported_names(mod)
         for name in candidates:
             if name not in found:
                 dep = _locate(name, packages)

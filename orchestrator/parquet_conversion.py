@@ -3,8 +3,8 @@
 The conversion needs pyarrow (:func:`orchestrator.columnar_files.stream_to_parquet`),
 whose libraries and modules cost a process ~45 MB of resident memory and stay
 loaded once imported. A run converts when its co-simulation is over, before its
-analyses and plots (which load matplotlib, ~40 MB more): in the run's own process
-the two would add up. :func:`convert_stream` therefore runs the conversion in a
+analyses and plots (which load matplotlib where a run draws its event or spectrum
+figures, ~40 MB more): in the run's own process the two would add up. :func:`convert_stream` therefore runs the conversion in a
 short-lived child Python process unless this process has imported pyarrow
 already (a notebook, a test), where converting here costs nothing more. The
 child's peak adds to the run's only while it runs, when the run holds the least

@@ -1,7 +1,9 @@
-"""Plot helpers shared by every PNG dtcosim writes (matplotlib Agg canvas, no pyplot global state).
+"""Plot helpers: matplotlib figures on the Agg canvas (no pyplot global state) and what every plot shares.
 
-Figures, envelopes of long curves (every extreme kept), backlash shading and the
-labels of the declared mesh kinds; the plots themselves live with their owners
+Figures in fixed margins, backlash shading and the PNG writing of the matplotlib figures
+(studies, reports, spectra, load events); envelopes of long curves (every extreme kept),
+the labels of the declared mesh kinds and speed units for every plot, also the run figures
+drawn by :mod:`orchestrator.raster`. The plots themselves live with their owners
 (:mod:`orchestrator.run.plots`, :mod:`orchestrator.run.analysis_plots`,
 :mod:`orchestrator.reports`, :mod:`orchestrator.study.plots`).
 """
@@ -10,12 +12,12 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
 from .atomic_files import atomic_path
+from .figure_files import DPI, Margins, axes_size, write_png
 
 RPM_PER_RAD_S = 60.0 / (2.0 * math.pi)
 
@@ -72,42 +74,9 @@ def shade_inside_backlash(ax, t: np.ndarray, force: np.ndarray, threshold_n: flo
                         lw=0, label=label or f"inside the backlash (|F| < {threshold_n:g} N)")
 
 
-#: resolution of every PNG [pixels per inch]
-DPI = 110
-
-
-@dataclass(frozen=True)
-class Margins:
-    """Fixed space around and between the axes of a figure [inches]: the layout of a figure drawn once.
-
-    A layout engine (matplotlib's constrained layout) measures every label before the
-    real drawing and so draws the text of a figure twice; the figures of every run know
-    their labels and take fixed margins instead (:func:`new_figure`, :func:`new_grid`),
-    wide enough for tick labels of up to seven characters (matplotlib moves a common
-    offset or power of ten out of the labels), with the axis labels at fixed distances
-    from the axes (``xlabel_gap``, ``ylabel_gap``; placed automatically, every drawing
-    measures the tick labels again). :func:`legend_room` widens the right margin to a
-    legend placed beside the axes.
-    """
-
-    left: float = 0.85
-    right: float = 0.2
-    bottom: float = 0.55
-    top: float = 0.4
-    hspace: float = 0.3
-    wspace: float = 0.8
-    xlabel_gap: float = 0.27
-    ylabel_gap: float = 0.64
-
-
 def _grid(width: float, height: float, rows: int, columns: int, margins: Margins) -> dict[str, float]:
     """The grid parameters (figure fractions) that place ``rows`` x ``columns`` axes by ``margins``."""
-    inner_w = width - margins.left - margins.right
-    inner_h = height - margins.top - margins.bottom
-    axes_w = (inner_w - (columns - 1) * margins.wspace) / columns
-    axes_h = (inner_h - (rows - 1) * margins.hspace) / rows
-    if axes_w <= 0.0 or axes_h <= 0.0:
-        raise ValueError(f"a {width:g} x {height:g} in figure has no room for {rows} x {columns} axes within {margins}")
+    axes_w, axes_h = axes_size(width, height, rows, columns, margins)
     return {"left": margins.left / width, "right": 1.0 - margins.right / width, "bottom": margins.bottom / height,
             "top": 1.0 - margins.top / height, "hspace": margins.hspace / axes_h, "wspace": margins.wspace / axes_w}
 
@@ -175,38 +144,11 @@ def new_figure(rows: int = 1, height: float = 4.0, sharex: bool = True, width: f
                margins: Margins | None = None):
     """A headless figure of ``rows`` stacked axes, ``width`` x ``height`` inches: (figure, axes array).
 
-    ``margins`` fixes the layout (see :class:`Margins`); without, matplotlib's constrained
+    ``margins`` fixes the layout (see :class:`~orchestrator.figure_files.Margins`); without, matplotlib's constrained
     layout places the axes (for figures whose labels and legends vary).
     """
     fig = _figure(width, height)
     return fig, _subplots(fig, rows, 1, sharex, margins)[:, 0]
-
-
-def new_grid(rows: int, columns: int, height: float, width: float, sharex: str | bool = "col",
-             margins: Margins | None = None):
-    """A headless figure of ``rows`` x ``columns`` axes: (figure, 2-D axes array); ``margins`` as :func:`new_figure`."""
-    fig = _figure(width, height)
-    return fig, _subplots(fig, rows, columns, sharex, margins)
-
-
-def legend_room(fig, legends, margins: Margins) -> None:
-    """Widen the right margin of a fixed layout to the widest of ``legends`` placed beside the axes.
-
-    The legends' text is laid out once here and kept by matplotlib for the drawing.
-    """
-    if not legends:
-        return
-    from matplotlib import rc_context
-
-    renderer = fig.canvas.get_renderer()
-    with rc_context(TEXT_RENDERING):  # measured as it will be drawn
-        widest = max(leg.get_window_extent(renderer).width for leg in legends) / fig.dpi
-    grid = legends[0].axes.get_gridspec()
-    rows, columns = grid.get_geometry()
-    grid.update(**_grid(*fig.get_size_inches(), rows, columns, replace(margins, right=margins.right + widest + 0.05)))
-    for ax in fig.axes:
-        if ax.get_subplotspec() is not None and ax.get_subplotspec().get_gridspec() is grid:
-            ax.set_position(ax.get_subplotspec().get_position(fig))
 
 
 def axes_pixels(ax) -> int:
@@ -215,27 +157,17 @@ def axes_pixels(ax) -> int:
     return max(int(ax.get_position().width * fig.get_figwidth() * fig.dpi), 1)
 
 
-#: zlib level of the PNG files: 1 costs about a third of the default 6's time; the palette keeps them small
-PNG_COMPRESS_LEVEL = 1
-
 #: how text is rendered: FreeType's outlines unhinted (matplotlib's default auto-hints every glyph: the
 #: text then costs about a fifth more for no better reading at 110 dpi)
 TEXT_RENDERING = {"text.hinting": "no_hinting"}
 
 
 def encode_png(canvas, path: Path) -> None:
-    """Write a drawn Agg canvas as an 8-bit palette PNG.
-
-    A plot has few colours (lines, shades and their anti-aliased edges): an adaptive
-    palette of 256 (``FASTOCTREE``, straight from the RGBA pixels) holds them, and the file
-    is about a third of the RGBA one matplotlib writes, for about half its encoding time.
-    """
+    """Write a drawn Agg canvas as an 8-bit palette PNG (:func:`orchestrator.figure_files.write_png`)."""
     from PIL import Image
 
     width, height = canvas.get_width_height(physical=True)
-    image = Image.frombuffer("RGBA", (width, height), canvas.buffer_rgba(), "raw", "RGBA", 0, 1)
-    image = image.quantize(256, method=Image.Quantize.FASTOCTREE)
-    image.save(path, format="png", compress_level=PNG_COMPRESS_LEVEL, dpi=(DPI, DPI))
+    write_png(Image.frombuffer("RGBA", (width, height), canvas.buffer_rgba(), "raw", "RGBA", 0, 1), path)
 
 
 def save_figure(fig, path: Path) -> Path:

@@ -17,7 +17,7 @@ import numpy as np
 
 from .atomic_files import atomic_path, write_text_atomic
 
-_PACKAGES = ("dtcosim", "numpy", "scipy", "fmpy", "pythonfmu", "matplotlib")
+_PACKAGES = ("dtcosim", "numpy", "scipy", "fmpy", "pythonfmu", "matplotlib", "pillow")
 
 
 def versions() -> dict[str, str]:

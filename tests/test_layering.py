@@ -7,6 +7,7 @@ from the syntax tree). The layers, bottom up::
     fmus.slaves <- fmus (build, registry, documentation, checks)            the FMUs
     orchestrator.inputs <- cosim <- interop <- run <- study <- commands     reading and running FMUs
                            cosim <- provision <- study, commands            finding and building them
+    orchestrator.raster <- run                                              the run figures' renderer
 
 The co-simulation only reads FMUs: below ``orchestrator.provision`` the orchestrator reaches
 only the FMU's record, the registry and the archive checks of ``fmus`` (:data:`FMUS_READ`).
@@ -14,6 +15,7 @@ only the FMU's record, the registry and the archive checks of ``fmus`` (:data:`F
 
 from __future__ import annotations
 
+import ast
 import subprocess
 import sys
 from pathlib import Path
@@ -25,7 +27,8 @@ from fmus.source_closure import direct_imports, import_closure
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGES = {"components": ROOT / "components", "fmus": ROOT / "fmus", "orchestrator": ROOT / "orchestrator"}
 
-_ORCHESTRATOR_READS = {"orchestrator.inputs", "orchestrator.cosim", "orchestrator.interop", "orchestrator.run"}
+_ORCHESTRATOR_READS = {"orchestrator.inputs", "orchestrator.cosim", "orchestrator.interop", "orchestrator.run",
+                       "orchestrator.raster"}
 
 #: layer -> the layers of its own top-level package it may import; everything imports the base modules
 #: (``orchestrator.errors``, ...). ``fmus`` is the package's own modules (build, registry, documentation).
@@ -40,7 +43,9 @@ ALLOWED = {
     "orchestrator.cosim": {"orchestrator.inputs", "orchestrator.cosim"},
     "orchestrator.provision": {"orchestrator.inputs", "orchestrator.cosim", "orchestrator.provision"},
     "orchestrator.interop": {"orchestrator.inputs", "orchestrator.cosim", "orchestrator.interop"},
-    "orchestrator.run": {"orchestrator.inputs", "orchestrator.cosim", "orchestrator.interop", "orchestrator.run"},
+    "orchestrator.raster": {"orchestrator.raster"},
+    "orchestrator.run": {"orchestrator.inputs", "orchestrator.cosim", "orchestrator.interop", "orchestrator.run",
+                         "orchestrator.raster"},
     "orchestrator.reports": {"orchestrator.reports"},
     "orchestrator.study": _ORCHESTRATOR_READS | {"orchestrator.provision", "orchestrator.study"},
     "orchestrator.commands": _ORCHESTRATOR_READS | {"orchestrator.provision", "orchestrator.study",
@@ -59,6 +64,7 @@ FMUS_ALLOWED = {
     "orchestrator.interop": FMUS_READ | {"fmus.start_values", "fmus.model_description", "fmus.slaves.interface"},
     "orchestrator.run": FMUS_READ | {"fmus.start_values", "fmus.model_description", "fmus.slaves.interface"},
     "orchestrator.reports": set(),
+    "orchestrator.raster": set(),
 }
 
 def _layer(name: str) -> str | None:
@@ -178,3 +184,14 @@ def test_the_fmu_model_imports_no_integrator_of_scipy_and_no_matplotlib():
             "print(sorted(k for k in sys.modules if k.startswith(('scipy.integrate', 'matplotlib'))))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=ROOT)
     assert out.stdout.strip() == "[]"
+
+
+def test_the_run_figures_renderer_imports_no_matplotlib():
+    """orchestrator.raster draws without matplotlib: no import of it, nor of the matplotlib helpers of the base."""
+    closure = import_closure(_modules_of("orchestrator.raster"), PACKAGES)
+    assert "orchestrator.plotting" not in closure
+    for module in closure.values():
+        tree = ast.parse(module.path.read_text(encoding="utf-8"))
+        names = [a.name for n in ast.walk(tree) if isinstance(n, ast.Import) for a in n.names]
+        names += [n.module or "" for n in ast.walk(tree) if isinstance(n, ast.ImportFrom) and not n.level]
+        assert not [n for n in names if n.split(".")[0] == "matplotlib"], module.path

@@ -4,6 +4,7 @@ The physics of :mod:`components.model` is written once, as plain Python function
 and arrays in kernel packages (:mod:`components.model.kernel`). This subpackage knows nothing
 of that physics; it turns such sources into runnable forms:
 
+import_statements  the import statements of a source, parsed once per content (also for fmus)
 sources      :class:`~components.compile.sources.KernelSource`: a kernel's files and digest
 jit          the sources compiled by numba once per process (any copy of them shares it)
 numba_cache  numba's disk cache keyed by the sources, in the per-user cache

@@ -10,44 +10,21 @@ compiled form: any copy of the same sources (the host's, each FMU build's) is th
 
 from __future__ import annotations
 
-import ast
 import hashlib
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
-from typing import Iterator
 
-
-#: the fields of a statement that hold statements (an import is a statement, found only in these)
-_BODIES = ("body", "orelse", "finalbody", "handlers", "cases")
-
-#: relative imports of the module sources parsed in this process, by their sha256: copies of a kernel (the
-#: host's, an FMU build's) and kernels sharing modules are parsed once
-_RELATIVE_IMPORTS: dict[bytes, tuple[str, ...]] = {}
-
-
-def _statements(body: list) -> Iterator[ast.AST]:
-    for node in body:
-        yield node
-        for field in _BODIES:
-            inner = getattr(node, field, None)
-            if inner:
-                yield from _statements(inner)
+from .import_statements import import_statements
 
 
 def _relative_imports(code: bytes, filename: str) -> tuple[str, ...]:
     """First names of the modules ``code`` imports relatively from its own package, in order."""
-    key = hashlib.sha256(code).digest()
-    if key not in _RELATIVE_IMPORTS:
-        stems: list[str] = []
-        for node in _statements(ast.parse(code, filename=filename).body):
-            if isinstance(node, ast.ImportFrom) and node.level == 1:
-                if node.module:
-                    stems.append(node.module.split(".")[0])
-                else:
-                    stems += [alias.name for alias in node.names]
-        _RELATIVE_IMPORTS[key] = tuple(stems)
-    return _RELATIVE_IMPORTS[key]
+    stems: list[str] = []
+    for statement in import_statements(code, filename):
+        if statement.is_from and statement.level == 1:
+            stems += [statement.module.split(".")[0]] if statement.module else list(statement.names)
+    return tuple(stems)
 
 
 def _sibling_imports(path: Path) -> list[str]:

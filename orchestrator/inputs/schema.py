@@ -42,7 +42,7 @@ class Table(BaseModel):
     """A table of an input file (frozen; unknown keys, type mismatches and non-finite numbers are errors)."""
 
     model_config = ConfigDict(extra="forbid", strict=True, frozen=True, allow_inf_nan=False,
-                              arbitrary_types_allowed=True)
+                              arbitrary_types_allowed=True, defer_build=True)
 
 
 class PlausibilityTable(Table):

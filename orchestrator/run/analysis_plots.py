@@ -1,7 +1,8 @@
 """PNG plots of a run's analyses: contact-force spectra, load duration distributions, load events.
 
 matplotlib's figure API on the Agg canvas (no display, no pyplot), each figure in a
-fixed layout drawn once (:mod:`orchestrator.plotting`). Every function takes the
+fixed layout drawn once (:mod:`orchestrator.plotting`); the load duration distributions,
+drawn by every run, by the run figures' own renderer (:mod:`orchestrator.raster`). Every function takes the
 plain result objects of :mod:`components.analysis.fatigue` and
 :mod:`components.analysis.spectrum` (or arrays) and a path, writes one PNG and returns the path.
 """
@@ -16,7 +17,10 @@ import numpy as np
 from components.analysis.load_duration import LoadDurationDistribution
 from components.analysis.spectrum import amplitude_spectrum
 
-from ..plotting import Margins, axes_pixels, envelope, new_figure, save_figure, shade_inside_backlash
+from ..figure_files import Margins
+from ..plotting import axes_pixels, envelope, new_figure, save_figure, shade_inside_backlash
+from ..raster.figure import Figure as RasterFigure
+from ..raster.figure import save_figure as save_raster_figure
 
 #: a title above and an x label below every panel
 _PANEL_MARGINS = Margins(top=0.35, hspace=0.75)
@@ -75,40 +79,28 @@ def plot_load_duration(ldds: Sequence[LoadDurationDistribution], path: str | Pat
     """Load duration distributions (time per load bin, log scale), one panel per signal.
 
     Torques are drawn in kN m (forces in kN); the log time axis shows the rare extreme
-    loads (e.g. of a load event) next to the hours-equivalent of normal operation.
+    loads (e.g. of a load event) next to the hours-equivalent of normal operation. Drawn by
+    the run figures' renderer (:mod:`orchestrator.raster`): every run draws it.
     """
-    fig, axes = new_figure(len(ldds), height=2.5 * len(ldds) + 0.2, sharex=False, margins=_PANEL_MARGINS)
-    from matplotlib.collections import PolyCollection  # imported with the figure (orchestrator.plotting)
-    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
-
-    for ax, ld in zip(axes, ldds):
+    fig = RasterFigure(10.0, 2.5 * len(ldds) + 0.2, rows=len(ldds), margins=_PANEL_MARGINS)
+    for (ax,), ld in zip(fig.axes, ldds):
         scale, unit = (1e-3, "kN m") if ld.unit in ("N.m", "N m") else (1e-3, "kN") if ld.unit == "N" else (1.0, ld.unit)
         edges = ld.edges * scale
         keep = ld.time_s > 0.0
-        ax.set_yscale("log")
-        # decades labelled as plain numbers, minor lines at 2 and 5 (mathematical text and eight unlabelled
-        # minor ticks per decade cost half of each panel's drawing)
-        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
-        ax.yaxis.set_minor_locator(LogLocator(subs=(2.0, 5.0)))
-        ax.yaxis.set_minor_formatter(NullFormatter())
-        if keep.any():  # one bar per non-empty bin, drawn as one collection, from below the axis up
+        ax.yscale = "log"  # decades labelled as plain numbers, minor lines at 2 and 5
+        if keep.any():  # one bar per non-empty bin, from the axis' bottom up
             time_s = ld.time_s[keep]
             low, high = float(time_s.min()), float(time_s.max())
-            bottom = 10.0 ** np.floor(np.log10(low) - 0.05)
-            left, right = edges[:-1][keep], edges[1:][keep]
-            bars = np.stack([np.column_stack([left, np.full_like(left, bottom * 1e-3)]),
-                             np.column_stack([left, time_s]), np.column_stack([right, time_s]),
-                             np.column_stack([right, np.full_like(left, bottom * 1e-3)])], axis=1)
-            ax.add_collection(PolyCollection(bars, facecolors="tab:blue", edgecolors="none", linewidths=0.0))
-            ax.set_ylim(bottom, high * 10.0 ** 0.1)
-        ax.set_xlim(edges[0], edges[-1])
-        ax.set_xlabel(f"{ld.name} [{unit}]")
-        ax.set_ylabel("time in bin [s]")
+            ax.bar(edges[:-1][keep], edges[1:][keep], time_s, color="tab:blue")
+            ax.ylim = (10.0 ** np.floor(np.log10(low) - 0.05), high * 10.0 ** 0.1)
+        ax.xlim = (float(edges[0]), float(edges[-1]))
+        ax.xlabel = f"{ld.name} [{unit}]"
+        ax.ylabel = "time in bin [s]"
         extra = f", {ld.time_outside_s:.3g} s outside the bins" if ld.time_outside_s > 0 else ""
         ax.set_title(f"{ld.name}: load duration distribution ({ld.analysed_time_s:.4g} s analysed, "
-                     f"{edges.size - 1} bins of {np.diff(edges).mean():.3g} {unit}{extra})", fontsize=9)
-        ax.grid(True, which="both", alpha=0.25)
-    return save_figure(fig, Path(path))
+                     f"{edges.size - 1} bins of {np.diff(edges).mean():.3g} {unit}{extra})", size_pt=9.0)
+        ax.grid(alpha=0.25, minor=True)
+    return save_raster_figure(fig, Path(path))
 
 
 def plot_event_response(

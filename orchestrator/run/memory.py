@@ -1,12 +1,14 @@
 """Handing freed memory back between the phases of a run (co-simulation, results file, analyses, plots).
 
-A whole run holds its samples, the FMUs' code and matplotlib in one process (numba's
-LLVM too where the kernels run just in time; pyarrow only where the caller imported
-it: :mod:`orchestrator.parquet_conversion`); what a phase allocates and frees would
+A whole run holds its samples, the FMUs' code and the figures' libraries in one process
+(Pillow; matplotlib where it draws the event or spectrum figures; numba's LLVM too where
+the kernels run just in time; pyarrow only where the caller imported it:
+:mod:`orchestrator.parquet_conversion`); what a phase allocates and frees would
 otherwise stay in the process and add to the next phase's peak:
 
 * matplotlib figures are reference cycles (figure <-> canvas <-> renderer), so their
-  pixel buffers go only when the cyclic garbage collector runs;
+  pixel buffers go only when the cyclic garbage collector runs (the run figures'
+  renderer, :mod:`orchestrator.raster`, makes none);
 * glibc's ``malloc`` keeps freed heap memory mapped (``malloc_trim`` returns it);
   the results files' buffers come from it too.
 

@@ -1,4 +1,4 @@
-"""PNG plots of a drivetrain run (matplotlib, Agg canvas; no pyplot global state).
+"""PNG plots of a drivetrain run, drawn by the run figures' own renderer (:mod:`orchestrator.raster`).
 
 * ``rotor_speed.png`` - rotor speed over time, the wind description (paper Fig. 15);
 * ``generator_speed.png`` - generator speed against the ideal gearbox, ratio x rotor
@@ -9,6 +9,7 @@
 The variables come from the components' declared roles and signals
 (:mod:`orchestrator.cosim.roles`); a plot whose signals are not declared or not
 recorded is skipped and :func:`plot_run` says why. The analysis window is shaded.
+Curves are drawn as their min/max envelope at the axes' resolution (every extreme kept).
 """
 
 from __future__ import annotations
@@ -20,48 +21,41 @@ import numpy as np
 from ..cosim.outcome import RunOutcome
 from ..cosim.roles import GEARBOX, GENERATOR, WIND_SOURCE, ComponentRole
 from ..cosim.resolved import ResolvedSystem
-from ..plotting import (
-    MESH_KIND_STYLES,
-    RPM_PER_RAD_S,
-    Margins,
-    axes_pixels,
-    envelope,
-    legend_room,
-    new_figure,
-    new_grid,
-    plot_envelope,
-    save_figure,
-)
+from ..figure_files import Margins
+from ..plotting import MESH_KIND_STYLES, RPM_PER_RAD_S, envelope
+from ..raster.axes import Axes
+from ..raster.figure import Figure, save_figure
 from .derived import Skipped, generator_vs_ideal, single_role
 from .memory import release_between_phases
 
 
-#: the layouts of the figures (fixed: each is drawn once, see :class:`~orchestrator.plotting.Margins`)
+#: the least space around the axes of the figures (see :class:`~orchestrator.figure_files.Margins`)
 _SPEED_MARGINS = Margins()
 #: contact forces: a title above every row, the window's axes with their own tick labels
 _FORCE_MARGINS = Margins(top=0.75, hspace=0.4, wspace=0.9)
 
 
-def _shade_window(ax, window) -> None:
-    ax.axvspan(window[0], window[1], color="0.93", zorder=0, label=f"analysis window {window[0]:g}-{window[1]:g} s")
+def _shade_window(ax: Axes, window) -> None:
+    ax.span(window[0], window[1], color="0.93", label=f"analysis window {window[0]:g}-{window[1]:g} s")
 
 
 def plot_rotor_speed(outcome: RunOutcome, column: str, window, path: Path, title_suffix: str = "") -> Path:
     """Rotor speed [rpm] over time (Fig. 15)."""
     t = outcome.time_s
     w = outcome.column(column) * RPM_PER_RAD_S
-    fig, (ax,) = new_figure(margins=_SPEED_MARGINS)
+    fig = Figure(10.0, 4.0, margins=_SPEED_MARGINS)
+    (ax,) = fig.axes[0]
     _shade_window(ax, window)
-    plot_envelope(ax, t, w, lw=0.8, color="C0", label=f"rotor speed {column}")
+    ax.curve(*envelope(t, w, fig.axes_pixels()), width_pt=0.8, color="C0", label=f"rotor speed {column}")
     sel = (t >= window[0]) & (t <= window[1])
     if sel.any():
-        ax.axhline(w[sel].mean(), color="C3", lw=1.0, ls="--", label=f"mean over window: {w[sel].mean():.4g} rpm")
-    ax.set_xlabel("time [s]")
-    ax.set_ylabel("rotor speed [rpm]")
+        mean = float(w[sel].mean())
+        ax.hline(mean, color="C3", width_pt=1.0, dashed=True, label=f"mean over window: {mean:.4g} rpm")
+    ax.xlabel, ax.ylabel = "time [s]", "rotor speed [rpm]"
     ax.set_title("Rotor speed: stochastic wind description, eq. 13-14 (paper Fig. 15)" + title_suffix)
-    ax.grid(True, lw=0.3)
-    ax.legend(loc="best", fontsize=8)
-    ax.set_xlim(t[0], t[-1])
+    ax.grid(width_pt=0.3)
+    ax.set_legend("best", 8.0)
+    ax.xlim = (float(t[0]), float(t[-1]))
     return save_figure(fig, path)
 
 
@@ -71,31 +65,31 @@ def plot_generator_speed(outcome: RunOutcome, rotor_column: str, gen_column: str
     t = outcome.time_s
     gen = outcome.column(gen_column) * RPM_PER_RAD_S
     ideal = ratio * outcome.column(rotor_column) * RPM_PER_RAD_S
-    fig, (ax, ax2) = new_figure(2, height=6.0, margins=_SPEED_MARGINS)
+    fig = Figure(10.0, 6.0, rows=2, margins=_SPEED_MARGINS, sharex="all")
+    (ax,), (ax2,) = fig.axes
+    bins = fig.axes_pixels()
     _shade_window(ax, window)
-    plot_envelope(ax, t, ideal, lw=1.6, color="C1", label=f"ideal gearbox: {ratio:.6g} x rotor speed")
-    plot_envelope(ax, t, gen, lw=0.8, color="C0", label=f"simulated generator speed {gen_column}")
-    ax.set_ylabel("speed [rpm]")
+    ax.curve(*envelope(t, ideal, bins), width_pt=1.6, color="C1", label=f"ideal gearbox: {ratio:.6g} x rotor speed")
+    ax.curve(*envelope(t, gen, bins), width_pt=0.8, color="C0", label=f"simulated generator speed {gen_column}")
+    ax.ylabel = "speed [rpm]"
     ax.set_title("Generator speed vs ideal gearbox (paper Fig. 16)" + title_suffix)
-    ax.grid(True, lw=0.3)
-    ax.legend(loc="best", fontsize=8)
+    ax.grid(width_pt=0.3)
+    ax.set_legend("best", 8.0)
     with np.errstate(divide="ignore", invalid="ignore"):
         dev = 100.0 * (gen / ideal - 1.0)
     _shade_window(ax2, window)
-    plot_envelope(ax2, t, dev, lw=0.7, color="C2", label="generator / ideal - 1")
-    ax2.axhline(0.0, color="0.3", lw=0.6)
-    ax2.set_xlabel("time [s]")
-    ax2.set_ylabel("difference [%]")
-    ax2.grid(True, lw=0.3)
-    ax2.legend(loc="best", fontsize=8)
-    ax2.set_xlim(t[0], t[-1])
+    ax2.curve(*envelope(t, dev, bins), width_pt=0.7, color="C2", label="generator / ideal - 1")
+    ax2.hline(0.0, color="0.3", width_pt=0.6)
+    ax2.xlabel, ax2.ylabel = "time [s]", "difference [%]"
+    ax2.grid(width_pt=0.3)
+    ax2.set_legend("best", 8.0)
+    ax2.xlim = (float(t[0]), float(t[-1]))
     # scale both panels to the analysis window; a larger start-up transient is clipped
     for axis, curves in ((ax, (gen, ideal)), (ax2, (dev,))):
         limits = window_limits(t, curves, window, 0.15)
         if limits is not None and limits[2]:
-            axis.set_ylim(limits[0], limits[1])
-            axis.text(0.005, 0.02, "scaled to the analysis window (start-up transient clipped)",
-                      transform=axis.transAxes, fontsize=7, color="0.35")
+            axis.ylim = (limits[0], limits[1])
+            axis.note("scaled to the analysis window (start-up transient clipped)", 0.005, 0.02, 7.0, "0.35")
     return save_figure(fig, path)
 
 
@@ -160,13 +154,11 @@ def plot_contact_forces(outcome: RunOutcome, gearbox: ComponentRole, window, pat
     if not stages:
         return None
     names = list(stages)
-    fig, axes = new_grid(len(names), 2, height=2.6 * len(names) + 1.0, width=15.0, margins=_FORCE_MARGINS)
+    fig = Figure(15.0, 2.6 * len(names) + 1.0, rows=len(names), columns=2, margins=_FORCE_MARGINS, sharex="col")
     t = outcome.time_s
-    bins = axes_pixels(axes[0][0])
-    legends = []
+    bins = fig.axes_pixels()
     merged = False
-    for row, stage in zip(axes, names):
-        whole, zoom = row
+    for (whole, zoom), stage in zip(fig.axes, names):
         _shade_window(whole, window)
         groups = symmetric_groups(stages[stage])
         for k, (var, kind, y, same) in enumerate(groups):
@@ -179,27 +171,25 @@ def plot_contact_forces(outcome: RunOutcome, gearbox: ComponentRole, window, pat
             te, ye = envelope(t, y, bins)
             ye = ye / 1e3
             for ax in (whole, zoom):
-                ax.plot(te, ye, lw=0.7, ls=style, color=f"C{k % 10}", label=text if ax is zoom else None)
+                ax.curve(te, ye, width_pt=0.7, dashed=style == "--", color=f"C{k % 10}",
+                         label=text if ax is zoom else None)
         limits = window_limits(t, [y for _, _, y, _ in groups], window, 0.08)
         if limits is not None:
-            zoom.set_xlim(max(window[0], t[0]), min(window[1], t[-1]))
-            zoom.set_ylim(limits[0] / 1e3, limits[1] / 1e3)
+            zoom.xlim = (max(window[0], float(t[0])), min(window[1], float(t[-1])))
+            zoom.ylim = (limits[0] / 1e3, limits[1] / 1e3)
         for ax in (whole, zoom):
-            ax.set_ylabel("force [kN]")
-            ax.grid(True, lw=0.3)
-        whole.set_title(f"{gearbox.component}.{stage}: whole run", fontsize=10, loc="left")
-        zoom.set_title(f"{gearbox.component}.{stage}: analysis window {window[0]:g}-{window[1]:g} s", fontsize=10,
-                       loc="left")
-        # outside the axes: inside, it hid the peaks of load events and start-up swings
-        legends.append(zoom.legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), fontsize=7, ncol=1,
-                                   borderaxespad=0.0))
-    legend_room(fig, legends, _FORCE_MARGINS)
-    for ax in axes[-1]:
-        ax.set_xlabel("time [s]")
-    axes[-1][0].set_xlim(t[0], t[-1])
+            ax.ylabel = "force [kN]"
+            ax.grid(width_pt=0.3)
+        whole.set_title(f"{gearbox.component}.{stage}: whole run", "left", 10.0)
+        zoom.set_title(f"{gearbox.component}.{stage}: analysis window {window[0]:g}-{window[1]:g} s", "left", 10.0)
+        # beside the axes: inside, it hid the peaks of load events and start-up swings
+        zoom.set_legend("beside", 7.0)
+    for ax in fig.axes[-1]:
+        ax.xlabel = "time [s]"
+    fig.axes[-1][0].xlim = (float(t[0]), float(t[-1]))
     note = ("\nplanet meshes that carry identical forces (by symmetry) are drawn once, named '= [2], [3]' in the "
             "legend") if merged else ""
-    fig.suptitle("Gear contact forces of all stages (paper Fig. 17)" + title_suffix + note, fontsize=10)
+    fig.set_suptitle("Gear contact forces of all stages (paper Fig. 17)" + title_suffix + note, 10.0)
     return save_figure(fig, path)
 
 
@@ -246,7 +236,7 @@ def plot_run(system: ResolvedSystem, outcome: RunOutcome, out_dir: str | Path,
                                             out_dir / "generator_speed.png", suffix))
     except Skipped as exc:
         skipped.append({"analysis": "plot:generator_speed", "reason": str(exc)})
-    # a drawn figure is a reference cycle: its pixels go when the collector runs, before the largest figure
+    # a large run hands the memory its earlier phases freed back before the largest figure
     release_between_phases(outcome.values.nbytes)
     try:
         p = plot_contact_forces(outcome, single_role(system, GEARBOX), window, out_dir / "contact_forces.png", suffix)

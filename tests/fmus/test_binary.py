@@ -76,3 +76,28 @@ def test_every_built_fmu_carries_the_binary_and_its_records(fmu_path):
             assert archive.read(f"binaries/linux64/{name}.so") == binary.compiled_binary().read_bytes()
             assert archive.read("resources/slaveclass.txt").decode().strip() == name
             assert archive.read("resources/python.txt").decode() == binary.python_record()
+
+
+def test_a_build_waits_for_the_compile_started_in_the_background_and_compiles_once(tmp_path, monkeypatch):
+    if binary.compiler() is None:
+        pytest.skip("no C compiler")
+    monkeypatch.setenv("DTCOSIM_CACHE_DIR", str(tmp_path))
+    compiles = []
+    real = binary._compile
+    monkeypatch.setattr(binary, "_compile", lambda cc, target: compiles.append(target) or real(cc, target))
+    thread = binary.compile_in_background()
+    path = binary.compiled_binary()  # while the thread compiles: waits for it
+    thread.join(timeout=60)
+    assert path.is_file() and path.is_relative_to(tmp_path) and compiles == [path]
+    assert ctypes.CDLL(str(path)).fmi2GetVersion  # the whole file
+
+
+def test_a_failing_background_compile_leaves_the_error_to_the_caller(tmp_path, monkeypatch, capfd):
+    monkeypatch.setenv("DTCOSIM_CACHE_DIR", str(tmp_path))
+    monkeypatch.setattr(binary, "compiler", lambda: str(tmp_path / "broken-cc"))
+    (tmp_path / "broken-cc").write_text("#!/bin/sh\necho 'broken-cc: cannot compile' >&2\nexit 1\n")
+    (tmp_path / "broken-cc").chmod(0o755)
+    binary.compile_in_background().join(timeout=60)
+    assert "Traceback" not in capfd.readouterr().err  # nothing of the thread reaches the user
+    with pytest.raises(binary.NativeBuildError, match="broken-cc could not compile .*cannot compile"):
+        binary.compiled_binary()

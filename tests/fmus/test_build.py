@@ -372,3 +372,22 @@ def test_bytecode_of_a_source_two_fmus_embed_is_compiled_once_and_names_each_fil
     outer = {}
     exec(marshal.loads(second[16:]), outer)
     assert outer["outer"]().__code__.co_filename == "resources/b/mod.py" and outer["outer"]()() == 1
+
+
+def test_members_are_appended_without_touching_the_others_and_never_twice(tmp_path):
+    from fmus.model_description import add_members
+
+    fmu = tmp_path / "x.fmu"
+    with zipfile.ZipFile(fmu, "w", zipfile.ZIP_DEFLATED) as archive:
+        archive.writestr("modelDescription.xml", b"<fmiModelDescription/>" * 100)
+    before = fmu.read_bytes()
+    add_members(fmu, {"documentation/cross-check/X_ref.csv": b'"time"\n0.0\n'})
+    after = fmu.read_bytes()
+    # the first member's local header and compressed data are where they were, byte for byte
+    with zipfile.ZipFile(fmu) as archive:
+        first = archive.getinfo("modelDescription.xml")
+        end = first.header_offset + 30 + len(first.filename) + len(first.extra) + first.compress_size
+        assert after[:end] == before[:end]
+        assert archive.read("documentation/cross-check/X_ref.csv") == b'"time"\n0.0\n' and archive.testzip() is None
+    with pytest.raises(ValueError, match="already has documentation/cross-check/X_ref.csv"):
+        add_members(fmu, {"documentation/cross-check/X_ref.csv": b""})

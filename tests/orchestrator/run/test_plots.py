@@ -1,6 +1,11 @@
-"""The figures of every run, drawn once in fixed layouts: every text inside the figure, nothing hidden, the data drawn."""
+"""The figures of every run, laid out once: every text inside the figure and clear of the others, nothing hidden, the data drawn."""
 
 from __future__ import annotations
+
+import itertools
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -39,17 +44,17 @@ def _outcome(start_peak: float = 0.0) -> tuple[RunOutcome, ComponentRole]:
 
 @pytest.fixture
 def figures(monkeypatch):
-    """The figures the plot functions save, drawn, instead of their files."""
-    drawn = []
+    """The figures the plot functions save, laid out, instead of their files."""
+    laid_out = []
 
     def keep(fig, path):
-        fig.canvas.draw()
-        drawn.append(fig)
+        fig.lay_out()
+        laid_out.append(fig)
         return path
 
     monkeypatch.setattr(plots, "save_figure", keep)
-    monkeypatch.setattr(analysis_plots, "save_figure", keep)
-    return drawn
+    monkeypatch.setattr(analysis_plots, "save_raster_figure", keep)
+    return laid_out
 
 
 def _ldds() -> list[LoadDurationDistribution]:
@@ -69,43 +74,34 @@ def _draw_all(figures, start_peak=0.0):
     return figures
 
 
-def _drawn_tick_labels(axis, renderer):
-    """Window extents of the tick labels drawn (those at ticks inside the axis' view)."""
-    low, high = sorted(axis.get_view_interval())
-    return [label.get_window_extent(renderer) for label, at in zip(axis.get_ticklabels(), axis.get_ticklocs())
-            if label.get_visible() and label.get_text() and low <= at <= high]
+def _overlap(a, b) -> bool:
+    return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
 
 
 @pytest.mark.parametrize("start_peak", [0.0, 0.2])
-def test_every_text_of_the_run_figures_is_inside_the_figure(figures, start_peak):
+def test_every_text_of_the_run_figures_is_inside_the_figure_and_clear_of_the_others(figures, start_peak):
     for fig in _draw_all(figures, start_peak):
-        width, height = fig.canvas.get_width_height()
-        renderer = fig.canvas.get_renderer()
-        # each axes with its tick labels, axis labels, title and legend (also one beside it), and the figure's title
-        boxes = [(ax.get_title(loc="left") or ax.get_title() or ax.get_ylabel(), ax.get_tightbbox(renderer))
-                 for ax in fig.axes]
-        boxes += [(t.get_text(), t.get_window_extent(renderer)) for t in fig.texts if t.get_text()]
-        for name, box in boxes:
-            assert -0.5 <= box.x0 and box.x1 <= width + 0.5 and -0.5 <= box.y0 and box.y1 <= height + 0.5, (
-                f"{name!r} at {box} outside the {width} x {height} figure")
+        width, height = fig.size
+        texts = fig.texts()
+        boxes = [(t.text, t.box) for t in texts] + [("legend", ax.legend.box) for ax in fig.flat() if ax.legend]
+        for name, (x0, y0, x1, y1) in boxes:
+            assert -0.5 <= x0 and x1 <= width + 0.5 and -0.5 <= y0 and y1 <= height + 0.5, (
+                f"{name!r} at {(x0, y0, x1, y1)} outside the {width} x {height} figure")
+        for a, b in itertools.combinations(texts, 2):
+            assert not _overlap(a.box, b.box), (a.text, a.box, b.text, b.box)
 
 
 def test_axis_labels_clear_the_tick_labels_and_legends_beside_the_axes_clear_the_next(figures):
     for fig in _draw_all(figures, 0.2):
-        renderer = fig.canvas.get_renderer()
-        for ax in fig.axes:
-            ylabel = ax.yaxis.label.get_window_extent(renderer)
-            ticks = _drawn_tick_labels(ax.yaxis, renderer)
-            assert ticks and all(ylabel.x1 <= t.x0 for t in ticks), (ax.get_ylabel(), ylabel, ticks)
-            if ax.get_xlabel():
-                xlabel = ax.xaxis.label.get_window_extent(renderer)
-                ticks = _drawn_tick_labels(ax.xaxis, renderer)
-                assert ticks and all(xlabel.y1 <= t.y0 for t in ticks), (ax.get_xlabel(), xlabel, ticks)
-            legend = ax.get_legend()
-            if legend is not None:
-                box = legend.get_window_extent(renderer)
-                others = [o.get_window_extent(renderer) for o in fig.axes if o is not ax]
-                assert not any(box.overlaps(o) for o in others), (legend, box)
+        for ax in fig.flat():
+            texts = {role: [t.box for t in ax.texts if t.role == role] for role in ("xtick", "ytick", "xlabel", "ylabel")}
+            (ylabel,) = texts["ylabel"]
+            assert texts["ytick"] and all(ylabel[2] <= t[0] for t in texts["ytick"]), (ax.ylabel, ylabel)
+            if ax.xlabel:
+                (xlabel,) = texts["xlabel"]
+                assert texts["xtick"] and all(xlabel[1] >= t[3] for t in texts["xtick"]), (ax.xlabel, xlabel)
+            if ax.legend is not None:
+                assert not any(_overlap(ax.legend.box, other.box) for other in fig.flat() if other is not ax)
 
 
 @pytest.mark.parametrize("start_peak", [0.0, 0.2])
@@ -113,17 +109,18 @@ def test_every_stage_has_the_whole_run_and_the_window_scaled_to_it(figures, star
     outcome, gearbox = _outcome(start_peak)
     plots.plot_contact_forces(outcome, gearbox, WINDOW, "contact_forces.png")
     (fig,) = figures
-    assert len(fig.axes) == 6
-    stage1, zoom = fig.axes[0], fig.axes[1]
+    assert (fig.rows, fig.columns) == (3, 2)
+    stage1, zoom = fig.axes[0]
     # every sample's extremes are drawn: the envelope of stage 1's first curve spans the data
-    first = stage1.get_lines()[0].get_ydata()
+    first = stage1.lines[0].y
     assert first.max() == pytest.approx(outcome.values[:, 0].max() / 1e3)
     assert first.min() == pytest.approx(outcome.values[:, 0].min() / 1e3)
     inside = outcome.values[(T >= WINDOW[0]) & (T <= WINDOW[1]), :6] / 1e3  # stage 1's six meshes
-    low, high = zoom.get_ylim()
+    low, high = zoom.ylim
     pad = 0.08 * (inside.max() - inside.min())
     assert (low, high) == pytest.approx((inside.min() - pad, inside.max() + pad))  # the window's range, padded
-    assert zoom.get_xlim() == WINDOW
+    assert zoom.xlim == WINDOW
+    assert [t.value for t in zoom.xticks] == [10.0, 20.0, 30.0, 40.0, 50.0, 60.0]
     if start_peak:
         assert high - low < 0.5 * (first.max() - first.min())  # not squeezed by the start-up peak
 
@@ -135,21 +132,49 @@ def test_planet_meshes_with_identical_forces_are_drawn_once(figures, start_peak)
         outcome.values[:, i] = outcome.values[:, 3 * (i // 3)]
     plots.plot_contact_forces(outcome, gearbox, WINDOW, "contact_forces.png")
     (fig,) = figures
-    labels = [t.get_text() for t in fig.axes[len(fig.axes) // 3 - 1].get_legend().get_texts()]
-    assert "stage1.F_sp[1] (sun-planet) = [2], [3]" in labels and "stage1.F_rp[1] (ring-planet) = [2], [3]" in labels
+    zoom = fig.axes[0][1]
+    labels = [e.label for e in zoom.legend.entries]
+    assert labels == ["stage1.F_sp[1] (sun-planet) = [2], [3]", "stage1.F_rp[1] (ring-planet) = [2], [3]"]
+    assert [line.dashed for line in zoom.lines] == [False, True]
+    assert "drawn once, named '= [2], [3]'" in fig.suptitle.text
 
 
 def test_the_load_duration_bars_are_the_time_in_each_non_empty_bin(figures):
     ldds = _ldds()
     analysis_plots.plot_load_duration(ldds, "load_duration.png")
     (fig,) = figures
-    for ax, ld in zip(fig.axes, ldds):
-        (bars,) = ax.collections
-        tops = np.array([path.vertices[1:3, 1].max() for path in bars.get_paths()])
-        lefts = np.array([path.vertices[0, 0] for path in bars.get_paths()])
+    for (ax,), ld in zip(fig.axes, ldds):
+        (bars,) = ax.bars
         keep = ld.time_s > 0
-        np.testing.assert_allclose(tops, ld.time_s[keep])
-        np.testing.assert_allclose(lefts, ld.edges[:-1][keep] * 1e-3)
-        low, high = ax.get_ylim()
-        assert ax.get_yscale() == "log" and low < tops.min() and tops.max() < high
-        assert ax.get_xlabel() == f"{ld.name} [kN m]"
+        np.testing.assert_allclose(bars.top, ld.time_s[keep])
+        np.testing.assert_allclose(bars.left, ld.edges[:-1][keep] * 1e-3)
+        np.testing.assert_allclose(bars.right, ld.edges[1:][keep] * 1e-3)
+        low, high = ax.ylim
+        assert ax.yscale == "log" and low < bars.top.min() and bars.top.max() < high
+        assert [t.label for t in ax.yticks if t.major] == ["0.01", "0.1", "1"]
+        assert ax.xlabel == f"{ld.name} [kN m]"
+
+
+def test_the_run_figures_are_palette_pngs_drawn_without_matplotlib(tmp_path):
+    """The four figures in a fresh process: written as 8-bit palette PNGs at 110 dpi, matplotlib never imported."""
+    code = (f"import sys\nsys.path.insert(0, {str(Path(__file__).parent)!r})\nfrom pathlib import Path\n"
+            "import test_plots as t\nfrom orchestrator.run import analysis_plots, plots\n"
+            f"out = Path({str(tmp_path)!r})\noutcome, gearbox = t._outcome(0.2)\n"
+            "plots.plot_rotor_speed(outcome, 'wind.omega', t.WINDOW, out / 'rotor_speed.png')\n"
+            "plots.plot_generator_speed(outcome, 'wind.omega', 'generator.omega', 100.0, t.WINDOW,"
+            " out / 'generator_speed.png')\n"
+            "plots.plot_contact_forces(outcome, gearbox, t.WINDOW, out / 'contact_forces.png')\n"
+            "analysis_plots.plot_load_duration(t._ldds(), out / 'load_duration.png')\n"
+            "print('matplotlib' in sys.modules)")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.split() == ["False"]
+    from PIL import Image
+
+    sizes = {"rotor_speed": (1100, 440), "generator_speed": (1100, 660), "contact_forces": (1650, 968),
+             "load_duration": (1100, 847)}
+    for name, size in sizes.items():
+        with Image.open(tmp_path / f"{name}.png") as image:
+            assert (image.mode, image.size) == ("P", size)
+            assert image.info["dpi"] == pytest.approx((110, 110), abs=0.01)
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(f"{n}.png" for n in sizes)  # no temporary left
