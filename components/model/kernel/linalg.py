@@ -391,11 +391,10 @@ def _lu_solve_loop(lu, piv, lower, upper, b, out):
 
 #: the loops numba compiles in place of the numpy forms (see :mod:`components.compile.jit`)
 COMPILED = {"copy": _copy_loop, "matvec": _matvec_loop, "vecmat": _vecmat_loop, "vecmat_add": _vecmat_add_loop,
-            "axpy": _axpy_loop,
-            "axpy2": _axpy2_loop, "dot": _dot_loop, "subtract": _subtract_loop, "negate": _negate_loop,
-            "vecmat_sum": _vecmat_sum_loop, "matmul": _matmul_loop, "invert": _invert_loop,
-            "lu_factor": _lu_factor_loop, "lu_solve": _lu_solve_loop, "lu_pattern": _lu_pattern_loop, "sparse_vecmat": _sparse_vecmat_loop,
-            "matvec_pattern": _matvec_pattern_loop}
+            "axpy": _axpy_loop, "axpy2": _axpy2_loop, "dot": _dot_loop, "subtract": _subtract_loop,
+            "negate": _negate_loop, "vecmat_sum": _vecmat_sum_loop, "matmul": _matmul_loop, "invert": _invert_loop,
+            "lu_factor": _lu_factor_loop, "lu_solve": _lu_solve_loop, "lu_pattern": _lu_pattern_loop,
+            "sparse_vecmat": _sparse_vecmat_loop, "matvec_pattern": _matvec_pattern_loop}
 #: inlined into their callers by numba (no call boundary on the hot path)
-INLINE = ("copy", "matvec", "vecmat", "vecmat_add", "vecmat_sum", "axpy", "axpy2", "dot", "subtract", "negate", "sparse_vecmat",
-          "matvec_pattern")
+INLINE = ("copy", "matvec", "vecmat", "vecmat_add", "vecmat_sum", "axpy", "axpy2", "dot", "subtract", "negate",
+          "sparse_vecmat", "matvec_pattern")
