@@ -176,6 +176,9 @@ def main() -> int:
         print(f"  Gearbox of {args.baseline}, compiled             {per_step('baseline compiled')}")
     print("  recorded variables against the interpreted run's (largest difference relative to each variable's "
           "largest value): " + ", ".join(f"{name} {d:.1e}" for name, d in differences.items()))
+    if "baseline compiled" in recorded:
+        same = np.array_equal(recorded["compiled"], recorded["baseline compiled"])
+        print(f"  the compiled runs of today and of {args.baseline}: {'the same values to the bit' if same else 'differ'}")
     print("ratios (same process)")
     print(f"  interpreted / compiled                  {ratio('interpreted', 'compiled')}")
     if "baseline" in times:
