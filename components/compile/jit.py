@@ -12,9 +12,11 @@ module executes, its functions become numba dispatchers:
   first call, or loads it from the disk cache of :mod:`components.compile.numba_cache`);
   the names in the module's ``INLINE`` are inlined into their callers (``inline="always"``);
 * the module's ``COMPILED`` mapping (name -> function of the same module) replaces a function
-  written with numpy calls by the loop that numba compiles better (the linear-algebra
-  primitives of :mod:`components.model.kernel.linalg`: the interpreted kernel keeps numpy's
-  speed, the compiled one needs no BLAS).
+  written for the interpreter (numpy calls, or Python floats) by the loop that numba compiles
+  better (the linear-algebra primitives of :mod:`components.model.kernel.linalg`, the
+  integrator's vector updates, the contact law of every mesh, ...: the interpreted kernel runs
+  at numpy's speed instead of an operation per element, the compiled one needs no BLAS and no
+  temporaries).
 
 The relative imports of a later module then bind the dispatchers. Nothing else differs from
 the interpreted kernel, which is the same files imported normally.

@@ -15,19 +15,19 @@ from __future__ import annotations
 
 import math
 
-from .contact import contact_force, stiffness_sensitivity
-from .linalg import axpy, copy, sparse_vecmat
+import numpy as np
+
+from .contact import force_slopes, forces, stiffness_force_rates
+from .linalg import copy, sparse_vecmat, vecmat_add
 from .stiffness import stiffness_factors
 
 
 def deflections(y, n, nz_index, nz_value, a_port, offset, port, port_rate, out):
     """Mesh deflections [m] (row 0) and their rates [m/s] (row 1) of ``y = [q, v, ...]``, the port input and
     the constant offsets; every mesh row ``A`` through its nonzero columns (``nz_index``, ``nz_value``)."""
-    sparse_vecmat(y[:n], nz_index, nz_value, out[0])
-    sparse_vecmat(y[n:2 * n], nz_index, nz_value, out[1])
-    axpy(port, a_port, out[0])
-    axpy(port_rate, a_port, out[1])
-    axpy(1.0, offset, out[0])
+    sparse_vecmat(y[:2 * n].reshape(2, n), nz_index, nz_value, out)  # both rows at once (the numpy form)
+    out += np.multiply.outer((port, port_rate), a_port)
+    out[0] += offset
 
 
 def _deflections_loop(y, n, nz_index, nz_value, a_port, offset, port, port_rate, out):
@@ -82,8 +82,7 @@ def acceleration(y, port, port_rate, alpha, factor, nz_index, nz_value, a_port, 
     m = defl.shape[1]
     n2 = y.shape[0]
     deflections(y, n2 // 2, nz_index, nz_value, a_port, offset, port, port_rate, defl)
-    for i in range(m):
-        z[i] = contact_force(defl[0, i], defl[1, i], factor[i], contact[i])[0]
+    forces(defl, factor, contact, z[:m])
     copy(y, z[m:m + n2])
     z[m + n2] = port
     z[m + n2 + 1] = port_rate
@@ -100,11 +99,41 @@ def jacobian(y, port, port_rate, factor, a_port, offset, contact, defl, nz_index
     for padding); ``dv`` likewise with dF/d(rate) and ``S^T c S``.
     """
     n = dq.shape[0]
+    deflections(y, n, nz_index, nz_value, a_port, offset, port, port_rate, defl)
+    force_slopes(defl, factor, contact, fd, fv)
+    assemble_jacobian(fd, fv, nz_index, nz_value, a_port, cos_alpha, stks, stcs, stks_port, stcs_port, inv_m, dq, dv,
+                      port_jac)
+
+
+def assemble_jacobian(fd, fv, nz_index, nz_value, a_port, cos_alpha, stks, stcs, stks_port, stcs_port, inv_m, dq, dv,
+                      port_jac):
+    """:func:`jacobian`'s blocks from the meshes' dF/dd ``fd`` and dF/d(rate) ``fv``: every entry the springs' term
+    plus the meshes' in their order, times ``-1 / m`` of its row."""
+    dq[:, :] = stks
+    dv[:, :] = stcs
+    port_jac[0] = stks_port
+    port_jac[1] = stcs_port
+    valid = nz_index >= 0.0  # a mesh's bodies (padding at the end of its row)
+    pairs = valid[:, :, None] & valid[:, None, :]
+    index = nz_index.astype(np.intp)
+    rows = np.broadcast_to(index[:, :, None], pairs.shape)[pairs]  # in the loop's order: mesh, body, body
+    cols = np.broadcast_to(index[:, None, :], pairs.shape)[pairs]
+    bodies = index[valid]
+    for c, block, port_row in ((cos_alpha * fd, dq, port_jac[0]), (cos_alpha * fv, dv, port_jac[1])):
+        b = c[:, None] * nz_value
+        np.add.at(block, (rows, cols), (b[:, :, None] * nz_value[:, None, :])[pairs])  # in order, repeats too
+        np.add.at(port_row, bodies, (b * a_port[:, None])[valid])
+    s = -inv_m
+    dq *= s[:, None]
+    dv *= s[:, None]
+    port_jac *= s
+
+
+def _assemble_jacobian_loop(fd, fv, nz_index, nz_value, a_port, cos_alpha, stks, stcs, stks_port, stcs_port, inv_m, dq,
+                            dv, port_jac):
+    n = dq.shape[0]
     m = fd.shape[0]
     width = nz_index.shape[1]
-    deflections(y, n, nz_index, nz_value, a_port, offset, port, port_rate, defl)
-    for i in range(m):
-        _, fd[i], fv[i], _ = contact_force(defl[0, i], defl[1, i], factor[i], contact[i])
     for j in range(n):
         for col in range(n):
             dq[j, col] = stks[j, col]
@@ -144,15 +173,11 @@ def stiffness_rate(y, n, angle, speed, port, port_rate, nz_index, nz_value, a_po
     with the driver angle). Leaves the factors at ``angle`` in ``factor``."""
     stiffness_factors(angle, phasing, factor, slope)
     deflections(y, n, nz_index, nz_value, a_port, offset, port, port_rate, defl)
-    for i in range(sens.shape[0]):
-        sens[i] = stiffness_sensitivity(defl[0, i], defl[1, i], factor[i], contact[i]) * (slope[i] * speed)
-    for j in range(out.shape[0]):
-        s = 0.0
-        for i in range(sens.shape[0]):
-            s += sens[i] * force_rows[i, j]
-        out[j] += s
+    stiffness_force_rates(defl, factor, contact, slope, speed, sens)
+    vecmat_add(sens, force_rows, out)
 
 
-#: the one-pass loop numba compiles in place of the numpy form (see :mod:`components.compile.jit`)
-COMPILED = {"deflections": _deflections_loop}
+#: the loops numba compiles in place of the numpy forms (see :mod:`components.compile.jit`)
+COMPILED = {"deflections": _deflections_loop, "assemble_jacobian": _assemble_jacobian_loop}
+#: inlined into their callers by numba (the Jacobian's assembly is compiled once and called)
 INLINE = ("deflections", "acceleration")

@@ -53,7 +53,7 @@ from .layout import (
     JAC_MAX_AGE, JACOBIANS, MAX_STEPS, OK, OUT_KINEMATIC, OUT_RATE_INDEX, REJECTED, RTOL, STEP_TOO_SMALL,
     TOO_MANY_STEPS,
 )
-from .linalg import copy, invert, lu_factor, lu_pattern, lu_solve, matvec, matvec_pattern
+from .linalg import axpy, copy, invert, lu_factor, lu_pattern, lu_solve, matvec, matvec_pattern, negate, subtract
 from .motion import accel, jerk, rate, value
 from .stiffness import stiffness_factors
 
@@ -74,8 +74,7 @@ def factor(hd, dq, dv, ginv, piv):
     nonzero rows, see :func:`.linalg.lu_pattern`)."""
     n = dq.shape[0]
     g = -hd * dv - (hd * hd) * dq
-    for i in range(n):
-        g[i, i] += 1.0
+    g.reshape(-1)[::n + 1] += 1.0  # the diagonal
     if n > LU_ABOVE:
         ginv[:, :] = g
         lu_factor(ginv, piv[0])
@@ -116,6 +115,16 @@ def solve(ginv, piv, dq, dq_index, hd, r, out, work):
     ``dq_index``: the columns each row of ``dq`` can hold)."""
     n = dq.shape[0]
     matvec_pattern(dq, dq_index, r[:n], work)
+    work *= hd
+    work += r[n:]
+    apply_g(ginv, piv, work, out[n:])
+    np.multiply(out[n:], hd, out=out[:n])
+    out[:n] += r[:n]
+
+
+def _solve_loop(ginv, piv, dq, dq_index, hd, r, out, work):
+    n = dq.shape[0]
+    matvec_pattern(dq, dq_index, r[:n], work)
     for i in range(n):
         work[i] = r[n + i] + hd * work[i]
     apply_g(ginv, piv, work, out[n:])
@@ -127,8 +136,90 @@ def solve_lower(ginv, piv, hd, b, out):
     """``out = W^-1 [0, b]`` = ``[hd G^-1 b, G^-1 b]``."""
     n = ginv.shape[0]
     apply_g(ginv, piv, b, out[n:])
+    np.multiply(out[n:], hd, out=out[:n])
+
+
+def _solve_lower_loop(ginv, piv, hd, b, out):
+    n = ginv.shape[0]
+    apply_g(ginv, piv, b, out[n:])
     for i in range(n):
         out[i] = hd * out[n + i]
+
+
+def stage(k, w, y, c, out):
+    """``k += w``, then the stage's state ``out = y + c k`` (the stages of :func:`advance`)."""
+    k += w
+    np.multiply(k, c, out=out)
+    out += y
+
+
+def _stage_loop(k, w, y, c, out):
+    for i in range(k.shape[0]):
+        k[i] += w[i]
+        out[i] = y[i] + c * k[i]
+
+
+def third_rhs(fn, k2, f1, k1, f0, out):
+    """The third stage's right-hand side ``out = fn - e32 (k2 - f1) - 2 (k1 - f0)``."""
+    np.subtract(fn, E32 * (k2 - f1), out=out)
+    out -= 2.0 * (k1 - f0)
+
+
+def _third_rhs_loop(fn, k2, f1, k1, f0, out):
+    for i in range(out.shape[0]):
+        out[i] = fn[i] - E32 * (k2[i] - f1[i]) - 2.0 * (k1[i] - f0[i])
+
+
+def error_norm(k1, k2, k3, y, yn, n, atol_q, atol_v, rtol):
+    """``max |k1 - 2 k2 + k3| / (atol + rtol max(|y|, |yn|))`` (``atol_q`` on the first ``n`` entries, ``atol_v`` on
+    the rest); NaN where any entry is NaN."""
+    a, b = np.abs(y), np.abs(yn)
+    scale = np.where(b > a, b, a)  # Python's max(a, b) (np.maximum differs where one of them is NaN)
+    scale *= rtol
+    scale[:n] += atol_q
+    scale[n:] += atol_v
+    e = k1 + k3
+    e -= 2.0 * k2
+    np.abs(e, out=e)
+    e /= scale
+    return float(e.max())
+
+
+def _error_norm_loop(k1, k2, k3, y, yn, n, atol_q, atol_v, rtol):
+    err = 0.0
+    for i in range(k1.shape[0]):
+        atol = atol_q if i < n else atol_v
+        scale = atol + rtol * max(abs(y[i]), abs(yn[i]))
+        e = abs(k1[i] + k3[i] - 2.0 * k2[i]) / scale
+        if e > err or e != e:
+            err = e
+    return err
+
+
+def basis_terms(w_basis, c0, c1, c2, out):
+    """``out = c0 w_basis[0] + c1 w_basis[1] + c2 w_basis[2]``: the prescribed motions' part of ``h d W^-1 [0, f_t]``
+    from its basis (:func:`time_derivative_term`)."""
+    np.multiply(w_basis[0], c0, out=out)
+    out += w_basis[1] * c1
+    out += w_basis[2] * c2
+
+
+def _basis_terms_loop(w_basis, c0, c1, c2, out):
+    for i in range(out.shape[0]):
+        out[i] = w_basis[0, i] * c0 + w_basis[1, i] * c1 + w_basis[2, i] * c2
+
+
+def motion_terms(port_jac, kappa, port_rate, port_accel, jerk_, out):
+    """``out = port_jac[0] port_rate + port_jac[1] port_accel - kappa jerk_``: the prescribed motions' part of ``f_t``
+    (accelerations; :func:`time_derivative_term` with a time-varying mesh stiffness)."""
+    np.multiply(port_jac[0], port_rate, out=out)
+    out += port_jac[1] * port_accel
+    out -= kappa * jerk_
+
+
+def _motion_terms_loop(port_jac, kappa, port_rate, port_accel, jerk_, out):
+    for j in range(out.shape[0]):
+        out[j] = port_jac[0, j] * port_rate + port_jac[1, j] * port_accel - kappa[j] * jerk_
 
 
 def use_factorisation(hd, dq, dv, winvs, pivots, istate):
@@ -156,6 +247,15 @@ def use_factorisation(hd, dq, dv, winvs, pivots, istate):
 
 def twist_and_rate(twist_q, y, n, twist_port, port, tau):
     """Output-shaft twist [rad] and its rate [rad/s] at ``tau``: the weights on ``q`` and on ``v``, plus the port's."""
+    terms = np.empty((2, n + 1))
+    terms[0, 0] = twist_port * value(port, tau)
+    terms[1, 0] = twist_port * rate(port, tau)
+    np.multiply(y[:2 * n].reshape(2, n), twist_q[:n], out=terms[:, 1:])
+    twist, rate_ = np.add.accumulate(terms, 1)[:, -1].tolist()  # summed from the port's term on, as the loop
+    return twist, rate_
+
+
+def _twist_and_rate_loop(twist_q, y, n, twist_port, port, tau):
     twist = twist_port * value(port, tau)
     rate_ = twist_port * rate(port, tau)
     for i in range(n):
@@ -183,12 +283,12 @@ def time_derivative_term(k, y, t, h, hd, angle0, driver, port, winv, piv, w_basi
     """``h d W^-1 [0, f_t]`` into ``k.w_hdt``: the prescribed motions' part of the stages at local time ``t``
     (and the external loads', which move with the driver angle and speed)."""
     n = k.dq.shape[0]
-    n2 = 2 * n
     w_hdt = k.w_hdt
     n_ext = k.n_ext
     ext = k.fast[k.fast.shape[0] - n_ext:]  # the external rows (none without external loads)
     rates = k.w_ext[:n_ext]  # the time derivatives of the external terms
-    external_term_rates(angle0 + value(driver, t), rate(driver, t), accel(driver, t), k.load_rates, rates)
+    if n_ext:
+        external_term_rates(angle0 + value(driver, t), rate(driver, t), accel(driver, t), k.load_rates, rates)
     if not k.tvs:  # f_t = [port speed, port accel, driver jerk, external rates] @ [pj0; pj1; -kappa; external
         # rows]: W^-1 of the rows once per factorisation
         ist = k.istate
@@ -197,34 +297,25 @@ def time_derivative_term(k, y, t, h, hd, angle0, driver, port, winv, piv, w_basi
             solve_lower(winv, piv, hd, k.port_jac[0], w_basis[0])
             solve_lower(winv, piv, hd, k.port_jac[1], w_basis[1])
             solve_lower(winv, piv, hd, k.kappa, w_basis[2])
-            for i in range(n2):
-                w_basis[2, i] = -w_basis[2, i]
+            negate(w_basis[2])
             for r in range(n_ext):
                 if r != 1:  # the constant term has no rate
                     solve_lower(winv, piv, hd, ext[r], w_basis[3 + r])
             ist[SLOT_BASIS + active] = 1.0
-        c0 = hd * rate(port, t)
-        c1 = hd * accel(port, t)
-        c2 = hd * jerk(driver)
-        for i in range(n2):
-            w_hdt[i] = w_basis[0, i] * c0 + w_basis[1, i] * c1 + w_basis[2, i] * c2
+        basis_terms(w_basis, hd * rate(port, t), hd * accel(port, t), hd * jerk(driver), w_hdt)
         for r in range(n_ext):
             if r != 1:
-                c = hd * rates[r]
-                for i in range(n2):
-                    w_hdt[i] += w_basis[3 + r, i] * c
+                axpy(hd * rates[r], w_basis[3 + r], w_hdt)
         return
     pr = rate(port, t)
     pa = accel(port, t)
     jk = jerk(driver)
     da = k.da
-    for j in range(n):
-        da[j] = k.port_jac[0, j] * pr + k.port_jac[1, j] * pa - k.kappa[j] * jk
+    motion_terms(k.port_jac, k.kappa, pr, pa, jk, da)
     stiffness_rate(y, n, angle0 + value(driver, t), rate(driver, t), value(port, t), pr, k.nz_index, k.nz_value,
                    k.a_port, k.offset, k.contact, k.phasing, k.force_rows, k.factor, k.slope, k.defl, k.sens, da)
     for r in range(n_ext):
-        for j in range(n):
-            da[j] += rates[r] * ext[r, j]
+        axpy(rates[r], ext[r], da)
     da *= hd
     solve_lower(winv, piv, hd, da, w_hdt)
 
@@ -269,7 +360,6 @@ def advance(k, y, t_end, alpha_shift, driver, port, angle0, twist_q, twist_port)
         trapezoid per accepted step; 0 on failure). On failure the state is as it was.
     """
     n = k.dq.shape[0]
-    n2 = 2 * n
     m = k.last_force.shape[0]
     ist = k.istate
     control = k.control
@@ -294,9 +384,9 @@ def advance(k, y, t_end, alpha_shift, driver, port, angle0, twist_q, twist_port)
     if large and 0.0 < ist[H_FIRST] < h:  # the transient the new inputs start at a communication point: the first
         h = ist[H_FIRST]  # step the last one allowed (else the proposal from the smooth end of the step is rejected)
     first_rejected = False
-    for i in range(n):
-        f0[i] = y[n + i]
-        f0[n + i] = k.last_acc[i] + k.kappa[i] * alpha_shift
+    copy(y[n:], f0[:n])
+    copy(k.last_acc, f0[n:])
+    axpy(alpha_shift, k.kappa, f0[n:])
     # time, output-shaft twist and its rate at the last accepted internal step, and the twist's integral so far
     twist_t = 0.0
     twist_a, twist_r = twist_and_rate(twist_q, y, n, twist_port, port, 0.0)
@@ -323,29 +413,16 @@ def advance(k, y, t_end, alpha_shift, driver, port, angle0, twist_q, twist_port)
             w_basis = k.w_bases[active]
         time_derivative_term(k, y, t, h, hd, angle0, driver, port, winv, piv, w_basis)
         solve(winv, piv, k.dq, k.jac_index, hd, f0, k1, k.sol)
-        for i in range(n2):
-            k1[i] += w_hdt[i]
-            y1[i] = y[i] + (0.5 * h) * k1[i]
+        stage(k1, w_hdt, y, 0.5 * h, y1)
         evaluate(k, y1, t + 0.5 * h, angle0, driver, port, f1)
-        for i in range(n2):
-            rhs[i] = f1[i] - k1[i]
+        subtract(f1, k1, rhs)
         solve(winv, piv, k.dq, k.jac_index, hd, rhs, k2, k.sol)
-        for i in range(n2):
-            k2[i] += k1[i]
-            yn[i] = y[i] + h * k2[i]
+        stage(k2, k1, y, h, yn)
         evaluate(k, yn, t + h, angle0, driver, port, fn)
-        for i in range(n2):
-            rhs[i] = fn[i] - E32 * (k2[i] - f1[i]) - 2.0 * (k1[i] - f0[i])
+        third_rhs(fn, k2, f1, k1, f0, rhs)
         solve(winv, piv, k.dq, k.jac_index, hd, rhs, k3, k.sol)
-        err = 0.0
-        for i in range(n2):
-            k3[i] += w_hdt[i]
-            atol = atol_q if i < n else atol_v
-            scale = atol + rtol * max(abs(y[i]), abs(yn[i]))
-            e = abs(k1[i] + k3[i] - 2.0 * k2[i]) / scale
-            if e > err or e != e:
-                err = e
-        err = (h / 6.0) * err
+        axpy(1.0, w_hdt, k3)
+        err = (h / 6.0) * error_norm(k1, k2, k3, y, yn, n, atol_q, atol_v, rtol)
         if not math.isfinite(err):
             err = math.inf
         # ---- step control
@@ -413,5 +490,8 @@ def advance(k, y, t_end, alpha_shift, driver, port, angle0, twist_q, twist_port)
 
 
 #: the loops numba compiles in place of the numpy forms (see :mod:`components.compile.jit`)
-COMPILED = {"factor": _factor_loop}
-INLINE = ("twist_and_rate", "evaluate", "time_derivative_term", "refresh_jacobian", "advance")
+COMPILED = {"factor": _factor_loop, "solve": _solve_loop, "solve_lower": _solve_lower_loop,
+            "twist_and_rate": _twist_and_rate_loop, "stage": _stage_loop, "third_rhs": _third_rhs_loop,
+            "error_norm": _error_norm_loop, "basis_terms": _basis_terms_loop, "motion_terms": _motion_terms_loop}
+INLINE = ("twist_and_rate", "evaluate", "time_derivative_term", "refresh_jacobian", "advance", "stage", "third_rhs",
+          "error_norm", "basis_terms", "motion_terms")

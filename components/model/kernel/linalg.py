@@ -3,11 +3,18 @@
 Each is written once with numpy calls (what the interpreted kernel runs) and once as the loop
 numba compiles without BLAS or LAPACK (``COMPILED``; :mod:`components.compile.jit` swaps them
 in). Both perform the same floating-point operations in the same order - the products summed
-from the first term on, as the loops do (``np.cumsum``, not BLAS, whose blocked sums differ in
-the last bits) - so the interpreted and the compiled kernel compute the same numbers.
+from the first term on, as the loops do (``np.add.accumulate``, not BLAS nor ``np.sum``, whose
+blocked or pairwise sums differ in the last bits) - so the interpreted and the compiled kernel
+compute the same numbers. A loop's sum starts from ``0.0`` and is never ``-0.0``; the numpy forms
+store their sums plus ``0.0`` (:func:`_sums`), so an all-zero sum has the loop's sign too. A numpy
+form may add terms that the loop skips because they are exactly zero (a product over a pattern
+summed densely, the padding of a sparse row): adding ``+-0`` changes a sum at most in the sign of
+a zero, which the stored ``+ 0.0`` settles.
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 
@@ -17,25 +24,36 @@ def copy(src, dst):
     dst[:] = src
 
 
+def _sums(terms, out):
+    """``out = sum of terms`` along the last axis, from the first term on (numpy's ``add.accumulate`` adds in
+    order, unlike ``sum``), stored plus ``0.0``: with the sign a loop's sum has (never ``-0.0``)."""
+    np.add(np.add.accumulate(terms, -1)[..., -1], 0.0, out=out)
+
+
 def matvec(w, x, out):
     """``out = w @ x``."""
-    out[:] = np.cumsum(w * x, axis=1)[:, -1]
+    _sums(w * x, out)
 
 
 def vecmat(x, w, out):
     """``out = x @ w``."""
-    out[:] = np.cumsum(x[:, None] * w, axis=0)[-1]
+    _sums((x[:, None] * w).T, out)
 
 
 def matmul(a, b, out):
     """``out = a @ b``."""
-    out[:] = np.cumsum(a[:, :, None] * b[None, :, :], axis=1)[:, -1, :]
+    _sums(a[:, None, :] * b.T[None, :, :], out)
+
+
+def vecmat_add(x, w, out):
+    """``out += x @ w`` (each column's sum from the first term on, then added)."""
+    out += np.add.accumulate((x[:, None] * w).T, -1)[..., -1] + 0.0
 
 
 def vecmat_sum(a, wa, b, wb, tail, wt, out):
     """``out = a @ wa + b @ wb + tail @ wt``: the product of ``[a, b, tail] @ [wa; wb; wt]`` without joining them,
     summed from the first term of ``a`` to the last of ``tail``."""
-    out[:] = np.cumsum(np.concatenate((a[:, None] * wa, b[:, None] * wb, tail[:, None] * wt)), axis=0)[-1]
+    _sums(np.concatenate((a[:, None] * wa, b[:, None] * wb, tail[:, None] * wt)).T, out)
 
 
 def axpy(alpha, x, y):
@@ -43,45 +61,79 @@ def axpy(alpha, x, y):
     y += alpha * x
 
 
+def axpy2(alpha, x, beta, w, y):
+    """``y += alpha x + beta w``."""
+    y += alpha * x + beta * w
+
+
+def dot(x, y):
+    """``x . y``, summed from the first term on."""
+    if x.shape[0] == 0:
+        return 0.0
+    return float(np.add.accumulate(x * y)[-1]) + 0.0
+
+
+def subtract(a, b, out):
+    """``out = a - b``."""
+    np.subtract(a, b, out=out)
+
+
+def negate(x):
+    """``x = -x``."""
+    np.negative(x, out=x)
+
+
 def matvec_pattern(w, index, x, out):
     """``out = w @ x`` over the nonzero pattern of ``w`` only: ``out[i] = sum_p w[i, index[i, p]] x[index[i, p]]``
-    (``index < 0``: padding), summed from the first."""
-    idx = index.astype(np.int64)
-    valid = idx >= 0
-    safe = np.where(valid, idx, 0)
-    terms = np.where(valid, np.take_along_axis(w, safe, axis=1) * x[safe], 0.0)
-    out[:] = np.cumsum(terms, axis=1)[:, -1] if terms.shape[1] else 0.0
+    (``index``: ascending, ``< 0`` padding), summed from the first; ``w`` is zero outside the pattern.
+
+    The numpy form sums whole rows (:func:`matvec`) where ``x`` is finite: the terms outside the pattern are zero.
+    """
+    if all(map(math.isfinite, x.tolist())):
+        matvec(w, x, out)
+        return
+    valid = index >= 0.0
+    safe = np.where(valid, index, 0.0).astype(np.intp)
+    _sums(np.where(valid, np.take_along_axis(w, safe, 1) * x[safe], 0.0), out)
 
 
 def sparse_vecmat(x, index, value, out):
     """``out = x @ w`` for a sparse ``w`` held by columns: ``out[j] = sum_p x[index[j, p]] value[j, p]`` over the
-    nonzero rows of column ``j`` in ascending order (``index < 0``: padding), summed from the first."""
-    idx = index.astype(np.int64)
-    valid = idx >= 0
-    terms = np.where(valid, x[np.where(valid, idx, 0)] * value, 0.0)
-    out[:] = np.cumsum(terms, axis=1)[:, -1] if terms.shape[1] else 0.0
+    nonzero rows of column ``j`` in ascending order (``index < 0``: padding, its ``value`` 0), summed from the
+    first.
+
+    The numpy form also takes a stack of vectors, ``x`` of shape (k, len) and ``out`` (k, columns).
+    """
+    terms = x.take(index.astype(np.intp), -1)
+    terms *= value  # a padding term is x[..., -1] * 0: zero where that is finite
+    last = x[..., -1]
+    if not (math.isfinite(last) if x.ndim == 1 else all(map(math.isfinite, last.tolist()))):
+        terms = np.where(index >= 0.0, terms, 0.0)
+    _sums(terms, out)
 
 
 def invert(g, out):
-    """``out = g^-1`` by Gauss-Jordan elimination with partial pivoting (``g`` is overwritten)."""
+    """``out = g^-1`` by Gauss-Jordan elimination with partial pivoting (``g`` is overwritten).
+
+    The numpy form eliminates on ``[g, I]`` (each row operation once on both halves, the rows whose
+    factor is zero left alone, as the loop does).
+    """
     n = g.shape[0]
-    out[:] = 0.0
-    for i in range(n):
-        out[i, i] = 1.0
+    aug = np.zeros((n, 2 * n))
+    aug[:, :n] = g
+    aug.reshape(-1)[n::2 * n + 1] = 1.0  # the identity on the right
     for col in range(n):
-        pivot = col + int(np.argmax(np.abs(g[col:, col])))
+        f = aug[:, col]
+        pivot = col + int(np.abs(f[col:]).argmax())
         if pivot != col:
-            g[[col, pivot]] = g[[pivot, col]]
-            out[[col, pivot]] = out[[pivot, col]]
-        inv_p = 1.0 / float(g[col, col])  # a zero pivot raises ZeroDivisionError, as in the compiled form
-        g[col] *= inv_p
-        out[col] *= inv_p
-        f = g[:, col].copy()
-        f[col] = 0.0
-        rows = np.flatnonzero(f)
-        if rows.size:
-            g[rows] -= np.outer(f[rows], g[col])
-            out[rows] -= np.outer(f[rows], out[col])
+            aug[[col, pivot]] = aug[[pivot, col]]
+        row = aug[col]
+        row *= 1.0 / float(row[col])  # a zero pivot raises ZeroDivisionError, as in the compiled form
+        rows = f != 0.0
+        rows[col] = False
+        np.subtract(aug, f[:, None] * row, out=aug, where=rows[:, None])
+    g[:] = aug[:, :n]
+    out[:] = aug[:, n:]
     return out
 
 
@@ -90,47 +142,45 @@ def lu_factor(a, piv):
     ``a``; ``U`` on and above it), the row swapped with row ``k`` in ``piv[k]`` (as a float)."""
     n = a.shape[0]
     for k in range(n):
-        p = k + int(np.argmax(np.abs(a[k:, k])))
+        p = k + int(np.abs(a[k:, k]).argmax())
         piv[k] = p
         if p != k:
             a[[k, p]] = a[[p, k]]
-        inv_p = 1.0 / float(a[k, k])  # a zero pivot raises ZeroDivisionError, as in the compiled form
-        a[k + 1:, k] *= inv_p
         f = a[k + 1:, k]
-        rows = np.flatnonzero(f)
-        if rows.size:
-            a[k + 1 + rows, k + 1:] -= np.outer(f[rows], a[k, k + 1:])
+        f *= 1.0 / float(a[k, k])  # a zero pivot raises ZeroDivisionError, as in the compiled form
+        rest = a[k + 1:, k + 1:]  # the rows whose factor is zero left alone, as the loop does
+        np.subtract(rest, f[:, None] * a[k, k + 1:], out=rest, where=(f != 0.0)[:, None])
 
 
 def lu_pattern(lu, lower, upper):
     """The nonzero rows of every column of ``L`` (below the diagonal, ascending) into ``lower`` and of ``U`` (above
     it, ascending) into ``upper``, padded with -1: what :func:`lu_solve` visits."""
     n = lu.shape[0]
-    lower[:] = -1.0
-    upper[:] = -1.0
-    for j in range(n):
-        below = np.flatnonzero(lu[j + 1:, j]) + j + 1
-        above = np.flatnonzero(lu[:j, j])
-        lower[j, :below.size] = below
-        upper[j, :above.size] = above
+    rows = np.arange(n)
+    nonzero = lu.T != 0.0  # [column, row]
+    for side, out in ((rows[None, :] > rows[:, None], lower), (rows[None, :] < rows[:, None], upper)):
+        found = np.where(nonzero & side, rows[None, :], n)
+        found.sort(axis=1)  # each column's rows to the front, ascending; n (none) behind them
+        out[:] = np.where(found < n, found, -1)
 
 
 def lu_solve(lu, piv, lower, upper, b, out):
     """``out = a^-1 b`` from :func:`lu_factor`'s ``lu`` and ``piv``: column-oriented substitutions over the nonzero
-    rows of each column (:func:`lu_pattern`'s ``lower`` and ``upper``)."""
+    rows of each column (:func:`lu_pattern`'s ``lower`` and ``upper``; the numpy form finds them in ``lu``)."""
     n = lu.shape[0]
     out[:] = b
-    for k in range(n):
-        p = int(piv[k])
+    for k, p in enumerate(piv.astype(np.intp).tolist()):
         if p != k:
             out[k], out[p] = out[p], out[k]
-    for j in range(n):
-        rows = lower[j][lower[j] >= 0.0].astype(np.int64)
-        out[rows] -= lu[rows, j] * out[j]
+    for j in range(n - 1):
+        column = lu[j + 1:, j]
+        below = out[j + 1:]
+        np.subtract(below, column * out[j], out=below, where=column != 0.0)
     for j in range(n - 1, -1, -1):
         out[j] = out[j] / lu[j, j]
-        rows = upper[j][upper[j] >= 0.0].astype(np.int64)
-        out[rows] -= lu[rows, j] * out[j]
+        column = lu[:j, j]
+        above = out[:j]
+        np.subtract(above, column * out[j], out=above, where=column != 0.0)
 
 
 # ---------------------------------------------------------------- the compiled forms
@@ -165,6 +215,14 @@ def _matmul_loop(a, b, out):
             out[i, j] = s
 
 
+def _vecmat_add_loop(x, w, out):
+    for j in range(out.shape[0]):
+        s = 0.0
+        for i in range(x.shape[0]):
+            s += x[i] * w[i, j]
+        out[j] += s
+
+
 def _vecmat_sum_loop(a, wa, b, wb, tail, wt, out):
     for j in range(out.shape[0]):
         s = 0.0
@@ -180,6 +238,28 @@ def _vecmat_sum_loop(a, wa, b, wb, tail, wt, out):
 def _axpy_loop(alpha, x, y):
     for i in range(x.shape[0]):
         y[i] += alpha * x[i]
+
+
+def _axpy2_loop(alpha, x, beta, w, y):
+    for i in range(x.shape[0]):
+        y[i] += alpha * x[i] + beta * w[i]
+
+
+def _dot_loop(x, y):
+    s = 0.0
+    for i in range(x.shape[0]):
+        s += x[i] * y[i]
+    return s
+
+
+def _subtract_loop(a, b, out):
+    for i in range(out.shape[0]):
+        out[i] = a[i] - b[i]
+
+
+def _negate_loop(x):
+    for i in range(x.shape[0]):
+        x[i] = -x[i]
 
 
 def _matvec_pattern_loop(w, index, x, out):
@@ -310,9 +390,11 @@ def _lu_solve_loop(lu, piv, lower, upper, b, out):
 
 
 #: the loops numba compiles in place of the numpy forms (see :mod:`components.compile.jit`)
-COMPILED = {"copy": _copy_loop, "matvec": _matvec_loop, "vecmat": _vecmat_loop, "axpy": _axpy_loop,
-            "vecmat_sum": _vecmat_sum_loop, "matmul": _matmul_loop, "invert": _invert_loop,
-            "lu_factor": _lu_factor_loop, "lu_solve": _lu_solve_loop, "lu_pattern": _lu_pattern_loop, "sparse_vecmat": _sparse_vecmat_loop,
-            "matvec_pattern": _matvec_pattern_loop}
+COMPILED = {"copy": _copy_loop, "matvec": _matvec_loop, "vecmat": _vecmat_loop, "vecmat_add": _vecmat_add_loop,
+            "axpy": _axpy_loop, "axpy2": _axpy2_loop, "dot": _dot_loop, "subtract": _subtract_loop,
+            "negate": _negate_loop, "vecmat_sum": _vecmat_sum_loop, "matmul": _matmul_loop, "invert": _invert_loop,
+            "lu_factor": _lu_factor_loop, "lu_solve": _lu_solve_loop, "lu_pattern": _lu_pattern_loop,
+            "sparse_vecmat": _sparse_vecmat_loop, "matvec_pattern": _matvec_pattern_loop}
 #: inlined into their callers by numba (no call boundary on the hot path)
-INLINE = ("copy", "matvec", "vecmat", "vecmat_sum", "axpy", "sparse_vecmat", "matvec_pattern")
+INLINE = ("copy", "matvec", "vecmat", "vecmat_add", "vecmat_sum", "axpy", "axpy2", "dot", "subtract", "negate",
+          "sparse_vecmat", "matvec_pattern")

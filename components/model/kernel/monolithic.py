@@ -86,6 +86,10 @@ def contact_forces_many(d, rate, factor, contact, force, d_force_d_deflection, d
 
 def stiffness_factors_many(angles, phasing, factor, slope):
     """Mesh stiffness multipliers and slopes at many driver angles: ``factor``, ``slope`` of shape (N, n_mesh)."""
+    stiffness_factors(angles[:, None], phasing, factor, slope)  # the numpy form, at every angle at once
+
+
+def _stiffness_factors_many_loop(angles, phasing, factor, slope):
     for s in range(angles.shape[0]):
         stiffness_factors(angles[s], phasing, factor[s], slope[s])
 
@@ -98,3 +102,7 @@ def regularised_many(d, contact, d_bl, d_bl_prime, d_bl_second):
             d_bl[s, i] = a
             d_bl_prime[s, i] = b
             d_bl_second[s, i] = c
+
+
+#: the loop numba compiles in place of the numpy form (see :mod:`components.compile.jit`)
+COMPILED = {"stiffness_factors_many": _stiffness_factors_many_loop}

@@ -36,7 +36,7 @@ from .layout import (
     S_TWIST_PORT, SCALARS, SENS, SLOPE, SOL, STATE_FIRST, STATE_LAST, STCS, STCS_PORT, STKS, STKS_PORT, TWIST_Q, W_BASES,
     W_EXT, W_HDT, WINVS, Y, Y1, YN, Z, ALPHA_OUT_MAX,
 )
-from .linalg import copy, sparse_vecmat
+from .linalg import axpy2, copy, dot, sparse_vecmat
 from .motion import accel, fit, linear_target, taylor_target
 from .statics import static_deflection
 from .stiffness import stiffness_factors
@@ -64,8 +64,29 @@ def matrix(buf, lay, slot, rows):
     return v.reshape((rows, v.shape[0] // rows))
 
 
+#: buffers whose views the interpreted :func:`views` keeps, at most (the least recently made dropped first)
+KEPT_VIEWS = 8
+_kept_views: dict = {}
+
+
 def views(buf, lay, dims):
-    """The :class:`Gearbox` views of a buffer."""
+    """The :class:`Gearbox` views of a buffer.
+
+    The numpy form keeps the views it made for the last :data:`KEPT_VIEWS` buffers, by the identity of the
+    buffer and its offset and size tables (a model steps one buffer with the same tables every time: making
+    the ~60 views costs ~15 us, 4 % of an interpreted step). A kept entry holds those objects, so the identity
+    of no other can be mistaken for theirs; the tables are never changed in place.
+    """
+    key = (id(buf), id(lay), id(dims))
+    kept = _kept_views.get(key)
+    if kept is None:
+        if len(_kept_views) >= KEPT_VIEWS:
+            del _kept_views[next(iter(_kept_views))]
+        kept = _kept_views[key] = (buf, lay, dims, _views_loop(buf, lay, dims))
+    return kept[3]
+
+
+def _views_loop(buf, lay, dims):
     n = dims[D_N]
     m = dims[D_M]
     n2 = 2 * n
@@ -108,10 +129,8 @@ def outputs(buf, lay, dims):
     z = vector(buf, lay, Z)
     y = vector(buf, lay, Y)
     force = vector(buf, lay, LAST_FORCE)
-    for i in range(m):
-        z[i] = force[i]
-    for i in range(2 * n):
-        z[m + i] = y[i]
+    copy(force, z[:m])
+    copy(y, z[m:m + 2 * n])
     z[m + 2 * n] = sc[S_PORT_ANGLE]
     z[m + 2 * n + 1] = sc[S_PORT_SPEED]
     z[m + 2 * n + 2] = sc[S_DRIVER_SPEED]
@@ -240,9 +259,8 @@ def gearbox_step(buf, lay, dims, t, h, omega_rotor, phi_rotor, omega_gen, phi_ge
         d_torque = port0 - sc[S_PORT_ANGLE]
         anchor[0] = y[n + gdof]
         y[n + gdof] += dv
-        for j in range(n):
-            anchor[1 + j] = last_acc[j]
-            last_acc[j] += dv * k.fast[m + n + gdof, j] + d_torque * k.fast[m + 2 * n, j]
+        copy(last_acc, anchor[1:])
+        axpy2(dv, k.fast[m + n + gdof], d_torque, k.fast[m + 2 * n], last_acc)
     twist_start = sc[S_OUTPUT_TWIST]
     speed_start = out_kin * sc[S_DRIVER_SPEED] + y[out_idx]
     twist_q = vector(buf, lay, TWIST_Q)
@@ -251,8 +269,7 @@ def gearbox_step(buf, lay, dims, t, h, omega_rotor, phi_rotor, omega_gen, phi_ge
     if status != OK:
         if gdof >= 0:  # undo the re-anchoring (advance restored the state it was given)
             y[n + gdof] = anchor[0]
-            for j in range(n):
-                last_acc[j] = anchor[1 + j]
+            copy(anchor[1:], last_acc)
         return status, tau, h_fail, err
     sc[S_TIME] = t + h
     sc[S_DRIVER_ANGLE] = angle1
@@ -264,10 +281,7 @@ def gearbox_step(buf, lay, dims, t, h, omega_rotor, phi_rotor, omega_gen, phi_ge
     sc[S_LAST_OMEGA_ROTOR] = omega_rotor
     sc[S_LAST_OMEGA_GEN] = omega_gen
     sc[S_LAST_STEP] = h
-    twist_end = 0.0
-    for i in range(2 * n):
-        twist_end += twist_q[i] * y[i]
-    twist_end += sc[S_TWIST_PORT] * port1
+    twist_end = dot(twist_q, y) + sc[S_TWIST_PORT] * port1
     sc[S_OUTPUT_TWIST] = twist_end
     # (1/h) int T dt = k mean(twist) + c (twist_end - twist_start) / h: conserves the exchanged impulse
     sc[S_SHAFT_TORQUE_AVG] = sc[S_SHAFT_K] * twist_integral / h + sc[S_SHAFT_C] * (twist_end - twist_start) / h
@@ -280,6 +294,8 @@ def gearbox_step(buf, lay, dims, t, h, omega_rotor, phi_rotor, omega_gen, phi_ge
     return OK, tau, h, 0.0
 
 
+#: the loop numba compiles in place of the numpy form (see :mod:`components.compile.jit`)
+COMPILED = {"views": _views_loop}
 INLINE = ("vector", "matrix", "views", "external")
 #: entry points of the ahead-of-time compiled module (:mod:`components.compile.aot`) and their signatures
 AOT_EXPORTS = {

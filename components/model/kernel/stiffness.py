@@ -10,6 +10,8 @@ and the smootherstep argument ``s = clip((p/2 - |y|) / w + 1/2, 0, 1)``:
 
 from __future__ import annotations
 
+import numpy as np
+
 from .contact import sign
 
 #: rows of the phasing table: mesh cycles per driver radian, cycle at theta = 0 (shifted), p/2, 1/w, v, v p,
@@ -19,7 +21,19 @@ N_PHASING_ROWS = 7
 
 
 def stiffness_factors(angle, phasing, out_factor, out_slope):
-    """Multiplier [-] and its derivative by the driver angle [1/rad] of every mesh at driver angle ``angle`` [rad]."""
+    """Multiplier [-] and its derivative by the driver angle [1/rad] of every mesh at driver angle ``angle`` [rad].
+
+    The numpy form also takes a column of angles (shape (N, 1); the outputs (N, n_mesh)).
+    """
+    y = np.remainder(phasing[CYCLE0] + phasing[CYCLES_PER_RAD] * angle, 1.0) - 0.5  # Python's float % (the loop's)
+    s = np.minimum(np.maximum((phasing[HALF_P] - np.abs(y)) * phasing[INV_W] + 0.5, 0.0), 1.0)
+    s2 = s * s
+    out_factor[...] = 1.0 - phasing[VP] + phasing[VARIATION] * (s2 * s * (s * (6.0 * s - 15.0) + 10.0))
+    u = s - s2
+    out_slope[...] = phasing[SLOPE_SCALE] * (np.sign(y) + 0.0) * (u * u)  # + 0.0: sign(-0.0) is 0.0, as sign()'s
+
+
+def _stiffness_factors_loop(angle, phasing, out_factor, out_slope):
     for i in range(out_factor.shape[0]):
         y = (phasing[CYCLE0, i] + phasing[CYCLES_PER_RAD, i] * angle) % 1.0 - 0.5
         s = min(max((phasing[HALF_P, i] - abs(y)) * phasing[INV_W, i] + 0.5, 0.0), 1.0)
@@ -27,3 +41,7 @@ def stiffness_factors(angle, phasing, out_factor, out_slope):
         out_factor[i] = 1.0 - phasing[VP, i] + phasing[VARIATION, i] * (s2 * s * (s * (6.0 * s - 15.0) + 10.0))
         u = s - s2  # s (1 - s): the smootherstep's slope vanishes outside the ramps
         out_slope[i] = phasing[SLOPE_SCALE, i] * sign(y) * (u * u)
+
+
+#: the loop numba compiles in place of the numpy form (see :mod:`components.compile.jit`)
+COMPILED = {"stiffness_factors": _stiffness_factors_loop}
