@@ -64,7 +64,7 @@ def matrix(buf, lay, slot, rows):
     return v.reshape((rows, v.shape[0] // rows))
 
 
-#: buffers whose views the interpreted :func:`views` keeps, at most (the least recently made dropped first)
+#: buffers whose views the interpreted :func:`views` keeps, at most (all are dropped when one more is asked for)
 KEPT_VIEWS = 8
 _kept_views: dict = {}
 
@@ -72,16 +72,17 @@ _kept_views: dict = {}
 def views(buf, lay, dims):
     """The :class:`Gearbox` views of a buffer.
 
-    The numpy form keeps the views it made for the last :data:`KEPT_VIEWS` buffers, by the identity of the
+    The numpy form keeps the views it made for up to :data:`KEPT_VIEWS` buffers, by the identity of the
     buffer and its offset and size tables (a model steps one buffer with the same tables every time: making
     the ~60 views costs ~15 us, 4 % of an interpreted step). A kept entry holds those objects, so the identity
-    of no other can be mistaken for theirs; the tables are never changed in place.
+    of no other can be mistaken for theirs; the tables are never changed in place. Its dict operations are each
+    atomic, so FMUs stepped in threads of one process (a host's) may share it.
     """
     key = (id(buf), id(lay), id(dims))
     kept = _kept_views.get(key)
     if kept is None:
         if len(_kept_views) >= KEPT_VIEWS:
-            del _kept_views[next(iter(_kept_views))]
+            _kept_views.clear()
         kept = _kept_views[key] = (buf, lay, dims, _views_loop(buf, lay, dims))
     return kept[3]
 

@@ -237,7 +237,7 @@ def test_the_interpreted_views_are_kept_per_buffer():
     assert np.shares_memory(kept.state, tables[0][0])
     others = [step.views(*t) for t in tables[1:]]
     assert all(not np.shares_memory(k.state, tables[0][0]) for k in others)
-    again = step.views(*tables[0])  # dropped for the later ones, made anew from the same buffer
+    again = step.views(*tables[0])  # dropped when more were asked for, made anew from the same buffer
     assert again is not kept and all(_same(a, b) for a, b in zip(again[:-2], kept[:-2]))
     copy_of_tables = (tables[0][0], list(tables[0][1]), list(tables[0][2]))
     assert step.views(*copy_of_tables) is not again  # equal tables in other objects: views made for them
