@@ -111,7 +111,8 @@ def ensure_compiled_kernels(report: Callable[[str], None] | None = None, retry: 
 def _in_background(todo: list[AotKernel], report: Callable[[str], None] | None) -> str:
     """The build of ``todo`` in the background (started, or already running), and this process's kernels interpreted."""
     running = background_builder()
-    pid = running if running is not None else build_in_background(todo)
+    # compiling once this command has ended (or after a while): a short first run has the machine to itself
+    pid = running if running is not None else build_in_background(todo, after=os.getpid())
     if pid is None:  # numba missing or an unwritable cache: numba compiles them just in time, as before
         return "the kernels could not be compiled in the background"
     os.environ[JIT_VARIABLE] = "0"  # compiling them just in time now would cost as much as the build

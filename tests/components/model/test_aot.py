@@ -214,6 +214,29 @@ def test_a_background_build_is_one_detached_builder_that_records_what_it_did(tmp
     assert log.count("not built") == 1 and "no_such_provider" in log and "done in" in log
 
 
+def test_a_builder_started_after_a_command_holds_the_mark_at_once_and_compiles_once_the_command_ended(
+        tmp_path, monkeypatch):
+    """The first run's builder (``after`` = the run's pid) leaves the machine to the run while it lasts."""
+    import os
+    import time
+
+    monkeypatch.setenv("DTCOSIM_CACHE_DIR", str(tmp_path))
+    fake = AotKernel("_dtcosim_test_kernel_0123456789abcdef", "components.model.kernel:no_such_provider")
+    command = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(1.5)"])
+    builder = aot.build_in_background([fake], after=command.pid)
+    deadline = time.monotonic() + 10
+    while aot.background_builder() is None and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert aot.background_builder() == builder  # the mark is there while it waits: no second builder starts
+    assert aot.failed_before(fake) is None  # nothing compiled (nor failed) while the command runs
+    command.wait()
+    os.waitpid(builder, 0)
+    log = aot.build_log().read_text()
+    waited = float(log.split("waited ")[1].split(" s")[0])
+    assert 0.5 < waited < aot.WAIT_FOR_STARTER_S and f"for pid {command.pid} to end" in log
+    assert "no_such_provider" in (aot.failed_before(fake) or "") and not aot.build_lock_file().exists()
+
+
 def test_a_dead_builders_mark_is_cleared(tmp_path, monkeypatch):
     monkeypatch.setenv("DTCOSIM_CACHE_DIR", str(tmp_path))
     lock = aot.build_lock_file()
@@ -235,12 +258,14 @@ def test_the_first_run_does_not_wait_for_the_compiler(tmp_path, monkeypatch):
     monkeypatch.setenv(JIT_OFF_REASON_VARIABLE, "")
     fake = AotKernel("_dtcosim_test_kernel_0011223344556677", "components.model.kernel:no_such_provider")
     monkeypatch.setattr(compiled_kernels, "aot_kernels", lambda: (fake,))
+    import os
+
     started = []
-    monkeypatch.setattr(compiled_kernels, "build_in_background", lambda todo: started.append(todo) or 4242)
+    monkeypatch.setattr(compiled_kernels, "build_in_background",
+                        lambda todo, after=None: started.append((todo, after)) or 4242)
     said = []
     problem = compiled_kernels.ensure_compiled_kernels(said.append, background=True)
-    assert started == [[fake]] and problem == "being compiled in the background (pid 4242)"
-    import os
+    assert started == [([fake], os.getpid())] and problem == "being compiled in the background (pid 4242)"
 
     assert os.environ[JIT_VARIABLE] == "0"
     # what the kernels of this process and its FMUs say when they run interpreted: why, with the builder's pid
