@@ -288,12 +288,13 @@ def stage(name: str, model: dict, origin: str, staging_dir: Path,
         code = path.read_text(encoding="utf-8")
         if rel.startswith("slaves/"):
             code = rewrite_slave_imports(code, path.name)
-        target.write_text(code, encoding="utf-8")
+        data = code.encode("utf-8")
+        target.write_bytes(data)
         # its bytecode beside it, as the FMU will carry it (bytecode_members): the build's own import of the
         # staged package (pythonfmu reads the slave class) compiles nothing, and each source is compiled once
         pyc = Path(importlib.util.cache_from_source(str(target)))
         pyc.parent.mkdir(exist_ok=True)
-        pyc.write_bytes(_unchecked_pyc(target.read_bytes(), f"resources/{package}/{rel}"))
+        pyc.write_bytes(_unchecked_pyc(data, f"resources/{package}/{rel}"))
     _bundle_compiled_kernels(package_dir)
     info = {"format": BUILD_FORMAT, "fmu": name, "origin": origin, "build_id": build_id}
     (package_dir / "__init__.py").write_text(

@@ -69,22 +69,6 @@ def _statements_of(module: SourceModule) -> tuple[ImportStatement, ...]:
     return import_statements(module.path.read_bytes(), str(module.path))
 
 
-def _imported_names(module: SourceModule) -> list[str]:
-    """Absolute names of every module an import statement of ``module`` may refer to."""
-    out: list[str] = []
-    for statement in _statements_of(module):
-        if not statement.is_from:
-            for name in statement.names:
-                parts = name.split(".")
-                out += [".".join(parts[:i]) for i in range(1, len(parts) + 1)]
-            continue
-        base = _absolute(module, statement)
-        pieces = base.split(".")
-        out += [".".join(pieces[:i]) for i in range(1, len(pieces) + 1)]
-        out += [f"{base}.{name}" for name in statement.names if name != "*"]
-    return out
-
-
 def _imports(module: SourceModule) -> list[list[str]]:
     """Per imported name of every import statement of ``module``: the absolute names it may be, most specific first."""
     out: list[list[str]] = []
@@ -160,7 +144,7 @@ def import_closure(roots: Iterable[str], packages: Mapping[str, Path]) -> dict[s
         found[mod.name] = mod
         parts = mod.name.split(".")
         candidates = [".".join(parts[:i]) for i in range(1, len(parts))]
-        candidates += _imported_names(mod)
+        candidates += [name for names in _imports(mod) for name in names]  # every name a statement may mean
         for name in candidates:
             if name not in found:
                 dep = _locate(name, packages)

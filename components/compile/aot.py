@@ -308,14 +308,21 @@ def background_builder() -> int | None:
         pid = int(lock.read_text(encoding="utf-8").split()[0])
     except (OSError, ValueError, IndexError):
         return None
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:  # killed before it could remove its mark
+    if not _alive(pid):  # killed before it could remove its mark
         lock.unlink(missing_ok=True)
         return None
+    return pid
+
+
+def _alive(pid: int) -> bool:
+    """Whether process ``pid`` exists (another user's counts)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
     except PermissionError:  # alive, another user's
         pass
-    return pid
+    return True
 
 
 def build_log() -> Path:
@@ -433,13 +440,7 @@ def _wait_for_exit(pid: int, limit_s: float) -> float:
     import time
 
     start = time.monotonic()
-    while time.monotonic() - start < limit_s:
-        try:
-            os.kill(pid, 0)
-        except ProcessLookupError:
-            break
-        except PermissionError:  # alive, another user's
-            pass
+    while time.monotonic() - start < limit_s and _alive(pid):
         time.sleep(0.1)
     return time.monotonic() - start
 
