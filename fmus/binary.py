@@ -19,6 +19,7 @@ The other platforms' binaries (``win64``) stay pythonfmu's.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import os
 import shutil
@@ -28,6 +29,7 @@ import sysconfig
 import tempfile
 import threading
 from pathlib import Path
+from typing import Iterator
 
 from components.compile.user_cache import user_cache_root
 
@@ -41,6 +43,7 @@ CLASS_FILE = "slaveclass.txt"
 #: the FMU member the binary replaces
 BINARY_FOLDER = "binaries/linux64"
 #: one compile at a time in a process: a caller that comes while :func:`compile_in_background` compiles waits for it
+#: (and one at a time across processes: :func:`_one_compiler`)
 _COMPILING = threading.Lock()
 
 
@@ -108,8 +111,25 @@ def compiled_binary() -> Path:
                                "(Debian: apt install gcc), or the FMU keeps pythonfmu's binary")
     key = hashlib.sha256(source + cc.encode()).hexdigest()[:16]
     target = user_cache_root() / "native" / key / "dtcosim_fmi2.so"
-    with _COMPILING:
+    if target.is_file():
+        return target
+    with _COMPILING, _one_compiler(target.parent):  # a thread of this process, another process (a forked builder)
         return target if target.is_file() else _compile(cc, target)
+
+
+@contextlib.contextmanager
+def _one_compiler(folder: Path) -> Iterator[None]:
+    """Hold an exclusive ``flock`` on ``folder`` (created if missing): one process compiles into it at a time, and
+    the others then find its result."""
+    import fcntl
+
+    folder.mkdir(parents=True, exist_ok=True)
+    fd = os.open(folder, os.O_RDONLY | os.O_DIRECTORY)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)
 
 
 def _compile(cc: str, target: Path) -> Path:

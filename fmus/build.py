@@ -59,6 +59,7 @@ from components.model.wind import WindParameters
 
 from . import binary, model_description, registry, runtime_files
 from .build_lock import build_lock, building_prefix
+from .build_pool import build_each
 from .parameter_ranges import parameter_bounds
 from .records import full_record
 from .slaves import base as slave_base
@@ -285,10 +286,7 @@ def stage(name: str, model: dict, origin: str, staging_dir: Path,
     for rel, path in _embedded_files(name, source):
         target = package_dir / rel
         target.parent.mkdir(parents=True, exist_ok=True)
-        code = path.read_text(encoding="utf-8")
-        if rel.startswith("slaves/"):
-            code = rewrite_slave_imports(code, path.name)
-        data = code.encode("utf-8")
+        data = _staged_source(rel, path)
         target.write_bytes(data)
         # its bytecode beside it, as the FMU will carry it (bytecode_members): the build's own import of the
         # staged package (pythonfmu reads the slave class) compiles nothing, and each source is compiled once
@@ -306,6 +304,14 @@ def stage(name: str, model: dict, origin: str, staging_dir: Path,
     (Path(staging_dir) / RECORD_FILE).write_text(json.dumps(full_record(name, "", model, origin), indent=1),
                                                  encoding="utf-8")
     return script, package_dir, build_id
+
+
+def _staged_source(rel: str, path: Path) -> bytes:
+    """The content of embedded module ``rel`` (from ``path``): a slave module's imports made package-relative."""
+    code = path.read_text(encoding="utf-8")
+    if rel.startswith("slaves/"):
+        code = rewrite_slave_imports(code, path.name)
+    return code.encode("utf-8")
 
 
 def _bundle_compiled_kernels(package_dir: Path) -> list[Path]:
@@ -533,11 +539,41 @@ def _staged_resources(tmp: Path, resources: dict[str, Path] | None) -> list[Path
 def build_all(out_dir: Path | str, preset: str = "table6", source: SourceTree | None = None,
               names: Sequence[str] = PRESET_FMU_NAMES, validate: bool = True,
               report: Callable[[str], None] | None = None) -> list[BuiltFmu]:
-    """Build the FMUs ``names`` (default: every FMU of a preset) into ``out_dir`` (``report``: see :func:`build_fmu`).
+    """Build the FMUs ``names`` (default: every FMU of a preset) into ``out_dir`` (``report``: see :func:`build_fmu`),
+    by :func:`build_several`."""
+    return build_several(names, out_dir, preset=preset, source=source, validate=validate, report=report)
 
-    The FMU binary, where it is not compiled yet (the first build of a machine), compiles beside the first FMU's
-    Python work."""
-    if names:
-        binary.compile_in_background()
-    return [build_fmu(name, out_dir, preset, source, validate, report=report) for name in names]
 
+def build_several(names: Sequence[str], out_dir: Path | str, report: Callable[[str], None] | None = None,
+                  **options) -> list[BuiltFmu]:
+    """``[build_fmu(name, out_dir, report=report, **options) for name in names]``, on two processes where that is
+    safe (:func:`fmus.build_pool.build_each`), holding the folder's build lock for both.
+
+    The FMU binary, where it is not compiled yet (the first build of a machine), compiles beside the Python work.
+    """
+    names = list(names)
+    if not names:
+        return []
+    with build_lock(out_dir, report):
+        prepare_builds(names, options.get("source"))
+        return build_each(functools.partial(_build_named, out_dir=out_dir, report=report, options=options), names,
+                          then=binary.compile_in_background)
+
+
+def _build_named(name: str, out_dir: Path | str, report: Callable[[str], None] | None, options: dict) -> BuiltFmu:
+    return build_fmu(name, out_dir, report=report, **options)
+
+
+def prepare_builds(names: Sequence[str], source: SourceTree | None = None) -> None:
+    """Do what every build of FMUs ``names`` starts with once, so that a forked builder (:mod:`fmus.build_pool`)
+    starts with it done: import what a build imports when first needed (fmpy's simulation and validation, the
+    slaves), find the modules each FMU embeds and compile their sources (the FMUs share most of them)."""
+    from fmpy import simulation, validation  # noqa: F401 - the cross-check run, the archive check
+
+    from . import cross_check, validation as fmu_validation  # noqa: F401
+
+    source = source or SourceTree.installed()
+    for name in names:
+        _kind(name).slave_class()
+        for rel, path in _embedded_files(name, source):
+            _compiled(_staged_source(rel, path))

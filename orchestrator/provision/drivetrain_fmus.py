@@ -13,7 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Callable, Iterable
 
-from fmus.build import BuiltFmu, build_fmu
+from fmus.build import BuiltFmu, build_several
 from fmus.build_lock import build_lock
 from fmus.registry import DRIVETRAIN_FILE, names_built_from
 
@@ -42,8 +42,8 @@ def build_drivetrain_fmus(spec: DrivetrainSpec, out_dir: Path, names: Iterable[s
     names = list(names)
     if report:
         report(f"building {', '.join(n + '.fmu' for n in names)} from {spec.origin} into {out_dir} ...")
-    return [build_fmu(n, out_dir, drivetrain=drivetrain, origin=spec.origin, rotor_speed_rad_s=spec.rotor_speed_rad_s,
-                      validate=validate, report=report) for n in names]
+    return build_several(names, out_dir, report, drivetrain=drivetrain, origin=spec.origin,
+                         rotor_speed_rad_s=spec.rotor_speed_rad_s, validate=validate)
 
 
 def ensure_drivetrain_fmus(spec: DrivetrainSpec, fmu_dir: Path, names: Iterable[str],

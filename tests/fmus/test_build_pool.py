@@ -1,0 +1,112 @@
+"""FMUs built on two processes (issue 34.3: a first run builds three FMUs while a second core idles).
+
+The pool's own behaviour (tests/helpers/build_pool_cases.py, each case in a fresh Python): both processes
+build, results in the order of the names, the first failure in that order raised, a killed or interrupted
+child reported and waited for; then real FMUs built on two processes against one process.
+"""
+
+from __future__ import annotations
+
+import json
+import marshal
+import os
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+import pytest
+
+from fmus import build_pool
+from fmus.build import build_all
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def run_case(case: str, folder: Path, *args: str, **env: str) -> dict:
+    proc = subprocess.run([sys.executable, "-m", "tests.helpers.build_pool_cases", case, str(folder), *args], cwd=ROOT,
+                          capture_output=True, text=True, timeout=60, env={**os.environ, **env})
+    assert proc.returncode == 0, proc.stderr
+    return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+def test_two_processes_build_and_the_results_keep_the_names_order(tmp_path):
+    out = run_case("both_processes", tmp_path)
+    assert out["names"] == ["a", "b", "c", "d"]
+    assert len(out["pids"]) == 2 and out["parent"] in out["pids"]
+
+
+@pytest.mark.parametrize("case, env", [("one_process", {build_pool.WORKERS_ENV: "1"}), ("beside_a_thread", {})])
+def test_one_process_when_asked_or_beside_another_thread(tmp_path, case, env):
+    out = run_case(case, tmp_path, **env)
+    assert out["pids"] == [out["parent"]]
+
+
+def test_the_first_failure_in_the_names_order_is_raised_and_no_further_build_starts(tmp_path):
+    out = run_case("first_failure_in_order", tmp_path)
+    assert out["raised"] == "ValueError"
+    assert out["message"].startswith("cannot build b ")
+
+
+def test_an_exception_that_does_not_pickle_comes_back_as_its_text(tmp_path):
+    out = run_case("unpicklable_failure_in_child", tmp_path)
+    assert out["raised"] == "BuildPoolError"
+    assert out["message"] == "_Local: b failed in the child"
+
+
+def test_a_killed_child_is_an_error_naming_what_it_left_unbuilt(tmp_path):
+    out = run_case("child_killed", tmp_path)
+    assert out["raised"] == "BuildPoolError"
+    assert "was killed by SIGKILL" in out["message"]
+    assert "b.fmu" in out["message"] and "a.fmu" not in out["message"]
+
+
+def test_an_interrupted_parent_stops_the_child_cleanly_and_waits_for_it(tmp_path):
+    out = run_case("interrupted", tmp_path)
+    assert out["cleaned"] and not out["unreaped_child"]
+    assert out["seconds"] < 10  # not the child's 30 s build
+
+
+@pytest.mark.parametrize("value, match", [("0", None), ("two", "DTCOSIM_BUILD_WORKERS='two': not a whole number")])
+def test_the_number_of_processes_from_the_environment(monkeypatch, value, match):
+    monkeypatch.setenv(build_pool.WORKERS_ENV, value)
+    if match is None:
+        assert build_pool.workers() == 1
+    else:
+        with pytest.raises(build_pool.BuildPoolError, match=match):
+            build_pool.workers()
+
+
+def _members(path: Path) -> dict[str, object]:
+    """Every member but ``modelDescription.xml`` (its generationDateAndTime differs); a pyc as its header and code
+    (marshal writes equal code with back-references that depend on reference counts)."""
+    with zipfile.ZipFile(path) as archive:
+        out = {}
+        for name in archive.namelist():
+            data = archive.read(name)
+            if name.endswith(".pyc"):
+                code = marshal.loads(data[16:])
+                out[name] = (data[:16], code, code.co_filename)
+            elif name != "modelDescription.xml":
+                out[name] = data
+        return out
+
+
+def test_the_fmu_binary_is_compiled_once_when_both_processes_need_it(tmp_path):
+    out = run_case("binary_compiled_once", tmp_path, DTCOSIM_CACHE_DIR=str(tmp_path / "cache"))
+    assert len(out["compiles"]) == 1
+    assert out["paths"][0] == out["paths"][1] and Path(out["paths"][0]).is_file()
+
+
+@pytest.mark.slow
+def test_fmus_built_on_two_processes_equal_those_built_on_one(tmp_path, monkeypatch):
+    names = ["GeneratorRotor", "WindSource"]
+    monkeypatch.setenv(build_pool.WORKERS_ENV, "1")
+    one = build_all(tmp_path / "one", names=names)
+    out = run_case("fmus_on_two_processes", tmp_path / "two", ",".join(names), **{build_pool.WORKERS_ENV: "2"})
+    assert out["pool_runs"] == [2]  # built on two processes
+    assert [[name, build_id] for name, _, build_id in out["built"]] == [[b.name, b.build_id] for b in one]
+    for a, (name, path, _) in zip(one, out["built"]):
+        assert Path(path) == tmp_path / "two" / f"{name}.fmu"
+        assert _members(a.path) == _members(Path(path))
+    assert not list((tmp_path / "two").glob(".*-building-*"))
