@@ -63,6 +63,9 @@ D = 1.0 / (2.0 + math.sqrt(2.0))
 #: the kept factorisations are used again (equal internal steps, the first-step cap; module docstring)
 LU_ABOVE = 24
 E32 = 6.0 + math.sqrt(2.0)
+#: two step sizes whose ``h d`` differ by at most this fraction share a factorisation: the equal steps that end on
+#: a communication point recur up to round-off (``remaining / pieces`` of a remainder itself rounded)
+SAME_HD = 1e-12
 #: bounds of the error order observed between two rejected attempts
 ORDER_MIN, ORDER_MAX = 0.2, 3.0
 
@@ -228,7 +231,7 @@ def use_factorisation(hd, dq, dv, winvs, pivots, istate):
     istate[CLOCK] += 1.0
     slot = -1
     for s in range(N_SLOTS):
-        if istate[SLOT_HD + s] == hd:
+        if abs(istate[SLOT_HD + s] - hd) <= SAME_HD * hd:
             slot = s
             break
     if slot < 0:
@@ -240,7 +243,7 @@ def use_factorisation(hd, dq, dv, winvs, pivots, istate):
         istate[SLOT_HD + slot] = hd
         istate[SLOT_BASIS + slot] = 0.0
     istate[SLOT_USED + slot] = istate[CLOCK]
-    istate[HD] = hd
+    istate[HD] = istate[SLOT_HD + slot]
     istate[ACTIVE] = float(slot)
     return slot
 
@@ -399,18 +402,19 @@ def advance(k, y, t_end, alpha_shift, driver, port, angle0, twist_q, twist_port)
         last = h >= remaining * (1.0 - 1e-12)
         if last:
             h = remaining
-        elif large:  # equal steps to the communication point: their sizes recur, and so do their factorisations
+        else:  # equal steps to the communication point: their sizes recur, and so do their factorisations
             pieces = math.ceil(remaining / h * (1.0 - 1e-12))
             h = remaining / pieces
         if ist[AGE] < 0.0 or ist[AGE] >= max_age:
             refresh_jacobian(k, y, t, angle0, driver, port)
         # ---- one step
         hd = h * D
-        if hd != ist[HD]:
+        if abs(hd - ist[HD]) > SAME_HD * hd:
             active = use_factorisation(hd, k.dq, k.dv, k.winvs, k.pivots, ist)
             winv = k.winvs[active]
             piv = k.pivots[active]
             w_basis = k.w_bases[active]
+        hd = ist[HD]  # the active factorisation's (the step's h d up to round-off)
         time_derivative_term(k, y, t, h, hd, angle0, driver, port, winv, piv, w_basis)
         solve(winv, piv, k.dq, k.jac_index, hd, f0, k1, k.sol)
         stage(k1, w_hdt, y, 0.5 * h, y1)
