@@ -14,7 +14,7 @@ and ``W^-1 = (I - h d J)^-1``, ``d = 1 / (2 + sqrt 2)``::
   matrix (:func:`factor`, :func:`solve`), factorised once per Jacobian and step size: as its inverse,
   or as LU factors in large models (more than :data:`LU_ABOVE` degrees of freedom: the
   lateral-torsional gearboxes). Four factorisations are kept (:func:`use_factorisation`, least
-  recently used replaced), and the step sizes are made to recur so that they are used again:
+  recently used replaced), used again as the step sizes recur.
 * **Step sizes that recur**: the rest of a communication step is divided into equal steps of at most
   the proposed size (``H / k`` from a communication point), not the proposal and a last step
   shortened to end on the communication point, whose size differs at every communication step and
@@ -23,10 +23,9 @@ and ``W^-1 = (I - h d J)^-1``, ``d = 1 / (2 + sqrt 2)``::
   internal step of a communication step was rejected (new inputs start a transient there, where the
   proposal from the smooth end of the last step fails two or three times in a lateral-torsional
   gearbox), the next ones start with at most the step their predecessor's first step proposed, while
-  that is smaller than the proposal. In the paper's scenario (12 degrees of freedom, H = 20 ms) this
-  takes 884 factorisations instead of 2883 (one for most communication steps) for about as many
-  internal steps (6182 against 6247, 22 of them rejected against 59), and every recorded variable
-  stays as close to a run at a hundredth of the tolerances as before.
+  that is smaller than the proposal. In the paper's scenario (12 degrees of freedom, H = 20 ms) most
+  communication steps then need no factorisation of their own (with the shortened last step nearly
+  every one did), for about as many internal steps and fewer rejected ones.
 * **Jacobian reuse**: the method is a W-method (second order for any ``W``), so the Jacobian is
   refreshed only when older than ``jacobian_max_age`` accepted steps or after a rejected step;
   a stale Jacobian that hurts accuracy causes a rejection, which forces a refresh.
@@ -62,7 +61,7 @@ from .stiffness import stiffness_factors
 
 D = 1.0 / (2.0 + math.sqrt(2.0))
 #: above this many degrees of freedom (a lateral-torsional gearbox) a factorisation is what a step costs most: ``G`` is
-#: kept as its LU factors (n^3/3 operations, not an inverse's n^3; fewer operations for each solve with an inverse)
+#: kept as its LU factors (n^3/3 operations, not an inverse's n^3); up to it as its inverse (a solve is one product)
 LU_ABOVE = 24
 E32 = 6.0 + math.sqrt(2.0)
 #: two step sizes whose ``h d`` differ by at most this fraction share a factorisation (the step then runs with the
@@ -230,7 +229,8 @@ def _motion_terms_loop(port_jac, kappa, port_rate, port_accel, jerk_, out):
 
 def use_factorisation(hd, dq, dv, winvs, pivots, istate):
     """Make the factorisation for ``hd`` the active one of the ``N_SLOTS`` kept (same Jacobian), factorising it into
-    the least recently used slot where none is kept; returns its slot."""
+    the least recently used slot where none is kept within :data:`SAME_HD`; returns its slot (its ``h d`` is then
+    ``istate[HD]``, the one the step runs with)."""
     istate[CLOCK] += 1.0
     slot = -1
     for s in range(N_SLOTS):
