@@ -26,12 +26,14 @@ import errno
 import io
 import os
 import stat
+import tempfile
 import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from .archive_checks import extract_fmu
 from .cross_check_case import CrossCheckCase, CrossCheckError, stated_inputs
 
 #: where in the FMU the cross-check files are
@@ -64,13 +66,37 @@ def reference_members(fmu_path: Path, case: CrossCheckCase) -> dict[str, bytes]:
     step = _step_of(md)
     inputs = stated_inputs(case, md, step)
     outputs = [v.name for v in md.modelVariables if v.causality == "output"]
-    result = simulate_fmu(str(fmu_path), start_time=case.start_time, stop_time=case.stop_time, step_size=step,
-                          output_interval=step, input=inputs if len(inputs.dtype.names) > 1 else None,
-                          output=outputs, validate=False)
+    with tempfile.TemporaryDirectory(prefix="dtcosim_cross_check_") as unzipped:
+        try:
+            extract_fmu(fmu_path, unzipped)
+            result = simulate_fmu(unzipped, start_time=case.start_time, stop_time=case.stop_time, step_size=step,
+                                  output_interval=step, input=inputs if len(inputs.dtype.names) > 1 else None,
+                                  output=outputs, validate=False)
+        finally:
+            forget_python_from(Path(unzipped))
     opt = f"StartTime,{case.start_time!r}\nStopTime,{case.stop_time!r}\nStepSize,{step!r}\nRelTol,{REL_TOL:g}\n"
     return {f"{MEMBER_DIR}/{model}_in.csv": _csv_text(inputs).encode(),
             f"{MEMBER_DIR}/{model}_ref.opt": opt.encode(),
             f"{MEMBER_DIR}/{model}_ref.csv": _csv_text(result[["time", *outputs]]).encode()}
+
+
+def forget_python_from(folder: Path) -> None:
+    """Drop from this process the modules an FMU run in it imported from ``folder`` (the FMU's extracted
+    resources, about to be deleted) and the ``sys.path`` entries inside it: a later instance of the same FMU, from
+    another folder, imports its own copy instead of reusing modules whose files are gone."""
+    import importlib
+    import sys
+
+    root = os.path.realpath(folder)
+
+    def inside(path: object) -> bool:
+        return isinstance(path, str) and os.path.realpath(path).startswith(root + os.sep)
+
+    for name, module in list(sys.modules.items()):
+        if inside(getattr(module, "__file__", None)):
+            del sys.modules[name]
+    sys.path[:] = [entry for entry in sys.path if not inside(entry)]
+    importlib.invalidate_caches()
 
 
 # ----------------------------------------------------------------------------- comparison
@@ -128,8 +154,6 @@ def _read_member_csv(archive: zipfile.ZipFile, name: str, what: str, fmu: Path) 
 
 
 def _parse_csv(text: str, where: str, read_csv) -> np.ndarray:
-    import tempfile
-
     with tempfile.NamedTemporaryFile("w", suffix=".csv", delete=False) as tmp:
         tmp.write(text)
     try:

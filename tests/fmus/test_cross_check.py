@@ -151,3 +151,17 @@ def test_an_fmu_without_a_cross_check_is_named(tmp_path):
     (tmp_path / "r.csv").write_text('"time","y"\n0,1\n1,1\n')
     with pytest.raises(CrossCheckError, match="no cross-check reference"):
         compare(reference_fmu("Feedthrough"), tmp_path / "r.csv")
+
+
+def test_the_cross_check_run_leaves_no_module_or_path_of_its_deleted_folder(tmp_path):
+    """A build's stand-alone run imports the FMU's package from an extraction it deletes: a later instance of the
+    FMU (the run that built it) must import its own copy, not reuse modules whose files are gone."""
+    import os
+
+    from fmus.build import build_fmu
+
+    before = list(sys.path)
+    built = build_fmu("GeneratorRotor", tmp_path)
+    left = [name for name in list(sys.modules) if name.startswith(built.package) or name == built.slave_module]
+    assert left == []
+    assert [entry for entry in sys.path if entry not in before and not os.path.exists(entry)] == []
