@@ -556,12 +556,8 @@ def build_several(names: Sequence[str], out_dir: Path | str, report: Callable[[s
         return []
     with build_lock(out_dir, report):
         prepare_builds(names, options.get("source"))
-        return build_each(functools.partial(_build_named, out_dir=out_dir, report=report, options=options), names,
+        return build_each(functools.partial(build_fmu, out_dir=out_dir, report=report, **options), names,
                           then=binary.compile_in_background)
-
-
-def _build_named(name: str, out_dir: Path | str, report: Callable[[str], None] | None, options: dict) -> BuiltFmu:
-    return build_fmu(name, out_dir, report=report, **options)
 
 
 def prepare_builds(names: Sequence[str], source: SourceTree | None = None) -> None:
