@@ -19,6 +19,7 @@ from fmus.registry import DRIVETRAIN_FILE, names_built_from
 
 from ..inputs.drivetrain_file import DrivetrainSpec
 from .folders import drivetrain_fmu_dir
+from .other_builds import swap_in
 from .staleness import broken_fmu, stale_project_fmus
 
 #: the FMUs a drivetrain file is built into
@@ -64,7 +65,7 @@ def ensure_drivetrain_fmus(spec: DrivetrainSpec, fmu_dir: Path, names: Iterable[
 
     if todo():
         with build_lock(folder, report):  # decided again and built by one process at a time
-            names = todo()  # another process may have built them meanwhile
+            names = [n for n in todo() if not swap_in(paths[n])]  # built meanwhile, or kept aside (other_builds)
             if names:
                 build_drivetrain_fmus(spec, folder, names, report)
     return folder

@@ -12,6 +12,9 @@ package or a source checkout. Inside it:
     Gearbox and GeneratorRotor built from a drivetrain file, one folder per file content.
 ``series/<load record stem>-<sha256[:16]>/``
     The TimeSeriesSource built from a scenario's load record, one folder per selected content.
+``.other-builds/<Name>/<build id>.fmu`` (beside each of these FMUs)
+    The builds of other dtcosim versions set aside, the last three per FMU
+    (:mod:`orchestrator.provision.other_builds`).
 """
 
 from __future__ import annotations

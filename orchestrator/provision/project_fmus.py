@@ -27,6 +27,7 @@ from ..inputs.scenario import Scenario
 from .drivetrain_fmus import ensure_drivetrain_fmus
 from .folders import default_fmu_dir
 from .locate import missing_fmus, resolve_fmu_paths
+from .other_builds import swap_in
 from .staleness import broken_fmu, stale_project_fmus
 from .series_fmus import ensure_series_fmu
 
@@ -78,6 +79,8 @@ def ensure_fmus(scenario: Scenario, fmu_dir: str | Path | None = None, build: bo
         if _missing_preset_fmus(scenario, fmu_dir, managed):
             with build_lock(fmu_dir, report):  # decided again and built by one process at a time
                 names = _missing_preset_fmus(scenario, fmu_dir, managed)  # another process may have built them
+                if managed:  # another version's FMUs set aside, this version's taken back where kept
+                    names = [n for n in names if not swap_in(fmu_dir / f"{n}.fmu")]
                 if names:
                     if report:
                         report(f"building {', '.join(n + '.fmu' for n in names)} into {fmu_dir} ...")

@@ -20,6 +20,7 @@ from fmus.slaves.time_series_source import DATA_FILE
 
 from ..inputs.series_spec import SeriesSpec
 from .folders import series_fmu_dir
+from .other_builds import swap_in
 from .staleness import broken_fmu, stale_project_fmus
 
 #: the FMU a load record is built into
@@ -47,6 +48,6 @@ def ensure_series_fmu(spec: SeriesSpec, fmu_dir: Path, report: Callable[[str], N
 
     if needed():
         with build_lock(path.parent, report):  # decided again and built by one process at a time
-            if needed():  # another process may have built it meanwhile
+            if needed() and not swap_in(path):  # built meanwhile, or kept aside (other_builds)
                 build_series_fmu(spec, path.parent, report)
     return path

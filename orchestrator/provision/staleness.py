@@ -130,11 +130,17 @@ def stale_project_fmus(paths: Mapping[str, Path]) -> list[str]:
     """
     out = []
     for comp, path in paths.items():
-        build = remembered("stale", Path(path), lambda p: {"stale_build": _stale_build(p)})["stale_build"]
+        build = stale_build(Path(path))
         if build is not None:
             out.append(f"{path} ({comp}) was built from other code than the installed dtcosim (build {build}); "
                        f"rebuild it with `dtcosim build --out {Path(path).parent}`")
     return out
+
+
+def stale_build(path: Path) -> str | None:
+    """The build id of the project FMU ``path`` if it was built from other code than the installed (None: current,
+    or not the project's); remembered (:func:`remembered`)."""
+    return remembered("stale", Path(path), lambda p: {"stale_build": _stale_build(p)})["stale_build"]
 
 
 def _stale_build(path: Path) -> str | None:
