@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 import marshal
 import os
+import re
 import subprocess
 import sys
 import zipfile
@@ -51,14 +52,15 @@ def test_the_first_failure_in_the_names_order_is_raised_and_no_further_build_sta
 def test_an_exception_that_does_not_pickle_comes_back_as_its_text(tmp_path):
     out = run_case("unpicklable_failure_in_child", tmp_path)
     assert out["raised"] == "BuildPoolError"
-    assert out["message"] == "_Local: b failed in the child"
+    assert re.fullmatch(r"_Local: [ab] failed in the child", out["message"])  # whichever name the child took
 
 
 def test_a_killed_child_is_an_error_naming_what_it_left_unbuilt(tmp_path):
     out = run_case("child_killed", tmp_path)
     assert out["raised"] == "BuildPoolError"
     assert "was killed by SIGKILL" in out["message"]
-    assert "b.fmu" in out["message"] and "a.fmu" not in out["message"]
+    left = sorted(set("abc") - set(out["built_here"]))
+    assert left and out["message"].startswith(", ".join(n + ".fmu" for n in left) + " not built: ")
 
 
 def test_an_interrupted_parent_stops_the_child_cleanly_and_waits_for_it(tmp_path):

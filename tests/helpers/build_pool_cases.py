@@ -85,16 +85,19 @@ def unpicklable_failure_in_child(folder: Path) -> dict:
 
 
 def child_killed(folder: Path) -> dict:
+    built_here = []
+
     def build(name: str) -> str:
         if _in_child():
             os.kill(os.getpid(), signal.SIGKILL)
         time.sleep(0.3)
+        built_here.append(name)
         return name
 
     try:
         build_each(build, ["a", "b", "c"], processes=2)
     except BuildPoolError as exc:
-        return {"raised": "BuildPoolError", "message": str(exc)}
+        return {"raised": "BuildPoolError", "message": str(exc), "built_here": built_here}
     return {"raised": None}
 
 
