@@ -72,8 +72,7 @@ def can_fork() -> bool:
     return hasattr(os, "fork") and threading.active_count() == 1
 
 
-def build_each(build: Callable[[str], T], names: Sequence[str], processes: int | None = None,
-               then: Callable[[], object] | None = None) -> list[T]:
+def build_each(build: Callable[[str], T], names: Sequence[str], processes: int | None = None) -> list[T]:
     """``[build(name) for name in names]``, on this process and a forked child when that helps.
 
     Parameters
@@ -83,9 +82,6 @@ def build_each(build: Callable[[str], T], names: Sequence[str], processes: int |
     names : sequence of str
     processes : int, optional
         Processes to use (default :func:`workers`); only 1 and 2 are distinguished.
-    then : callable, optional
-        Called in this process before its first build, after the fork (it may start a thread: the
-        FMU binary's compile, :func:`fmus.binary.compile_in_background`).
 
     Raises
     ------
@@ -97,10 +93,8 @@ def build_each(build: Callable[[str], T], names: Sequence[str], processes: int |
     names = list(names)
     processes = workers() if processes is None else processes
     if processes < 2 or len(names) < 2 or len(names) > _MAX_NAMES or not can_fork():
-        if then is not None:
-            then()
         return [build(name) for name in names]
-    return _Pool(build, names).run(then)
+    return _Pool(build, names).run()
 
 
 class _Pool:
@@ -110,7 +104,7 @@ class _Pool:
         self.build = build
         self.names = names
 
-    def run(self, then: Callable[[], object] | None) -> list:
+    def run(self) -> list:
         queue_r, queue_w = os.pipe()
         os.write(queue_w, bytes(range(len(self.names))))
         os.close(queue_w)  # read to the end: the queue is empty
@@ -124,8 +118,6 @@ class _Pool:
             self._child(queue_r, result_w)
         os.close(result_w)
         try:
-            if then is not None:
-                then()
             mine = self._take_and_build(queue_r)
         except BaseException:  # interrupted: the child stops too, and its build cleans up
             _drain(queue_r)

@@ -69,13 +69,19 @@ def write(staging_dir: Path, name: str, origin: str, model: Mapping[str, Any], b
     """
     out = Path(staging_dir) / "runtime"
     out.mkdir(parents=True, exist_ok=True)
-    required, optional = imported_modules(sources)
-    req = from_environment(name, required, optional=optional)
+    req = requirements(name, sources)
     requirements_file = out / REQUIREMENTS_FILE
     requirements_file.write_text(format_requirements(req, _HEADER), encoding="utf-8")
     docs = write_documentation(out / "documentation", BuildFacts(name, origin, model, build_id, version, req,
                                                                  carried_platforms()))
     return RuntimeFiles(req, requirements_file, docs)
+
+
+def requirements(name: str, sources: Iterable[Path]) -> RuntimeRequirements:
+    """What FMU ``name``, whose embedded code is ``sources``, requires of its host's Python: the packages its code
+    imports, in the ranges of the versions installed here (:func:`fmus.requirements.from_environment`)."""
+    required, optional = imported_modules(sources)
+    return from_environment(name, required, optional=optional)
 
 
 def describe(xml: bytes, req: RuntimeRequirements) -> bytes:

@@ -80,11 +80,12 @@ def is_unpacked(sha256: str) -> bool:
     return _folder(sha256).is_dir()
 
 
-def unpacked(path: Path, sha256: str, extract) -> Path:
+def unpacked(path: Path, sha256: str, extract, fallback: bool = True) -> Path | None:
     """The folder of the FMU ``path`` (content ``sha256``) unpacked whole, extracted by ``extract(path, folder)`` if not yet.
 
     ``extract`` raises what it raises (a damaged archive, a full disk); a folder it leaves
-    behind is removed first.
+    behind is removed first. Where the cache cannot be written: a temporary folder of this process, or None
+    without ``fallback``.
     """
     final = _folder(sha256)
     if final.is_dir():
@@ -96,7 +97,7 @@ def unpacked(path: Path, sha256: str, extract) -> Path:
         final.parent.mkdir(parents=True, exist_ok=True)
         partial = Path(tempfile.mkdtemp(prefix=PARTIAL_PREFIX, dir=final.parent))
     except OSError:  # a read-only or full cache: a folder of this process's own
-        return _extract_temporarily(path, sha256, extract)
+        return _extract_temporarily(path, sha256, extract) if fallback else None
     try:
         extract(path, partial)
         _compile_missing_bytecode(partial)
@@ -108,6 +109,9 @@ def unpacked(path: Path, sha256: str, extract) -> Path:
         os.rename(partial, final)
     except OSError:  # another process renamed its copy first (or the cache refuses): use that one, or our own
         if not final.is_dir():
+            if not fallback:
+                shutil.rmtree(partial, ignore_errors=True)
+                return None
             return _keep_temporarily(partial)
         shutil.rmtree(partial, ignore_errors=True)
     _prune(final.parent)

@@ -44,7 +44,7 @@ def build_drivetrain_fmus(spec: DrivetrainSpec, out_dir: Path, names: Iterable[s
     if report:
         report(f"building {', '.join(n + '.fmu' for n in names)} from {spec.origin} into {out_dir} ...")
     return build_several(names, out_dir, report, drivetrain=drivetrain, origin=spec.origin,
-                         rotor_speed_rad_s=spec.rotor_speed_rad_s, validate=validate)
+                         rotor_speed_rad_s=spec.rotor_speed_rad_s, validate=validate, after_each=unpack_ahead)
 
 
 def ensure_drivetrain_fmus(spec: DrivetrainSpec, fmu_dir: Path, names: Iterable[str],

@@ -28,6 +28,7 @@ from .drivetrain_fmus import ensure_drivetrain_fmus
 from .folders import default_fmu_dir
 from .locate import missing_fmus, resolve_fmu_paths
 from .other_builds import swap_in
+from .unpack_ahead import unpack_ahead
 from .staleness import broken_fmu, stale_project_fmus
 from .series_fmus import ensure_series_fmu
 
@@ -84,7 +85,7 @@ def ensure_fmus(scenario: Scenario, fmu_dir: str | Path | None = None, build: bo
                 if names:
                     if report:
                         report(f"building {', '.join(n + '.fmu' for n in names)} into {fmu_dir} ...")
-                    build_all(fmu_dir, names=names)
+                    build_all(fmu_dir, names=names, after_each=unpack_ahead)
     return resolve_fmu_paths(scenario, fmu_dir)
 
 

@@ -13,6 +13,7 @@ import os
 import re
 import subprocess
 import sys
+import threading
 import zipfile
 from pathlib import Path
 
@@ -25,10 +26,16 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 def run_case(case: str, folder: Path, *args: str, **env: str) -> dict:
+    lines = case_lines(case, folder, *args, **env)
+    return lines[-1]
+
+
+def case_lines(case: str, folder: Path, *args: str, **env: str) -> list[dict]:
+    """Every JSON line a case printed (its result last)."""
     proc = subprocess.run([sys.executable, "-m", "tests.helpers.build_pool_cases", case, str(folder), *args], cwd=ROOT,
                           capture_output=True, text=True, timeout=60, env={**os.environ, **env})
     assert proc.returncode == 0, proc.stderr
-    return json.loads(proc.stdout.strip().splitlines()[-1])
+    return [json.loads(line) for line in proc.stdout.strip().splitlines()]
 
 
 def test_two_processes_build_and_the_results_keep_the_names_order(tmp_path):
@@ -94,6 +101,24 @@ def _members(path: Path) -> dict[str, object]:
         return out
 
 
+def test_the_fmu_binary_is_compiled_beside_the_builds_start_and_is_there_when_they_fork(tmp_path, monkeypatch):
+    """A first build compiles the binary while :func:`fmus.build.prepare_builds` runs (the C compiler is another
+    process), and waits for it before the fork: no thread runs then, and neither builder waits for the compiler."""
+    from fmus import binary, build
+
+    if binary.compiler() is None:
+        pytest.skip("no C compiler")
+    monkeypatch.setenv("DTCOSIM_CACHE_DIR", str(tmp_path / "cache"))
+    threads = threading.active_count()
+    seen = []
+    monkeypatch.setattr(build, "prepare_builds", lambda names, source=None: seen.append(
+        ("prepare", threading.active_count() - threads)))
+    monkeypatch.setattr(build, "build_each", lambda one, names: seen.append(
+        ("fork", threading.active_count() - threads, sorted((tmp_path / "cache" / "native").glob("*/*.so")) != [])))
+    build.build_several(["GeneratorRotor", "WindSource"], tmp_path / "fmus")
+    assert seen == [("prepare", 1), ("fork", 0, True)]
+
+
 def test_the_fmu_binary_is_compiled_once_when_both_processes_need_it(tmp_path):
     out = run_case("binary_compiled_once", tmp_path, DTCOSIM_CACHE_DIR=str(tmp_path / "cache"))
     assert len(out["compiles"]) == 1
@@ -104,9 +129,17 @@ def test_the_fmu_binary_is_compiled_once_when_both_processes_need_it(tmp_path):
 def test_fmus_built_on_two_processes_equal_those_built_on_one(tmp_path, monkeypatch):
     names = ["GeneratorRotor", "WindSource"]
     monkeypatch.setenv(build_pool.WORKERS_ENV, "1")
+    monkeypatch.setenv("DTCOSIM_CACHE_DIR", str(tmp_path / "c"))  # both without compiled kernels to carry
     one = build_all(tmp_path / "one", names=names)
-    out = run_case("fmus_on_two_processes", tmp_path / "two", ",".join(names), **{build_pool.WORKERS_ENV: "2"})
+    lines = case_lines("fmus_on_two_processes", tmp_path / "two", ",".join(names), DTCOSIM_CACHE_DIR=str(tmp_path / "c"),
+                       **{build_pool.WORKERS_ENV: "2"})
+    out = lines[-1]
     assert out["pool_runs"] == [2]  # built on two processes
+    # each FMU unpacked for the run by the process that built it: one of them by the child
+    unpacked = {name: (pid, folder) for name, pid, folder in (line["unpacked"] for line in lines[:-1])}
+    assert sorted(unpacked) == sorted(names) and out["unpacked_now"] == [True, True]
+    assert len({pid for pid, _ in unpacked.values()}) == 2 and out["parent"] in {p for p, _ in unpacked.values()}
+    assert all(Path(folder).parent == tmp_path / "c" / "unpacked" for _, folder in unpacked.values())
     assert [[name, build_id] for name, _, build_id in out["built"]] == [[b.name, b.build_id] for b in one]
     for a, (name, path, _) in zip(one, out["built"]):
         assert Path(path) == tmp_path / "two" / f"{name}.fmu"

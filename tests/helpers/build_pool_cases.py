@@ -148,18 +148,30 @@ def binary_compiled_once(folder: Path) -> dict:
 
 
 def fmus_on_two_processes(folder: Path) -> dict:
+    """Real FMUs built on two processes, each unpacked for the run by the process that built it."""
     from fmus import build, build_pool
+    from orchestrator.cosim.fmu_interface import file_sha256
+    from orchestrator.cosim.unpacked_fmus import is_unpacked
+    from orchestrator.provision.unpack_ahead import unpack_ahead
 
     runs = []
     run = build_pool._Pool.run
 
-    def recorded(self, then):
+    def recorded(self):
         runs.append(len(self.names))
-        return run(self, then)
+        return run(self)
+
+    unpacked_by = {}
+
+    def unpack(path: Path):
+        folder = unpack_ahead(path)
+        print(json.dumps({"unpacked": [path.stem, os.getpid(), str(folder)]}), flush=True)  # the child's too
+        return folder
 
     build_pool._Pool.run = recorded
-    built = build.build_all(folder, names=sys.argv[3].split(","))
-    return {"pool_runs": runs, "built": [[b.name, str(b.path), b.build_id] for b in built]}
+    built = build.build_all(folder, names=sys.argv[3].split(","), after_each=unpack)
+    return {"pool_runs": runs, "built": [[b.name, str(b.path), b.build_id] for b in built],
+            "unpacked_now": [is_unpacked(file_sha256(b.path)) for b in built], "parent": PARENT}
 
 
 if __name__ == "__main__":
