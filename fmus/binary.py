@@ -26,6 +26,7 @@ import shutil
 import subprocess
 import sys
 import sysconfig
+import signal
 import tempfile
 import threading
 from pathlib import Path
@@ -42,8 +43,7 @@ PYTHON_FILE = "python.txt"
 CLASS_FILE = "slaveclass.txt"
 #: the FMU member the binary replaces
 BINARY_FOLDER = "binaries/linux64"
-#: one compile at a time in a process: a caller that comes while :func:`compile_in_background` compiles waits for it
-#: (and one at a time across processes: :func:`_one_compiler`)
+#: one compile at a time in a process (and one at a time across processes: :func:`_one_compiler`)
 _COMPILING = threading.Lock()
 
 
@@ -109,12 +109,18 @@ def compiled_binary() -> Path:
     if cc is None:
         raise NativeBuildError("no C compiler (cc, gcc or clang) to build the FMU binary: install one "
                                "(Debian: apt install gcc), or the FMU keeps pythonfmu's binary")
-    key = hashlib.sha256(source + cc.encode()).hexdigest()[:16]
-    target = user_cache_root() / "native" / key / "dtcosim_fmi2.so"
+    target = _target(source, cc)
     if target.is_file():
         return target
-    with _COMPILING, _one_compiler(target.parent):  # a thread of this process, another process (a forked builder)
+    # one at a time: a thread of this process, another process (a forked builder, a compile started by
+    # start_compile, which holds the lock until it has ended)
+    with _COMPILING, _one_compiler(target.parent):
         return target if target.is_file() else _compile(cc, target)
+
+
+def _target(source: bytes, cc: str) -> Path:
+    """Where the binary of ``source`` compiled by ``cc`` is cached."""
+    return user_cache_root() / "native" / hashlib.sha256(source + cc.encode()).hexdigest()[:16] / "dtcosim_fmi2.so"
 
 
 @contextlib.contextmanager
@@ -146,19 +152,62 @@ def _compile(cc: str, target: Path) -> Path:
     return target
 
 
-def compile_in_background() -> threading.Thread:
-    """Start :func:`compiled_binary` in a thread (the compiler is another process: it runs beside this one's
-    Python work); a later :func:`compiled_binary` waits for it, and raises what it would have raised."""
+class BackgroundCompile:
+    """The binary compiling in a process of its own (:func:`start_compile`)."""
 
-    def compile_quietly() -> None:
+    def __init__(self, process: subprocess.Popen) -> None:
+        self.process = process
+
+    def finish(self) -> None:
+        """Wait for the compile to end (a build that needed the binary has waited for it already)."""
+        self.process.wait()
+
+    def stop(self) -> None:
+        """End the compile now (its temporary folder removed): this process was interrupted."""
+        if self.process.poll() is None:
+            self.process.send_signal(signal.SIGINT)
+        self.process.wait()
+
+
+def start_compile() -> BackgroundCompile | None:
+    """Start compiling the binary where it is missing (the first build of a machine), in a process of its own that
+    holds the compile lock (:func:`_one_compiler`) until it has ended: whoever needs the binary meanwhile - this
+    process, a builder it forks, another command - waits for it there, and compiles it itself if it failed (and
+    says why). The compiler runs beside the Python work that comes before the binary is needed; a process, not a
+    thread, so that this process may fork builders meanwhile (:func:`fmus.build_pool.can_fork`).
+
+    None where there is nothing to start: the binary is there, no compiler or not linux (the build says so), or
+    another process is compiling it.
+    """
+    import fcntl
+
+    cc = compiler()
+    if not sys.platform.startswith("linux") or cc is None:
+        return None
+    target = _target(_source_bytes(), cc)
+    if target.is_file():
+        return None
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)
+        fd = os.open(target.parent, os.O_RDONLY | os.O_DIRECTORY)
+    except OSError:  # an unwritable cache: the build reports it
+        return None
+    try:
         try:
-            compiled_binary()
-        except Exception:  # noqa: BLE001 - a thread's traceback would reach the user: the caller that needs the
-            pass  # binary compiles again and reports what goes wrong (a missing compiler, a full disk) its own way
-
-    thread = threading.Thread(target=compile_quietly, name="dtcosim-fmu-binary", daemon=True)
-    thread.start()
-    return thread
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:  # being compiled by another process
+            return None
+        if target.is_file():
+            return None
+        # the lock goes with the inherited descriptor: held until the compiling process has ended
+        env = {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in sys.path if p)}
+        process = subprocess.Popen([sys.executable, "-m", __name__, cc, str(target)], pass_fds=(fd,), env=env,
+                                   stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    except OSError:
+        return None
+    finally:
+        os.close(fd)
+    return BackgroundCompile(process)
 
 
 def native_members(model_identifier: str, class_name: str) -> dict[str, bytes]:
@@ -173,3 +222,17 @@ def native_members(model_identifier: str, class_name: str) -> dict[str, bytes]:
     return {f"{BINARY_FOLDER}/{model_identifier}.so": binary,
             f"resources/{PYTHON_FILE}": python_record().encode(),
             f"resources/{CLASS_FILE}": (class_name + "\n").encode()}
+
+
+def main(argv: list[str]) -> int:
+    """``python -m fmus.binary CC TARGET``: the process :func:`start_compile` starts (it inherits the compile lock)."""
+    cc, target = argv
+    try:
+        _compile(cc, Path(target))
+    except (NativeBuildError, OSError, KeyboardInterrupt):  # told by the build that needs it, which compiles again
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

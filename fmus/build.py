@@ -554,21 +554,27 @@ def build_several(names: Sequence[str], out_dir: Path | str, report: Callable[[s
     ``after_each(path)``: called with each FMU once it is in place, by the process that built it (e.g. to unpack it
     for the run that asked for it, off that run's path when a forked builder built it); what it returns is ignored.
 
-    The FMU binary, where it is not compiled yet (the first build of a machine), compiles beside
-    :func:`prepare_builds` (the C compiler is another process), and is there before the builds fork: a forked
-    builder finds it instead of both waiting for it (it took ~0.45 s on the path of a first run's builds).
+    The FMU binary, where it is not compiled yet (the first build of a machine), compiles in a process of its own
+    from the start (:func:`fmus.binary.start_compile`), beside :func:`prepare_builds` and the builds' first steps;
+    begun at the fork, it took ~0.45 s on the path of a first run's builds.
     """
     names = list(names)
     if not names:
         return []
     with build_lock(out_dir, report):
-        compiling = binary.compile_in_background()
+        compiling = binary.start_compile()
         try:
             prepare_builds(names, options.get("source"))
-        finally:
-            compiling.join()  # no thread may run at the fork (fmus.build_pool.can_fork)
-        build = functools.partial(build_fmu, out_dir=out_dir, report=report, **options)
-        return build_each(build if after_each is None else functools.partial(_build_then, build, after_each), names)
+            build = functools.partial(build_fmu, out_dir=out_dir, report=report, **options)
+            built = build_each(build if after_each is None else functools.partial(_build_then, build, after_each),
+                               names)
+        except BaseException:
+            if compiling is not None:
+                compiling.stop()
+            raise
+        if compiling is not None:
+            compiling.finish()
+        return built
 
 
 def _build_then(build: Callable[[str], BuiltFmu], after: Callable[[Path], object], name: str) -> BuiltFmu:

@@ -78,18 +78,32 @@ def test_every_built_fmu_carries_the_binary_and_its_records(fmu_path):
             assert archive.read("resources/python.txt").decode() == binary.python_record()
 
 
-def test_a_build_waits_for_the_compile_started_in_the_background_and_compiles_once(tmp_path, monkeypatch):
+def test_a_build_waits_for_the_compile_started_in_its_own_process_and_compiles_nothing_itself(tmp_path, monkeypatch):
     if binary.compiler() is None:
         pytest.skip("no C compiler")
     monkeypatch.setenv("DTCOSIM_CACHE_DIR", str(tmp_path))
     compiles = []
     real = binary._compile
     monkeypatch.setattr(binary, "_compile", lambda cc, target: compiles.append(target) or real(cc, target))
-    thread = binary.compile_in_background()
-    path = binary.compiled_binary()  # while the thread compiles: waits for it
-    thread.join(timeout=60)
-    assert path.is_file() and path.is_relative_to(tmp_path) and compiles == [path]
+    compiling = binary.start_compile()
+    assert compiling is not None and binary.start_compile() is None  # one compiling process at a time
+    path = binary.compiled_binary()  # while the other process compiles: waits for it
+    assert compiling.process.poll() == 0  # it had ended (the lock is released when it ends)
+    compiling.finish()
+    assert path.is_file() and path.is_relative_to(tmp_path) and compiles == []  # compiled there, not here
     assert ctypes.CDLL(str(path)).fmi2GetVersion  # the whole file
+    assert binary.start_compile() is None  # nothing to compile any more
+    assert [p.name for p in path.parent.iterdir()] == [path.name]  # no temporary folder left
+
+
+def test_an_interrupted_compile_leaves_no_binary_and_no_temporary_folder(tmp_path, monkeypatch):
+    if binary.compiler() is None:
+        pytest.skip("no C compiler")
+    monkeypatch.setenv("DTCOSIM_CACHE_DIR", str(tmp_path))
+    compiling = binary.start_compile()
+    compiling.stop()
+    assert not list((tmp_path / "native").glob("*/*"))  # nothing half-written
+    assert binary.compiled_binary().is_file()  # the next build compiles it
 
 
 def test_a_failing_background_compile_leaves_the_error_to_the_caller(tmp_path, monkeypatch, capfd):
@@ -97,7 +111,9 @@ def test_a_failing_background_compile_leaves_the_error_to_the_caller(tmp_path, m
     monkeypatch.setattr(binary, "compiler", lambda: str(tmp_path / "broken-cc"))
     (tmp_path / "broken-cc").write_text("#!/bin/sh\necho 'broken-cc: cannot compile' >&2\nexit 1\n")
     (tmp_path / "broken-cc").chmod(0o755)
-    binary.compile_in_background().join(timeout=60)
-    assert "Traceback" not in capfd.readouterr().err  # nothing of the thread reaches the user
+    compiling = binary.start_compile()
+    compiling.finish()
+    assert compiling.process.returncode == 1
+    assert capfd.readouterr().err == ""  # nothing of the compiling process reaches the user
     with pytest.raises(binary.NativeBuildError, match="broken-cc could not compile .*cannot compile"):
         binary.compiled_binary()
