@@ -71,6 +71,10 @@ RELIABILITY_FACTORS: Mapping[float, float] = {
 }
 #: ISO 281:2007 9.3.3: a_ISO is limited to this
 A_ISO_MAX = 50.0
+#: a bearing whose equivalent load is at most this fraction of C carries the round-off of the model's forces, not a
+#: load (a symmetric planetary's sun, a carrier bearing without gravity or errors: ~1e-9 N against C ~1e6 N; a real
+#: light load is above 1e-4 C): its lives are infinite, not the (C/P)^p of a round-off (~1e53 h)
+UNLOADED_BELOW = 1e-9
 #: the range of the viscosity ratio kappa of the a_ISO equations (above the maximum it counts as the maximum)
 KAPPA_MIN, KAPPA_MAX = 0.1, 4.0
 
@@ -305,6 +309,11 @@ class BearingLife:
         return self.lnm_h if self.lnm_h is not None else self.l10_h
 
     @property
+    def unloaded(self) -> bool:
+        """Whether the equivalent load is only round-off (at most :data:`UNLOADED_BELOW` C): the lives are infinite."""
+        return self.equivalent_load_n <= UNLOADED_BELOW * self.dynamic_load_rating_n
+
+    @property
     def met(self) -> bool:
         """Whether the life covers the duty (L [h] >= duty hours)."""
         return self.life_h >= self.duty_hours
@@ -315,7 +324,7 @@ class BearingLife:
         return {"name": self.name, "type": self.bearing_type, "C_n": self.dynamic_load_rating_n,
                 "exponent": self.exponent, "P_eq_n": self.equivalent_load_n, "revolutions": self.revolutions,
                 "duty_h": self.duty_hours, "L10_mrev": fin(self.l10_mrev), "L10_h": fin(self.l10_h),
-                "Lnm_mrev": fin(self.lnm_mrev), "Lnm_h": fin(self.lnm_h), "met": self.met,
+                "Lnm_mrev": fin(self.lnm_mrev), "Lnm_h": fin(self.lnm_h), "met": self.met, "unloaded": self.unloaded,
                 "modification": self.modification.describe()}
 
 
@@ -337,6 +346,9 @@ def bearing_life(name: str, bearing_type: str, dynamic_load_rating_n: float, loa
         revolutions per hour.
     modification : LifeModification, optional
         Reliability and a_ISO (default: none, only L10).
+
+    An equivalent load of at most :data:`UNLOADED_BELOW` C is round-off: the lives are infinite
+    (:attr:`BearingLife.unloaded`).
     """
     p = life_exponent(bearing_type)
     mod = modification or LifeModification()
@@ -344,8 +356,11 @@ def bearing_life(name: str, bearing_type: str, dynamic_load_rating_n: float, loa
     p_eq = equivalent_load(loads_n, revolutions, p)
     total = float(np.sum(revolutions))
     per_hour = total / hours
-    l10 = basic_rating_life_mrev(dynamic_load_rating_n, p_eq, p)
-    lnm = modified_life_mrev(bearing_type, dynamic_load_rating_n, loads_n, revolutions, mod) if mod.given else None
+    if p_eq <= UNLOADED_BELOW * positive("dynamic_load_rating", dynamic_load_rating_n):  # round-off, not a load
+        l10, lnm = math.inf, (math.inf if mod.given else None)
+    else:
+        l10 = basic_rating_life_mrev(dynamic_load_rating_n, p_eq, p)
+        lnm = modified_life_mrev(bearing_type, dynamic_load_rating_n, loads_n, revolutions, mod) if mod.given else None
     to_h = lambda life: math.inf if math.isinf(life) else life_hours(life, per_hour)  # noqa: E731
     return BearingLife(name, bearing_type, float(dynamic_load_rating_n), p, p_eq, total, hours, l10, to_h(l10),
                        lnm, None if lnm is None else to_h(lnm), mod)

@@ -21,6 +21,7 @@ from ..inputs.drivetrain_file import DrivetrainSpec
 from .folders import drivetrain_fmu_dir
 from .other_builds import swap_in
 from .staleness import broken_fmu, stale_project_fmus
+from .unpack_ahead import unpack_ahead
 
 #: the FMUs a drivetrain file is built into
 DRIVETRAIN_FMU_NAMES = names_built_from(DRIVETRAIN_FILE)

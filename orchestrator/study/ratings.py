@@ -39,7 +39,7 @@ from typing import Any
 
 import numpy as np
 
-from components.analysis.bearing_life import BearingLife, bearing_life
+from components.analysis.bearing_life import UNLOADED_BELOW, BearingLife, bearing_life
 from components.analysis.gear_rating import GearDamage, gear_damage, miner_damage
 from components.errors import ParameterError
 
@@ -192,7 +192,8 @@ def compute_ratings(res: LifetimeResults) -> Ratings:
         except ParameterError as exc:  # e.g. the bearing never turned in the analysed windows
             out.bearings.append((b, None, f"not rated: {exc.expected} ({exc.name} = {exc.value})"))
             continue
-        out.bearings.append((b, life, ""))
+        out.bearings.append((b, life, f"unloaded: P_eq at round-off (below {UNLOADED_BELOW:g} C), no fatigue life"
+                             if life.unloaded else ""))
     return out
 
 
@@ -290,9 +291,13 @@ def report_lines(res: LifetimeResults, ratings: Ratings) -> list[str]:
             if life is None:
                 lines.append(f"  {p.name:<22} {note}")
                 continue
+            head = f"  {p.name:<22} {p.bearing_type}, C = {p.rating_n:.4g} N, P_eq = {life.equivalent_load_n:.4g} N: "
+            if life.unloaded:
+                lines.append(head + f"no load to rate (round-off of the model's forces, below {UNLOADED_BELOW:g} C): "
+                             "no fatigue life (met)")
+                continue
             lnm = "" if life.lnm_h is None else f", L_nm {life.lnm_h:.4g} h"
-            lines.append(f"  {p.name:<22} {p.bearing_type}, C = {p.rating_n:.4g} N, P_eq = {life.equivalent_load_n:.4g} N: "
-                         f"L10 {life.l10_h:.4g} h{lnm} ({'met' if life.life_h >= ratings.design_hours else 'NOT met'})")
+            lines.append(head + f"L10 {life.l10_h:.4g} h{lnm} ({'met' if life.life_h >= ratings.design_hours else 'NOT met'})")
     return lines
 
 

@@ -99,3 +99,18 @@ def test_a_bearing_that_never_turns_is_refused():
         equivalent_load(np.array([1e5]), np.array([0.0]), 3.0)
     with pytest.raises(ParameterError, match="ball"):
         bearing_life("b", "needle", 1e5, np.array([1e5]), np.array([1.0]), 1.0)
+
+
+@pytest.mark.parametrize("load_n, unloaded", [(1e-9, True), (1e-3, True), (1.1e-3, False), (100.0, False)])
+def test_a_load_at_round_off_is_no_load_and_the_lives_are_infinite(load_n, unloaded):
+    # C = 1 MN: a floating sun's bearing carries ~1e-9 N of round-off, which (C/P)^3 made ~1e45 x 1e6 rev;
+    # at most 1e-9 C (here 1e-3 N) is no load; just above it the life is (C/P)^p as ever
+    revs = np.full(3, 10.0)
+    life = bearing_life("sun", "ball", 1e6, np.full(3, load_n), revs, duty_hours=1.0,
+                        modification=LifeModification(reliability_percent=99.0, a_iso=1.0))
+    assert life.unloaded is unloaded and life.met
+    if unloaded:
+        assert math.isinf(life.l10_mrev) and math.isinf(life.l10_h) and math.isinf(life.lnm_h)
+        assert life.as_dict()["L10_h"] is None and life.as_dict()["unloaded"] is True
+    else:
+        assert life.l10_mrev == pytest.approx((1e6 / load_n) ** 3, rel=1e-12) and math.isfinite(life.lnm_h)

@@ -66,3 +66,11 @@ def test_planet_and_gear_bearings_have_their_iso_281_lives(tmp_path):
                                                                             rel=5e-3)
     # the planets share alike: equal lives
     assert float(rows["stage1.planet_bearing[3]"]["L10 [h]"]) == pytest.approx(float(planet["L10 [h]"]), rel=1e-6)
+    # the suns and carriers float: round-off, reported as no load (not an L10 of ~1e50 h)
+    for s in (1, 2):
+        for m in ("sun", "carrier"):
+            row = rows[f"stage{s}.{m}_bearing"]
+            assert float(row["P_eq [N]"]) < 1e-9 * float(row["C [N]"]) and row["L10 [h]"] == ""
+            assert row["note"].startswith("unloaded: P_eq at round-off") and row["met"] == "True"
+    line = next(x for x in (out / "lifetime_report.txt").read_text().splitlines() if x.strip().startswith("stage1.sun_bearing "))
+    assert "no load to rate" in line and "L10" not in line
