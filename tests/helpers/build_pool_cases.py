@@ -161,8 +161,6 @@ def fmus_on_two_processes(folder: Path) -> dict:
         runs.append(len(self.names))
         return run(self)
 
-    unpacked_by = {}
-
     def unpack(path: Path):
         folder = unpack_ahead(path)
         print(json.dumps({"unpacked": [path.stem, os.getpid(), str(folder)]}), flush=True)  # the child's too
