@@ -333,6 +333,9 @@ def bearing_life(name: str, bearing_type: str, dynamic_load_rating_n: float, loa
                  modification: LifeModification | None = None) -> BearingLife:
     """ISO 281 L10 (and L_nm) of a bearing from its load spectrum over a duty.
 
+    An equivalent load of at most :data:`UNLOADED_BELOW` C is round-off: the lives are infinite
+    (:attr:`BearingLife.unloaded`).
+
     Parameters
     ----------
     name : str
@@ -346,9 +349,6 @@ def bearing_life(name: str, bearing_type: str, dynamic_load_rating_n: float, loa
         revolutions per hour.
     modification : LifeModification, optional
         Reliability and a_ISO (default: none, only L10).
-
-    An equivalent load of at most :data:`UNLOADED_BELOW` C is round-off: the lives are infinite
-    (:attr:`BearingLife.unloaded`).
     """
     p = life_exponent(bearing_type)
     mod = modification or LifeModification()

@@ -87,9 +87,9 @@ def test_a_build_waits_for_the_compile_started_in_its_own_process_and_compiles_n
     monkeypatch.setattr(binary, "_compile", lambda cc, target: compiles.append(target) or real(cc, target))
     compiling = binary.start_compile()
     assert compiling is not None and binary.start_compile() is None  # one compiling process at a time
-    path = binary.compiled_binary()  # while the other process compiles: waits for it
-    assert compiling.process.poll() == 0  # it had ended (the lock is released when it ends)
+    path = binary.compiled_binary()  # while the other process compiles: waits for it (or finds its result)
     compiling.finish()
+    assert compiling.process.returncode == 0
     assert path.is_file() and path.is_relative_to(tmp_path) and compiles == []  # compiled there, not here
     assert ctypes.CDLL(str(path)).fmi2GetVersion  # the whole file
     assert binary.start_compile() is None  # nothing to compile any more
