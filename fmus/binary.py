@@ -23,10 +23,10 @@ import contextlib
 import hashlib
 import os
 import shutil
+import signal
 import subprocess
 import sys
 import sysconfig
-import signal
 import tempfile
 import threading
 from pathlib import Path
