@@ -28,9 +28,9 @@ from .drivetrain_fmus import ensure_drivetrain_fmus
 from .folders import default_fmu_dir
 from .locate import missing_fmus, resolve_fmu_paths
 from .other_builds import swap_in
-from .unpack_ahead import unpack_ahead
 from .staleness import broken_fmu, stale_project_fmus
 from .series_fmus import ensure_series_fmu
+from .unpack_ahead import unpack_ahead
 
 
 def ensure_fmus(scenario: Scenario, fmu_dir: str | Path | None = None, build: bool = True,
