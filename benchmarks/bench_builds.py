@@ -8,9 +8,13 @@ an empty per-user cache apart from the compiled FMU binary, so every build pays 
 pays in its process (the source closures, the bytecode, fmpy's imports) but not the binary's
 one-time compile; the kernels are interpreted as on a first run (``DTCOSIM_AOT=0 DTCOSIM_JIT=0``).
 Printed: the medians of the wall time (what the user waits for) and of the CPU time of the process
-and its children (the work, which a second process does not reduce), and their ratios.
+and its children (the work, which a second process does not reduce), and their ratios. With
+``--baseline REV`` the sources of git revision ``REV`` (``git archive`` into a temporary folder: the
+repository is not touched) build the same FMUs in the same turns, and the ratios of this tree's
+times to theirs are printed (medians of the turns' ratios).
 
-Run: ``python benchmarks/bench_builds.py [--repeat 5] [--fmu NAME ...]`` (default: the paper scenario's three).
+Run: ``python benchmarks/bench_builds.py [--repeat 5] [--fmu NAME ...] [--baseline REV]`` (default: the paper
+scenario's three, no baseline).
 """
 
 from __future__ import annotations
@@ -35,13 +39,25 @@ build_all(sys.argv[1], names=sys.argv[2].split(","))
 """
 
 
-def timed_build(names: list[str], processes: int, cache: Path, out: Path) -> tuple[float, float]:
-    """(wall, CPU) seconds of one build in a fresh process; CPU is the process's and its forked builder's."""
+def archive_tree(revision: str, out_dir: Path) -> Path:
+    """The files of git ``revision`` in ``out_dir/baseline-tree``."""
+    tree, archive = out_dir / "baseline-tree", out_dir / "baseline.tar"
+    subprocess.run(["git", "-C", str(REPO), "archive", "--format=tar", f"--output={archive}", revision], check=True,
+                   capture_output=True)
+    shutil.unpack_archive(archive, tree)
+    return tree
+
+
+def timed_build(names: list[str], processes: int, cache: Path, out: Path, tree: Path = REPO) -> tuple[float, float]:
+    """(wall, CPU) seconds of one build in a fresh process importing dtcosim from ``tree``; CPU is the process's and
+    its forked builder's."""
     env = {**os.environ, "DTCOSIM_CACHE_DIR": str(cache), "DTCOSIM_BUILD_WORKERS": str(processes),
            "DTCOSIM_AOT": "0", "DTCOSIM_JIT": "0"}
     env.pop("PYTHONDONTWRITEBYTECODE", None)
     t0 = time.perf_counter()
-    proc = subprocess.Popen([sys.executable, "-c", CHILD, str(out), ",".join(names)], cwd=REPO, env=env,
+    env.pop("PYTHONPATH", None)
+    code = "import sys; sys.path.insert(0, sys.argv.pop(1))\n" + CHILD
+    proc = subprocess.Popen([sys.executable, "-c", code, str(tree), str(out), ",".join(names)], cwd=tree, env=env,
                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     _, status, usage = os.wait4(proc.pid, 0)
     wall = time.perf_counter() - t0
@@ -54,29 +70,43 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--repeat", type=int, default=5)
     parser.add_argument("--fmu", nargs="+", default=list(DEFAULT_FMUS))
+    parser.add_argument("--baseline", metavar="REV", help="also build with the sources of git revision REV")
     args = parser.parse_args()
-    times: dict[int, list[tuple[float, float]]] = {1: [], 2: []}
     with tempfile.TemporaryDirectory(prefix="dtcosim-bench-builds-") as tmp:
+        trees = {"this tree": REPO}
+        if args.baseline:
+            trees[args.baseline] = archive_tree(args.baseline, Path(tmp))
+        times = {(label, processes): [] for label in trees for processes in (1, 2)}
         cache = Path(tmp) / "cache"
-        timed_build(args.fmu[:1], 1, cache, Path(tmp) / "warm-up")  # compiles the FMU binary once
+        for tree in trees.values():  # compiles the FMU binary once (twice if the baseline's C sources differ)
+            timed_build(args.fmu[:1], 1, cache, Path(tmp) / "warm-up", tree)
+            shutil.rmtree(Path(tmp) / "warm-up")
         for i in range(args.repeat):
-            for processes in (1, 2):
-                out = Path(tmp) / f"out-{processes}-{i}"
-                times[processes].append(timed_build(args.fmu, processes, cache, out))
+            for label, processes in times:
+                out = Path(tmp) / f"out-{i}"
+                times[label, processes].append(timed_build(args.fmu, processes, cache, out, trees[label]))
                 shutil.rmtree(out)
     print(f"building {', '.join(args.fmu)} into an empty folder, medians of {args.repeat} taking turns")
     medians = {}
-    for processes, values in times.items():
+    for (label, processes), values in times.items():
         wall = statistics.median(w for w, _ in values)
         cpu = statistics.median(c for _, c in values)
-        medians[processes] = (wall, cpu)
+        medians[label, processes] = (wall, cpu)
         runs = ", ".join(f"{w:.2f}" for w, _ in values)
-        print(f"  {processes} process{'es' if processes > 1 else '  '}  {wall:6.2f} s wall  {cpu:6.2f} s CPU   "
-              f"(walls {runs})")
-    ratios = [one[0] / two[0] for one, two in zip(times[1], times[2])]
-    print(f"ratio of wall times, 1 / 2 processes: {medians[1][0] / medians[2][0]:.2f} "
-          f"(median of the turns' ratios {statistics.median(ratios):.2f}); "
-          f"CPU 2 / 1: {medians[2][1] / medians[1][1]:.2f}")
+        print(f"  {label:>10}  {processes} process{'es' if processes > 1 else '  '}  {wall:6.2f} s wall  "
+              f"{cpu:6.2f} s CPU   (walls {runs})")
+    for label in trees:
+        ratios = [one[0] / two[0] for one, two in zip(times[label, 1], times[label, 2])]
+        print(f"{label}: ratio of wall times, 1 / 2 processes: {medians[label, 1][0] / medians[label, 2][0]:.2f} "
+              f"(median of the turns' ratios {statistics.median(ratios):.2f}); "
+              f"CPU 2 / 1: {medians[label, 2][1] / medians[label, 1][1]:.2f}")
+    if args.baseline:
+        for processes in (1, 2):
+            pairs = list(zip(times["this tree", processes], times[args.baseline, processes]))
+            cpu = statistics.median(now[1] / base[1] for now, base in pairs)
+            wall = statistics.median(now[0] / base[0] for now, base in pairs)
+            print(f"this tree / {args.baseline}, {processes} process{'es' if processes > 1 else ''}: "
+                  f"CPU {cpu:.2f}, wall {wall:.2f} (medians of the turns' ratios)")
 
 
 if __name__ == "__main__":

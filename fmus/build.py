@@ -436,6 +436,7 @@ def _build_archive(name, kind, model, origin, source, part_dir: Path, resources,
                                       [path for _, path in _embedded_files(name, source)])
         importlib.invalidate_caches()
         try:
+            _import_staged(script, package_dir)
             fmu_path = Path(FmuBuilder.build_FMU(script, dest=part_dir / f"{name}.fmu",
                                                  project_files=[package_dir, Path(tmp) / RECORD_FILE,
                                                                 runtime.requirements_file,
@@ -471,6 +472,21 @@ def _build_archive(name, kind, model, origin, source, part_dir: Path, resources,
     if case is not None:
         _add_cross_check(name, fmu_path, case)
     return BuiltFmu(name, fmu_path, build_id, package, script.stem)
+
+
+def _import_staged(script: Path, package_dir: Path) -> None:
+    """Import the entry module ``script`` and the staged package from their bytecode, then delete that bytecode.
+
+    pythonfmu's build imports the entry module by name (found in ``sys.modules`` after this) and copies the
+    package folder whole into a folder of its own, then leaves ``__pycache__`` out of the archive: without the
+    ~65 bytecode files the copy writes half the files (the FMU's own bytecode comes from :func:`bytecode_members`).
+    """
+    folder = str(script.parent)
+    if folder not in sys.path:
+        sys.path.insert(0, folder)
+    importlib.import_module(script.stem)
+    for cache in [path for path in package_dir.rglob("__pycache__") if path.is_dir()]:
+        shutil.rmtree(cache)
 
 
 def bytecode_members(fmu_path: Path) -> dict[str, bytes]:
