@@ -42,9 +42,7 @@ import re
 import shutil
 import sys
 import tempfile
-import types
 import warnings
-import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Sequence
@@ -57,7 +55,7 @@ from components.errors import DtcosimError
 from components.model.drivetrain import Drivetrain
 from components.model.wind import WindParameters
 
-from . import binary, model_description, registry, runtime_files
+from . import binary, bytecode, model_description, registry, runtime_files
 from .build_lock import build_lock, building_prefix
 from .build_pool import build_each
 from .parameter_ranges import parameter_bounds
@@ -288,11 +286,11 @@ def stage(name: str, model: dict, origin: str, staging_dir: Path,
         target.parent.mkdir(parents=True, exist_ok=True)
         data = _staged_source(rel, path)
         target.write_bytes(data)
-        # its bytecode beside it, as the FMU will carry it (bytecode_members): the build's own import of the
+        # its bytecode beside it, as the FMU will carry it (fmus.bytecode): the build's own import of the
         # staged package (pythonfmu reads the slave class) compiles nothing, and each source is compiled once
         pyc = Path(importlib.util.cache_from_source(str(target)))
         pyc.parent.mkdir(exist_ok=True)
-        pyc.write_bytes(_unchecked_pyc(data, f"resources/{package}/{rel}"))
+        pyc.write_bytes(bytecode.unchecked_pyc(data, f"resources/{package}/{rel}"))
     _bundle_compiled_kernels(package_dir)
     info = {"format": BUILD_FORMAT, "fmu": name, "origin": origin, "build_id": build_id}
     (package_dir / "__init__.py").write_text(
@@ -460,7 +458,7 @@ def _build_archive(name, kind, model, origin, source, part_dir: Path, resources,
         members.update(binary.native_members(name, name))
     except binary.NativeBuildError as exc:  # the FMU keeps pythonfmu's binary: C hosts must preload libpython
         warnings.warn(f"{name}.fmu keeps pythonfmu's linux64 binary: {exc}", stacklevel=2)
-    members.update(bytecode_members(fmu_path))
+    members.update(bytecode.members(fmu_path))
     model_description.rewrite_archive(fmu_path, members)
     if validate:
         from .validation import check_fmu
@@ -479,7 +477,7 @@ def _import_staged(script: Path, package_dir: Path) -> None:
 
     pythonfmu's build imports the entry module by name (found in ``sys.modules`` after this) and copies the
     package folder whole into a folder of its own, then leaves ``__pycache__`` out of the archive: without the
-    ~65 bytecode files the copy writes half the files (the FMU's own bytecode comes from :func:`bytecode_members`).
+    ~65 bytecode files the copy writes half the files (the FMU's own bytecode comes from :func:`fmus.bytecode.members`).
     """
     folder = str(script.parent)
     if folder not in sys.path:
@@ -487,47 +485,6 @@ def _import_staged(script: Path, package_dir: Path) -> None:
     importlib.import_module(script.stem)
     for cache in [path for path in package_dir.rglob("__pycache__") if path.is_dir()]:
         shutil.rmtree(cache)
-
-
-def bytecode_members(fmu_path: Path) -> dict[str, bytes]:
-    """The bytecode of every Python module in the FMU's ``resources/``, as archive members beside the sources.
-
-    An FMU is extracted into a new folder for each run, where Python would compile its ~45
-    modules again every time (~0.05 s per FMU). Each ``<module>.py`` therefore gets its
-    ``__pycache__/<module>.<python tag>.pyc`` compiled by this interpreter as an *unchecked-hash* pyc
-    (PEP 552): the same Python uses it without looking at the source's time stamp (the
-    extraction sets new ones), another version ignores it and compiles the source. Derived
-    from the sources like the compiled kernels, they leave the build id alone.
-    """
-    out = {}
-    with zipfile.ZipFile(fmu_path) as archive:
-        for member in archive.namelist():
-            if member.startswith("resources/") and member.endswith(".py"):
-                out[importlib.util.cache_from_source(member)] = _unchecked_pyc(archive.read(member), member)
-    return out
-
-
-def _unchecked_pyc(source: bytes, filename: str) -> bytes:
-    """What ``py_compile`` writes for ``source`` as an unchecked-hash pyc whose code names ``filename``.
-
-    The FMUs of one build embed mostly the same modules (under their own package names): each
-    distinct source is compiled once per process (:func:`_compiled`) and its code objects renamed.
-    """
-    from importlib._bootstrap_external import _code_to_hash_pyc  # what py_compile itself writes with
-
-    code = _renamed(_compiled(source), filename)
-    return bytes(_code_to_hash_pyc(code, importlib.util.source_hash(source), checked=False))
-
-
-@functools.lru_cache(maxsize=512)
-def _compiled(source: bytes):
-    return compile(source, "<embedded>", "exec", dont_inherit=True)
-
-
-def _renamed(code, filename: str):
-    """``code`` and every code object in it with ``co_filename`` = ``filename`` (as compiled under that name)."""
-    consts = tuple(_renamed(c, filename) if isinstance(c, types.CodeType) else c for c in code.co_consts)
-    return code.replace(co_filename=filename, co_consts=consts)
 
 
 def _add_cross_check(name: str, fmu_path: Path, case) -> None:
@@ -601,10 +558,17 @@ def _build_then(build: Callable[[str], BuiltFmu], after: Callable[[Path], object
 
 def prepare_builds(names: Sequence[str], source: SourceTree | None = None) -> None:
     """Do what every build of FMUs ``names`` starts with once, so that a forked builder (:mod:`fmus.build_pool`)
-    starts with it done: import what a build imports when first needed (fmpy's simulation and validation, the
-    slaves), find the modules each FMU embeds and compile their sources (the FMUs share most of them), and look up
-    the installed distributions their requirements name (each reads a file list once per process)."""
+    starts with it done: import what a build imports when first needed (fmpy's simulation and validation, the XML
+    parsers fmpy and pythonfmu use, the slaves), find the modules each FMU embeds and compile their sources (the
+    FMUs share most of them), and look up the installed distributions their requirements name (each reads a file
+    list once per process)."""
+    import sysconfig
+    import xml.dom.expatbuilder  # noqa: F401 - pythonfmu's model description (minidom.parseString)
+
     from fmpy import simulation, validation  # noqa: F401 - the cross-check run, the archive check
+    from lxml import etree  # noqa: F401 - fmpy.read_model_description's parser
+
+    sysconfig.get_config_vars()  # the FMU binary's members (fmus.binary) read them
 
     from . import cross_check, validation as fmu_validation  # noqa: F401
 
@@ -613,5 +577,5 @@ def prepare_builds(names: Sequence[str], source: SourceTree | None = None) -> No
         _kind(name).slave_class()
         embedded = _embedded_files(name, source)
         for rel, path in embedded:
-            _compiled(_staged_source(rel, path))
+            bytecode.compiled(_staged_source(rel, path))
         runtime_files.requirements(name, [path for _, path in embedded])

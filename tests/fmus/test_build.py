@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 import shutil
+import sys
 import zipfile
 from xml.etree import ElementTree as ET
 
@@ -15,6 +16,7 @@ from fmpy.validation import validate_fmu
 from components.model.description import build
 from components.model.presets import cosim_preset
 from fmus import build as fmu_build
+from fmus import bytecode
 from fmus.build import (
     BuildError,
     SourceTree,
@@ -346,8 +348,31 @@ def test_an_interrupted_build_leaves_the_previous_fmu_whole_and_nothing_half_wri
     assert sorted(p.name for p in out.iterdir()) == ["WindSource.fmu"]
 
 
+def test_pythonfmu_gets_the_slave_imported_and_a_package_without_bytecode(tmp_path, monkeypatch):
+    """The staged package's bytecode serves the build's own import only: pythonfmu finds the entry module imported
+    and copies sources alone (it leaves __pycache__ out of the archive anyway)."""
+    from pythonfmu import FmuBuilder
+
+    seen = {}
+    real = FmuBuilder.build_FMU
+
+    def build_fmu(script, **options):
+        package = options["project_files"][0]
+        seen["imported"] = script.stem in sys.modules and f"{package.name}.slaves.generator_rotor" in sys.modules
+        seen["bytecode"] = sorted(p.name for p in package.rglob("*.pyc"))
+        seen["sources"] = len(list(package.rglob("*.py")))
+        return real(script, **options)
+
+    monkeypatch.setattr(FmuBuilder, "build_FMU", staticmethod(build_fmu))
+    built = fmu_build.build_fmu("GeneratorRotor", tmp_path)
+    assert seen["imported"] and seen["bytecode"] == [] and seen["sources"] > 20
+    with zipfile.ZipFile(built.path) as archive:  # the FMU still carries each module's bytecode
+        names = set(archive.namelist())
+    assert f"resources/{built.package}/slaves/__pycache__/generator_rotor.{sys.implementation.cache_tag}.pyc" in names
+
+
 def test_bytecode_of_a_source_two_fmus_embed_is_compiled_once_and_names_each_file(tmp_path):
-    """fmus.build._unchecked_pyc: the code py_compile writes (same header and code), under each member's name."""
+    """fmus.bytecode.unchecked_pyc: the code py_compile writes (same header and code), under each member's name."""
     import importlib.util
     import marshal
     import py_compile
@@ -357,10 +382,11 @@ def test_bytecode_of_a_source_two_fmus_embed_is_compiled_once_and_names_each_fil
     py_compile.compile(str(tmp_path / "mod.py"), cfile=str(tmp_path / "mod.pyc"), dfile="resources/a/mod.py",
                        doraise=True, invalidation_mode=py_compile.PycInvalidationMode.UNCHECKED_HASH)
     expected = (tmp_path / "mod.pyc").read_bytes()
-    fmu_build._compiled.cache_clear()
-    first = fmu_build._unchecked_pyc(source, "resources/a/mod.py")
-    second = fmu_build._unchecked_pyc(source, "resources/b/mod.py")
-    assert fmu_build._compiled.cache_info().misses == 1 and fmu_build._compiled.cache_info().hits == 1
+    bytecode.compiled.cache_clear()
+    bytecode.unchecked_pyc.cache_clear()
+    first = bytecode.unchecked_pyc(source, "resources/a/mod.py")
+    second = bytecode.unchecked_pyc(source, "resources/b/mod.py")
+    assert bytecode.compiled.cache_info().misses == 1 and bytecode.compiled.cache_info().hits == 1
     assert first[:16] == expected[:16] == second[:16] and expected[8:16] == importlib.util.source_hash(source)
     assert marshal.loads(first[16:]) == marshal.loads(expected[16:])
 
