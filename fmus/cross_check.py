@@ -72,7 +72,7 @@ def reference_members(fmu_path: Path, case: CrossCheckCase) -> dict[str, bytes]:
             extract_fmu(fmu_path, unzipped)
             result = simulate_fmu(unzipped, start_time=case.start_time, stop_time=case.stop_time, step_size=step,
                                   output_interval=step, input=inputs if len(inputs.dtype.names) > 1 else None,
-                                  output=outputs, validate=False)
+                                  output=outputs, validate=False, model_description=md)
         finally:
             forget_python_from(Path(unzipped))
     opt = f"StartTime,{case.start_time!r}\nStopTime,{case.stop_time!r}\nStepSize,{step!r}\nRelTol,{REL_TOL:g}\n"
