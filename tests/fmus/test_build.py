@@ -348,27 +348,35 @@ def test_an_interrupted_build_leaves_the_previous_fmu_whole_and_nothing_half_wri
     assert sorted(p.name for p in out.iterdir()) == ["WindSource.fmu"]
 
 
-def test_pythonfmu_gets_the_slave_imported_and_a_package_without_bytecode(tmp_path, monkeypatch):
-    """The staged package's bytecode serves the build's own import only: pythonfmu finds the entry module imported
-    and copies sources alone (it leaves __pycache__ out of the archive anyway)."""
+def test_the_builds_own_import_of_the_staged_package_compiles_and_writes_no_bytecode(tmp_path, monkeypatch):
+    """The staged modules' bytecode is the FMU's, held in memory: pythonfmu's import of the slave compiles none of
+    them and writes no __pycache__ into the folder it copies; the FMU still carries each module's bytecode."""
+    import importlib.machinery
+
     from pythonfmu import FmuBuilder
 
-    seen = {}
+    compiled, seen = [], {}
+    real_compile = importlib.machinery.SourceFileLoader.source_to_code
+    monkeypatch.setattr(importlib.machinery.SourceFileLoader, "source_to_code",
+                        lambda self, data, path, **kw: compiled.append(str(path)) or real_compile(self, data, path, **kw))
     real = FmuBuilder.build_FMU
 
     def build_fmu(script, **options):
         package = options["project_files"][0]
-        seen["imported"] = script.stem in sys.modules and f"{package.name}.slaves.generator_rotor" in sys.modules
-        seen["bytecode"] = sorted(p.name for p in package.rglob("*.pyc"))
-        seen["sources"] = len(list(package.rglob("*.py")))
-        return real(script, **options)
+        out = real(script, **options)
+        seen["imported"] = f"{package.name}.slaves.generator_rotor" in sys.modules
+        seen["compiled"] = [path for path in compiled if path.startswith(str(script.parent))]
+        seen["bytecode"] = sorted(p.name for p in script.parent.rglob("*.pyc"))
+        return out
 
     monkeypatch.setattr(FmuBuilder, "build_FMU", staticmethod(build_fmu))
     built = fmu_build.build_fmu("GeneratorRotor", tmp_path)
-    assert seen["imported"] and seen["bytecode"] == [] and seen["sources"] > 20
-    with zipfile.ZipFile(built.path) as archive:  # the FMU still carries each module's bytecode
+    assert seen == {"imported": True, "compiled": [], "bytecode": []}
+    with zipfile.ZipFile(built.path) as archive:
         names = set(archive.namelist())
     assert f"resources/{built.package}/slaves/__pycache__/generator_rotor.{sys.implementation.cache_tag}.pyc" in names
+    assert f"resources/{built.slave_module}.py" in names and \
+        f"resources/__pycache__/{built.slave_module}.{sys.implementation.cache_tag}.pyc" in names
 
 
 def test_bytecode_of_a_source_two_fmus_embed_is_compiled_once_and_names_each_file(tmp_path):
