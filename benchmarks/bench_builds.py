@@ -11,7 +11,8 @@ Printed: the medians of the wall time (what the user waits for) and of the CPU t
 and its children (the work, which a second process does not reduce), and their ratios. With
 ``--baseline REV`` the sources of git revision ``REV`` (``git archive`` into a temporary folder: the
 repository is not touched) build the same FMUs in the same turns, and the ratios of this tree's
-times to theirs are printed (medians of the turns' ratios).
+times to theirs are printed (medians of the turns' ratios), also of the builds' own CPU: each build
+process's less that of a process that only imports what it does (``imports only``, in the same turn).
 
 Run: ``python benchmarks/bench_builds.py [--repeat 5] [--fmu NAME ...] [--baseline REV]`` (default: the paper
 scenario's three, no baseline).
@@ -35,7 +36,7 @@ CHILD = """
 import sys
 import orchestrator.commands.cli  # what a run has imported when it builds
 from fmus.build import build_all
-build_all(sys.argv[1], names=sys.argv[2].split(","))
+build_all(sys.argv[1], names=[name for name in sys.argv[2].split(",") if name])
 """
 
 
@@ -76,7 +77,7 @@ def main() -> None:
         trees = {"this tree": REPO}
         if args.baseline:
             trees[args.baseline] = archive_tree(args.baseline, Path(tmp))
-        times = {(label, processes): [] for label in trees for processes in (1, 2)}
+        times = {(label, processes): [] for label in trees for processes in (0, 1, 2)}  # 0: imports only
         cache = Path(tmp) / "cache"
         for tree in trees.values():  # compiles the FMU binary once (twice if the baseline's C sources differ)
             timed_build(args.fmu[:1], 1, cache, Path(tmp) / "warm-up", tree)
@@ -84,8 +85,9 @@ def main() -> None:
         for i in range(args.repeat):
             for label, processes in times:
                 out = Path(tmp) / f"out-{i}"
-                times[label, processes].append(timed_build(args.fmu, processes, cache, out, trees[label]))
-                shutil.rmtree(out)
+                names = args.fmu if processes else []
+                times[label, processes].append(timed_build(names, max(processes, 1), cache, out, trees[label]))
+                shutil.rmtree(out, ignore_errors=True)
     print(f"building {', '.join(args.fmu)} into an empty folder, medians of {args.repeat} taking turns")
     medians = {}
     for (label, processes), values in times.items():
@@ -93,8 +95,8 @@ def main() -> None:
         cpu = statistics.median(c for _, c in values)
         medians[label, processes] = (wall, cpu)
         runs = ", ".join(f"{w:.2f}" for w, _ in values)
-        print(f"  {label:>10}  {processes} process{'es' if processes > 1 else '  '}  {wall:6.2f} s wall  "
-              f"{cpu:6.2f} s CPU   (walls {runs})")
+        what = f"{processes} process{'es' if processes > 1 else '  '}" if processes else "imports only"
+        print(f"  {label:>10}  {what}  {wall:6.2f} s wall  {cpu:6.2f} s CPU   (walls {runs})")
     for label in trees:
         ratios = [one[0] / two[0] for one, two in zip(times[label, 1], times[label, 2])]
         print(f"{label}: ratio of wall times, 1 / 2 processes: {medians[label, 1][0] / medians[label, 2][0]:.2f} "
@@ -105,8 +107,12 @@ def main() -> None:
             pairs = list(zip(times["this tree", processes], times[args.baseline, processes]))
             cpu = statistics.median(now[1] / base[1] for now, base in pairs)
             wall = statistics.median(now[0] / base[0] for now, base in pairs)
+            # the builds' own CPU: each turn's process less the same turn's process that only imported
+            own = {label: [t[1] - i[1] for t, i in zip(times[label, processes], times[label, 0])] for label in trees}
+            builds = statistics.median(now / base for now, base in zip(own["this tree"], own[args.baseline]))
             print(f"this tree / {args.baseline}, {processes} process{'es' if processes > 1 else ''}: "
-                  f"CPU {cpu:.2f}, wall {wall:.2f} (medians of the turns' ratios)")
+                  f"CPU {cpu:.2f}, wall {wall:.2f}; the builds' own CPU {statistics.median(own['this tree']):.2f} "
+                  f"against {statistics.median(own[args.baseline]):.2f} s, {builds:.2f} (medians of the turns)")
 
 
 if __name__ == "__main__":
