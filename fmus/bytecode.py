@@ -43,8 +43,8 @@ def unchecked_pyc(source: bytes, filename: str) -> bytes:
 
     The FMUs of one build embed mostly the same modules (under their own package names): each
     distinct source is compiled once per process (:func:`compiled`) and its code objects renamed.
-    Remembered: :func:`fmus.build.stage` writes the staged modules' bytecode and :func:`members` then asks for
-    the same (source, name) pairs.
+    Remembered: :func:`fmus.build.stage` asks for the staged modules' bytecode (the build's own import takes it
+    from memory) and :func:`members` then for the same (source, name) pairs.
     """
     from importlib._bootstrap_external import _code_to_hash_pyc  # what py_compile itself writes with
 
@@ -53,7 +53,9 @@ def unchecked_pyc(source: bytes, filename: str) -> bytes:
 
 
 @functools.lru_cache(maxsize=512)
-def compiled(source: bytes):
+def compiled(source: bytes) -> types.CodeType:
+    """The code of module source ``source``, compiled once per process (named ``<embedded>``: see
+    :func:`unchecked_pyc`)."""
     return compile(source, "<embedded>", "exec", dont_inherit=True)
 
 
