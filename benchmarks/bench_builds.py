@@ -30,6 +30,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from baseline_tree import archive_tree
+
 REPO = Path(__file__).resolve().parents[1]
 DEFAULT_FMUS = ("Gearbox", "GeneratorRotor", "WindSource")
 CHILD = """
@@ -38,15 +40,6 @@ import orchestrator.commands.cli  # what a run has imported when it builds
 from fmus.build import build_all
 build_all(sys.argv[1], names=[name for name in sys.argv[2].split(",") if name])
 """
-
-
-def archive_tree(revision: str, out_dir: Path) -> Path:
-    """The files of git ``revision`` in ``out_dir/baseline-tree``."""
-    tree, archive = out_dir / "baseline-tree", out_dir / "baseline.tar"
-    subprocess.run(["git", "-C", str(REPO), "archive", "--format=tar", f"--output={archive}", revision], check=True,
-                   capture_output=True)
-    shutil.unpack_archive(archive, tree)
-    return tree
 
 
 def timed_build(names: list[str], processes: int, cache: Path, out: Path, tree: Path = REPO) -> tuple[float, float]:

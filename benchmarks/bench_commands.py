@@ -36,6 +36,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from baseline_tree import archive_tree
+
 DTCOSIM = [sys.executable, "-m", "orchestrator.commands.cli"]
 
 
@@ -97,15 +99,6 @@ def _stop_background_compile(cache: Path) -> None:
             os.killpg(pid, signal.SIGTERM)
         except ProcessLookupError:
             pass
-
-
-def archive_tree(revision: str, out_dir: Path) -> Path:
-    """The files of git ``revision`` in ``out_dir/baseline-tree``."""
-    tree, archive = out_dir / "baseline-tree", out_dir / "baseline.tar"
-    subprocess.run(["git", "-C", str(Path(__file__).resolve().parents[1]), "archive", "--format=tar",
-                    f"--output={archive}", revision], check=True, capture_output=True)
-    shutil.unpack_archive(archive, tree)
-    return tree
 
 
 def first_run(repeat: int, baseline: str | None = None) -> None:
