@@ -12,7 +12,8 @@ and its children (the work, which a second process does not reduce), and their r
 ``--baseline REV`` the sources of git revision ``REV`` (``git archive`` into a temporary folder: the
 repository is not touched) build the same FMUs in the same turns, and the ratios of this tree's
 times to theirs are printed (medians of the turns' ratios), also of the builds' own CPU: each build
-process's less that of a process that only imports what it does (``imports only``, in the same turn).
+process's less that of a process that only imports what it does (``imports only``, in the same turn),
+and the sizes of the FMU archives.
 
 Run: ``python benchmarks/bench_builds.py [--repeat 5] [--fmu NAME ...] [--baseline REV]`` (default: the paper
 scenario's three, no baseline).
@@ -71,6 +72,7 @@ def main() -> None:
         if args.baseline:
             trees[args.baseline] = archive_tree(args.baseline, Path(tmp))
         times = {(label, processes): [] for label in trees for processes in (0, 1, 2)}  # 0: imports only
+        sizes: dict[str, dict[str, int]] = {}
         cache = Path(tmp) / "cache"
         for tree in trees.values():  # compiles the FMU binary once (twice if the baseline's C sources differ)
             timed_build(args.fmu[:1], 1, cache, Path(tmp) / "warm-up", tree)
@@ -80,6 +82,8 @@ def main() -> None:
                 out = Path(tmp) / f"out-{i}"
                 names = args.fmu if processes else []
                 times[label, processes].append(timed_build(names, max(processes, 1), cache, out, trees[label]))
+                if processes == 1:
+                    sizes[label] = {path.stem: path.stat().st_size for path in sorted(out.glob("*.fmu"))}
                 shutil.rmtree(out, ignore_errors=True)
     print(f"building {', '.join(args.fmu)} into an empty folder, medians of {args.repeat} taking turns")
     medians = {}
@@ -106,6 +110,8 @@ def main() -> None:
             print(f"this tree / {args.baseline}, {processes} process{'es' if processes > 1 else ''}: "
                   f"CPU {cpu:.2f}, wall {wall:.2f}; the builds' own CPU {statistics.median(own['this tree']):.2f} "
                   f"against {statistics.median(own[args.baseline]):.2f} s, {builds:.2f} (medians of the turns)")
+        print(f"archive sizes, this tree / {args.baseline}: " + ", ".join(
+            f"{name} {size / sizes[args.baseline][name]:.3f} ({size} bytes)" for name, size in sizes["this tree"].items()))
 
 
 if __name__ == "__main__":
