@@ -12,13 +12,16 @@
    the warm runs' cache; then ``--repeat`` first runs, each in an empty cache of its own (the compile
    it starts in the background is ended after it), take turns with warm runs in that cache; printed:
    the medians of both and the ratio of the first run's wall time to the warm run's (target, issue 34:
-   <= 3), and how long the background compile took.
+   <= 3), and how long the background compile took. With ``--baseline REV`` a first run of the sources of
+   git revision ``REV`` (``git archive`` into a temporary folder, imported through ``PYTHONPATH``; the
+   repository is not touched) takes its turn after each first run of this tree, and the medians of the
+   turns' ratios this tree / ``REV`` are printed.
 
 The commands run with ``PYTHONDONTWRITEBYTECODE`` removed from their environment, as in a user's
 shell: with it set every command compiles dtcosim's modules again. The machine's other work
 changes the absolute times; the ratios are measured in the same run.
 
-Run: ``python benchmarks/bench_commands.py [--repeat N] [--no-plots] [--first-run]``.
+Run: ``python benchmarks/bench_commands.py [--repeat N] [--no-plots] [--first-run [--baseline REV]]``.
 """
 
 from __future__ import annotations
@@ -32,6 +35,8 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+
+from baseline_tree import archive_tree
 
 DTCOSIM = [sys.executable, "-m", "orchestrator.commands.cli"]
 
@@ -96,16 +101,21 @@ def _stop_background_compile(cache: Path) -> None:
             pass
 
 
-def first_run(repeat: int) -> None:
+def first_run(repeat: int, baseline: str | None = None) -> None:
     """One first run whose background compile is awaited (the warm runs' cache), then ``repeat`` first runs, each
-    with an empty cache of its own (its background compile ended after it), taking turns with warm runs."""
+    with an empty cache of its own (its background compile ended after it), taking turns with warm runs (and with
+    first runs of revision ``baseline``)."""
     from components.compile.aot import build_lock_file
 
     with tempfile.TemporaryDirectory(prefix="dtcosim-bench-first-") as tmp:
-        def first(tag: str) -> tuple[tuple[float, float], Path]:
+        tree = archive_tree(baseline, Path(tmp)) if baseline else None
+
+        def first(tag: str, sources: Path | None = None) -> tuple[tuple[float, float], Path]:
             cache = Path(tmp) / f"cache-{tag}"
             env = environment(DTCOSIM_CACHE_DIR=str(cache), MPLCONFIGDIR=str(Path(tmp) / f"matplotlib-{tag}"))
             env.pop("DTCOSIM_FMU_DIR", None)
+            if sources is not None:
+                env["PYTHONPATH"] = str(sources)
             return timed(DTCOSIM + ["run", "--out", str(Path(tmp) / f"first-{tag}")], env, Path(tmp)), cache
 
         (wall, cpu), cache = first("warm")
@@ -119,15 +129,24 @@ def first_run(repeat: int) -> None:
         warm_argv = DTCOSIM + ["run", "--out", str(Path(tmp) / "warm")]
         timed(warm_argv, warm_env, Path(tmp))  # the warm-up
         times: dict[str, list[tuple[float, float]]] = {"first dtcosim run, empty caches": [], "dtcosim run": []}
+        other = f"first run of {baseline}, empty caches"
+        if baseline:
+            times[other] = []
         for i in range(repeat):
-            measured, fresh = first(str(i))
-            _stop_background_compile(fresh)
-            shutil.rmtree(fresh, ignore_errors=True)
-            times["first dtcosim run, empty caches"].append(measured)
+            for name, tag, sources in [("first dtcosim run, empty caches", str(i), None)] + (
+                    [(other, f"baseline-{i}", tree)] if baseline else []):
+                measured, fresh = first(tag, sources)
+                _stop_background_compile(fresh)
+                shutil.rmtree(fresh, ignore_errors=True)
+                times[name].append(measured)
             times["dtcosim run"].append(timed(warm_argv, warm_env, Path(tmp)))
         medians = report(times)
         ratio = medians["first dtcosim run, empty caches"][0] / medians["dtcosim run"][0]
         print(f"ratio: first run wall / warm run wall  {ratio:.2f}   (target <= 3)")
+        if baseline:
+            pairs = list(zip(times["first dtcosim run, empty caches"], times[other]))
+            print(f"first run, this tree / {baseline}: CPU {statistics.median(a[1] / b[1] for a, b in pairs):.2f}, "
+                  f"wall {statistics.median(a[0] / b[0] for a, b in pairs):.2f} (medians of the turns' ratios)")
 
 
 def main() -> None:
@@ -135,10 +154,11 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=5, help="measured runs of each command (default 5)")
     parser.add_argument("--no-plots", action="store_true", help="also time `dtcosim run --no-plots`")
     parser.add_argument("--first-run", action="store_true", help="time the first run with empty caches instead")
+    parser.add_argument("--baseline", metavar="REV", help="with --first-run: also first runs of git revision REV")
     args = parser.parse_args()
     if args.first_run:
         print(f"the first `dtcosim run` with empty caches against warm runs (median of {args.repeat})")
-        first_run(args.repeat)
+        first_run(args.repeat, args.baseline)
         return
     print(f"whole commands in fresh processes, median of {args.repeat} (taking turns, after one warm-up each)")
     medians = report(warm(args.repeat, args.no_plots, environment()))

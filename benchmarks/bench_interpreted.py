@@ -40,7 +40,6 @@ import one_blas_thread  # noqa: F401 - first: one BLAS thread (CPU time without 
 import argparse
 import os
 import resource
-import shutil
 import statistics
 import subprocess
 import sys
@@ -49,6 +48,8 @@ from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
+
+from baseline_tree import archive_tree
 
 #: the commit before the interpreted kernel was made faster (issue 34.3: its per-step cost)
 BASE_REVISION = "b1dfac4"
@@ -69,15 +70,6 @@ def kernel_form(kernel: str | None):
         os.environ.pop(ENVIRONMENT_VARIABLE, None)
         if previous is not None:
             os.environ[ENVIRONMENT_VARIABLE] = previous
-
-
-def archive_tree(revision: str, out_dir: Path) -> Path:
-    """The files of git ``revision`` in ``out_dir/baseline-tree`` (``git archive``: the repository is not touched)."""
-    tree, archive = out_dir / "baseline-tree", out_dir / "baseline.tar"
-    subprocess.run(["git", "-C", str(REPO), "archive", "--format=tar", f"--output={archive}", revision], check=True,
-                   capture_output=True)
-    shutil.unpack_archive(archive, tree)
-    return tree
 
 
 def child(tree: Path, code: str, *args: str, env: dict[str, str] | None = None) -> str:

@@ -166,12 +166,15 @@ def extract_fmu(path: str | Path, target: str | Path) -> Path:
             raise FmuArchiveError(f"{path}: {problems[0]}")
         left = MAX_FMU_BYTES
         target.mkdir(parents=True, exist_ok=True)
+        made = {target}  # folders made (or there): each is made once, not asked for again by every member
         for info in infos:
             dest = target.joinpath(*info.filename.split("/"))
+            folder = dest if info.is_dir() else dest.parent
+            if folder not in made:
+                folder.mkdir(parents=True, exist_ok=True)
+                made.add(folder)
             if info.is_dir():
-                dest.mkdir(parents=True, exist_ok=True)
                 continue
-            dest.parent.mkdir(parents=True, exist_ok=True)
             try:
                 with archive.open(info) as member, open(dest, "wb") as out:
                     while chunk := member.read(1 << 20):

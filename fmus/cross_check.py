@@ -23,7 +23,6 @@ host that runs the same binary with the same inputs should meet.
 from __future__ import annotations
 
 import errno
-import io
 import os
 import stat
 import tempfile
@@ -45,11 +44,13 @@ MAX_RESULT_BYTES = 256 << 20
 
 
 def _csv_text(table: np.ndarray) -> str:
-    out = io.StringIO()
-    out.write(",".join(f'"{n}"' for n in table.dtype.names) + "\n")
-    for row in table:
-        out.write(",".join(repr(float(x)) for x in row) + "\n")
-    return out.getvalue()
+    """The structured array ``table`` as CSV: a header of quoted names, each cell ``repr(float(value))``."""
+    columns = np.empty((len(table), len(table.dtype.names)))
+    for i, name in enumerate(table.dtype.names):
+        columns[:, i] = table[name]  # to float64 as float() converts each value
+    lines = [",".join(f'"{n}"' for n in table.dtype.names)]
+    lines += [",".join(map(repr, row)) for row in columns.tolist()]
+    return "\n".join(lines) + "\n"
 
 
 def _step_of(md) -> float:
@@ -71,7 +72,7 @@ def reference_members(fmu_path: Path, case: CrossCheckCase) -> dict[str, bytes]:
             extract_fmu(fmu_path, unzipped)
             result = simulate_fmu(unzipped, start_time=case.start_time, stop_time=case.stop_time, step_size=step,
                                   output_interval=step, input=inputs if len(inputs.dtype.names) > 1 else None,
-                                  output=outputs, validate=False)
+                                  output=outputs, validate=False, model_description=md)
         finally:
             forget_python_from(Path(unzipped))
     opt = f"StartTime,{case.start_time!r}\nStopTime,{case.stop_time!r}\nStepSize,{step!r}\nRelTol,{REL_TOL:g}\n"
@@ -87,10 +88,19 @@ def forget_python_from(folder: Path) -> None:
     import importlib
     import sys
 
-    root = os.path.realpath(folder)
+    root = os.path.realpath(folder) + os.sep
+    heads: dict[str, str] = {}  # real paths by folder: a process's ~450 modules lie in a few dozen folders
+
+    def real(path: str) -> str:  # os.path.realpath(path), resolving each folder once
+        head, tail = os.path.split(path)
+        if tail in ("", ".", "..") or os.path.islink(path):
+            return os.path.realpath(path)
+        if head not in heads:
+            heads[head] = os.path.realpath(head)
+        return os.path.join(heads[head], tail)
 
     def inside(path: object) -> bool:
-        return isinstance(path, str) and os.path.realpath(path).startswith(root + os.sep)
+        return isinstance(path, str) and real(path).startswith(root)
 
     for name, module in list(sys.modules.items()):
         if inside(getattr(module, "__file__", None)):

@@ -59,9 +59,10 @@ def fmpy_problems(fmu_path: Path | str) -> list[str]:
     return backslashes
 
 
-def convention_problems(fmu_path: Path | str) -> list[str]:
-    """dtcosim conventions: described variables, a unit on every Real, state handling enabled."""
-    md = read_model_description(str(fmu_path), validate=False)
+def convention_problems(fmu_path: Path | str, md=None, names: set[str] | None = None) -> list[str]:
+    """dtcosim conventions: described variables, a unit on every Real, state handling enabled (``md``, ``names``:
+    the FMU's model description and member names, where the caller has read them)."""
+    md = md if md is not None else read_model_description(str(fmu_path), validate=False)
     problems = []
     for v in md.modelVariables:
         if not v.description:
@@ -73,13 +74,14 @@ def convention_problems(fmu_path: Path | str) -> list[str]:
         problems.append("The FMU does not support co-simulation.")
     elif not (cs.canGetAndSetFMUstate and cs.canSerializeFMUstate):
         problems.append("canGetAndSetFMUstate and canSerializeFMUstate must be true.")
-    return problems + runtime_declaration_problems(fmu_path)
+    return problems + runtime_declaration_problems(fmu_path, names)
 
 
-def runtime_declaration_problems(fmu_path: Path | str) -> list[str]:
+def runtime_declaration_problems(fmu_path: Path | str, names: set[str] | None = None) -> list[str]:
     """What a foreign host needs to be told: documentation and readable declared requirements."""
-    with zipfile.ZipFile(fmu_path) as archive:
-        names = set(archive.namelist())
+    if names is None:
+        with zipfile.ZipFile(fmu_path) as archive:
+            names = set(archive.namelist())
     problems = []
     if DOCUMENTATION_MEMBER not in names:
         problems.append(f"The FMU has no {DOCUMENTATION_MEMBER}.")
@@ -141,7 +143,7 @@ def check_fmu(fmu_path: Path | str) -> list[str]:
     loading = archive_problems(fmu_path, identifier, md.generationTool or "", names)
     if problems:
         return list(problems) + loading
-    return loading + (convention_problems(fmu_path) if RECORD_MEMBER in names else [])
+    return loading + (convention_problems(fmu_path, md, names) if RECORD_MEMBER in names else [])
 
 
 def fmu_files(paths: Iterable[Path | str]) -> list[Path]:

@@ -26,7 +26,7 @@ computes anyway) loads that folder:
 
 Nothing in the folder is written after the rename (fmpy and the slaves write nothing there,
 numba caches in the user cache): the FMUs' modules come with their bytecode
-(:func:`fmus.build.bytecode_members`), and what this interpreter would still compile (an FMU
+(:func:`fmus.bytecode.members`), and what this interpreter would still compile (an FMU
 built by another Python version) is compiled before the rename. The folder's name therefore
 carries the interpreter's bytecode tag: another Python version unpacks a folder of its own.
 """

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 import shutil
+import sys
 import zipfile
 from xml.etree import ElementTree as ET
 
@@ -15,6 +16,7 @@ from fmpy.validation import validate_fmu
 from components.model.description import build
 from components.model.presets import cosim_preset
 from fmus import build as fmu_build
+from fmus import bytecode
 from fmus.build import (
     BuildError,
     SourceTree,
@@ -346,8 +348,39 @@ def test_an_interrupted_build_leaves_the_previous_fmu_whole_and_nothing_half_wri
     assert sorted(p.name for p in out.iterdir()) == ["WindSource.fmu"]
 
 
+def test_the_builds_own_import_of_the_staged_package_compiles_and_writes_no_bytecode(tmp_path, monkeypatch):
+    """The staged modules' bytecode is the FMU's, held in memory: pythonfmu's import of the slave compiles none of
+    them and writes no __pycache__ into the folder it copies; the FMU still carries each module's bytecode."""
+    import importlib.machinery
+
+    from pythonfmu import FmuBuilder
+
+    compiled, seen = [], {}
+    real_compile = importlib.machinery.SourceFileLoader.source_to_code
+    monkeypatch.setattr(importlib.machinery.SourceFileLoader, "source_to_code",
+                        lambda self, data, path, **kw: compiled.append(str(path)) or real_compile(self, data, path, **kw))
+    real = FmuBuilder.build_FMU
+
+    def build_fmu(script, **options):
+        package = options["project_files"][0]
+        out = real(script, **options)
+        seen["imported"] = f"{package.name}.slaves.generator_rotor" in sys.modules
+        seen["compiled"] = [path for path in compiled if path.startswith(str(script.parent))]
+        seen["bytecode"] = sorted(p.name for p in script.parent.rglob("*.pyc"))
+        return out
+
+    monkeypatch.setattr(FmuBuilder, "build_FMU", staticmethod(build_fmu))
+    built = fmu_build.build_fmu("GeneratorRotor", tmp_path)
+    assert seen == {"imported": True, "compiled": [], "bytecode": []}
+    with zipfile.ZipFile(built.path) as archive:
+        names = set(archive.namelist())
+    assert f"resources/{built.package}/slaves/__pycache__/generator_rotor.{sys.implementation.cache_tag}.pyc" in names
+    assert f"resources/{built.slave_module}.py" in names and \
+        f"resources/__pycache__/{built.slave_module}.{sys.implementation.cache_tag}.pyc" in names
+
+
 def test_bytecode_of_a_source_two_fmus_embed_is_compiled_once_and_names_each_file(tmp_path):
-    """fmus.build._unchecked_pyc: the code py_compile writes (same header and code), under each member's name."""
+    """fmus.bytecode.unchecked_pyc: the code py_compile writes (same header and code), under each member's name."""
     import importlib.util
     import marshal
     import py_compile
@@ -357,10 +390,11 @@ def test_bytecode_of_a_source_two_fmus_embed_is_compiled_once_and_names_each_fil
     py_compile.compile(str(tmp_path / "mod.py"), cfile=str(tmp_path / "mod.pyc"), dfile="resources/a/mod.py",
                        doraise=True, invalidation_mode=py_compile.PycInvalidationMode.UNCHECKED_HASH)
     expected = (tmp_path / "mod.pyc").read_bytes()
-    fmu_build._compiled.cache_clear()
-    first = fmu_build._unchecked_pyc(source, "resources/a/mod.py")
-    second = fmu_build._unchecked_pyc(source, "resources/b/mod.py")
-    assert fmu_build._compiled.cache_info().misses == 1 and fmu_build._compiled.cache_info().hits == 1
+    bytecode.compiled.cache_clear()
+    bytecode.unchecked_pyc.cache_clear()
+    first = bytecode.unchecked_pyc(source, "resources/a/mod.py")
+    second = bytecode.unchecked_pyc(source, "resources/b/mod.py")
+    assert bytecode.compiled.cache_info().misses == 1 and bytecode.compiled.cache_info().hits == 1
     assert first[:16] == expected[:16] == second[:16] and expected[8:16] == importlib.util.source_hash(source)
     assert marshal.loads(first[16:]) == marshal.loads(expected[16:])
 

@@ -165,3 +165,44 @@ def test_the_cross_check_run_leaves_no_module_or_path_of_its_deleted_folder(tmp_
     left = [name for name in list(sys.modules) if name.startswith(built.package) or name == built.slave_module]
     assert left == []
     assert [entry for entry in sys.path if entry not in before and not os.path.exists(entry)] == []
+
+
+@pytest.mark.parametrize("dtype", [[("time", "f8"), ("y", "f8")], [("time", "f8"), ("n", "i4"), ("b", "?")],
+                                   [("time", "f8"), ("big", "i8"), ("small", "f4")]])
+def test_the_csv_cells_are_repr_of_float_of_each_value(dtype):
+    from fmus.cross_check import _csv_text
+
+    rng = np.random.default_rng(1)
+    table = np.zeros(7, dtype=dtype)
+    for name in table.dtype.names:
+        table[name] = rng.normal(size=7) * 1e9 if table.dtype[name].kind != "b" else rng.random(7) > 0.5
+    table["time"][3] = -0.0
+    by_row = [",".join(f'"{n}"' for n in table.dtype.names)] + [",".join(repr(float(x)) for x in row) for row in table]
+    assert _csv_text(table) == "\n".join(by_row) + "\n"
+    assert _csv_text(table[:0]) == by_row[0] + "\n"
+
+
+def test_forgetting_a_folder_resolves_links_of_files_and_folders(tmp_path, monkeypatch):
+    """Modules whose files lie in the folder through a linked folder or a linked file are forgotten; others stay."""
+    import os
+    import types
+
+    from fmus.cross_check import forget_python_from
+
+    inside, outside = tmp_path / "fmu" / "resources", tmp_path / "other"
+    inside.mkdir(parents=True)
+    outside.mkdir()
+    (inside / "m.py").write_text("")
+    (tmp_path / "via").symlink_to(inside)
+    (outside / "linked.py").symlink_to(inside / "m.py")
+    (outside / "own.py").write_text("")
+    files = {"_t_direct": inside / "m.py", "_t_via_folder": tmp_path / "via" / "m.py",
+             "_t_via_file": outside / "linked.py", "_t_outside": outside / "own.py"}
+    for name, path in files.items():
+        module = types.ModuleType(name)
+        module.__file__ = str(path)
+        monkeypatch.setitem(sys.modules, name, module)
+    monkeypatch.setattr(sys, "path", [*sys.path, str(tmp_path / "via"), str(outside), os.path.relpath(inside)])
+    forget_python_from(tmp_path / "fmu")
+    assert [name for name in files if name in sys.modules] == ["_t_outside"]
+    assert str(outside) in sys.path and str(tmp_path / "via") not in sys.path and os.path.relpath(inside) not in sys.path
