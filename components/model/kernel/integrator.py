@@ -252,12 +252,16 @@ def use_factorisation(hd, dq, dv, winvs, pivots, istate):
 
 
 def twist_and_rate(twist_q, y, n, twist_port, port, tau):
-    """Output-shaft twist [rad] and its rate [rad/s] at ``tau``: the weights on ``q`` and on ``v``, plus the port's."""
-    terms = np.empty((2, n + 1))
-    terms[0, 0] = twist_port * value(port, tau)
-    terms[1, 0] = twist_port * rate(port, tau)
-    np.multiply(y[:2 * n].reshape(2, n), twist_q[:n], out=terms[:, 1:])
-    twist, rate_ = np.add.accumulate(terms, 1)[:, -1].tolist()  # summed from the port's term on, as the loop
+    """Output-shaft twist [rad] and its rate [rad/s] at ``tau``: the weights on ``q`` and on ``v``, plus the port's.
+
+    The numpy form runs the loop on Python floats (22 products: cheaper than numpy's calls on them)."""
+    curve = port.tolist()
+    twist = twist_port * value(curve, tau)
+    rate_ = twist_port * rate(curve, tau)
+    state = y[:2 * n].tolist()
+    for w, q, v in zip(twist_q[:n].tolist(), state[:n], state[n:]):  # summed from the port's term on, as the loop
+        twist += w * q
+        rate_ += w * v
     return twist, rate_
 
 

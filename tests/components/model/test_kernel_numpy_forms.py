@@ -243,6 +243,20 @@ def test_the_interpreted_views_are_kept_per_buffer():
     assert step.views(*copy_of_tables) is not again  # equal tables in other objects: views made for them
 
 
+def test_the_contact_rows_are_kept_per_table():
+    """The numpy form reads a contact table's rows once per table object: an equal table in another object, or the
+    same one after more tables than kept were read, is read anew."""
+    contact = _module("contact")
+    tables = [np.full((3, 9), float(i)) for i in range(contact.KEPT_TABLES + 1)]
+    rows = contact.table_rows(tables[0])
+    assert rows == tables[0].tolist() and contact.table_rows(tables[0]) is rows
+    equal = tables[0].copy()
+    assert contact.table_rows(equal) is not rows and contact.table_rows(equal) == rows
+    assert [contact.table_rows(t) for t in tables[1:]] == [t.tolist() for t in tables[1:]]
+    again = contact.table_rows(tables[0])  # dropped when more were asked for, read anew
+    assert again is not rows and again == rows
+
+
 def test_models_stepped_in_turns_step_as_alone():
     """Interpreted gearboxes stepped in turns (more than the views kept) compute what each computes alone."""
     from components.model.kernel.step import KEPT_VIEWS
