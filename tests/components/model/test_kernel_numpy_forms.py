@@ -140,7 +140,8 @@ def _model_cases(rng, a: Assembly, nonfinite: bool) -> dict:
         "forces": lambda: (defl, factor, table, np.empty(m)),
         "force_slopes": lambda: (defl, factor, table, np.empty(m), np.empty(m)),
         "stiffness_force_rates": lambda: (defl, factor, table, rng.normal(size=m), 1.7, np.empty(m)),
-        "deflections": lambda: (y, n, a.nz_index, a.nz_value, a.port_deflection, a.mesh_offset, 1e-3, -2e-2,
+        "deflections": lambda: (y, n, a.nz_index, a.nz_value, a.port_deflection,
+                                _signed_zeros(rng, a.mesh_offset + rng.normal(0.0, 1e-5, m)), 1e-3, -2e-2,
                                 np.empty((2, m))),
         "assemble_jacobian": lambda: (_signed_zeros(rng, rng.normal(0, 1e9, m)), rng.normal(0, 1e3, m), a.nz_index,
                                       a.nz_value, a.port_deflection, a.cos_alpha, a.STkS, a.STcS, stks_port, stcs_port,
@@ -255,6 +256,25 @@ def test_the_contact_rows_are_kept_per_table():
     assert [contact.table_rows(t) for t in tables[1:]] == [t.tolist() for t in tables[1:]]
     again = contact.table_rows(tables[0])  # dropped when more were asked for, read anew
     assert again is not rows and again == rows
+
+
+def test_the_extended_mesh_patterns_are_kept_per_table():
+    """deflections' numpy form extends a mesh pattern once per set of table objects: other objects (equal or not), or
+    the same after more patterns than kept were extended, are extended anew."""
+    dynamics = _module("dynamics")
+    a = ASSEMBLIES["table6"]
+    n, m = a.n_dof, a.n_mesh
+    tables = tuple(np.array(t) for t in (a.nz_index, a.nz_value, a.port_deflection, a.mesh_offset))
+    kept = dynamics.extended_pattern(n, *tables)
+    assert dynamics.extended_pattern(n, *tables) is kept
+    assert kept[0].shape == (2, m, a.nz_index.shape[1] + 2) and kept[0].dtype == np.intp
+    offset = np.full(m, 7.0)
+    other = dynamics.extended_pattern(n, *tables[:3], offset)
+    assert other is not kept and _same(other[1][:, -1], offset)
+    for k in range(dynamics.KEPT_PATTERNS):
+        dynamics.extended_pattern(n, tables[0].copy(), *tables[1:])
+    again = dynamics.extended_pattern(n, *tables)  # dropped when more were asked for, made anew
+    assert again is not kept and all(_same(x, y) for x, y in zip(again, kept))
 
 
 def test_models_stepped_in_turns_step_as_alone():
