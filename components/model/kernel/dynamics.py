@@ -67,8 +67,9 @@ def extended_pattern(n, nz_index, nz_value, a_port, offset):
     value = np.concatenate((np.where(valid, nz_value, 0.0), a_port[:, None], offset[:, None]), axis=1)
     if len(_kept_patterns) >= KEPT_PATTERNS:
         _kept_patterns.clear()
-    _kept_patterns[id(nz_index)] = (nz_index, nz_value, a_port, offset, n, (index, value))
-    return index, value
+    pattern = index, value
+    _kept_patterns[id(nz_index)] = (nz_index, nz_value, a_port, offset, n, pattern)
+    return pattern
 
 
 def _deflections_loop(y, n, nz_index, nz_value, a_port, offset, port, port_rate, out):
