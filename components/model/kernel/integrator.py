@@ -119,12 +119,15 @@ def solve(ginv, piv, dq, dq_index, hd, r, out, work):
     """``out = W^-1 r`` by blocks: ``x2 = G^-1 (r2 + hd dq r1)``, ``x1 = r1 + hd x2`` (``work``: n entries;
     ``dq_index``: the columns each row of ``dq`` can hold)."""
     n = dq.shape[0]
-    matvec_pattern(dq, dq_index, r[:n], work)
+    r1 = r[:n]
+    x1 = out[:n]
+    x2 = out[n:]
+    matvec_pattern(dq, dq_index, r1, work)
     work *= hd
     work += r[n:]
-    apply_g(ginv, piv, work, out[n:])
-    np.multiply(out[n:], hd, out=out[:n])
-    out[:n] += r[:n]
+    apply_g(ginv, piv, work, x2)
+    np.multiply(x2, hd, out=x1)
+    x1 += r1
 
 
 def _solve_loop(ginv, piv, dq, dq_index, hd, r, out, work):
