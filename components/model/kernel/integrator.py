@@ -181,8 +181,9 @@ def _third_rhs_loop(fn, k2, f1, k1, f0, out):
 def error_norm(k1, k2, k3, y, yn, n, atol_q, atol_v, rtol):
     """``max |k1 - 2 k2 + k3| / (atol + rtol max(|y|, |yn|))`` (``atol_q`` on the first ``n`` entries, ``atol_v`` on
     the rest); NaN where any entry is NaN."""
-    a, b = np.abs(y), np.abs(yn)
-    scale = np.where(b > a, b, a)  # Python's max(a, b) (np.maximum differs where one of them is NaN)
+    scale = np.abs(y)
+    b = np.abs(yn)
+    np.copyto(scale, b, where=b > scale)  # Python's max(a, b) (np.maximum differs where one of them is NaN)
     scale *= rtol
     scale[:n] += atol_q
     scale[n:] += atol_v
@@ -190,7 +191,9 @@ def error_norm(k1, k2, k3, y, yn, n, atol_q, atol_v, rtol):
     e -= 2.0 * k2
     np.abs(e, out=e)
     e /= scale
-    return float(e.max())
+    ratios = e.tolist()
+    total = sum(ratios)  # of ratios >= 0 or NaN: NaN where one of them is (max skips a NaN after the first entry)
+    return max(ratios) if total == total else math.nan
 
 
 def _error_norm_loop(k1, k2, k3, y, yn, n, atol_q, atol_v, rtol):
@@ -377,6 +380,10 @@ def advance(k, y, t_end, alpha_shift, driver, port, angle0, twist_q, twist_port)
     ist = k.istate
     control = k.control
     f0, f1, fn, k1, k2, k3, y1, yn, rhs, w_hdt = k.f0, k.f1, k.fn, k.k1, k.k2, k.k3, k.y1, k.yn, k.rhs, k.w_hdt
+    dq, jac_index, sol = k.dq, k.jac_index, k.sol
+    last_acc, forces, last_force = k.last_acc, k.z[:m], k.last_force  # what an accepted step keeps
+    defl0, defl1, last_defl0, last_defl1 = k.defl[0], k.defl[1], k.last_defl[0], k.last_defl[1]
+    fn_acc = fn[n:]
     copy(k.state, k.backup)  # restored on failure
     rtol = control[RTOL]
     atol_q = control[ATOL_Q]
@@ -419,21 +426,21 @@ def advance(k, y, t_end, alpha_shift, driver, port, angle0, twist_q, twist_port)
         # ---- one step
         hd = h * D
         if abs(hd - ist[HD]) > SAME_HD * hd:
-            active = use_factorisation(hd, k.dq, k.dv, k.winvs, k.pivots, ist)
+            active = use_factorisation(hd, dq, k.dv, k.winvs, k.pivots, ist)
             winv = k.winvs[active]
             piv = k.pivots[active]
             w_basis = k.w_bases[active]
         hd = ist[HD]  # the active factorisation's (the step's h d up to round-off)
         time_derivative_term(k, y, t, h, hd, angle0, driver, port, winv, piv, w_basis)
-        solve(winv, piv, k.dq, k.jac_index, hd, f0, k1, k.sol)
+        solve(winv, piv, dq, jac_index, hd, f0, k1, sol)
         stage(k1, w_hdt, y, 0.5 * h, y1)
         evaluate(k, y1, t + 0.5 * h, angle0, driver, port, f1)
         subtract(f1, k1, rhs)
-        solve(winv, piv, k.dq, k.jac_index, hd, rhs, k2, k.sol)
+        solve(winv, piv, dq, jac_index, hd, rhs, k2, sol)
         stage(k2, k1, y, h, yn)
         evaluate(k, yn, t + h, angle0, driver, port, fn)
         third_rhs(fn, k2, f1, k1, f0, rhs)
-        solve(winv, piv, k.dq, k.jac_index, hd, rhs, k3, k.sol)
+        solve(winv, piv, dq, jac_index, hd, rhs, k3, sol)
         axpy(1.0, w_hdt, k3)
         err = (h / 6.0) * error_norm(k1, k2, k3, y, yn, n, atol_q, atol_v, rtol)
         if not math.isfinite(err):
@@ -448,10 +455,10 @@ def advance(k, y, t_end, alpha_shift, driver, port, angle0, twist_q, twist_port)
             t = t_end if last else t + h
             copy(yn, y)
             copy(fn, f0)
-            copy(fn[n:], k.last_acc)
-            copy(k.z[:m], k.last_force)
-            copy(k.defl[0], k.last_defl[0])
-            copy(k.defl[1], k.last_defl[1])
+            copy(fn_acc, last_acc)
+            copy(forces, last_force)
+            copy(defl0, last_defl0)
+            copy(defl1, last_defl1)
             alpha_out = abs(out_kin * accel(driver, t) + f0[out_idx])
             if alpha_out > ist[ALPHA_OUT_MAX]:  # eq. 11's running maximum
                 ist[ALPHA_OUT_MAX] = alpha_out

@@ -152,7 +152,7 @@ def _model_cases(rng, a: Assembly, nonfinite: bool) -> dict:
         "twist_and_rate": lambda: (np.concatenate((a.S[-1], np.zeros(n))), y, n, -1.3, curve, 2.5e-3),
         "stage": lambda: (*vectors(3), 0.7e-3, np.empty(2 * n)),
         "third_rhs": lambda: (*vectors(5), np.empty(2 * n)),
-        "error_norm": lambda: (*vectors(5), n, 3e-9, 3e-6, 3e-5),
+        "error_norm": lambda: (*vectors(2), y, *vectors(2), n, 3e-9, 3e-6, 3e-5),  # y: NaN or inf when nonfinite
         "basis_terms": lambda: (_signed_zeros(rng, rng.normal(size=(4, 2 * n))), 0.3, -1e-3, 2e-6, np.empty(2 * n)),
         "motion_terms": lambda: (rng.normal(size=(2, n)), a.kinematic_ratio, 0.2, -3.0, 40.0, np.empty(n)),
         "stiffness_factors": lambda: (rng.normal(0.0, 30.0), phasing, np.empty(m), np.empty(m)),
