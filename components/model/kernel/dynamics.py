@@ -34,7 +34,7 @@ def deflections(y, n, nz_index, nz_value, a_port, offset, port, port_rate, out):
     x[:2 * n] = y[:2 * n]
     x[2 * n:] = port, port_rate, 1.0, 0.0
     terms = x.take(index)
-    terms *= value  # the padding's terms 1 * 0 or 0 * 0, the offset's on the rates offset * 0: zeros
+    terms *= value  # the padding's terms 0 * 0, the (finite) offset's on the rates offset * 0: zeros
     sums(terms, out)  # (+ 0.0: the loop's sums start from 0.0, never -0.0)
 
 
@@ -60,10 +60,10 @@ def extended_pattern(n, nz_index, nz_value, a_port, offset):
         return kept[5]
     m = nz_index.shape[0]
     valid = nz_index >= 0.0
-    column = lambda entry: np.full((m, 1), float(entry))  # noqa: E731
-    index = np.stack((np.concatenate((np.where(valid, nz_index, 2 * n + 3.0), column(2 * n), column(2 * n + 2)), 1),
-                      np.concatenate((np.where(valid, nz_index + n, 2 * n + 3.0), column(2 * n + 1), column(2 * n + 3)),
-                                     1))).astype(np.intp)
+    index = np.stack([np.concatenate((np.where(valid, nz_index + first, 2 * n + 3.0), np.full((m, 1), port_entry),
+                                      np.full((m, 1), constant)), 1)
+                      for first, port_entry, constant in ((0, 2 * n, 2 * n + 2), (n, 2 * n + 1, 2 * n + 3))])
+    index = index.astype(np.intp)
     value = np.concatenate((np.where(valid, nz_value, 0.0), a_port[:, None], offset[:, None]), axis=1)
     if len(_kept_patterns) >= KEPT_PATTERNS:
         _kept_patterns.clear()

@@ -101,13 +101,10 @@ def sparse_vecmat(x, index, value, out):
     """``out = x @ w`` for a sparse ``w`` held by columns: ``out[j] = sum_p x[index[j, p]] value[j, p]`` over the
     nonzero rows of column ``j`` in ascending order (``index < 0``: padding, its ``value`` 0), summed from the
     first.
-
-    The numpy form also takes a stack of vectors, ``x`` of shape (k, len) and ``out`` (k, columns).
     """
-    terms = x.take(index.astype(np.intp), -1)
-    terms *= value  # a padding term is x[..., -1] * 0: zero where that is finite
-    last = x[..., -1]
-    if not (math.isfinite(last) if x.ndim == 1 else all(map(math.isfinite, last.tolist()))):
+    terms = x.take(index.astype(np.intp))
+    terms *= value  # a padding term is x[-1] * 0: zero where that is finite
+    if not math.isfinite(x[-1]):
         terms = np.where(index >= 0.0, terms, 0.0)
     sums(terms, out)
 
