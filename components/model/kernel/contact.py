@@ -125,7 +125,31 @@ def _every_mesh(defl, factor, contact):
     loop over the arrays, and than the law vectorised over the meshes).
     """
     d, rate = defl.tolist()
-    return list(map(contact_force, d, rate, factor.tolist(), contact.tolist()))
+    return list(map(contact_force, d, rate, factor.tolist(), table_rows(contact)))
+
+
+#: contact tables whose rows :func:`table_rows` keeps as lists, at most (all dropped when one more is asked for)
+KEPT_TABLES = 8
+_kept_rows: dict = {}
+
+
+def table_rows(contact):
+    """The rows of a contact table as lists of Python floats, kept by the table's identity (numpy form only).
+
+    A table is written once, when its model's buffer is made, and never changed in place; a model evaluates its
+    meshes with the same table object every time (the kept views of :func:`components.model.kernel.step.views`),
+    so its rows are read once (``tolist`` of the 13 x 9 table of the paper's gearbox costs ~1.5 us, a tenth of the
+    contact laws it feeds). A kept entry holds the table, so no other object can take its identity; dict
+    operations are atomic, so threads stepping models of one process may share it.
+    """
+    kept = _kept_rows.get(id(contact))
+    if kept is not None and kept[0] is contact:
+        return kept[1]
+    if len(_kept_rows) >= KEPT_TABLES:
+        _kept_rows.clear()
+    rows = contact.tolist()
+    _kept_rows[id(contact)] = (contact, rows)
+    return rows
 
 
 def mesh_forces(defl, factor, contact, force, elastic):
@@ -143,7 +167,7 @@ def forces(defl, factor, contact, out):
 def stiffness_force_rates(defl, factor, contact, slope, speed, out):
     """dF/dt [N/s] of every mesh from its stiffness factor's rate ``slope speed`` (:func:`stiffness_sensitivity`)."""
     d, rate = defl.tolist()
-    out[:] = list(map(stiffness_sensitivity, d, rate, factor.tolist(), contact.tolist()))
+    out[:] = list(map(stiffness_sensitivity, d, rate, factor.tolist(), table_rows(contact)))
     out *= slope * speed
 
 

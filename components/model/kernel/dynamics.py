@@ -18,16 +18,58 @@ import math
 import numpy as np
 
 from .contact import force_slopes, forces, stiffness_force_rates
-from .linalg import copy, sparse_vecmat, vecmat_add
+from .linalg import copy, sparse_vecmat, sums, vecmat_add
 from .stiffness import stiffness_factors
 
 
 def deflections(y, n, nz_index, nz_value, a_port, offset, port, port_rate, out):
     """Mesh deflections [m] (row 0) and their rates [m/s] (row 1) of ``y = [q, v, ...]``, the port input and
-    the constant offsets; every mesh row ``A`` through its nonzero columns (``nz_index``, ``nz_value``)."""
-    sparse_vecmat(y[:2 * n].reshape(2, n), nz_index, nz_value, out)  # both rows at once (the numpy form)
-    out += np.multiply.outer((port, port_rate), a_port)
-    out[0] += offset
+    the constant offsets; every mesh row ``A`` through its nonzero columns (``nz_index``, ``nz_value``).
+
+    The numpy form sums each mesh's terms, its port term and its offset as one row of terms, in the loop's order: the
+    terms on ``x = [q, v, port, port_rate, 1, 0]`` of the pattern extended by those columns (:func:`extended_pattern`).
+    """
+    index, value = extended_pattern(n, nz_index, nz_value, a_port, offset)
+    x = np.empty(2 * n + 4)
+    x[:2 * n] = y[:2 * n]
+    x[2 * n:] = port, port_rate, 1.0, 0.0
+    terms = x.take(index)
+    terms *= value  # the padding's terms 0 * 0, the (finite) offset's on the rates offset * 0: zeros
+    sums(terms, out)  # (+ 0.0: the loop's sums start from 0.0, never -0.0)
+
+
+#: mesh patterns whose extended form :func:`extended_pattern` keeps, at most (all dropped when one more is asked for)
+KEPT_PATTERNS = 8
+_kept_patterns: dict = {}
+
+
+def extended_pattern(n, nz_index, nz_value, a_port, offset):
+    """The terms of :func:`deflections`' numpy form: the entries of ``x = [q, v, port, port_rate, 1, 0]`` (``intp``,
+    shape (2, meshes, width + 2): deflections, then rates) and the weights (meshes, width + 2) of every mesh's row:
+    its nonzero columns, the padding pointed at the last entry (0) with weight 0, then the port with ``a_port`` and the
+    constant (1 for the deflections, 0 for the rates) with ``offset``.
+
+    Kept by the identity of the four tables: a model's are written once, when its buffer is made, never changed in
+    place, and passed as the same objects at every evaluation (the kept views of
+    :func:`components.model.kernel.step.views`). A kept entry holds them, so no other object can take their
+    identity; dict operations are atomic, so threads stepping models of one process may share it.
+    """
+    kept = _kept_patterns.get(id(nz_index))
+    if (kept is not None and kept[0] is nz_index and kept[1] is nz_value and kept[2] is a_port and kept[3] is offset
+            and kept[4] == n):
+        return kept[5]
+    m = nz_index.shape[0]
+    valid = nz_index >= 0.0
+    index = np.stack([np.concatenate((np.where(valid, nz_index + first, 2 * n + 3.0), np.full((m, 1), port_entry),
+                                      np.full((m, 1), constant)), 1)
+                      for first, port_entry, constant in ((0, 2 * n, 2 * n + 2), (n, 2 * n + 1, 2 * n + 3))])
+    index = index.astype(np.intp)
+    value = np.concatenate((np.where(valid, nz_value, 0.0), a_port[:, None], offset[:, None]), axis=1)
+    if len(_kept_patterns) >= KEPT_PATTERNS:
+        _kept_patterns.clear()
+    pattern = index, value
+    _kept_patterns[id(nz_index)] = (nz_index, nz_value, a_port, offset, n, pattern)
+    return pattern
 
 
 def _deflections_loop(y, n, nz_index, nz_value, a_port, offset, port, port_rate, out):

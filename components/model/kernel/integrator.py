@@ -119,12 +119,15 @@ def solve(ginv, piv, dq, dq_index, hd, r, out, work):
     """``out = W^-1 r`` by blocks: ``x2 = G^-1 (r2 + hd dq r1)``, ``x1 = r1 + hd x2`` (``work``: n entries;
     ``dq_index``: the columns each row of ``dq`` can hold)."""
     n = dq.shape[0]
-    matvec_pattern(dq, dq_index, r[:n], work)
+    r1 = r[:n]
+    x1 = out[:n]
+    x2 = out[n:]
+    matvec_pattern(dq, dq_index, r1, work)
     work *= hd
     work += r[n:]
-    apply_g(ginv, piv, work, out[n:])
-    np.multiply(out[n:], hd, out=out[:n])
-    out[:n] += r[:n]
+    apply_g(ginv, piv, work, x2)
+    np.multiply(x2, hd, out=x1)
+    x1 += r1
 
 
 def _solve_loop(ginv, piv, dq, dq_index, hd, r, out, work):
@@ -178,8 +181,9 @@ def _third_rhs_loop(fn, k2, f1, k1, f0, out):
 def error_norm(k1, k2, k3, y, yn, n, atol_q, atol_v, rtol):
     """``max |k1 - 2 k2 + k3| / (atol + rtol max(|y|, |yn|))`` (``atol_q`` on the first ``n`` entries, ``atol_v`` on
     the rest); NaN where any entry is NaN."""
-    a, b = np.abs(y), np.abs(yn)
-    scale = np.where(b > a, b, a)  # Python's max(a, b) (np.maximum differs where one of them is NaN)
+    scale = np.abs(y)
+    b = np.abs(yn)
+    np.copyto(scale, b, where=b > scale)  # Python's max(a, b) (np.maximum differs where one of them is NaN)
     scale *= rtol
     scale[:n] += atol_q
     scale[n:] += atol_v
@@ -187,7 +191,9 @@ def error_norm(k1, k2, k3, y, yn, n, atol_q, atol_v, rtol):
     e -= 2.0 * k2
     np.abs(e, out=e)
     e /= scale
-    return float(e.max())
+    ratios = e.tolist()
+    total = sum(ratios)  # of ratios >= 0 or NaN: NaN where one of them is (max skips a NaN after the first entry)
+    return max(ratios) if total == total else math.nan
 
 
 def _error_norm_loop(k1, k2, k3, y, yn, n, atol_q, atol_v, rtol):
@@ -252,12 +258,16 @@ def use_factorisation(hd, dq, dv, winvs, pivots, istate):
 
 
 def twist_and_rate(twist_q, y, n, twist_port, port, tau):
-    """Output-shaft twist [rad] and its rate [rad/s] at ``tau``: the weights on ``q`` and on ``v``, plus the port's."""
-    terms = np.empty((2, n + 1))
-    terms[0, 0] = twist_port * value(port, tau)
-    terms[1, 0] = twist_port * rate(port, tau)
-    np.multiply(y[:2 * n].reshape(2, n), twist_q[:n], out=terms[:, 1:])
-    twist, rate_ = np.add.accumulate(terms, 1)[:, -1].tolist()  # summed from the port's term on, as the loop
+    """Output-shaft twist [rad] and its rate [rad/s] at ``tau``: the weights on ``q`` and on ``v``, plus the port's.
+
+    The numpy form runs the loop on Python floats (22 products: cheaper than numpy's calls on them)."""
+    curve = port.tolist()
+    twist = twist_port * value(curve, tau)
+    rate_ = twist_port * rate(curve, tau)
+    state = y[:2 * n].tolist()
+    for w, q, v in zip(twist_q[:n].tolist(), state[:n], state[n:]):  # summed from the port's term on, as the loop
+        twist += w * q
+        rate_ += w * v
     return twist, rate_
 
 
@@ -370,6 +380,10 @@ def advance(k, y, t_end, alpha_shift, driver, port, angle0, twist_q, twist_port)
     ist = k.istate
     control = k.control
     f0, f1, fn, k1, k2, k3, y1, yn, rhs, w_hdt = k.f0, k.f1, k.fn, k.k1, k.k2, k.k3, k.y1, k.yn, k.rhs, k.w_hdt
+    dq, jac_index, sol = k.dq, k.jac_index, k.sol
+    last_acc, forces, last_force = k.last_acc, k.z[:m], k.last_force  # what an accepted step keeps
+    defl0, defl1, last_defl0, last_defl1 = k.defl[0], k.defl[1], k.last_defl[0], k.last_defl[1]
+    fn_acc = fn[n:]
     copy(k.state, k.backup)  # restored on failure
     rtol = control[RTOL]
     atol_q = control[ATOL_Q]
@@ -412,21 +426,21 @@ def advance(k, y, t_end, alpha_shift, driver, port, angle0, twist_q, twist_port)
         # ---- one step
         hd = h * D
         if abs(hd - ist[HD]) > SAME_HD * hd:
-            active = use_factorisation(hd, k.dq, k.dv, k.winvs, k.pivots, ist)
+            active = use_factorisation(hd, dq, k.dv, k.winvs, k.pivots, ist)
             winv = k.winvs[active]
             piv = k.pivots[active]
             w_basis = k.w_bases[active]
         hd = ist[HD]  # the active factorisation's (the step's h d up to round-off)
         time_derivative_term(k, y, t, h, hd, angle0, driver, port, winv, piv, w_basis)
-        solve(winv, piv, k.dq, k.jac_index, hd, f0, k1, k.sol)
+        solve(winv, piv, dq, jac_index, hd, f0, k1, sol)
         stage(k1, w_hdt, y, 0.5 * h, y1)
         evaluate(k, y1, t + 0.5 * h, angle0, driver, port, f1)
         subtract(f1, k1, rhs)
-        solve(winv, piv, k.dq, k.jac_index, hd, rhs, k2, k.sol)
+        solve(winv, piv, dq, jac_index, hd, rhs, k2, sol)
         stage(k2, k1, y, h, yn)
         evaluate(k, yn, t + h, angle0, driver, port, fn)
         third_rhs(fn, k2, f1, k1, f0, rhs)
-        solve(winv, piv, k.dq, k.jac_index, hd, rhs, k3, k.sol)
+        solve(winv, piv, dq, jac_index, hd, rhs, k3, sol)
         axpy(1.0, w_hdt, k3)
         err = (h / 6.0) * error_norm(k1, k2, k3, y, yn, n, atol_q, atol_v, rtol)
         if not math.isfinite(err):
@@ -441,10 +455,10 @@ def advance(k, y, t_end, alpha_shift, driver, port, angle0, twist_q, twist_port)
             t = t_end if last else t + h
             copy(yn, y)
             copy(fn, f0)
-            copy(fn[n:], k.last_acc)
-            copy(k.z[:m], k.last_force)
-            copy(k.defl[0], k.last_defl[0])
-            copy(k.defl[1], k.last_defl[1])
+            copy(fn_acc, last_acc)
+            copy(forces, last_force)
+            copy(defl0, last_defl0)
+            copy(defl1, last_defl1)
             alpha_out = abs(out_kin * accel(driver, t) + f0[out_idx])
             if alpha_out > ist[ALPHA_OUT_MAX]:  # eq. 11's running maximum
                 ist[ALPHA_OUT_MAX] = alpha_out

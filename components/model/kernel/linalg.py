@@ -6,7 +6,7 @@ in). Both perform the same floating-point operations in the same order - the pro
 from the first term on, as the loops do (``np.add.accumulate``, not BLAS nor ``np.sum``, whose
 blocked or pairwise sums differ in the last bits) - so the interpreted and the compiled kernel
 compute the same numbers. A loop's sum starts from ``0.0`` and is never ``-0.0``; the numpy forms
-store their sums plus ``0.0`` (:func:`_sums`), so an all-zero sum has the loop's sign too. A numpy
+store their sums plus ``0.0`` (:func:`sums`), so an all-zero sum has the loop's sign too. A numpy
 form may add terms that the loop skips because they are exactly zero (a product over a pattern
 summed densely, the padding of a sparse row): adding ``+-0`` changes a sum at most in the sign of
 a zero, which the stored ``+ 0.0`` settles.
@@ -24,7 +24,7 @@ def copy(src, dst):
     dst[:] = src
 
 
-def _sums(terms, out):
+def sums(terms, out):
     """``out = sum of terms`` along the last axis, from the first term on (numpy's ``add.accumulate`` adds in
     order, unlike ``sum``), stored plus ``0.0``: with the sign a loop's sum has (never ``-0.0``)."""
     np.add(np.add.accumulate(terms, -1)[..., -1], 0.0, out=out)
@@ -32,17 +32,17 @@ def _sums(terms, out):
 
 def matvec(w, x, out):
     """``out = w @ x``."""
-    _sums(w * x, out)
+    sums(w * x, out)
 
 
 def vecmat(x, w, out):
     """``out = x @ w``."""
-    _sums((x[:, None] * w).T, out)
+    sums((x[:, None] * w).T, out)
 
 
 def matmul(a, b, out):
     """``out = a @ b``."""
-    _sums(a[:, None, :] * b.T[None, :, :], out)
+    sums(a[:, None, :] * b.T[None, :, :], out)
 
 
 def vecmat_add(x, w, out):
@@ -53,7 +53,7 @@ def vecmat_add(x, w, out):
 def vecmat_sum(a, wa, b, wb, tail, wt, out):
     """``out = a @ wa + b @ wb + tail @ wt``: the product of ``[a, b, tail] @ [wa; wb; wt]`` without joining them,
     summed from the first term of ``a`` to the last of ``tail``."""
-    _sums(np.concatenate((a[:, None] * wa, b[:, None] * wb, tail[:, None] * wt)).T, out)
+    sums(np.concatenate((a[:, None] * wa, b[:, None] * wb, tail[:, None] * wt)).T, out)
 
 
 def axpy(alpha, x, y):
@@ -94,22 +94,19 @@ def matvec_pattern(w, index, x, out):
         return
     valid = index >= 0.0
     safe = np.where(valid, index, 0.0).astype(np.intp)
-    _sums(np.where(valid, np.take_along_axis(w, safe, 1) * x[safe], 0.0), out)
+    sums(np.where(valid, np.take_along_axis(w, safe, 1) * x[safe], 0.0), out)
 
 
 def sparse_vecmat(x, index, value, out):
     """``out = x @ w`` for a sparse ``w`` held by columns: ``out[j] = sum_p x[index[j, p]] value[j, p]`` over the
     nonzero rows of column ``j`` in ascending order (``index < 0``: padding, its ``value`` 0), summed from the
     first.
-
-    The numpy form also takes a stack of vectors, ``x`` of shape (k, len) and ``out`` (k, columns).
     """
-    terms = x.take(index.astype(np.intp), -1)
-    terms *= value  # a padding term is x[..., -1] * 0: zero where that is finite
-    last = x[..., -1]
-    if not (math.isfinite(last) if x.ndim == 1 else all(map(math.isfinite, last.tolist()))):
+    terms = x.take(index.astype(np.intp))
+    terms *= value  # a padding term is x[-1] * 0: zero where that is finite
+    if not math.isfinite(x[-1]):
         terms = np.where(index >= 0.0, terms, 0.0)
-    _sums(terms, out)
+    sums(terms, out)
 
 
 def invert(g, out):

@@ -140,7 +140,8 @@ def _model_cases(rng, a: Assembly, nonfinite: bool) -> dict:
         "forces": lambda: (defl, factor, table, np.empty(m)),
         "force_slopes": lambda: (defl, factor, table, np.empty(m), np.empty(m)),
         "stiffness_force_rates": lambda: (defl, factor, table, rng.normal(size=m), 1.7, np.empty(m)),
-        "deflections": lambda: (y, n, a.nz_index, a.nz_value, a.port_deflection, a.mesh_offset, 1e-3, -2e-2,
+        "deflections": lambda: (y, n, a.nz_index, a.nz_value, a.port_deflection,
+                                _signed_zeros(rng, a.mesh_offset + rng.normal(0.0, 1e-5, m)), 1e-3, -2e-2,
                                 np.empty((2, m))),
         "assemble_jacobian": lambda: (_signed_zeros(rng, rng.normal(0, 1e9, m)), rng.normal(0, 1e3, m), a.nz_index,
                                       a.nz_value, a.port_deflection, a.cos_alpha, a.STkS, a.STcS, stks_port, stcs_port,
@@ -151,7 +152,7 @@ def _model_cases(rng, a: Assembly, nonfinite: bool) -> dict:
         "twist_and_rate": lambda: (np.concatenate((a.S[-1], np.zeros(n))), y, n, -1.3, curve, 2.5e-3),
         "stage": lambda: (*vectors(3), 0.7e-3, np.empty(2 * n)),
         "third_rhs": lambda: (*vectors(5), np.empty(2 * n)),
-        "error_norm": lambda: (*vectors(5), n, 3e-9, 3e-6, 3e-5),
+        "error_norm": lambda: (*vectors(2), y, *vectors(2), n, 3e-9, 3e-6, 3e-5),  # y: NaN or inf when nonfinite
         "basis_terms": lambda: (_signed_zeros(rng, rng.normal(size=(4, 2 * n))), 0.3, -1e-3, 2e-6, np.empty(2 * n)),
         "motion_terms": lambda: (rng.normal(size=(2, n)), a.kinematic_ratio, 0.2, -3.0, 40.0, np.empty(n)),
         "stiffness_factors": lambda: (rng.normal(0.0, 30.0), phasing, np.empty(m), np.empty(m)),
@@ -241,6 +242,39 @@ def test_the_interpreted_views_are_kept_per_buffer():
     assert again is not kept and all(_same(a, b) for a, b in zip(again[:-2], kept[:-2]))
     copy_of_tables = (tables[0][0], list(tables[0][1]), list(tables[0][2]))
     assert step.views(*copy_of_tables) is not again  # equal tables in other objects: views made for them
+
+
+def test_the_contact_rows_are_kept_per_table():
+    """The numpy form reads a contact table's rows once per table object: an equal table in another object, or the
+    same one after more tables than kept were read, is read anew."""
+    contact = _module("contact")
+    tables = [np.full((3, 9), float(i)) for i in range(contact.KEPT_TABLES + 1)]
+    rows = contact.table_rows(tables[0])
+    assert rows == tables[0].tolist() and contact.table_rows(tables[0]) is rows
+    equal = tables[0].copy()
+    assert contact.table_rows(equal) is not rows and contact.table_rows(equal) == rows
+    assert [contact.table_rows(t) for t in tables[1:]] == [t.tolist() for t in tables[1:]]
+    again = contact.table_rows(tables[0])  # dropped when more were asked for, read anew
+    assert again is not rows and again == rows
+
+
+def test_the_extended_mesh_patterns_are_kept_per_table():
+    """deflections' numpy form extends a mesh pattern once per set of table objects: other objects (equal or not), or
+    the same after more patterns than kept were extended, are extended anew."""
+    dynamics = _module("dynamics")
+    a = ASSEMBLIES["table6"]
+    n, m = a.n_dof, a.n_mesh
+    tables = tuple(np.array(t) for t in (a.nz_index, a.nz_value, a.port_deflection, a.mesh_offset))
+    kept = dynamics.extended_pattern(n, *tables)
+    assert dynamics.extended_pattern(n, *tables) is kept
+    assert kept[0].shape == (2, m, a.nz_index.shape[1] + 2) and kept[0].dtype == np.intp
+    offset = np.full(m, 7.0)
+    other = dynamics.extended_pattern(n, *tables[:3], offset)
+    assert other is not kept and _same(other[1][:, -1], offset)
+    for k in range(dynamics.KEPT_PATTERNS):
+        dynamics.extended_pattern(n, tables[0].copy(), *tables[1:])
+    again = dynamics.extended_pattern(n, *tables)  # dropped when more were asked for, made anew
+    assert again is not kept and all(_same(x, y) for x, y in zip(again, kept))
 
 
 def test_models_stepped_in_turns_step_as_alone():
