@@ -22,13 +22,17 @@ host that runs the same binary with the same inputs should meet.
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import os
+import signal
 import stat
 import tempfile
+import threading
 import zipfile
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Iterator
 
 import numpy as np
 
@@ -70,15 +74,48 @@ def reference_members(fmu_path: Path, case: CrossCheckCase) -> dict[str, bytes]:
     with tempfile.TemporaryDirectory(prefix="dtcosim_cross_check_") as unzipped:
         try:
             extract_fmu(fmu_path, unzipped)
-            result = simulate_fmu(unzipped, start_time=case.start_time, stop_time=case.stop_time, step_size=step,
-                                  output_interval=step, input=inputs if len(inputs.dtype.names) > 1 else None,
-                                  output=outputs, validate=False, model_description=md)
+            with stop_signals_held():
+                result = simulate_fmu(unzipped, start_time=case.start_time, stop_time=case.stop_time,
+                                      step_size=step, output_interval=step,
+                                      input=inputs if len(inputs.dtype.names) > 1 else None, output=outputs,
+                                      validate=False, model_description=md)
         finally:
             forget_python_from(Path(unzipped))
     opt = f"StartTime,{case.start_time!r}\nStopTime,{case.stop_time!r}\nStepSize,{step!r}\nRelTol,{REL_TOL:g}\n"
     return {f"{MEMBER_DIR}/{model}_in.csv": _csv_text(inputs).encode(),
             f"{MEMBER_DIR}/{model}_ref.opt": opt.encode(),
             f"{MEMBER_DIR}/{model}_ref.csv": _csv_text(result[["time", *outputs]]).encode()}
+
+
+#: the signals that stop a command (Ctrl-C, a scheduler's kill, a closed terminal)
+STOP_SIGNALS = tuple(getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, name))
+
+
+@contextlib.contextmanager
+def stop_signals_held() -> Iterator[None]:
+    """Stop signals that arrive during the block are held, and handed to the handlers in place before it once it has
+    ended (which raise there, e.g. KeyboardInterrupt).
+
+    The FMU's slave runs in this interpreter: a KeyboardInterrupt raised inside its ``do_step`` becomes an
+    ``fmi2Error`` and the run a misleading "cross-check run failed" (a Ctrl-C during a first run's builds ended it
+    with that message and status 1, not as interrupted). Held, the signal waits for the run's end (a fraction of a
+    second). Only Python handlers are held, and only in the main thread (where they run).
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    held: list[int] = []
+    previous = {s: signal.getsignal(s) for s in STOP_SIGNALS}
+    previous = {s: h for s, h in previous.items() if callable(h)}
+    for s in previous:
+        signal.signal(s, lambda signum, frame: held.append(signum))
+    try:
+        yield
+    finally:
+        for s, handler in previous.items():
+            signal.signal(s, handler)
+        if held:
+            previous[held[0]](held[0], None)
 
 
 def forget_python_from(folder: Path) -> None:
