@@ -140,6 +140,11 @@ def equivalent_load(loads_n: np.ndarray, revolutions: np.ndarray, exponent: floa
     return scale * float(np.sum(n * (loads / scale) ** p) / total) ** (1.0 / p)  # scaled: no overflow
 
 
+def round_off_load(load_n: float, dynamic_load_rating_n: float) -> bool:
+    """Whether ``load_n`` is the round-off of the model's forces rather than a load: at most :data:`UNLOADED_BELOW` C."""
+    return load_n <= UNLOADED_BELOW * dynamic_load_rating_n
+
+
 def basic_rating_life_mrev(dynamic_load_rating_n: float, load_n: float, exponent: float) -> float:
     """L10 = (C / P)^p [1e6 rev] (inf for P = 0)."""
     c = positive("dynamic_load_rating", dynamic_load_rating_n)
@@ -310,8 +315,8 @@ class BearingLife:
 
     @property
     def unloaded(self) -> bool:
-        """Whether the equivalent load is only round-off (at most :data:`UNLOADED_BELOW` C): the lives are infinite."""
-        return self.equivalent_load_n <= UNLOADED_BELOW * self.dynamic_load_rating_n
+        """Whether the equivalent load is only round-off (:func:`round_off_load`): the lives are infinite."""
+        return round_off_load(self.equivalent_load_n, self.dynamic_load_rating_n)
 
     @property
     def met(self) -> bool:
@@ -356,7 +361,7 @@ def bearing_life(name: str, bearing_type: str, dynamic_load_rating_n: float, loa
     p_eq = equivalent_load(loads_n, revolutions, p)
     total = float(np.sum(revolutions))
     per_hour = total / hours
-    if p_eq <= UNLOADED_BELOW * positive("dynamic_load_rating", dynamic_load_rating_n):  # round-off, not a load
+    if round_off_load(p_eq, positive("dynamic_load_rating", dynamic_load_rating_n)):
         l10, lnm = math.inf, (math.inf if mod.given else None)
     else:
         l10 = basic_rating_life_mrev(dynamic_load_rating_n, p_eq, p)

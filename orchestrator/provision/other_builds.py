@@ -51,10 +51,14 @@ def set_aside(path: Path, build: str) -> Path:
     target = shelf / f"{build}.fmu"
     os.replace(path, target)
     os.utime(target)  # when it was set aside: the order in which shelved builds are dropped
-    shelved = sorted(shelf.glob("*.fmu"), key=lambda p: p.stat().st_mtime_ns, reverse=True)
-    for old in shelved[KEEP:]:
+    for old in _shelved(shelf)[KEEP:]:
         old.unlink(missing_ok=True)
     return target
+
+
+def _shelved(shelf: Path) -> list[Path]:
+    """The builds on ``shelf``, the one set aside last first."""
+    return sorted(shelf.glob("*.fmu"), key=lambda p: p.stat().st_mtime_ns, reverse=True)
 
 
 def take_back(path: Path) -> bool:
@@ -62,7 +66,7 @@ def take_back(path: Path) -> bool:
     shelf = _shelf(path)
     if not shelf.is_dir():
         return False
-    for candidate in sorted(shelf.glob("*.fmu"), key=lambda p: p.stat().st_mtime_ns, reverse=True):
+    for candidate in _shelved(shelf):
         if broken_fmu(candidate) is not None:
             candidate.unlink(missing_ok=True)
         elif stale_build(candidate) is None:
