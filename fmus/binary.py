@@ -127,15 +127,29 @@ def _target(source: bytes, cc: str) -> Path:
 def _one_compiler(folder: Path) -> Iterator[None]:
     """Hold an exclusive ``flock`` on ``folder`` (created if missing): one process compiles into it at a time, and
     the others then find its result."""
+    fd = _locked(folder)
+    try:
+        yield
+    finally:
+        os.close(fd)
+
+
+def _locked(folder: Path, wait: bool = True) -> int | None:
+    """A descriptor of ``folder`` (created if missing) that holds its exclusive ``flock`` until it is closed; None
+    without ``wait`` where another process holds the lock."""
     import fcntl
 
     folder.mkdir(parents=True, exist_ok=True)
     fd = os.open(folder, os.O_RDONLY | os.O_DIRECTORY)
     try:
-        fcntl.flock(fd, fcntl.LOCK_EX)
-        yield
-    finally:
+        fcntl.flock(fd, fcntl.LOCK_EX if wait else fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
         os.close(fd)
+        return None
+    except BaseException:
+        os.close(fd)
+        raise
+    return fd
 
 
 def _compile(cc: str, target: Path) -> Path:
@@ -179,8 +193,6 @@ def start_compile() -> BackgroundCompile | None:
     None where there is nothing to start: the binary is there, no compiler or not linux (the build says so), or
     another process is compiling it.
     """
-    import fcntl
-
     cc = compiler()
     if not sys.platform.startswith("linux") or cc is None:
         return None
@@ -188,15 +200,12 @@ def start_compile() -> BackgroundCompile | None:
     if target.is_file():
         return None
     try:
-        target.parent.mkdir(parents=True, exist_ok=True)
-        fd = os.open(target.parent, os.O_RDONLY | os.O_DIRECTORY)
+        fd = _locked(target.parent, wait=False)
     except OSError:  # an unwritable cache: the build reports it
         return None
+    if fd is None:  # being compiled by another process
+        return None
     try:
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:  # being compiled by another process
-            return None
         if target.is_file():
             return None
         # the lock goes with the inherited descriptor: held until the compiling process has ended
