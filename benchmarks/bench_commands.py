@@ -118,7 +118,7 @@ def first_run(repeat: int, baseline: str | None = None) -> None:
                 env["PYTHONPATH"] = str(sources)
             return timed(DTCOSIM + ["run", "--out", str(Path(tmp) / f"first-{tag}")], env, Path(tmp)), cache
 
-        (wall, cpu), cache = first("warm")
+        _, cache = first("warm")
         waited = time.perf_counter()
         os.environ["DTCOSIM_CACHE_DIR"] = str(cache)  # where build_lock_file looks
         while build_lock_file().exists():  # the kernels compiling in the background, for later runs
