@@ -8,13 +8,16 @@
    ``--no-plots`` adds ``dtcosim run --no-plots``.
 2. **The first run after install** (``--first-run``): ``dtcosim run`` with an empty per-user cache
    (``DTCOSIM_CACHE_DIR`` and ``MPLCONFIGDIR`` in a new temporary folder: no FMUs, no compiled
-   kernels, no matplotlib font list). One such run whose background kernel compile is awaited makes
+   kernels, no matplotlib font list) from a copy of this tree without bytecode, imported through
+   ``PYTHONPATH`` (after ``pip install -e .`` no module of dtcosim is compiled yet: Python compiles
+   each one the first run imports; ``--keep-bytecode``: this tree, its bytecode as its runs left
+   it). One such run whose background kernel compile is awaited makes
    the warm runs' cache; then ``--repeat`` first runs, each in an empty cache of its own (the compile
    it starts in the background is ended after it), take turns with warm runs in that cache; printed:
    the medians of both and the ratio of the first run's wall time to the warm run's (target, issue 34:
    <= 3), and how long the background compile took. With ``--baseline REV`` a first run of the sources of
-   git revision ``REV`` (``git archive`` into a temporary folder, imported through ``PYTHONPATH``; the
-   repository is not touched) takes its turn after each first run of this tree, and the medians of the
+   git revision ``REV`` (``git archive`` into a temporary folder, a new copy of it for each run, imported
+   through ``PYTHONPATH``; the repository is not touched) takes its turn after each first run of this tree, and the medians of the
    turns' ratios this tree / ``REV`` are printed.
 
 The commands run with ``PYTHONDONTWRITEBYTECODE`` removed from their environment, as in a user's
@@ -36,7 +39,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from baseline_tree import archive_tree
+from baseline_tree import archive_tree, working_tree_copy
 
 DTCOSIM = [sys.executable, "-m", "orchestrator.commands.cli"]
 
@@ -101,10 +104,11 @@ def _stop_background_compile(cache: Path) -> None:
             pass
 
 
-def first_run(repeat: int, baseline: str | None = None) -> None:
+def first_run(repeat: int, baseline: str | None = None, keep_bytecode: bool = False) -> None:
     """One first run whose background compile is awaited (the warm runs' cache), then ``repeat`` first runs, each
-    with an empty cache of its own (its background compile ended after it), taking turns with warm runs (and with
-    first runs of revision ``baseline``)."""
+    with an empty cache of its own (its background compile ended after it) and, unless ``keep_bytecode``, from a
+    copy of this tree without bytecode of its own, taking turns with warm runs (and with first runs of revision
+    ``baseline``, each from a new copy of it unless ``keep_bytecode``)."""
     from components.compile.aot import build_lock_file
 
     with tempfile.TemporaryDirectory(prefix="dtcosim-bench-first-") as tmp:
@@ -132,12 +136,22 @@ def first_run(repeat: int, baseline: str | None = None) -> None:
         other = f"first run of {baseline}, empty caches"
         if baseline:
             times[other] = []
+        def fresh_sources(i: int, of_baseline: bool) -> Path | None:
+            """The sources of one first run: a new copy without bytecode (None: this tree as it is)."""
+            if keep_bytecode:
+                return tree if of_baseline else None
+            folder = Path(tmp) / f"sources-{'baseline-' if of_baseline else ''}{i}"
+            return shutil.copytree(tree, folder) if of_baseline else working_tree_copy(folder)
+
         for i in range(repeat):
-            for name, tag, sources in [("first dtcosim run, empty caches", str(i), None)] + (
-                    [(other, f"baseline-{i}", tree)] if baseline else []):
+            for name, tag, of_baseline in [("first dtcosim run, empty caches", str(i), False)] + (
+                    [(other, f"baseline-{i}", True)] if baseline else []):
+                sources = fresh_sources(i, of_baseline)
                 measured, fresh = first(tag, sources)
                 _stop_background_compile(fresh)
                 shutil.rmtree(fresh, ignore_errors=True)
+                if sources not in (None, tree):
+                    shutil.rmtree(sources, ignore_errors=True)
                 times[name].append(measured)
             times["dtcosim run"].append(timed(warm_argv, warm_env, Path(tmp)))
         medians = report(times)
@@ -155,10 +169,13 @@ def main() -> None:
     parser.add_argument("--no-plots", action="store_true", help="also time `dtcosim run --no-plots`")
     parser.add_argument("--first-run", action="store_true", help="time the first run with empty caches instead")
     parser.add_argument("--baseline", metavar="REV", help="with --first-run: also first runs of git revision REV")
+    parser.add_argument("--keep-bytecode", action="store_true",
+                        help="with --first-run: first runs of this tree as it is (its modules' bytecode already "
+                             "compiled), not of a copy without it")
     args = parser.parse_args()
     if args.first_run:
         print(f"the first `dtcosim run` with empty caches against warm runs (median of {args.repeat})")
-        first_run(args.repeat, args.baseline)
+        first_run(args.repeat, args.baseline, args.keep_bytecode)
         return
     print(f"whole commands in fresh processes, median of {args.repeat} (taking turns, after one warm-up each)")
     medians = report(warm(args.repeat, args.no_plots, environment()))
