@@ -41,6 +41,8 @@ HEADER = "dtcosim_fmu.h"
 #: resource files the binary reads
 PYTHON_FILE = "python.txt"
 CLASS_FILE = "slaveclass.txt"
+#: the folder of the user cache holding the compiled binaries, one folder per source and compiler
+CACHE_FOLDER = "native"
 #: the FMU member the binary replaces
 BINARY_FOLDER = "binaries/linux64"
 #: one compile at a time in a process (and one at a time across processes: :func:`_one_compiler`)
@@ -118,9 +120,16 @@ def compiled_binary() -> Path:
         return target if target.is_file() else _compile(cc, target)
 
 
+def cached_binary() -> Path | None:
+    """Where the binary of these sources, compiled by this machine's compiler, is kept (whether compiled yet or not);
+    None without a compiler."""
+    cc = compiler()
+    return None if cc is None else _target(_source_bytes(), cc)
+
+
 def _target(source: bytes, cc: str) -> Path:
     """Where the binary of ``source`` compiled by ``cc`` is cached."""
-    return user_cache_root() / "native" / hashlib.sha256(source + cc.encode()).hexdigest()[:16] / "dtcosim_fmi2.so"
+    return user_cache_root() / CACHE_FOLDER / hashlib.sha256(source + cc.encode()).hexdigest()[:16] / "dtcosim_fmi2.so"
 
 
 @contextlib.contextmanager

@@ -8,16 +8,48 @@ are in :mod:`tests.helpers`.
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import subprocess
 import sys
 import sysconfig
+import tempfile
 import venv
+from importlib import metadata
 from pathlib import Path
 
 import pytest
 
 from tests.helpers.scenarios import TOY_SCENARIO, dtcosim, write_scenario
+
+
+#: the folders of the per-user cache a test session shares with the user's (compiled code, keyed by its sources)
+SHARED_CACHE_FOLDERS = ("aot", "native")
+
+
+def pytest_configure(config):
+    """The session's own per-user cache (``DTCOSIM_CACHE_DIR``, removed at its end), sharing only the compiled code
+    of the user's: the tests build and unpack hundreds of FMUs (~2 GB unpacked) that are no one's after the
+    session. Where ``DTCOSIM_CACHE_DIR`` is set already (a worker of a parallel run inherits the controller's),
+    everything goes there."""
+    if os.environ.get("DTCOSIM_CACHE_DIR"):
+        return
+    from components.compile.user_cache import user_cache_root
+
+    users = user_cache_root()
+    session = Path(tempfile.mkdtemp(prefix="dtcosim-test-cache-"))
+    try:
+        numba = [f"numba-{metadata.version('numba')}"]
+    except metadata.PackageNotFoundError:
+        numba = []
+    for name in (*SHARED_CACHE_FOLDERS, *numba):
+        try:
+            (users / name).mkdir(parents=True, exist_ok=True)
+        except OSError:  # a read-only home: the session compiles into its own cache
+            continue
+        (session / name).symlink_to(users / name, target_is_directory=True)
+    os.environ["DTCOSIM_CACHE_DIR"] = str(session)
+    config.add_cleanup(lambda: shutil.rmtree(session, ignore_errors=True))
 
 
 @pytest.hookimpl(tryfirst=True)

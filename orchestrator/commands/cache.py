@@ -1,15 +1,17 @@
-"""``dtcosim cache [--prune]``: what the per-user cache of compiled kernels holds, and removing what is stale.
+"""``dtcosim cache [--prune]``: what the per-user cache of compiled code and unpacked FMUs holds, and removing what is stale.
 
 The cache (:func:`components.compile.user_cache.user_cache_root`, ``~/.cache/dtcosim``) keeps
 the kernels compiled ahead of time (``aot/<python tag>-numpy<version>/``, one module per
-kernel version: :mod:`components.compile.aot`), numba's just-in-time machine code
-(``numba-<numba version>/<source hash>/``) and the FMUs runs have unpacked
+kernel version: :mod:`components.compile.aot`, with the log of their last build), numba's
+just-in-time machine code (``numba-<numba version>/<source hash>/``), the FMU binary
+(``native/<source and compiler hash>/``: :mod:`fmus.binary`) and the FMUs runs have unpacked
 (``unpacked/<content hash>-<Python tag>/``: :mod:`orchestrator.cosim.unpacked_fmus`). Every new version of a
-kernel's sources adds entries and nothing removes the old ones: ``--prune`` deletes every entry that the
-installed dtcosim, Python, numpy and numba would not load (FMUs carry their own compiled
-modules, so an older FMU keeps running; a later run rebuilds what it needs), and every unpacked
+kernel's or the binary's sources adds entries and nothing removes the old ones: ``--prune`` deletes every entry
+that the installed dtcosim, Python, numpy, numba and C compiler would not load (FMUs carry their own compiled
+modules and binary, so an older FMU keeps running; a later run rebuilds what it needs), and every unpacked
 FMU that is not one of the FMU folder's (:func:`orchestrator.provision.folders.default_fmu_dir`;
-a later run of it unpacks it again) unless used within the hour (a run may be loading it).
+a later run of it unpacks it again) unless a process holds it (a run is loading it). The FMU folder itself
+(``fmus/`` where no other is chosen) is the FMUs dtcosim builds, not a cache entry: its size is printed.
 """
 
 from __future__ import annotations
@@ -19,10 +21,12 @@ import shutil
 from dataclasses import dataclass
 from pathlib import Path
 
-from components.compile.aot import aot_directory
+from components.compile.aot import aot_directory, build_log
 from components.compile.numba_cache import source_hash
 from components.compile.user_cache import user_cache_root
 from components.model.kernel import KERNELS
+from fmus.binary import CACHE_FOLDER as NATIVE_FOLDER
+from fmus.binary import cached_binary
 
 from ..cosim.compiled_kernels import aot_kernels
 from ..cosim.fmu_interface import file_sha256
@@ -58,20 +62,24 @@ def _jit_keys() -> tuple[str | None, set[str]]:
 
 
 def cache_entries(root: Path | None = None) -> list[CacheEntry]:
-    """Every module of ``aot/``, every kernel folder of ``numba-*/`` and every unpacked FMU, marked current or stale."""
+    """Every module of ``aot/``, every kernel folder of ``numba-*/``, every FMU binary and every unpacked FMU, marked
+    current or stale."""
     root = Path(root or user_cache_root())
     entries = []
     current_aot_dir = aot_directory()
     current_files = {k.file().name for k in aot_kernels()}
     for folder in sorted((root / "aot").glob("*")):
-        for path in sorted(p for p in folder.iterdir() if not p.name.startswith(".build-")):
-            current = folder == current_aot_dir and path.name in current_files
+        for path in sorted(p for p in folder.iterdir() if not p.name.startswith(".")):  # a build's own files
+            current = folder == current_aot_dir and (path.name in current_files or path == build_log())
             entries.append(CacheEntry(path, _size(path), current))
     numba_dir, hashes = _jit_keys()
     for folder in sorted(root.glob("numba-*")):
         for kernel_dir in sorted(p for p in folder.iterdir() if p.is_dir()):
             current = folder.name == numba_dir and kernel_dir.name in hashes
             entries.append(CacheEntry(kernel_dir, _size(kernel_dir), current))
+    binary = cached_binary()
+    for folder in sorted(p for p in (root / NATIVE_FOLDER).glob("*") if p.is_dir()):
+        entries.append(CacheEntry(folder, _size(folder), binary is not None and folder == binary.parent))
     unpacked = sorted(p for p in (root / UNPACKED_FOLDER).glob("*") if p.is_dir())
     if unpacked:
         built = {folder_name(file_sha256(p)) for p in default_fmu_dir().rglob("*.fmu") if p.is_file()}
@@ -84,7 +92,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("cache", help=help_line("cache"),
                        description=__doc__.splitlines()[0].split(": ", 1)[1])
     p.add_argument("--prune", action="store_true",
-                   help="delete every entry the installed dtcosim, Python, numpy and numba would not load")
+                   help="delete every entry the installed dtcosim, Python, numpy, numba and C compiler would not load, "
+                        "and the unpacked FMUs no run holds that are not the FMU folder's")
     p.set_defaults(func=run)
 
 
@@ -107,10 +116,13 @@ def run(args: argparse.Namespace) -> int:
                 shutil.rmtree(e.path, ignore_errors=True)
             else:
                 e.path.unlink(missing_ok=True)
-        for folder in [*(root / "aot").glob("*"), *root.glob("numba-*"), root / UNPACKED_FOLDER]:
+        for folder in [*(root / "aot").glob("*"), *root.glob("numba-*"), root / NATIVE_FOLDER, root / UNPACKED_FOLDER]:
             if folder.is_dir() and not any(folder.iterdir()):
                 folder.rmdir()
         print(f"pruned {len(stale)} stale entries")
     elif stale:
         print("`dtcosim cache --prune` removes the stale entries")
+    fmu_dir = default_fmu_dir()
+    if fmu_dir.is_dir():
+        print(f"FMU folder {fmu_dir}: {_size(fmu_dir) / 1e6:.1f} MB (the FMUs runs build; not pruned)")
     return 0

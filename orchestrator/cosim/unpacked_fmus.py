@@ -18,8 +18,14 @@ computes anyway) loads that folder:
 * **Checked at each use.** The folder lists its files with their sizes (:data:`MANIFEST`,
   written before the rename); one whose files are not all there as listed (deleted or
   changed since) is never loaded: it is set aside and the FMU unpacked anew.
+* **Held while used.** A process that loads a folder holds a shared lock (``flock``) on its
+  :data:`MANIFEST` until it ends (a forked child shares it): an FMU's modules may import more of
+  its files at any time of a run, however long.
 * **Bounded.** Each use touches the folder; when a new one is added, those beyond the
-  :data:`KEPT` most recently used are removed (unless used within the last hour).
+  :data:`KEPT` most recently used are removed unless a process holds them (the remover takes
+  the lock exclusively, without waiting, and moves the folder away before deleting it; a
+  process that takes a folder checks after locking that it is still the one under that name).
+  Where ``flock`` is missing (Windows), one used within the last hour is kept instead.
   ``dtcosim cache`` lists them.
 * **Best effort.** Where the cache cannot be written (read-only, full) the FMU is
   extracted into a temporary folder of the run's own, as before, which goes when the process ends.
@@ -46,11 +52,17 @@ from pathlib import Path
 
 from components.compile.user_cache import user_cache_root
 
+try:
+    import fcntl
+except ImportError:  # Windows: no flock; folders used within the last hour are kept instead
+    fcntl = None
+
 #: the folder of the user cache holding the unpacked FMUs
 FOLDER = "unpacked"
 #: unpacked FMUs kept (the most recently used; 3-4 MB each)
 KEPT = 32
-#: an unpacked FMU used this recently [s] is never removed
+#: without ``flock`` (Windows), an unpacked FMU used this recently [s] is never removed; a partial folder (being
+#: unpacked, or set aside) is removed once this old
 IN_USE_S = 3600.0
 #: prefix of a folder being unpacked or set aside as damaged (never loaded; removed by a later unpacking once unused)
 PARTIAL_PREFIX = ".unpacking-"
@@ -59,6 +71,8 @@ PARTIAL_PREFIX = ".unpacking-"
 MANIFEST = ".members.json"
 
 _temporary_root: Path | None = None
+#: the folders this process holds: their manifest's open descriptor (the shared lock), by folder
+_held: dict[Path, int] = {}
 
 
 def store() -> Path:
@@ -89,10 +103,10 @@ def unpacked(path: Path, sha256: str, extract, fallback: bool = True) -> Path | 
     """
     final = _folder(sha256)
     if final.is_dir():
-        if _whole(final):
+        if _whole(final) and (final in _held or _hold(final)):
             _touch(final)
             return final
-        _set_aside(final)  # files deleted or changed since: unpacked anew
+        _set_aside(final)  # files deleted or changed since (or being removed): unpacked anew
     try:
         final.parent.mkdir(parents=True, exist_ok=True)
         partial = Path(tempfile.mkdtemp(prefix=PARTIAL_PREFIX, dir=final.parent))
@@ -105,15 +119,20 @@ def unpacked(path: Path, sha256: str, extract, fallback: bool = True) -> Path | 
     except BaseException:
         shutil.rmtree(partial, ignore_errors=True)
         raise
+    descriptor = _lock(partial, exclusive=False)  # held across the rename: the folder is never unheld under its name
     try:
         os.rename(partial, final)
     except OSError:  # another process renamed its copy first (or the cache refuses): use that one, or our own
-        if not final.is_dir():
+        _release(descriptor)
+        if not final.is_dir() or not _hold(final):
             if not fallback:
                 shutil.rmtree(partial, ignore_errors=True)
                 return None
             return _keep_temporarily(partial)
         shutil.rmtree(partial, ignore_errors=True)
+    else:
+        if descriptor is not None:
+            _held[final] = descriptor
     _prune(final.parent)
     return final
 
@@ -157,8 +176,62 @@ def _compile_missing_bytecode(folder: Path) -> None:
                 pass
 
 
+def _lock(folder: Path, exclusive: bool) -> int | None:
+    """The open descriptor of ``folder``'s manifest locked shared (or exclusively), without waiting; None where it is
+    locked the other way, has no manifest, or there is no ``flock`` (then nothing is locked)."""
+    if fcntl is None:
+        return None
+    try:
+        fd = os.open(folder / MANIFEST, os.O_RDONLY)
+    except OSError:
+        return None
+    try:
+        fcntl.flock(fd, (fcntl.LOCK_EX if exclusive else fcntl.LOCK_SH) | fcntl.LOCK_NB)
+    except OSError:
+        os.close(fd)
+        return None
+    return fd
+
+
+def _release(fd: int | None) -> None:
+    if fd is not None:
+        os.close(fd)
+
+
+def _hold(folder: Path) -> bool:
+    """Hold ``folder`` for the rest of this process (a shared lock on its manifest); False where it is being removed,
+    or is no longer the folder that was locked. True without ``flock``."""
+    if fcntl is None:
+        return True
+    fd = _lock(folder, exclusive=False)
+    if fd is None:
+        return False
+    try:
+        same = os.fstat(fd).st_ino == (folder / MANIFEST).stat().st_ino  # not moved away meanwhile
+    except OSError:
+        same = False
+    if not same:
+        os.close(fd)
+        return False
+    _held[folder] = fd
+    return True
+
+
 def in_use(folder: Path) -> bool:
-    """True if ``folder`` was used (or set aside) within the last :data:`IN_USE_S`: another process may be loading it."""
+    """True if a process holds ``folder`` (one without its manifest cannot be held: it is never loaded); without
+    ``flock``: if it was used or set aside within the last :data:`IN_USE_S`."""
+    if folder in _held:
+        return True
+    if fcntl is None:
+        return _recent(folder)
+    if not (folder / MANIFEST).is_file():
+        return False
+    fd = _lock(folder, exclusive=True)
+    _release(fd)
+    return fd is None
+
+
+def _recent(folder: Path) -> bool:
     try:
         return time.time() - folder.stat().st_mtime <= IN_USE_S
     except OSError:
@@ -193,15 +266,39 @@ def _keep_temporarily(folder: Path) -> Path:
 
 
 def _prune(root: Path) -> None:
-    """Remove the unpacked FMUs beyond the :data:`KEPT` most recently used (none used in the last
-    :data:`IN_USE_S`: another process may be loading it) and partial folders abandoned as long ago."""
+    """Remove the unpacked FMUs beyond the :data:`KEPT` most recently used that no process holds, and partial folders
+    abandoned :data:`IN_USE_S` ago."""
     now = time.time()
     try:
         entries = [(p, p.stat().st_mtime) for p in root.iterdir() if p.is_dir()]
     except OSError:
         return
     whole = sorted(((p, t) for p, t in entries if not p.name.startswith(PARTIAL_PREFIX)), key=lambda e: -e[1])
-    partial = [(p, t) for p, t in entries if p.name.startswith(PARTIAL_PREFIX)]
-    for folder, used in [*whole[KEPT:], *partial]:
-        if now - used > IN_USE_S:
+    for folder, _ in whole[KEPT:]:
+        if folder not in _held:
+            _remove_unheld(folder)
+    for folder, made in entries:
+        if folder.name.startswith(PARTIAL_PREFIX) and now - made > IN_USE_S:
             shutil.rmtree(folder, ignore_errors=True)
+
+
+def _remove_unheld(folder: Path) -> None:
+    """Remove ``folder`` unless a process holds it: locked exclusively, moved out of the way, deleted (one without its
+    manifest, which no process can hold or load, at once)."""
+    if fcntl is None:
+        if not _recent(folder):
+            shutil.rmtree(folder, ignore_errors=True)
+        return
+    fd = None
+    if (folder / MANIFEST).is_file():
+        fd = _lock(folder, exclusive=True)
+        if fd is None:  # held by a process
+            return
+    try:
+        gone = folder.with_name(f"{PARTIAL_PREFIX}{folder.name}-removed-{os.getpid()}")
+        os.rename(folder, gone)
+    except OSError:
+        return
+    finally:
+        _release(fd)
+    shutil.rmtree(gone, ignore_errors=True)

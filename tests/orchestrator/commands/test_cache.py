@@ -1,4 +1,5 @@
-"""``dtcosim cache``: the per-user cache of compiled kernels listed, and only its stale entries pruned."""
+"""``dtcosim cache``: the per-user cache (compiled kernels, FMU binaries, unpacked FMUs) listed, and only its stale
+entries pruned."""
 
 from __future__ import annotations
 
@@ -8,17 +9,22 @@ import time
 
 import pytest
 
-from components.compile.aot import aot_directory
+from components.compile.aot import aot_directory, build_log
 from components.compile.numba_cache import source_hash
+from fmus.binary import cached_binary
 from orchestrator.commands.cli import main
+from orchestrator.cosim import unpacked_fmus
 from orchestrator.cosim.compiled_kernels import aot_kernels
-from orchestrator.cosim.unpacked_fmus import IN_USE_S, folder_name
+from orchestrator.cosim.unpacked_fmus import MANIFEST, folder_name
+from tests.helpers.holders import held_elsewhere
 
 
 @pytest.fixture
 def cache(tmp_path, monkeypatch):
-    """A cache with each installed kernel's module and JIT folder (current) and entries of older code (stale)."""
+    """A cache with each installed kernel's module and JIT folder (current) and entries of older code (stale); one
+    unpacked FMU is held by another process while the test runs (a run loading it)."""
     monkeypatch.setenv("DTCOSIM_CACHE_DIR", str(tmp_path))
+    monkeypatch.setattr(unpacked_fmus, "_held", {})
     numba = pytest.importorskip("numba")
     current = []
     for kernel in aot_kernels():
@@ -29,7 +35,16 @@ def cache(tmp_path, monkeypatch):
         jit.mkdir(parents=True)
         (jit / "index.nbi").write_bytes(b"y" * 10)
         current += [module, jit]
+    build_log().write_text("the log of the last build\n")
+    (aot_directory() / ".building").write_text("123\n")  # a build's own bookkeeping: not an entry
+    current.append(build_log())
+    binary = cached_binary()
+    if binary is not None:  # the FMU binary of these sources and this compiler
+        binary.parent.mkdir(parents=True)
+        binary.write_bytes(b"b" * 200)
+        current.append(binary.parent)
     stale = [aot_directory() / "_dtcosim_compiled_kernel_0000000000000000_aot.cpython-311-x86_64-linux-gnu.so",
+             tmp_path / "native" / "0000000000000000",  # the binary of older sources
              tmp_path / "aot" / "cpython-310-numpy1.26" / "_dtcosim_compiled_wind_0000000000000000_aot.so",
              tmp_path / f"numba-{numba.__version__}" / "0000000000000000",
              tmp_path / "numba-0.60.0" / source_hash(aot_kernels()[0].source)[:16]]
@@ -42,8 +57,9 @@ def cache(tmp_path, monkeypatch):
     (unpacked / "resources" / "x.py").write_bytes(b"u" * 100)
     current.append(unpacked)
     stale.append(tmp_path / "unpacked" / folder_name("0" * 64))  # an FMU run from elsewhere (or rebuilt since)
-    running = tmp_path / "unpacked" / folder_name("1" * 64)  # one from elsewhere that a run may be loading
+    running = tmp_path / "unpacked" / folder_name("1" * 64)  # one from elsewhere that a run is loading
     running.mkdir()
+    (running / MANIFEST).write_text("{}")
     current.append(running)
     for path in stale:
         if path.suffix == ".so":
@@ -52,9 +68,11 @@ def cache(tmp_path, monkeypatch):
         else:
             path.mkdir(parents=True)
             (path / "index.nbi").write_bytes(b"z")
-    long_ago = time.time() - 2 * IN_USE_S
-    os.utime(stale[-1], (long_ago, long_ago))  # last used more than an hour ago
-    return tmp_path, current, stale
+    (stale[-1] / MANIFEST).write_text("{}")
+    a_minute_ago = time.time() - 60
+    os.utime(stale[-1], (a_minute_ago, a_minute_ago))  # used a minute ago, but no process holds it
+    with held_elsewhere(running):
+        yield tmp_path, current, stale
 
 
 def test_the_listing_marks_what_the_installed_code_loads(cache, capsys):
@@ -67,7 +85,8 @@ def test_the_listing_marks_what_the_installed_code_loads(cache, capsys):
     for path in stale:
         assert "stale" in next(line for line in out.splitlines() if line.endswith(str(path.relative_to(root))))
     assert f"{len(current) + len(stale)} entries" in out and f"stale: {len(stale)}," in out
-    assert "`dtcosim cache --prune`" in out
+    assert "`dtcosim cache --prune`" in out and ".building" not in out
+    assert f"FMU folder {root / 'fmus'}: 0.0 MB" in out
     assert all(p.exists() for p in current + stale)  # listing changes nothing
 
 

@@ -12,14 +12,18 @@ import pytest
 
 from orchestrator.cosim import unpacked_fmus
 from orchestrator.cosim.unpacked_fmus import folder_name, is_unpacked, store, unpacked
+from tests.helpers.holders import held_elsewhere
 
 SHA = "ab" * 32
 
 
 @pytest.fixture
 def cache(tmp_path, monkeypatch):
+    """A cache of the test's own; the folders the test's unpacking holds are let go at its end."""
     monkeypatch.setenv("DTCOSIM_CACHE_DIR", str(tmp_path / "cache"))
-    return tmp_path / "cache"
+    monkeypatch.setattr(unpacked_fmus, "_held", {})
+    yield tmp_path / "cache"
+    _let_go()
 
 
 def _extractor(calls: list):
@@ -70,7 +74,8 @@ def test_a_failed_extraction_leaves_nothing_and_is_raised(cache, tmp_path):
 
 def test_a_copy_renamed_first_by_another_process_is_used(cache, tmp_path):
     def racing(path, folder):  # another process finishes the same FMU meanwhile
-        _extractor([])(path, store() / folder_name(SHA))
+        theirs = _extractor([])(path, store() / folder_name(SHA))
+        unpacked_fmus._write_manifest(theirs)
         return _extractor([])(path, folder)
 
     folder = unpacked(tmp_path / "A.fmu", SHA, racing)
@@ -87,20 +92,75 @@ def test_an_unwritable_cache_unpacks_into_a_folder_of_the_process(tmp_path, monk
     assert unpacked(tmp_path / "A.fmu", SHA, _extractor(calls)) == folder and len(calls) == 1
 
 
-def test_only_the_most_recently_used_are_kept_and_none_used_within_the_hour(cache, tmp_path, monkeypatch):
+def _let_go():
+    """This process stops holding the folders it unpacked (as if other processes had unpacked them and ended)."""
+    for fd in unpacked_fmus._held.values():
+        os.close(fd)
+    unpacked_fmus._held.clear()
+
+
+needs_flock = pytest.mark.skipif(unpacked_fmus.fcntl is None, reason="no flock (Windows): the hour rule")
+
+
+@needs_flock
+def test_beyond_the_most_recently_used_every_folder_no_process_holds_is_removed(cache, tmp_path, monkeypatch):
     monkeypatch.setattr(unpacked_fmus, "KEPT", 2)
-    old = time.time() - 2 * unpacked_fmus.IN_USE_S
-    for k in range(4):
-        folder = unpacked(tmp_path / "A.fmu", f"{k:02d}" * 32, _extractor([]))
-        os.utime(folder, (old + k, old + k))  # used long ago, 00 first
-    abandoned = store() / f"{unpacked_fmus.PARTIAL_PREFIX}x"
-    abandoned.mkdir()
-    os.utime(abandoned, (old, old))
-    unpacked(tmp_path / "A.fmu", "04" * 32, _extractor([]))  # a new one prunes: 2 kept
+    folders = []
+    for k in range(3):
+        folders.append(unpacked(tmp_path / "A.fmu", f"{k:02d}" * 32, _extractor([])))
+        os.utime(folders[-1], (time.time() - 10 + k,) * 2)  # 00 least recently used; all within the hour
+    assert len(list(store().iterdir())) == 3  # this process holds all three
+    _let_go()
+    with held_elsewhere(folders[0]):  # a run of another process still loads 00
+        unpacked(tmp_path / "A.fmu", "03" * 32, _extractor([]))  # a new one prunes: 2 kept, 00 held
+        assert sorted(p.name for p in store().iterdir()) == [folder_name(k * 32) for k in ("00", "02", "03")]
+    _let_go()
+    unpacked(tmp_path / "A.fmu", "04" * 32, _extractor([]))  # 00 no longer held
     assert sorted(p.name for p in store().iterdir()) == [folder_name(k * 32) for k in ("03", "04")]
-    unpacked(tmp_path / "A.fmu", "03" * 32, _extractor([]))  # used again: touched
-    unpacked(tmp_path / "A.fmu", "05" * 32, _extractor([]))  # beyond the 2 kept, but all used within the hour
-    assert sorted(p.name for p in store().iterdir()) == [folder_name(k * 32) for k in ("03", "04", "05")]
+
+
+@needs_flock
+def test_a_folder_held_by_this_process_is_never_removed_however_many_follow(cache, tmp_path, monkeypatch):
+    monkeypatch.setattr(unpacked_fmus, "KEPT", 1)
+    first = unpacked(tmp_path / "A.fmu", "00" * 32, _extractor([]))
+    os.utime(first, (time.time() - 7200,) * 2)  # used two hours ago: a long run
+    for k in (1, 2):
+        unpacked(tmp_path / "A.fmu", f"{k:02d}" * 32, _extractor([]))
+    assert first.is_dir() and (first / "resources" / "member.txt").is_file()
+
+
+@needs_flock
+def test_a_folder_being_removed_is_not_taken_but_unpacked_anew(cache, tmp_path, monkeypatch):
+    calls: list = []
+    folder = unpacked(tmp_path / "A.fmu", SHA, _extractor(calls))
+    _let_go()
+    fd = unpacked_fmus._lock(folder, exclusive=True)  # another process's pruning has locked it
+    try:
+        again = unpacked(tmp_path / "A.fmu", SHA, _extractor(calls))
+    finally:
+        os.close(fd)
+    assert again == folder and len(calls) == 2 and folder in unpacked_fmus._held
+
+
+def test_a_partial_folder_is_removed_once_abandoned_for_an_hour(cache, tmp_path):
+    old = time.time() - 2 * unpacked_fmus.IN_USE_S
+    store().mkdir(parents=True)
+    abandoned, fresh = store() / f"{unpacked_fmus.PARTIAL_PREFIX}x", store() / f"{unpacked_fmus.PARTIAL_PREFIX}y"
+    abandoned.mkdir()
+    fresh.mkdir()  # another process is unpacking into it
+    os.utime(abandoned, (old, old))
+    folder = unpacked(tmp_path / "A.fmu", SHA, _extractor([]))
+    assert sorted(store().iterdir()) == sorted([folder, fresh])
+
+
+@needs_flock
+def test_in_use_says_whether_any_process_holds_the_folder(cache, tmp_path, monkeypatch):
+    folder = unpacked(tmp_path / "A.fmu", SHA, _extractor([]))
+    assert unpacked_fmus.in_use(folder)
+    _let_go()
+    assert not unpacked_fmus.in_use(folder)
+    with held_elsewhere(folder):
+        assert unpacked_fmus.in_use(folder)
 
 
 def test_the_member_check_is_not_repeated_for_content_unpacked_whole(cache, toy_dir, monkeypatch):
