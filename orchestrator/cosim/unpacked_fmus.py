@@ -25,7 +25,9 @@ computes anyway) loads that folder:
   :data:`KEPT` most recently used are removed unless a process holds them (the remover takes
   the lock exclusively, without waiting, and moves the folder away before deleting it; a
   process that takes a folder checks after locking that it is still the one under that name).
-  Where ``flock`` is missing (Windows), one used within the last hour is kept instead.
+  Where nothing can be locked (Windows, a file system without ``flock``), one used within the
+  last hour is kept instead; a process using more than :data:`MAX_HELD` folders uses the
+  others unlocked (its own pruning spares them, another's does not).
   ``dtcosim cache`` lists them.
 * **Best effort.** Where the cache cannot be written (read-only, full) the FMU is
   extracted into a temporary folder of the run's own, as before, which goes when the process ends.
@@ -71,8 +73,11 @@ PARTIAL_PREFIX = ".unpacking-"
 MANIFEST = ".members.json"
 
 _temporary_root: Path | None = None
-#: the folders this process holds: their manifest's open descriptor (the shared lock), by folder
-_held: dict[Path, int] = {}
+#: the folders this process uses: their manifest's open descriptor (the shared lock), None where it could not lock
+#: it (its own pruning spares them all)
+_held: dict[Path, int | None] = {}
+#: the most folders a process holds (one open descriptor each); beyond, it uses them unlocked
+MAX_HELD = 256
 
 
 def store() -> Path:
@@ -119,7 +124,10 @@ def unpacked(path: Path, sha256: str, extract, fallback: bool = True) -> Path | 
     except BaseException:
         shutil.rmtree(partial, ignore_errors=True)
         raise
-    descriptor = _lock(partial, exclusive=False)  # held across the rename: the folder is never unheld under its name
+    try:  # held across the rename: the folder is never unheld under its name
+        descriptor = _lock(partial, exclusive=False) if len(_held) < MAX_HELD else None
+    except OSError:
+        descriptor = None
     try:
         os.rename(partial, final)
     except OSError:  # another process renamed its copy first (or the cache refuses): use that one, or our own
@@ -131,8 +139,7 @@ def unpacked(path: Path, sha256: str, extract, fallback: bool = True) -> Path | 
             return _keep_temporarily(partial)
         shutil.rmtree(partial, ignore_errors=True)
     else:
-        if descriptor is not None:
-            _held[final] = descriptor
+        _held[final] = descriptor
     _prune(final.parent)
     return final
 
@@ -178,18 +185,27 @@ def _compile_missing_bytecode(folder: Path) -> None:
 
 def _lock(folder: Path, exclusive: bool) -> int | None:
     """The open descriptor of ``folder``'s manifest locked shared (or exclusively), without waiting; None where it is
-    locked the other way, has no manifest, or there is no ``flock`` (then nothing is locked)."""
+    locked the other way or has no manifest.
+
+    Raises
+    ------
+    OSError
+        Nothing can be locked here: no ``flock`` (Windows), no descriptor left, a file system without locks.
+    """
     if fcntl is None:
-        return None
+        raise OSError("no flock on this platform")
     try:
         fd = os.open(folder / MANIFEST, os.O_RDONLY)
-    except OSError:
+    except FileNotFoundError:
         return None
     try:
         fcntl.flock(fd, (fcntl.LOCK_EX if exclusive else fcntl.LOCK_SH) | fcntl.LOCK_NB)
-    except OSError:
+    except BlockingIOError:
         os.close(fd)
         return None
+    except OSError:
+        os.close(fd)
+        raise
     return fd
 
 
@@ -200,10 +216,16 @@ def _release(fd: int | None) -> None:
 
 def _hold(folder: Path) -> bool:
     """Hold ``folder`` for the rest of this process (a shared lock on its manifest); False where it is being removed,
-    or is no longer the folder that was locked. True without ``flock``."""
-    if fcntl is None:
+    or is no longer the folder that was locked. True without locking it where nothing can be locked, or where this
+    process holds :data:`MAX_HELD` folders already (then only this process's pruning spares it)."""
+    if len(_held) >= MAX_HELD:
+        _held[folder] = None
         return True
-    fd = _lock(folder, exclusive=False)
+    try:
+        fd = _lock(folder, exclusive=False)
+    except OSError:
+        _held[folder] = None
+        return True
     if fd is None:
         return False
     try:
@@ -218,17 +240,16 @@ def _hold(folder: Path) -> bool:
 
 
 def in_use(folder: Path) -> bool:
-    """True if a process holds ``folder`` (one without its manifest cannot be held: it is never loaded); without
-    ``flock``: if it was used or set aside within the last :data:`IN_USE_S`."""
+    """True if a process holds ``folder`` (one without its manifest cannot be held: it is never loaded); where nothing
+    can be locked, if it was used or set aside within the last :data:`IN_USE_S`."""
     if folder in _held:
         return True
-    if fcntl is None:
+    try:
+        fd = _lock(folder, exclusive=True)
+    except OSError:
         return _recent(folder)
-    if not (folder / MANIFEST).is_file():
-        return False
-    fd = _lock(folder, exclusive=True)
     _release(fd)
-    return fd is None
+    return fd is None and (folder / MANIFEST).is_file()
 
 
 def _recent(folder: Path) -> bool:
@@ -284,16 +305,15 @@ def _prune(root: Path) -> None:
 
 def _remove_unheld(folder: Path) -> None:
     """Remove ``folder`` unless a process holds it: locked exclusively, moved out of the way, deleted (one without its
-    manifest, which no process can hold or load, at once)."""
-    if fcntl is None:
+    manifest, which no process can hold or load, at once). Where nothing can be locked: once unused for an hour."""
+    try:
+        fd = _lock(folder, exclusive=True)
+    except OSError:
         if not _recent(folder):
             shutil.rmtree(folder, ignore_errors=True)
         return
-    fd = None
-    if (folder / MANIFEST).is_file():
-        fd = _lock(folder, exclusive=True)
-        if fd is None:  # held by a process
-            return
+    if fd is None and (folder / MANIFEST).is_file():  # held by a process
+        return
     try:
         gone = folder.with_name(f"{PARTIAL_PREFIX}{folder.name}-removed-{os.getpid()}")
         os.rename(folder, gone)

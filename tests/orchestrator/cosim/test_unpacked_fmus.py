@@ -95,7 +95,8 @@ def test_an_unwritable_cache_unpacks_into_a_folder_of_the_process(tmp_path, monk
 def _let_go():
     """This process stops holding the folders it unpacked (as if other processes had unpacked them and ended)."""
     for fd in unpacked_fmus._held.values():
-        os.close(fd)
+        if fd is not None:
+            os.close(fd)
     unpacked_fmus._held.clear()
 
 
@@ -140,6 +141,30 @@ def test_a_folder_being_removed_is_not_taken_but_unpacked_anew(cache, tmp_path, 
     finally:
         os.close(fd)
     assert again == folder and len(calls) == 2 and folder in unpacked_fmus._held
+
+
+@needs_flock
+def test_beyond_max_held_folders_are_used_unlocked_and_spared_by_this_process_only(cache, tmp_path, monkeypatch):
+    monkeypatch.setattr(unpacked_fmus, "KEPT", 1)
+    monkeypatch.setattr(unpacked_fmus, "MAX_HELD", 1)
+    first = unpacked(tmp_path / "A.fmu", "00" * 32, _extractor([]))
+    second = unpacked(tmp_path / "A.fmu", "01" * 32, _extractor([]))
+    assert unpacked_fmus._held[first] is not None and unpacked_fmus._held[second] is None  # one descriptor only
+    os.utime(second, (time.time() - 10,) * 2)
+    unpacked(tmp_path / "A.fmu", "02" * 32, _extractor([]))  # this process's pruning spares both
+    assert first.is_dir() and second.is_dir()
+
+
+def test_where_nothing_can_be_locked_a_folder_used_within_the_hour_is_kept(cache, tmp_path, monkeypatch):
+    monkeypatch.setattr(unpacked_fmus, "fcntl", None)  # Windows
+    monkeypatch.setattr(unpacked_fmus, "KEPT", 1)
+    old, recent = (unpacked(tmp_path / "A.fmu", f"{k:02d}" * 32, _extractor([])) for k in range(2))
+    assert unpacked_fmus._held == {old: None, recent: None}  # used, nothing locked
+    os.utime(old, (time.time() - 2 * unpacked_fmus.IN_USE_S,) * 2)
+    os.utime(recent, (time.time() - 60,) * 2)
+    unpacked_fmus._held.clear()  # as seen by another process
+    unpacked(tmp_path / "A.fmu", "02" * 32, _extractor([]))
+    assert not old.exists() and recent.is_dir()
 
 
 def test_a_partial_folder_is_removed_once_abandoned_for_an_hour(cache, tmp_path):
