@@ -111,6 +111,7 @@ def unpacked(path: Path, sha256: str, extract, fallback: bool = True) -> Path | 
         if _whole(final) and (final in _held or _hold(final)):
             _touch(final)
             return final
+        _release(_held.pop(final, None))
         _set_aside(final)  # files deleted or changed since (or being removed): unpacked anew
     try:
         final.parent.mkdir(parents=True, exist_ok=True)
