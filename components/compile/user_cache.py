@@ -6,10 +6,13 @@ import os
 import sys
 from pathlib import Path
 
+#: environment variable naming the per-user cache folder
+CACHE_VARIABLE = "DTCOSIM_CACHE_DIR"
+
 
 def user_cache_root() -> Path:
     """Per-user cache directory of dtcosim (not created here)."""
-    explicit = os.environ.get("DTCOSIM_CACHE_DIR")
+    explicit = os.environ.get(CACHE_VARIABLE)
     if explicit:
         return Path(explicit)
     if sys.platform == "win32":

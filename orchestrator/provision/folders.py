@@ -23,7 +23,9 @@ import os
 from pathlib import Path
 from typing import Protocol
 
-from components.compile.user_cache import user_cache_root
+from components.compile.user_cache import CACHE_VARIABLE, user_cache_root
+
+from ..errors import EntryError
 
 #: environment variable naming the FMU folder
 FMU_DIR_VARIABLE = "DTCOSIM_FMU_DIR"
@@ -51,6 +53,39 @@ def default_fmu_dir() -> Path:
     if explicit:
         return Path(explicit)
     return user_cache_root() / "fmus"
+
+
+class FmuFolderError(EntryError):
+    """The FMU folder cannot be created: names the setting that chose it, its value and the reason."""
+
+    kind = "setting"
+
+
+def usable_fmu_dir(fmu_dir: str | Path | None = None) -> Path:
+    """The FMU folder to build into - ``fmu_dir`` (``--fmu-dir``), else :func:`default_fmu_dir` - created if missing.
+
+    Raises
+    ------
+    FmuFolderError
+        It cannot be created (a missing or read-only parent, a file in its place), naming where it was chosen.
+    """
+    folder = default_fmu_dir() if fmu_dir is None else Path(fmu_dir)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        where = f"{exc.filename}: " if exc.filename not in (None, str(folder)) else ""
+        reason = "a file is there" if folder.exists() and not folder.is_dir() else f"{where}{exc.strerror or exc}"
+        if fmu_dir is not None:
+            key, value = "--fmu-dir", str(fmu_dir)
+        elif os.environ.get(FMU_DIR_VARIABLE):
+            key, value = FMU_DIR_VARIABLE, os.environ[FMU_DIR_VARIABLE]
+        elif os.environ.get(CACHE_VARIABLE):
+            key, value = CACHE_VARIABLE, os.environ[CACHE_VARIABLE]
+        else:
+            key, value = "the FMU folder", str(folder)
+        raise FmuFolderError(key, value, f"a place for the FMU folder {folder}, which cannot be created ({reason}); "
+                             f"--fmu-dir or {FMU_DIR_VARIABLE} chooses another") from None
+    return folder
 
 
 def drivetrain_fmu_dir(fmu_dir: Path, spec: ContentKeyed) -> Path:

@@ -25,7 +25,7 @@ from ..cosim.compiled_kernels import ensure_compiled_kernels
 from ..inputs.drivetrain_file import DrivetrainSpec
 from ..inputs.scenario import Scenario
 from .drivetrain_fmus import ensure_drivetrain_fmus
-from .folders import default_fmu_dir
+from .folders import default_fmu_dir, usable_fmu_dir
 from .locate import missing_fmus, resolve_fmu_paths
 from .other_builds import swap_in
 from .staleness import broken_fmu, stale_project_fmus
@@ -61,9 +61,14 @@ def ensure_fmus(scenario: Scenario, fmu_dir: str | Path | None = None, build: bo
     ------
     ScenarioError
         ``components.<name>.fmu`` for a missing FMU that cannot be built.
+    FmuFolderError
+        The FMU folder cannot be created (where it was chosen and why).
     """
     managed = fmu_dir is None  # the project's own FMU folder: what is stale there is rebuilt, not only reported
-    fmu_dir = default_fmu_dir() if fmu_dir is None else Path(fmu_dir)
+    if build:  # created, or an error naming where it was chosen
+        fmu_dir = usable_fmu_dir(fmu_dir)
+    else:
+        fmu_dir = default_fmu_dir() if fmu_dir is None else Path(fmu_dir)
     if build:
         # the kernels the FMUs and the master step, once per machine
         ensure_compiled_kernels(report, background=kernels_in_background)
