@@ -13,7 +13,7 @@ from pathlib import Path
 from components.model.presets import PRESETS
 from fmus.registry import PRESET, names_built_from
 
-from ..provision.folders import default_fmu_dir
+from ..provision.folders import default_fmu_dir, usable_fmu_dir
 from .catalogue import help_line
 
 #: the FMUs built from a preset, in the registry's order
@@ -52,8 +52,8 @@ def run(args: argparse.Namespace) -> int:
 
     from ..cosim.compiled_kernels import ensure_compiled_kernels
 
+    fmu_dir = usable_fmu_dir(args.out, "--out")  # or an error naming the setting, before the kernels' compile
     ensure_compiled_kernels(report=print, retry=True)
-    fmu_dir = args.out if args.out is not None else default_fmu_dir()
     if args.scenario is not None:
         from ..inputs.scenario_file import find_scenario, load_scenario
         from ..provision.project_fmus import ensure_fmus

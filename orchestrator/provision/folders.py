@@ -61,8 +61,9 @@ class FmuFolderError(EntryError):
     kind = "setting"
 
 
-def usable_fmu_dir(fmu_dir: str | Path | None = None) -> Path:
-    """The FMU folder to build into - ``fmu_dir`` (``--fmu-dir``), else :func:`default_fmu_dir` - created if missing.
+def usable_fmu_dir(fmu_dir: str | Path | None = None, option: str = "--fmu-dir") -> Path:
+    """The FMU folder to build into - ``fmu_dir`` (given by the command-line ``option``), else
+    :func:`default_fmu_dir` - created if missing.
 
     Raises
     ------
@@ -76,7 +77,7 @@ def usable_fmu_dir(fmu_dir: str | Path | None = None) -> Path:
         where = f"{exc.filename}: " if exc.filename not in (None, str(folder)) else ""
         reason = "a file is there" if folder.exists() and not folder.is_dir() else f"{where}{exc.strerror or exc}"
         if fmu_dir is not None:
-            key, value = "--fmu-dir", str(fmu_dir)
+            key, value = option, str(fmu_dir)
         elif os.environ.get(FMU_DIR_VARIABLE):
             key, value = FMU_DIR_VARIABLE, os.environ[FMU_DIR_VARIABLE]
         elif os.environ.get(CACHE_VARIABLE):
@@ -84,7 +85,7 @@ def usable_fmu_dir(fmu_dir: str | Path | None = None) -> Path:
         else:
             key, value = "the FMU folder", str(folder)
         raise FmuFolderError(key, value, f"a place for the FMU folder {folder}, which cannot be created ({reason}); "
-                             f"--fmu-dir or {FMU_DIR_VARIABLE} chooses another") from None
+                             f"{option} or {FMU_DIR_VARIABLE} chooses another") from None
     return folder
 
 

@@ -44,6 +44,11 @@ def test_a_folder_that_cannot_be_created_is_refused_naming_the_setting(blocked, 
         usable_fmu_dir(given)
 
 
+def test_a_command_names_its_own_option(blocked):
+    with pytest.raises(FmuFolderError, match=rf"invalid setting entry --out = '{blocked}': .+; --out or DTCOSIM_FMU_DIR"):
+        usable_fmu_dir(blocked, "--out")
+
+
 def test_a_file_in_its_place_is_named_as_such(blocked):
     with pytest.raises(FmuFolderError, match=r"cannot be created \(a file is there\)"):
         usable_fmu_dir(blocked)
