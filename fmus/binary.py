@@ -41,8 +41,9 @@ HEADER = "dtcosim_fmu.h"
 #: resource files the binary reads
 PYTHON_FILE = "python.txt"
 CLASS_FILE = "slaveclass.txt"
-#: the folder of the user cache holding the compiled binaries, one folder per source and compiler
+#: the folder of the user cache holding the compiled binaries, one folder per source and compiler, and the file there
 CACHE_FOLDER = "native"
+BINARY_FILE = "dtcosim_fmi2.so"
 #: the FMU member the binary replaces
 BINARY_FOLDER = "binaries/linux64"
 #: one compile at a time in a process (and one at a time across processes: :func:`_one_compiler`)
@@ -103,6 +104,8 @@ def compiled_binary() -> Path:
     ------
     NativeBuildError
         No C compiler, or the compiler failed (its output in the message).
+    OSError
+        The user cache cannot be written (:func:`binary_bytes` then compiles it for the process).
     """
     if not sys.platform.startswith("linux"):
         raise NativeBuildError(f"the dtcosim FMU binary is built for linux64 only (this is {sys.platform})")
@@ -120,6 +123,31 @@ def compiled_binary() -> Path:
         return target if target.is_file() else _compile(cc, target)
 
 
+#: the binary compiled by this process where the user cache cannot be written, by source and compiler
+_compiled_here: dict[str, bytes] = {}
+
+
+def binary_bytes() -> bytes:
+    """The compiled binary's content: :func:`compiled_binary`'s, or where the user cache cannot be written (read-only,
+    missing), compiled once per process in a temporary folder removed at once.
+
+    Raises
+    ------
+    NativeBuildError
+        As :func:`compiled_binary`.
+    """
+    try:
+        return compiled_binary().read_bytes()
+    except OSError:
+        cc = compiler()
+        key = f"{source_digest()}-{cc}"
+        with _COMPILING:
+            if key not in _compiled_here:
+                with tempfile.TemporaryDirectory(prefix="dtcosim-binary-") as tmp:
+                    _compiled_here[key] = _compile(cc, Path(tmp) / BINARY_FILE).read_bytes()
+        return _compiled_here[key]
+
+
 def cached_binary() -> Path | None:
     """Where the binary of these sources, compiled by this machine's compiler, is kept (whether compiled yet or not);
     None without a compiler."""
@@ -129,7 +157,7 @@ def cached_binary() -> Path | None:
 
 def _target(source: bytes, cc: str) -> Path:
     """Where the binary of ``source`` compiled by ``cc`` is cached."""
-    return user_cache_root() / CACHE_FOLDER / hashlib.sha256(source + cc.encode()).hexdigest()[:16] / "dtcosim_fmi2.so"
+    return user_cache_root() / CACHE_FOLDER / hashlib.sha256(source + cc.encode()).hexdigest()[:16] / BINARY_FILE
 
 
 @contextlib.contextmanager
@@ -210,7 +238,7 @@ def start_compile() -> BackgroundCompile | None:
         return None
     try:
         fd = _locked(target.parent, wait=False)
-    except OSError:  # an unwritable cache: the build reports it
+    except OSError:  # an unwritable cache: each build compiles it for its own process (binary_bytes)
         return None
     if fd is None:  # being compiled by another process
         return None
@@ -236,7 +264,7 @@ def native_members(model_identifier: str, class_name: str) -> dict[str, bytes]:
     NativeBuildError
         As :func:`compiled_binary`.
     """
-    binary = compiled_binary().read_bytes()
+    binary = binary_bytes()
     return {f"{BINARY_FOLDER}/{model_identifier}.so": binary,
             f"resources/{PYTHON_FILE}": python_record().encode(),
             f"resources/{CLASS_FILE}": (class_name + "\n").encode()}

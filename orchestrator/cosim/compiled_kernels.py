@@ -30,6 +30,7 @@ from components.compile.aot import (
     missing,
 )
 from components.compile.jit import JIT_OFF_REASON_VARIABLE, JIT_VARIABLE
+from components.compile.user_cache import CACHE_VARIABLE, user_cache_root
 from components.model.kernel import AHEAD_OF_TIME
 
 from .stepping.compiled_loop import aot_loop_kernel
@@ -108,13 +109,33 @@ def ensure_compiled_kernels(report: Callable[[str], None] | None = None, retry: 
     return problem
 
 
+def _unwritable_cache() -> str | None:
+    """Why the compiled kernels' folder of the per-user cache cannot be created (None: it can)."""
+    try:
+        aot_directory().mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        where = f"{exc.filename}: " if exc.filename is not None else ""
+        return f"{where}{exc.strerror or exc}"
+    return None
+
+
 def _in_background(todo: list[AotKernel], report: Callable[[str], None] | None) -> str:
     """The build of ``todo`` in the background (started, or already running), and this process's kernels interpreted."""
     running = background_builder()
     # compiling once this command has ended (or after a while): a short first run has the machine to itself
     pid = running if running is not None else build_in_background(todo, after=os.getpid())
-    if pid is None:  # numba missing or an unwritable cache: numba compiles them just in time, as before
-        return "the kernels could not be compiled in the background"
+    if pid is None:
+        unwritable = _unwritable_cache()
+        if unwritable is None:  # numba missing: the kernels run interpreted (each FMU says so)
+            return "the kernels could not be compiled in the background"
+        # compiled just in time they would be compiled anew by every run (~35 s): interpreted
+        os.environ[JIT_VARIABLE] = "0"
+        os.environ[JIT_OFF_REASON_VARIABLE] = f"the per-user cache cannot be written: {unwritable}"
+        if report:
+            report(f"the per-user cache {user_cache_root()} cannot be written ({unwritable}): the kernels are not "
+                   f"compiled, and runs step them interpreted, which takes longer ({CACHE_VARIABLE} chooses a "
+                   "writable folder)")
+        return f"the per-user cache cannot be written ({unwritable})"
     os.environ[JIT_VARIABLE] = "0"  # compiling them just in time now would cost as much as the build
     os.environ[JIT_OFF_REASON_VARIABLE] = f"being compiled in the background for later runs (pid {pid})"
     if report:

@@ -117,3 +117,21 @@ def test_a_failing_background_compile_leaves_the_error_to_the_caller(tmp_path, m
     assert capfd.readouterr().err == ""  # nothing of the compiling process reaches the user
     with pytest.raises(binary.NativeBuildError, match="broken-cc could not compile .*cannot compile"):
         binary.compiled_binary()
+
+
+def test_where_the_cache_cannot_be_written_each_process_compiles_its_own_and_leaves_nothing(tmp_path, monkeypatch):
+    if binary.compiler() is None:
+        pytest.skip("no C compiler")
+    blocked = tmp_path / "a-file"
+    blocked.write_text("where the cache would be")
+    monkeypatch.setenv("DTCOSIM_CACHE_DIR", str(blocked))
+    monkeypatch.setattr(binary, "_compiled_here", {})
+    monkeypatch.setattr(binary.tempfile, "tempdir", str(tmp_path / "tmp"))
+    (tmp_path / "tmp").mkdir()
+    with pytest.raises(OSError):
+        binary.compiled_binary()
+    assert binary.start_compile() is None
+    first = binary.binary_bytes()
+    assert first[:4] == b"\x7fELF" and binary.binary_bytes() is first  # compiled once per process
+    assert list((tmp_path / "tmp").iterdir()) == []  # its temporary folder is gone
+    assert binary.native_members("Gearbox", "Gearbox")["binaries/linux64/Gearbox.so"] == first

@@ -277,6 +277,31 @@ def test_the_first_run_does_not_wait_for_the_compiler(tmp_path, monkeypatch):
     assert not any(c.isdigit() for c in line.split("log ")[0].replace("4242", "").replace("1 kernel", ""))
 
 
+def test_with_an_unwritable_cache_a_run_compiles_nothing_and_says_why(tmp_path, monkeypatch):
+    """Compiled just in time without a cache to keep them, the kernels would be compiled anew by every run (~35 s):
+    they run interpreted, and the message names the cache and the reason."""
+    import os
+
+    import orchestrator.cosim.compiled_kernels as compiled_kernels
+    from components.compile.jit import JIT_OFF_REASON_VARIABLE, JIT_VARIABLE
+
+    blocked = tmp_path / "a-file"
+    blocked.write_text("where the cache would be")
+    monkeypatch.setenv("DTCOSIM_CACHE_DIR", str(blocked))
+    monkeypatch.setenv(JIT_VARIABLE, "1")  # restored after the test, as the reason below
+    monkeypatch.setenv(JIT_OFF_REASON_VARIABLE, "")
+    fake = AotKernel("_dtcosim_test_kernel_0011223344556677", "components.model.kernel:no_such_provider")
+    monkeypatch.setattr(compiled_kernels, "aot_kernels", lambda: (fake,))
+    said = []
+    problem = compiled_kernels.ensure_compiled_kernels(said.append, background=True)
+    assert problem.startswith("the per-user cache cannot be written (") and os.environ[JIT_VARIABLE] == "0"
+    (line,) = said
+    assert line.startswith(f"the per-user cache {blocked} cannot be written (") and "runs step them interpreted" in line
+    assert "DTCOSIM_CACHE_DIR chooses a writable folder" in line
+    reason = try_compiled(KernelSource("nojit", kernel.WIND.entry.with_name("contact.py")))[1]
+    assert reason.startswith("no module compiled ahead of time yet: the per-user cache cannot be written: ")
+
+
 def test_without_just_in_time_compilation_a_kernel_runs_from_its_module_or_interpreted(tmp_path, monkeypatch):
     from components.compile.jit import JIT_VARIABLE
 
