@@ -68,11 +68,15 @@ def ensure_compiled_kernels(report: Callable[[str], None] | None = None, retry: 
     -------
     str or None
         None when every kernel is there (or ``DTCOSIM_AOT=0``); else why they are not (being built
-        in the background, or could not be built: the run goes on with numba's just-in-time kernels).
+        in the background, or could not be built: the run goes on with numba's just-in-time kernels;
+        the per-user cache cannot be written: the kernels run interpreted, ``DTCOSIM_JIT=0``).
     """
     if not enabled():
         return None
     todo = missing(aot_kernels())
+    unwritable = _unwritable_cache() if todo else None
+    if unwritable is not None:
+        return _interpreted(unwritable, report)
     if not retry:
         earlier = [(k, failed_before(k)) for k in todo]
         earlier = [(k, reason) for k, reason in earlier if reason is not None]
@@ -109,6 +113,19 @@ def ensure_compiled_kernels(report: Callable[[str], None] | None = None, retry: 
     return problem
 
 
+def _interpreted(unwritable: str, report: Callable[[str], None] | None) -> str:
+    """Nothing compiled: without a cache to keep them in, kernels compiled just in time would be compiled anew by
+    every process (~35 s each), so this one and its FMUs and workers run them interpreted."""
+    problem = f"the per-user cache cannot be written: {unwritable}"
+    os.environ[JIT_VARIABLE] = "0"
+    os.environ[JIT_OFF_REASON_VARIABLE] = problem
+    if report:
+        report(f"the per-user cache {user_cache_root()} cannot be written ({unwritable}): the kernels are not "
+               f"compiled, and runs step them interpreted, which takes longer ({CACHE_VARIABLE} chooses a "
+               "writable folder)")
+    return problem
+
+
 def _unwritable_cache() -> str | None:
     """Why the compiled kernels' folder of the per-user cache cannot be created (None: it can)."""
     try:
@@ -124,18 +141,8 @@ def _in_background(todo: list[AotKernel], report: Callable[[str], None] | None) 
     running = background_builder()
     # compiling once this command has ended (or after a while): a short first run has the machine to itself
     pid = running if running is not None else build_in_background(todo, after=os.getpid())
-    if pid is None:
-        unwritable = _unwritable_cache()
-        if unwritable is None:  # numba missing: the kernels run interpreted (each FMU says so)
-            return "the kernels could not be compiled in the background"
-        # compiled just in time they would be compiled anew by every run (~35 s): interpreted
-        os.environ[JIT_VARIABLE] = "0"
-        os.environ[JIT_OFF_REASON_VARIABLE] = f"the per-user cache cannot be written: {unwritable}"
-        if report:
-            report(f"the per-user cache {user_cache_root()} cannot be written ({unwritable}): the kernels are not "
-                   f"compiled, and runs step them interpreted, which takes longer ({CACHE_VARIABLE} chooses a "
-                   "writable folder)")
-        return f"the per-user cache cannot be written ({unwritable})"
+    if pid is None:  # numba missing: the kernels run interpreted (each FMU says so)
+        return "the kernels could not be compiled in the background"
     os.environ[JIT_VARIABLE] = "0"  # compiling them just in time now would cost as much as the build
     os.environ[JIT_OFF_REASON_VARIABLE] = f"being compiled in the background for later runs (pid {pid})"
     if report:

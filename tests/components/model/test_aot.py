@@ -277,8 +277,9 @@ def test_the_first_run_does_not_wait_for_the_compiler(tmp_path, monkeypatch):
     assert not any(c.isdigit() for c in line.split("log ")[0].replace("4242", "").replace("1 kernel", ""))
 
 
-def test_with_an_unwritable_cache_a_run_compiles_nothing_and_says_why(tmp_path, monkeypatch):
-    """Compiled just in time without a cache to keep them, the kernels would be compiled anew by every run (~35 s):
+@pytest.mark.parametrize("background", [True, False], ids=["run", "study or build"])
+def test_with_an_unwritable_cache_nothing_is_compiled_and_the_message_says_why(tmp_path, monkeypatch, background):
+    """Compiled just in time without a cache to keep them, the kernels would be compiled anew by every process (~35 s):
     they run interpreted, and the message names the cache and the reason."""
     import os
 
@@ -293,8 +294,8 @@ def test_with_an_unwritable_cache_a_run_compiles_nothing_and_says_why(tmp_path, 
     fake = AotKernel("_dtcosim_test_kernel_0011223344556677", "components.model.kernel:no_such_provider")
     monkeypatch.setattr(compiled_kernels, "aot_kernels", lambda: (fake,))
     said = []
-    problem = compiled_kernels.ensure_compiled_kernels(said.append, background=True)
-    assert problem.startswith("the per-user cache cannot be written (") and os.environ[JIT_VARIABLE] == "0"
+    problem = compiled_kernels.ensure_compiled_kernels(said.append, background=background)
+    assert problem.startswith("the per-user cache cannot be written: ") and os.environ[JIT_VARIABLE] == "0"
     (line,) = said
     assert line.startswith(f"the per-user cache {blocked} cannot be written (") and "runs step them interpreted" in line
     assert "DTCOSIM_CACHE_DIR chooses a writable folder" in line
