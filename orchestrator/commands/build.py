@@ -52,29 +52,35 @@ def run(args: argparse.Namespace) -> int:
 
     from ..cosim.compiled_kernels import ensure_compiled_kernels
 
-    fmu_dir = usable_fmu_dir(args.out, "--out")  # or an error naming the setting, before the kernels' compile
-    ensure_compiled_kernels(report=print, retry=True)
+    scenario = spec = None  # what to build from, read and checked before anything is created or compiled
     if args.scenario is not None:
         from ..inputs.scenario_file import find_scenario, load_scenario
-        from ..provision.project_fmus import ensure_fmus
 
         scenario = load_scenario(find_scenario(args.scenario))
+    elif args.drivetrain is not None:
+        from components.errors import ParameterError
+
+        from ..inputs.drivetrain_file import find_drivetrain, load_drivetrain_file
+
+        if args.preset != "table6":
+            raise ParameterError("--preset", args.preset, "no preset together with --drivetrain")
+        spec = load_drivetrain_file(find_drivetrain(args.drivetrain))
+        spec.cosim_drivetrain()  # a drivetrain the FMUs can be built from (with its generator)
+    fmu_dir = usable_fmu_dir(args.out, "--out")  # or an error naming the setting, before the kernels' compile
+    ensure_compiled_kernels(report=print, retry=True)
+    if scenario is not None:
+        from ..provision.project_fmus import ensure_fmus
+
         for comp, path in ensure_fmus(scenario, fmu_dir, report=print).items():
             print(f"{path}  ({comp})")
         return 0
-    if args.drivetrain is None:
+    if spec is None:
         for built in build_all(fmu_dir, args.preset, names=args.fmu or PRESET_FMUS, report=print):
             print(f"{built.path}  ({built.name}, preset {args.preset}, build {built.build_id})")
         return 0
-    from components.errors import ParameterError
-
-    from ..inputs.drivetrain_file import find_drivetrain, load_drivetrain_file
     from ..provision.drivetrain_fmus import DRIVETRAIN_FMU_NAMES, build_drivetrain_fmus
     from ..provision.folders import drivetrain_fmu_dir
 
-    if args.preset != "table6":
-        raise ParameterError("--preset", args.preset, "no preset together with --drivetrain")
-    spec = load_drivetrain_file(find_drivetrain(args.drivetrain))
     names = args.fmu or list(DRIVETRAIN_FMU_NAMES)
     out = args.out if args.out is not None else drivetrain_fmu_dir(fmu_dir, spec)
     for built in build_drivetrain_fmus(spec, out, names):
