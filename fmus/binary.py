@@ -22,7 +22,6 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import os
-import shutil
 import signal
 import subprocess
 import sys
@@ -32,6 +31,7 @@ import threading
 from pathlib import Path
 from typing import Iterator
 
+from components.compile.c_compiler import INSTALL_HINT, c_compiler
 from components.compile.user_cache import user_cache_root
 
 #: the C sources of the binary (the FMI functions, an instance, the Python runtime) and their header
@@ -80,12 +80,8 @@ def python_record() -> str:
 
 
 def compiler() -> str | None:
-    """A C compiler: ``$CC``, then Python's own (sysconfig ``CC``), then cc, gcc, clang."""
-    for candidate in (os.environ.get("CC"), (sysconfig.get_config_var("CC") or "").split(" ")[0], "cc", "gcc",
-                      "clang"):
-        if candidate and shutil.which(candidate):
-            return shutil.which(candidate)
-    return None
+    """A C compiler (:func:`components.compile.c_compiler.c_compiler`)."""
+    return c_compiler()
 
 
 def source_digest() -> str:
@@ -112,8 +108,7 @@ def compiled_binary() -> Path:
     source = _source_bytes()
     cc = compiler()
     if cc is None:
-        raise NativeBuildError("no C compiler (cc, gcc or clang) to build the FMU binary: install one "
-                               "(Debian: apt install gcc), or the FMU keeps pythonfmu's binary")
+        raise NativeBuildError(f"no C compiler (cc, gcc or clang) to build the FMU binary: {INSTALL_HINT}")
     target = _target(source, cc)
     if target.is_file():
         return target

@@ -460,7 +460,8 @@ def _build_archive(name, kind, model, origin, source, part_dir: Path, resources,
     try:
         members.update(binary.native_members(name, name))
     except binary.NativeBuildError as exc:  # the FMU keeps pythonfmu's binary: C hosts must preload libpython
-        warnings.warn(f"{name}.fmu keeps pythonfmu's linux64 binary: {exc}", stacklevel=2)
+        warnings.warn(f"{name}.fmu keeps pythonfmu's linux64 binary, which C hosts must preload libpython for: {exc}",
+                      stacklevel=2)
     members.update(bytecode.members(fmu_path))
     model_description.rewrite_archive(fmu_path, members)
     if validate:

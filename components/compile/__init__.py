@@ -9,6 +9,7 @@ sources      :class:`~components.compile.sources.KernelSource`: a kernel's files
 jit          the sources compiled by numba once per process (any copy of them shares it)
 numba_cache  numba's disk cache keyed by the sources, in the per-user cache
 aot          ahead-of-time extension modules (numba.pycc): compiled code without numba
+c_compiler   the machine's C compiler (the ahead-of-time build and the FMU binary need one)
 choice       which form runs (``$DTCOSIM_KERNEL``: auto, numpy = interpreted, compiled)
 user_cache   the per-user cache folder
 

@@ -44,6 +44,7 @@ from pathlib import Path
 from types import ModuleType
 from typing import Callable, Iterator, Sequence
 
+from .c_compiler import INSTALL_HINT, c_compiler
 from .numba_cache import user_cache_root
 from .sources import KernelSource
 
@@ -204,6 +205,8 @@ def build_module(kernel: AotKernel, directory: Path | None = None) -> Path:
     """
     from numba.pycc import CC  # optional requirement: only the builder needs numba
 
+    if c_compiler() is None:  # numba's own error is three lines about numpy.distutils and conda
+        raise RuntimeError(f"no C compiler (cc, gcc or clang) for numba's ahead-of-time build: {INSTALL_HINT}")
     jit = _jit_module_of(kernel.provider)
     directory = Path(directory or aot_directory())
     directory.mkdir(parents=True, exist_ok=True)
@@ -251,6 +254,12 @@ def failed_before(kernel: AotKernel) -> str | None:
         return None
 
 
+def _one_line(problem: str) -> str:
+    """The first line of a reason (what every message that quotes it shows in one line)."""
+    lines = [line.strip() for line in problem.strip().splitlines() if line.strip()]
+    return lines[0] if lines else "unknown reason"
+
+
 def _remember(kernel: AotKernel, problem: str | None) -> None:
     """Record (or, on success, clear) the failure of a build; best effort (a read-only cache keeps nothing)."""
     path = failure_file(kernel)
@@ -259,7 +268,7 @@ def _remember(kernel: AotKernel, problem: str | None) -> None:
             path.unlink(missing_ok=True)
         else:
             path.parent.mkdir(parents=True, exist_ok=True)
-            path.write_text(problem + "\n", encoding="utf-8")
+            path.write_text(_one_line(problem) + "\n", encoding="utf-8")
     except OSError:
         pass
 

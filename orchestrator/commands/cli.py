@@ -17,7 +17,8 @@ import importlib
 import os
 import signal
 import sys
-from collections.abc import Iterator, Sequence
+import warnings
+from collections.abc import Callable, Iterator, Sequence
 
 from components.errors import DtcosimError
 
@@ -105,6 +106,22 @@ def _command_signals() -> Iterator[None]:
         restore(previous)
 
 
+@contextlib.contextmanager
+def _warnings_as_lines(prog: Callable[[], str]) -> Iterator[None]:
+    """Python warnings that reach the user (a build's, a library's) as ``dtcosim run: warning: ...`` lines, not as
+    Python's ``file:line: UserWarning: ...`` with its source line, for the ``with`` block."""
+    previous = warnings.showwarning
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        print(f"{prog()}: warning: {message}", file=sys.stderr if file is None else file)
+
+    warnings.showwarning = show
+    try:
+        yield
+    finally:
+        warnings.showwarning = previous
+
+
 def _prog(args: argparse.Namespace) -> str:
     """``dtcosim run``: who speaks in an error line."""
     return f"dtcosim {args.command}" if args.command else "dtcosim"
@@ -120,8 +137,8 @@ def main(argv: list[str] | None = None) -> int:
     is one line naming the file, an unexpected exception one line saying it is a bug
     (:data:`DEBUG_VARIABLE` shows its traceback); both exit 1.
     """
-    with _command_signals():
-        args = argparse.Namespace(command=None)
+    args = argparse.Namespace(command=None)
+    with _command_signals(), _warnings_as_lines(lambda: _prog(args)):
         argv = sys.argv[1:] if argv is None else list(argv)
         try:
             parser = build_parser(argv)

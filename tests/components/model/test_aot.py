@@ -196,6 +196,23 @@ def test_a_failing_build_says_why_in_one_line_and_is_not_retried_on_every_run(tm
         compiled_kernels.ensure_compiled_kernels(said.append, retry=True)  # dtcosim build tries again
 
 
+def test_without_a_c_compiler_the_build_says_so_in_one_line(tmp_path, monkeypatch):
+    pytest.importorskip("numba")
+    monkeypatch.setenv("DTCOSIM_CACHE_DIR", str(tmp_path))
+    monkeypatch.setattr(aot, "c_compiler", lambda: None)
+    fake = AotKernel("_dtcosim_test_kernel_0123456789abcdef", "components.model.kernel:no_such_provider")
+    with pytest.raises(RuntimeError, match=r"^no C compiler \(cc, gcc or clang\) for numba's ahead-of-time build: "
+                                           r"install one \(Debian: apt install gcc\)$"):
+        aot.build_module(fake)
+
+
+def test_a_reason_of_several_lines_is_remembered_as_its_first(tmp_path, monkeypatch):
+    monkeypatch.setenv("DTCOSIM_CACHE_DIR", str(tmp_path))
+    fake = AotKernel("_dtcosim_test_kernel_0123456789abcdef", "components.model.kernel:no_such_provider")
+    aot._remember(fake, "RuntimeError: numba's compiler is missing. If using conda try:\n\n#> conda install gcc\n")
+    assert aot.failed_before(fake) == "RuntimeError: numba's compiler is missing. If using conda try:"
+
+
 def test_a_background_build_is_one_detached_builder_that_records_what_it_did(tmp_path, monkeypatch):
     """The builder of a kernel that cannot be built (a provider that does not exist) records why and removes its mark;
     a second request while it runs gets its pid instead of a second builder."""

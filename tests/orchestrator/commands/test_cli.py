@@ -97,3 +97,24 @@ def test_version_names_dtcosim_and_what_results_depend_on(capsys):
     out = capsys.readouterr().out
     assert out.startswith(f"dtcosim {__version__} (python ")
     assert all(f"{name} " in out for name in ("numpy", "scipy", "fmpy", "pythonfmu"))
+
+
+def test_a_python_warning_reaches_the_user_as_one_line_of_the_command(tmp_path, monkeypatch, capsys):
+    import warnings
+
+    from orchestrator.commands import cache
+    from orchestrator.commands.cli import main
+
+    def warns(root=None):
+        warnings.warn("Gearbox.fmu keeps pythonfmu's linux64 binary: no C compiler", stacklevel=2)
+        return []
+
+    monkeypatch.setenv("DTCOSIM_CACHE_DIR", str(tmp_path))
+    monkeypatch.setattr(cache, "cache_entries", warns)
+    shown = warnings.showwarning
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")
+        assert main(["cache"]) == 0
+        assert warnings.showwarning is shown  # restored after the command
+    err = capsys.readouterr().err
+    assert err == "dtcosim cache: warning: Gearbox.fmu keeps pythonfmu's linux64 binary: no C compiler\n"
