@@ -264,17 +264,26 @@ def test_a_dead_builders_mark_is_cleared(tmp_path, monkeypatch):
     assert aot.background_builder() is None and not lock.exists()
 
 
-def test_the_first_run_does_not_wait_for_the_compiler(tmp_path, monkeypatch):
-    """ensure_compiled_kernels(background=True): the build starts detached, this process compiles nothing just in
-    time (DTCOSIM_JIT=0: its kernels run interpreted) and the message says what happens, without a duration."""
+def _one_missing_kernel(monkeypatch, cache):
+    """``orchestrator.cosim.compiled_kernels`` with one kernel to build (a fake) and the cache at ``cache``; the JIT
+    switch and its reason restored after the test."""
     import orchestrator.cosim.compiled_kernels as compiled_kernels
     from components.compile.jit import JIT_OFF_REASON_VARIABLE, JIT_VARIABLE
 
-    monkeypatch.setenv("DTCOSIM_CACHE_DIR", str(tmp_path))
-    monkeypatch.setenv(JIT_VARIABLE, "1")  # restored after the test, as the reason below
+    monkeypatch.setenv("DTCOSIM_CACHE_DIR", str(cache))
+    monkeypatch.setenv(JIT_VARIABLE, "1")
     monkeypatch.setenv(JIT_OFF_REASON_VARIABLE, "")
     fake = AotKernel("_dtcosim_test_kernel_0011223344556677", "components.model.kernel:no_such_provider")
     monkeypatch.setattr(compiled_kernels, "aot_kernels", lambda: (fake,))
+    return compiled_kernels, fake
+
+
+def test_the_first_run_does_not_wait_for_the_compiler(tmp_path, monkeypatch):
+    """ensure_compiled_kernels(background=True): the build starts detached, this process compiles nothing just in
+    time (DTCOSIM_JIT=0: its kernels run interpreted) and the message says what happens, without a duration."""
+    from components.compile.jit import JIT_VARIABLE
+
+    compiled_kernels, fake = _one_missing_kernel(monkeypatch, tmp_path)
     import os
 
     started = []
@@ -300,16 +309,11 @@ def test_with_an_unwritable_cache_nothing_is_compiled_and_the_message_says_why(t
     they run interpreted, and the message names the cache and the reason."""
     import os
 
-    import orchestrator.cosim.compiled_kernels as compiled_kernels
-    from components.compile.jit import JIT_OFF_REASON_VARIABLE, JIT_VARIABLE
+    from components.compile.jit import JIT_VARIABLE
 
     blocked = tmp_path / "a-file"
     blocked.write_text("where the cache would be")
-    monkeypatch.setenv("DTCOSIM_CACHE_DIR", str(blocked))
-    monkeypatch.setenv(JIT_VARIABLE, "1")  # restored after the test, as the reason below
-    monkeypatch.setenv(JIT_OFF_REASON_VARIABLE, "")
-    fake = AotKernel("_dtcosim_test_kernel_0011223344556677", "components.model.kernel:no_such_provider")
-    monkeypatch.setattr(compiled_kernels, "aot_kernels", lambda: (fake,))
+    compiled_kernels, _ = _one_missing_kernel(monkeypatch, blocked)
     said = []
     problem = compiled_kernels.ensure_compiled_kernels(said.append, background=background)
     assert problem.startswith("the per-user cache cannot be written: ") and os.environ[JIT_VARIABLE] == "0"
