@@ -125,14 +125,11 @@ def unpacked(path: Path, sha256: str, extract, fallback: bool = True) -> Path | 
     except BaseException:
         shutil.rmtree(partial, ignore_errors=True)
         raise
-    try:  # held across the rename: the folder is never unheld under its name
-        descriptor = _lock(partial, exclusive=False) if len(_held) < MAX_HELD else None
-    except OSError:
-        descriptor = None
+    _hold(partial)  # held across the rename: the folder is never unheld under its name
     try:
         os.rename(partial, final)
     except OSError:  # another process renamed its copy first (or the cache refuses): use that one, or our own
-        _release(descriptor)
+        _release(_held.pop(partial, None))
         if not final.is_dir() or not _hold(final):
             if not fallback:
                 shutil.rmtree(partial, ignore_errors=True)
@@ -140,7 +137,7 @@ def unpacked(path: Path, sha256: str, extract, fallback: bool = True) -> Path | 
             return _keep_temporarily(partial)
         shutil.rmtree(partial, ignore_errors=True)
     else:
-        _held[final] = descriptor
+        _held[final] = _held.pop(partial, None)
     _prune(final.parent)
     return final
 
