@@ -65,11 +65,10 @@ def ensure_fmus(scenario: Scenario, fmu_dir: str | Path | None = None, build: bo
         The FMU folder cannot be created (where it was chosen and why).
     """
     managed = fmu_dir is None  # the project's own FMU folder: what is stale there is rebuilt, not only reported
-    if build:  # created, or an error naming where it was chosen
-        fmu_dir = usable_fmu_dir(fmu_dir)
-    else:
+    if not build:
         fmu_dir = default_fmu_dir() if fmu_dir is None else Path(fmu_dir)
-    if build:
+    else:
+        fmu_dir = usable_fmu_dir(fmu_dir)  # created, or an error naming where it was chosen
         # the kernels the FMUs and the master step, once per machine
         ensure_compiled_kernels(report, background=kernels_in_background)
         wanted: dict[str, tuple[DrivetrainSpec, list[str]]] = {}
