@@ -15,16 +15,27 @@ import sys
 import sysconfig
 import tempfile
 import venv
-from importlib import metadata
 from pathlib import Path
 
 import pytest
 
+from components.compile.user_cache import CACHE_VARIABLE, user_cache_root
 from tests.helpers.scenarios import TOY_SCENARIO, dtcosim, write_scenario
 
 
-#: the folders of the per-user cache a test session shares with the user's (compiled code, keyed by its sources)
-SHARED_CACHE_FOLDERS = ("aot", "native")
+def _compiled_code_folders() -> list[str]:
+    """The folders of the per-user cache holding compiled code, keyed by its sources: the kernels compiled ahead of
+    time, the FMU binaries and numba's machine code (where numba is installed)."""
+    from components.compile.aot import aot_directory
+    from components.compile.numba_cache import cache_folder
+    from fmus.binary import CACHE_FOLDER
+
+    names = [aot_directory().parent.name, CACHE_FOLDER]
+    try:
+        names.append(cache_folder().name)
+    except ImportError:
+        pass
+    return names
 
 
 def pytest_configure(config):
@@ -32,23 +43,17 @@ def pytest_configure(config):
     of the user's: the tests build and unpack hundreds of FMUs (~2 GB unpacked) that are no one's after the
     session. Where ``DTCOSIM_CACHE_DIR`` is set already (a worker of a parallel run inherits the controller's),
     everything goes there."""
-    if os.environ.get("DTCOSIM_CACHE_DIR"):
+    if os.environ.get(CACHE_VARIABLE):
         return
-    from components.compile.user_cache import user_cache_root
-
     users = user_cache_root()
     session = Path(tempfile.mkdtemp(prefix="dtcosim-test-cache-"))
-    try:
-        numba = [f"numba-{metadata.version('numba')}"]
-    except metadata.PackageNotFoundError:
-        numba = []
-    for name in (*SHARED_CACHE_FOLDERS, *numba):
+    for name in _compiled_code_folders():
         try:
             (users / name).mkdir(parents=True, exist_ok=True)
         except OSError:  # a read-only home: the session compiles into its own cache
             continue
         (session / name).symlink_to(users / name, target_is_directory=True)
-    os.environ["DTCOSIM_CACHE_DIR"] = str(session)
+    os.environ[CACHE_VARIABLE] = str(session)
     config.add_cleanup(lambda: shutil.rmtree(session, ignore_errors=True))
 
 

@@ -43,15 +43,20 @@ def source_hash(path: str | os.PathLike) -> str:
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
 
 
+def cache_folder() -> Path:
+    """``<user cache>/numba-<numba version>``: where this numba keeps every kernel's machine code (imports numba)."""
+    import numba  # optional requirement: the compiled gearbox kernel
+
+    return user_cache_root() / f"numba-{numba.__version__}"
+
+
 def kernel_cache_dir(source_path: str | os.PathLike, module_name: str) -> Path:
     """Cache directory of the kernel module ``module_name`` compiled from ``source_path``.
 
     Keyed by numba version, code hash and module name.
     """
-    import numba  # optional requirement: the compiled gearbox kernel
-
     safe = "".join(c if c.isalnum() or c in "._-" else "_" for c in module_name)
-    return user_cache_root() / f"numba-{numba.__version__}" / source_hash(source_path)[:16] / safe
+    return cache_folder() / source_hash(source_path)[:16] / safe
 
 
 def enable_stable_cache(dispatchers, source_path: str | os.PathLike, module_name: str) -> bool:

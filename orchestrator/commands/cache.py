@@ -22,7 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from components.compile.aot import aot_directory, build_log
-from components.compile.numba_cache import source_hash
+from components.compile.numba_cache import cache_folder, source_hash
 from components.compile.user_cache import user_cache_root
 from components.model.kernel import KERNELS
 from fmus.binary import CACHE_FOLDER as NATIVE_FOLDER
@@ -54,11 +54,11 @@ def _size(path: Path) -> int:
 def _jit_keys() -> tuple[str | None, set[str]]:
     """numba's version directory name and the source hashes of the kernels its cache is keyed by."""
     try:
-        import numba  # optional requirement: only to name the current just-in-time cache
+        folder = cache_folder()  # numba is an optional requirement: only to name the current just-in-time cache
     except ImportError:
         return None, set()
     files = {f for k in KERNELS for f in k.files} | {k.source for k in aot_kernels() if k.source is not None}
-    return f"numba-{numba.__version__}", {source_hash(f)[:16] for f in files}
+    return folder.name, {source_hash(f)[:16] for f in files}
 
 
 def cache_entries(root: Path | None = None) -> list[CacheEntry]:
