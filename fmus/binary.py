@@ -135,7 +135,7 @@ def binary_bytes() -> bytes:
         return compiled_binary().read_bytes()
     except OSError:
         cc = compiler()
-        key = f"{source_digest()}-{cc}"
+        key = _target(_source_bytes(), cc).parent.name  # the cache's key of the source and the compiler
         with _COMPILING:
             if key not in _compiled_here:
                 with tempfile.TemporaryDirectory(prefix="dtcosim-binary-") as tmp:
