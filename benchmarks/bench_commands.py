@@ -136,6 +136,7 @@ def first_run(repeat: int, baseline: str | None = None, keep_bytecode: bool = Fa
         other = f"first run of {baseline}, empty caches"
         if baseline:
             times[other] = []
+
         def fresh_sources(i: int, of_baseline: bool) -> Path | None:
             """The sources of one first run: a new copy without bytecode (None: this tree as it is)."""
             if keep_bytecode:
