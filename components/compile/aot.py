@@ -45,7 +45,7 @@ from types import ModuleType
 from typing import Callable, Iterator, Sequence
 
 from .c_compiler import INSTALL_HINT, c_compiler
-from .numba_cache import user_cache_root
+from .numba_cache import user_cache_root, warm_mark
 from .sources import KernelSource
 
 #: prefix of a provider that names a kernel source (:meth:`AotKernel.of`)
@@ -225,6 +225,39 @@ def build_module(kernel: AotKernel, directory: Path | None = None) -> Path:
     return target
 
 
+def warm_just_in_time(kernel: AotKernel) -> None:
+    """Where the kernel has no extension module (no C compiler, say), compile its ``AOT_EXPORTS`` just in time into
+    numba's disk cache (:mod:`components.compile.numba_cache`) and mark it warm (:func:`is_warm`): runs then load the
+    machine code instead of compiling it themselves (~35 s of CPU for the gearbox kernel, in every process without
+    the cache).
+
+    The entry points are compiled for their exports' argument types: what a run calls them with, so a run finds
+    every function in the cache (numba keys a function compiled with a declared return type apart).
+
+    Raises
+    ------
+    RuntimeError
+        Where numba cannot keep the machine code on disk (nothing would be warm).
+    """
+    from numba.core.sigutils import normalize_signature  # optional requirement: only the builder needs numba
+
+    jit = _jit_module_of(kernel.provider)
+    if not getattr(jit, "DISK_CACHE", False):
+        raise RuntimeError(f"numba cannot keep the just-in-time kernel {kernel.shared} in its disk cache")
+    for entry, signature in jit.AOT_EXPORTS.items():
+        arguments, _ = normalize_signature(signature)
+        getattr(jit, entry).compile(tuple(arguments))
+    mark = warm_mark(kernel.shared)
+    mark.parent.mkdir(parents=True, exist_ok=True)
+    mark.write_text(f"{kernel.provider}\n", encoding="utf-8")
+
+
+def is_warm(kernel: AotKernel) -> bool:
+    """Whether numba's cache holds the kernel's entry points compiled just in time (:func:`warm_just_in_time`)."""
+    mark = warm_mark(kernel.shared)
+    return mark is not None and mark.is_file()
+
+
 def _jit_module_of(provider: str) -> ModuleType:
     """The just-in-time module a provider string names (see :class:`AotKernel`)."""
     if provider.startswith(_KERNEL_PROVIDER):
@@ -273,11 +306,13 @@ def _remember(kernel: AotKernel, problem: str | None) -> None:
         pass
 
 
-def build_in_subprocess(kernels: Sequence[AotKernel], timeout_s: float = 600.0) -> str | None:
+def build_in_subprocess(kernels: Sequence[AotKernel], timeout_s: float = 600.0,
+                        just_in_time: bool = False) -> str | None:
     """Build ``kernels`` in child Python processes, one per kernel, concurrently; None on success, else why not.
 
     The reason is one line (the first failing kernel's last line of output); each kernel's
-    outcome is remembered (:func:`failed_before`).
+    outcome is remembered (:func:`failed_before`). ``just_in_time``: :func:`warm_just_in_time` instead (nothing
+    remembered: a kernel left cold is compiled by the runs that need it).
     """
     if not kernels:
         return None
@@ -287,7 +322,8 @@ def build_in_subprocess(kernels: Sequence[AotKernel], timeout_s: float = 600.0) 
     children = []
     try:
         for k in kernels:
-            children.append(subprocess.Popen([sys.executable, "-m", __name__, f"{k.shared}={k.provider}"],
+            mode = ["--just-in-time"] if just_in_time else []
+            children.append(subprocess.Popen([sys.executable, "-m", __name__, *mode, f"{k.shared}={k.provider}"],
                                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env))
         problems = []
         for kernel, child in zip(kernels, children):
@@ -297,7 +333,8 @@ def build_in_subprocess(kernels: Sequence[AotKernel], timeout_s: float = 600.0) 
                 lines = [line for line in (err or out).strip().splitlines() if line.strip()]
                 problem = lines[-1] if lines else f"the builder exited with status {child.returncode}"
                 problems.append(problem)
-            _remember(kernel, problem)
+            if not just_in_time:
+                _remember(kernel, problem)
     except (OSError, subprocess.TimeoutExpired) as exc:
         for child in children:
             child.kill()
@@ -352,7 +389,9 @@ def build_in_background(kernels: Sequence[AotKernel], after: int | None = None) 
     writes :func:`build_log`. With ``after`` (a pid: the command that starts it) it takes the lock
     at once but compiles only once that process has ended, or after :data:`WAIT_FOR_STARTER_S`:
     a short first run does not share the machine with numba's compiler (on 2 cores it took
-    0.4-0.6 s longer). None where nothing can be started (numba missing, an unwritable cache).
+    0.4-0.6 s longer). A kernel it cannot build, or whose build failed before, it compiles just in time
+    into numba's cache instead (:func:`warm_just_in_time`). None where nothing can be started (numba
+    missing, an unwritable cache).
     """
     if not kernels or importlib.util.find_spec("numba") is None:
         return None
@@ -410,7 +449,8 @@ def _take(lock: Path) -> bool:
 
 
 def _background(lock: Path, items: Sequence[str]) -> int:
-    """The detached builder: each kernel in turn, remembering failures, then its mark removed."""
+    """The detached builder: each kernel in turn, remembering failures (then compiling that kernel just in time into
+    numba's cache), then its mark removed."""
     import time
 
     if not _take(lock):
@@ -427,21 +467,39 @@ def _background(lock: Path, items: Sequence[str]) -> int:
         for item in items:
             shared, _, provider = item.partition("=")
             kernel = AotKernel(shared, provider)
-            if kernel.file().is_file() or failed_before(kernel) is not None:  # built, or failed, by a builder before
+            if kernel.file().is_file():  # built by a builder before
                 continue
             t0 = time.perf_counter()
-            try:
-                path = build_module(kernel)
-            except Exception as exc:  # noqa: BLE001 - recorded: later runs do not retry it each time
-                _remember(kernel, f"{type(exc).__name__}: {exc}")
-                print(f"{kernel.module_name}: not built ({type(exc).__name__}: {exc})", flush=True)
-                continue
-            _remember(kernel, None)
-            print(f"{path}: built in {time.perf_counter() - t0:.1f} s", flush=True)
+            if failed_before(kernel) is None:
+                try:
+                    path = build_module(kernel)
+                except Exception as exc:  # noqa: BLE001 - recorded: later runs do not retry it each time
+                    _remember(kernel, f"{type(exc).__name__}: {exc}")
+                    print(f"{kernel.module_name}: not built ({type(exc).__name__}: {exc})", flush=True)
+                else:
+                    _remember(kernel, None)
+                    print(f"{path}: built in {time.perf_counter() - t0:.1f} s", flush=True)
+                    continue
+            if not is_warm(kernel):  # no module: numba's cache instead, so that no run compiles it just in time
+                _warm(kernel)
         print(f"done in {time.perf_counter() - start:.1f} s (process CPU {time.process_time():.1f} s)", flush=True)
     finally:
         lock.unlink(missing_ok=True)
     return 0
+
+
+def _warm(kernel: AotKernel) -> None:
+    """:func:`warm_just_in_time`, saying in the log what came of it."""
+    import time
+
+    t0 = time.perf_counter()
+    try:
+        warm_just_in_time(kernel)
+    except Exception as exc:  # noqa: BLE001 - the runs compile it just in time themselves, as before
+        print(f"{kernel.shared}: not compiled just in time ({type(exc).__name__}: {_one_line(str(exc))})", flush=True)
+    else:
+        print(f"{kernel.shared}: compiled just in time into numba's cache in {time.perf_counter() - t0:.1f} s",
+              flush=True)
 
 
 def _wait_for_exit(pid: int, limit_s: float) -> float:
@@ -455,17 +513,24 @@ def _wait_for_exit(pid: int, limit_s: float) -> float:
 
 
 def main(argv: Sequence[str]) -> int:
-    """``python -m components.compile.aot [--background LOCK [--after PID]] SHARED=PROVIDER ...``: build each kernel.
+    """``python -m components.compile.aot [--background LOCK [--after PID] | --just-in-time] SHARED=PROVIDER ...``:
+    build each kernel.
 
     Providers: see :class:`AotKernel`. ``--background``: the detached builder of
-    :func:`build_in_background`, which removes ``LOCK`` when it ends (``--after``: it compiles once ``PID`` ended).
+    :func:`build_in_background`, which removes ``LOCK`` when it ends (``--after``: it compiles once ``PID`` ended);
+    a kernel it cannot build (or that failed before) it compiles just in time into numba's cache
+    (:func:`warm_just_in_time`). ``--just-in-time``: only that.
     """
     if argv[:1] == ["--background"]:
         return _background(Path(argv[1]), argv[2:])
-    for item in argv:
+    just_in_time = argv[:1] == ["--just-in-time"]
+    for item in argv[1:] if just_in_time else argv:
         shared, _, provider = item.partition("=")
-        path = build_module(AotKernel(shared, provider))
-        print(path)
+        kernel = AotKernel(shared, provider)
+        if just_in_time:
+            warm_just_in_time(kernel)
+        else:
+            print(build_module(kernel))
     return 0
 
 

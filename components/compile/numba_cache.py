@@ -33,6 +33,7 @@ from __future__ import annotations
 import hashlib
 import importlib
 import os
+import sys
 from pathlib import Path
 
 from .user_cache import user_cache_root
@@ -43,11 +44,33 @@ def source_hash(path: str | os.PathLike) -> str:
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
 
 
-def cache_folder() -> Path:
-    """``<user cache>/numba-<numba version>``: where this numba keeps every kernel's machine code (imports numba)."""
-    import numba  # optional requirement: the compiled gearbox kernel
+def cache_folder(version: str | None = None) -> Path:
+    """``<user cache>/numba-<numba version>``: where numba ``version`` (default: the installed one, imported) keeps
+    every kernel's machine code."""
+    if version is None:
+        import numba  # optional requirement: the compiled gearbox kernel
 
-    return user_cache_root() / f"numba-{numba.__version__}"
+        version = numba.__version__
+    return user_cache_root() / f"numba-{version}"
+
+
+#: the folder of :func:`cache_folder` that holds the marks of :func:`warm_mark`
+WARM_FOLDER = "warm"
+
+
+def warm_mark(shared: str) -> Path | None:
+    """The file that says numba's cache holds kernel ``shared``'s entry points for this Python, compiled just in time
+    ahead of its runs (:func:`components.compile.aot.warm_just_in_time`); None where numba is not installed.
+
+    Inside the numba version's folder, so that removing that folder removes the mark; found without importing numba.
+    """
+    from importlib import metadata
+
+    try:
+        version = metadata.version("numba")
+    except metadata.PackageNotFoundError:
+        return None
+    return cache_folder(version) / WARM_FOLDER / f"{shared}.{sys.implementation.cache_tag}"
 
 
 def kernel_cache_dir(source_path: str | os.PathLike, module_name: str) -> Path:
@@ -80,6 +103,7 @@ def enable_stable_cache(dispatchers, source_path: str | os.PathLike, module_name
         class _StableLocator(base_locator):
             def __init__(self, py_func, py_file):
                 self._lineno = py_func.__code__.co_firstlineno
+                self._py_file = py_file  # numba names it in its warning about a function it cannot cache
 
             def get_cache_path(self):
                 return str(directory)

@@ -6,7 +6,8 @@ kernel version: :mod:`components.compile.aot`, with the log of their last build)
 just-in-time machine code (``numba-<numba version>/<source hash>/``), the FMU binary
 (``native/<source and compiler hash>/``: :mod:`fmus.binary`) and the FMUs runs have unpacked
 (``unpacked/<content hash>-<Python tag>/``: :mod:`orchestrator.cosim.unpacked_fmus`). Every new version of a
-kernel's or the binary's sources adds entries and nothing removes the old ones: ``--prune`` deletes every entry
+kernel's or the binary's sources adds entries (with, for each, the reason its ahead-of-time build failed, or the
+mark that numba's cache holds it compiled just in time) and nothing removes the old ones: ``--prune`` deletes every entry
 that the installed dtcosim, Python, numpy, numba and C compiler would not load (FMUs carry their own compiled
 modules and binary, so an older FMU keeps running; a later run rebuilds what it needs), and every unpacked
 FMU that is not one of the FMU folder's (:func:`orchestrator.provision.folders.default_fmu_dir`;
@@ -21,8 +22,8 @@ import shutil
 from dataclasses import dataclass
 from pathlib import Path
 
-from components.compile.aot import aot_directory, build_log
-from components.compile.numba_cache import cache_folder, source_hash
+from components.compile.aot import aot_directory, build_log, failure_file
+from components.compile.numba_cache import WARM_FOLDER, cache_folder, source_hash, warm_mark
 from components.compile.user_cache import user_cache_root
 from components.model.kernel import KERNELS
 from fmus.binary import CACHE_FOLDER as NATIVE_FOLDER
@@ -67,16 +68,19 @@ def cache_entries(root: Path | None = None) -> list[CacheEntry]:
     root = Path(root or user_cache_root())
     entries = []
     current_aot_dir = aot_directory()
-    current_files = {k.file().name for k in aot_kernels()}
+    current_files = {k.file().name for k in aot_kernels()} | {failure_file(k).name for k in aot_kernels()}
     for folder in sorted((root / "aot").glob("*")):
         for path in sorted(p for p in folder.iterdir() if not p.name.startswith(".")):  # a build's own files
             current = folder == current_aot_dir and (path.name in current_files or path == build_log())
             entries.append(CacheEntry(path, _size(path), current))
     numba_dir, hashes = _jit_keys()
+    marks = {warm_mark(k.shared) for k in aot_kernels()}
     for folder in sorted(root.glob("numba-*")):
-        for kernel_dir in sorted(p for p in folder.iterdir() if p.is_dir()):
+        for kernel_dir in sorted(p for p in folder.iterdir() if p.is_dir() and p.name != WARM_FOLDER):
             current = folder.name == numba_dir and kernel_dir.name in hashes
             entries.append(CacheEntry(kernel_dir, _size(kernel_dir), current))
+        for mark in sorted((folder / WARM_FOLDER).glob("*")):  # what the runs of a machine without C compiler load
+            entries.append(CacheEntry(mark, _size(mark), mark in marks))
     binary = cached_binary()
     for folder in sorted(p for p in (root / NATIVE_FOLDER).glob("*") if p.is_dir()):
         entries.append(CacheEntry(folder, _size(folder), binary is not None and folder == binary.parent))
@@ -116,7 +120,8 @@ def run(args: argparse.Namespace) -> int:
                 shutil.rmtree(e.path, ignore_errors=True)
             else:
                 e.path.unlink(missing_ok=True)
-        for folder in [*(root / "aot").glob("*"), *root.glob("numba-*"), root / NATIVE_FOLDER, root / UNPACKED_FOLDER]:
+        for folder in [*(root / "aot").glob("*"), *root.glob(f"numba-*/{WARM_FOLDER}"), *root.glob("numba-*"),
+                       root / NATIVE_FOLDER, root / UNPACKED_FOLDER]:
             if folder.is_dir() and not any(folder.iterdir()):
                 folder.rmdir()
         print(f"pruned {len(stale)} stale entries")

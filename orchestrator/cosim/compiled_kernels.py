@@ -7,12 +7,14 @@ and llvmlite (~75 MB less resident memory, ~0.5 s less start-up: ``bench_long_ru
 ``dtcosim run`` (whenever it may build FMUs) starts their build in the background and steps
 this run's kernels interpreted meanwhile (compiling them just in time would cost as much as
 the build), so that the first run of a machine does not wait for a compiler. Where they
-cannot be built (no numba, no C compiler) it says so once and the kernels run just in time,
-as before.
+cannot be built (no C compiler) numba compiles them just in time into its cache instead, in the
+same way (in the background for a run, meanwhile interpreted; waited for by builds and studies),
+and later runs load its machine code; without numba the kernels run interpreted.
 """
 
 from __future__ import annotations
 
+import importlib.util
 import os
 import time
 from typing import Callable
@@ -27,9 +29,10 @@ from components.compile.aot import (
     build_log,
     enabled,
     failed_before,
+    is_warm,
     missing,
 )
-from components.compile.jit import JIT_OFF_REASON_VARIABLE, JIT_VARIABLE
+from components.compile.jit import JIT_OFF_REASON_VARIABLE, JIT_VARIABLE, jit_enabled
 from components.compile.user_cache import CACHE_VARIABLE, user_cache_root
 from components.model.kernel import AHEAD_OF_TIME
 
@@ -49,7 +52,9 @@ def ensure_compiled_kernels(report: Callable[[str], None] | None = None, retry: 
     """Build the kernels missing in :func:`~components.compile.aot.aot_directory`.
 
     A kernel version whose build failed on this machine before (no C compiler, say) is not
-    retried on every run, only with ``retry`` (``dtcosim build``) or once its sources change.
+    retried on every run, only with ``retry`` (``dtcosim build``) or once its sources change;
+    numba compiles it just in time into its cache instead, once, in the same way as the build
+    (in the background, or now).
 
     Parameters
     ----------
@@ -68,8 +73,9 @@ def ensure_compiled_kernels(report: Callable[[str], None] | None = None, retry: 
     -------
     str or None
         None when every kernel is there (or ``DTCOSIM_AOT=0``); else why they are not (being built
-        in the background, or could not be built: the run goes on with numba's just-in-time kernels;
-        the per-user cache cannot be written: the kernels run interpreted, ``DTCOSIM_JIT=0``).
+        in the background, or could not be built: the run goes on with numba's just-in-time kernels,
+        or interpreted while those are compiled in the background; the per-user cache cannot be
+        written: the kernels run interpreted, ``DTCOSIM_JIT=0``).
     """
     if not enabled():
         return None
@@ -83,11 +89,7 @@ def ensure_compiled_kernels(report: Callable[[str], None] | None = None, retry: 
         if earlier:
             todo = [k for k in todo if k not in dict(earlier)]
             if not todo:
-                problem = earlier[0][1]
-                if report:
-                    report(f"kernels not compiled ahead of time on this machine ({problem}); numba compiles them "
-                           "just in time (`dtcosim build` tries again)")
-                return problem
+                return _just_in_time([k for k, _ in earlier], earlier[0][1], report, background)
     if not todo:
         return None
     if background:
@@ -107,9 +109,47 @@ def ensure_compiled_kernels(report: Callable[[str], None] | None = None, retry: 
             problem = build_in_subprocess(todo)
     except (OSError, TimeoutError) as exc:  # an unwritable cache, a builder that never ends: just in time instead
         problem = f"{type(exc).__name__}: {exc}"
+    if problem:
+        return _just_in_time(todo, problem, report, background=False)
     if report:
-        report(f"kernels not compiled ahead of time ({problem}); numba compiles them just in time instead" if problem
-               else f"compiled {len(todo)} kernel(s) ahead of time in {time.perf_counter() - start:.0f} s")
+        report(f"compiled {len(todo)} kernel(s) ahead of time in {time.perf_counter() - start:.0f} s")
+    return None
+
+
+def _just_in_time(kernels: list[AotKernel], problem: str, report: Callable[[str], None] | None,
+                  background: bool) -> str:
+    """The kernels could not be compiled ahead of time (``problem``): numba compiles them just in time instead, once
+    per machine into its cache (:func:`~components.compile.aot.warm_just_in_time`), so that no run waits for it
+    unannounced (~35 s of CPU for the gearbox kernel). ``background``: in the detached builder, this process's
+    kernels interpreted meanwhile; else now, waiting."""
+    numba = importlib.util.find_spec("numba") is not None
+    cold = [k for k in kernels if not is_warm(k)] if numba and jit_enabled() else []
+    if cold and background:
+        running = background_builder()
+        pid = running if running is not None else build_in_background(cold, after=os.getpid())
+        if pid is not None:
+            os.environ[JIT_VARIABLE] = "0"
+            os.environ[JIT_OFF_REASON_VARIABLE] = f"being compiled just in time in the background for later runs " \
+                                                  f"(pid {pid})"
+            if report:
+                report(f"kernels not compiled ahead of time on this machine ({problem}): numba compiles them just in "
+                       f"time in the background for later runs instead (pid {pid}, log {build_log()}); until then, "
+                       "runs step them interpreted, which takes longer (`dtcosim build` tries the ahead-of-time "
+                       "build again)")
+            return problem
+    elif cold:
+        if report:
+            report(f"kernels not compiled ahead of time ({problem}): numba compiles them just in time into its cache "
+                   "instead (once per machine and version) ...")
+        start = time.perf_counter()
+        not_warm = build_in_subprocess(cold, just_in_time=True)
+        if report:
+            report(f"not compiled just in time either ({not_warm}): each process compiles them itself" if not_warm
+                   else f"compiled {len(cold)} kernel(s) just in time in {time.perf_counter() - start:.0f} s")
+        return problem
+    if report:
+        report(f"kernels not compiled ahead of time on this machine ({problem}); numba runs them compiled just in "
+               "time (`dtcosim build` tries the ahead-of-time build again)")
     return problem
 
 
@@ -146,7 +186,7 @@ def _in_background(todo: list[AotKernel], report: Callable[[str], None] | None) 
     os.environ[JIT_VARIABLE] = "0"  # compiling them just in time now would cost as much as the build
     os.environ[JIT_OFF_REASON_VARIABLE] = f"being compiled in the background for later runs (pid {pid})"
     if report:
-        what = (f"the kernels are still being compiled ahead of time in the background (pid {pid}" if running is not None
+        what = (f"the kernels are still being compiled in the background (pid {pid}" if running is not None
                 else f"compiling {len(todo)} kernel(s) ahead of time in the background for later runs (pid {pid}")
         report(f"{what}, log {build_log()}); until they are built, runs step them interpreted, which takes longer")
     return f"being compiled in the background (pid {pid})"

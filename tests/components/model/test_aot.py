@@ -183,15 +183,22 @@ def test_a_failing_build_says_why_in_one_line_and_is_not_retried_on_every_run(tm
     said = []
     problem = compiled_kernels.ensure_compiled_kernels(said.append)
     assert problem is not None and "no_such_provider" in problem and "\n" not in problem
-    assert aot.failed_before(fake) == problem and "numba compiles them just in time" in said[-1]
+    assert aot.failed_before(fake) == problem
+    # then compiled just in time into numba's cache instead, which fails too for this kernel: the runs compile it
+    assert said[-2].startswith(f"kernels not compiled ahead of time ({problem}): numba compiles them just in time")
+    assert said[-1].startswith("not compiled just in time either (") and "no_such_provider" in said[-1]
+    assert said[-1].endswith("each process compiles them itself") and not aot.is_warm(fake)
 
-    def no_build(kernels):
-        raise AssertionError(f"rebuilt {kernels}")
+    def no_build(kernels, just_in_time=False):
+        raise AssertionError(f"rebuilt {kernels}" if not just_in_time else "compiled just in time again")
 
     monkeypatch.setattr(compiled_kernels, "build_in_subprocess", no_build)
+    monkeypatch.setattr(aot, "warm_mark", lambda shared: tmp_path / "warm")  # as if numba's cache held it
+    (tmp_path / "warm").write_text("")
     said.clear()
     assert compiled_kernels.ensure_compiled_kernels(said.append) == problem  # remembered, not rebuilt
-    assert len(said) == 1 and problem in said[0] and "`dtcosim build` tries again" in said[0]
+    assert len(said) == 1 and problem in said[0] and "numba runs them compiled just in time" in said[0]
+    assert "`dtcosim build` tries the ahead-of-time build again" in said[0]
     with pytest.raises(AssertionError, match="rebuilt"):
         compiled_kernels.ensure_compiled_kernels(said.append, retry=True)  # dtcosim build tries again
 
@@ -301,6 +308,89 @@ def test_the_first_run_does_not_wait_for_the_compiler(tmp_path, monkeypatch):
     assert line.startswith("compiling 1 kernel(s) ahead of time in the background for later runs (pid 4242, log ")
     assert line.endswith("until they are built, runs step them interpreted, which takes longer")
     assert not any(c.isdigit() for c in line.split("log ")[0].replace("4242", "").replace("1 kernel", ""))
+
+
+def test_without_a_c_compiler_the_builder_compiles_the_kernel_just_in_time_and_later_processes_load_it(
+        tmp_path, monkeypatch):
+    """The background builder on a machine without a C compiler: the module is not built (remembered), numba's cache
+    gets the kernel's entry points instead, and a later process that steps the kernel compiles nothing."""
+    pytest.importorskip("numba")
+    import os
+
+    monkeypatch.setenv("DTCOSIM_CACHE_DIR", str(tmp_path / "cache"))
+    no_compilers = tmp_path / "bin"
+    no_compilers.mkdir()
+    monkeypatch.setenv("PATH", str(no_compilers))  # the builder runs sys.executable by its full path
+    wind = AotKernel.of(kernel.WIND)
+    os.waitpid(aot.build_in_background([wind]), 0)
+    log = aot.build_log().read_text()
+    assert f"{wind.module_name}: not built (RuntimeError: no C compiler (cc, gcc or clang)" in log
+    assert f"{wind.shared}: compiled just in time into numba's cache in " in log, log
+    assert aot.failed_before(wind).startswith("RuntimeError: no C compiler") and aot.is_warm(wind)
+    assert not wind.file().exists() and not aot.build_lock_file().exists()
+    later = textwrap.dedent("""
+        import numpy as np
+        from components.model.wind import PhasorStepper, RotorSpeedProcess, WindParameters
+        stepper = PhasorStepper(RotorSpeedProcess(WindParameters()), kernel="compiled")
+        stepper.reset(0.0)
+        for k in range(5):
+            stepper.advance(k * 0.01, 0.01)
+        stepper.acceleration_and_jerk()
+        print("stepped", stepper._kernel.__name__)
+    """)
+    env = {**os.environ, "NUMBA_DEBUG_CACHE": "1", "PYTHONPATH": str(Path(__file__).parents[3])}
+    out = subprocess.run([sys.executable, "-c", later], capture_output=True, text=True, env=env, check=True).stdout
+    assert "stepped _dtcosim_kernel_wind_" in out and "data loaded" in out, out
+    assert "data saved" not in out, out  # every function the step called came from the cache
+
+
+def _failed_kernel(monkeypatch, cache):
+    """:func:`_one_missing_kernel` whose ahead-of-time build failed before."""
+    compiled_kernels, fake = _one_missing_kernel(monkeypatch, cache)
+    aot._remember(fake, "RuntimeError: no C compiler (cc, gcc or clang) for numba's ahead-of-time build")
+    return compiled_kernels, fake
+
+
+def test_without_a_module_a_run_leaves_the_just_in_time_compile_to_the_background(tmp_path, monkeypatch):
+    """A run where the ahead-of-time build failed before and numba's cache is cold: the detached builder compiles the
+    kernels just in time, this process runs them interpreted (it does not wait ~35 s unannounced), and says so."""
+    import os
+
+    from components.compile.jit import JIT_VARIABLE
+
+    compiled_kernels, fake = _failed_kernel(monkeypatch, tmp_path)
+    started = []
+    monkeypatch.setattr(compiled_kernels, "build_in_background",
+                        lambda todo, after=None: started.append((todo, after)) or 4242)
+    said = []
+    problem = compiled_kernels.ensure_compiled_kernels(said.append, background=True)
+    assert started == [([fake], os.getpid())] and problem == aot.failed_before(fake)
+    assert os.environ[JIT_VARIABLE] == "0"
+    assert try_compiled(KernelSource("nojit", kernel.WIND.entry.with_name("contact.py"))) == (
+        None, "no module compiled ahead of time yet: being compiled just in time in the background for later runs "
+              "(pid 4242)")
+    (line,) = said
+    assert line.startswith(f"kernels not compiled ahead of time on this machine ({problem}): numba compiles them just "
+                           "in time in the background for later runs instead (pid 4242, log ")
+    assert "until then, runs step them interpreted" in line
+
+
+def test_without_a_module_a_study_waits_for_the_just_in_time_compile_once(tmp_path, monkeypatch):
+    """Builds and studies (not in the background) compile them just in time now, in child processes, and say so."""
+    import os
+
+    from components.compile.jit import JIT_VARIABLE
+
+    compiled_kernels, fake = _failed_kernel(monkeypatch, tmp_path)
+    asked = []
+    monkeypatch.setattr(compiled_kernels, "build_in_subprocess",
+                        lambda todo, just_in_time=False: asked.append((todo, just_in_time)))
+    said = []
+    assert compiled_kernels.ensure_compiled_kernels(said.append) == aot.failed_before(fake)
+    assert asked == [([fake], True)] and os.environ[JIT_VARIABLE] == "1"
+    assert said[0].endswith("numba compiles them just in time into its cache instead (once per machine and "
+                            "version) ...")
+    assert said[1].startswith("compiled 1 kernel(s) just in time in ")
 
 
 @pytest.mark.parametrize("background", [True, False], ids=["run", "study or build"])

@@ -109,3 +109,28 @@ def test_the_light_load_registers_every_symbol_a_context_refresh_would():
     got = json.loads(proc.stdout.strip().splitlines()[-1])
     assert any(name.startswith("NRT_") for name in got["light"]), got
     assert got["refresh"] == [], got
+
+
+
+def test_numba_s_warning_about_a_function_it_cannot_cache_finds_the_file_it_names(tmp_path, monkeypatch):
+    """numba warns where it cannot cache a function (lifted loops, dynamic globals: met at ``NUMBA_OPT=0``) and names
+    the locator's file; the stable cache's locator has it, so the compile goes on in memory (it raised
+    AttributeError)."""
+    from types import SimpleNamespace
+
+    from numba import njit
+    from numba.core.errors import NumbaWarning
+
+    from components.compile.numba_cache import enable_stable_cache
+
+    monkeypatch.setenv("DTCOSIM_CACHE_DIR", str(tmp_path))
+
+    def twice(x):
+        return 2 * x
+
+    dispatcher = njit(cache=False)(twice)
+    assert enable_stable_cache([dispatcher], __file__, "test_uncachable")
+    lifted = SimpleNamespace(lifted=[SimpleNamespace(can_cache=False)], fndesc=SimpleNamespace(qualname="twice"))
+    with pytest.warns(NumbaWarning, match='Cannot cache compiled function "twice" as it uses lifted code'):
+        assert dispatcher._cache._impl.check_cachable(lifted) is False
+    assert dispatcher(2.0) == 4.0

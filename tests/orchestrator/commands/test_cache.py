@@ -9,8 +9,8 @@ import time
 
 import pytest
 
-from components.compile.aot import aot_directory, build_log
-from components.compile.numba_cache import source_hash
+from components.compile.aot import aot_directory, build_log, failure_file
+from components.compile.numba_cache import source_hash, warm_mark
 from fmus.binary import cached_binary
 from orchestrator.commands.cli import main
 from orchestrator.cosim import unpacked_fmus
@@ -35,6 +35,11 @@ def cache(tmp_path, monkeypatch):
         jit.mkdir(parents=True)
         (jit / "index.nbi").write_bytes(b"y" * 10)
         current += [module, jit]
+    failed, warm = failure_file(aot_kernels()[0]), warm_mark(aot_kernels()[0].shared)  # as without a C compiler
+    failed.write_text("RuntimeError: no C compiler\n")
+    warm.parent.mkdir(parents=True)
+    warm.write_text("kernel:...\n")
+    current += [failed, warm]
     build_log().write_text("the log of the last build\n")
     (aot_directory() / ".building").write_text("123\n")  # a build's own bookkeeping: not an entry
     current.append(build_log())
@@ -48,6 +53,8 @@ def cache(tmp_path, monkeypatch):
              tmp_path / "aot" / "cpython-310-numpy1.26" / "_dtcosim_compiled_wind_0000000000000000_aot.so",
              tmp_path / f"numba-{numba.__version__}" / "0000000000000000",
              tmp_path / "numba-0.60.0" / source_hash(aot_kernels()[0].source)[:16]]
+    older_warm = warm.with_name("_dtcosim_kernel_gearbox_0000000000000000.cpython-311")  # older sources' mark
+    older_warm.write_text("kernel:...\n")
     monkeypatch.delenv("DTCOSIM_FMU_DIR", raising=False)
     built = tmp_path / "fmus" / "drivetrains" / "x-0123" / "Gearbox.fmu"  # an FMU of the FMU folder
     built.parent.mkdir(parents=True)
@@ -69,6 +76,7 @@ def cache(tmp_path, monkeypatch):
             path.mkdir(parents=True)
             (path / "index.nbi").write_bytes(b"z")
     (stale[-1] / MANIFEST).write_text("{}")
+    stale.append(older_warm)
     a_minute_ago = time.time() - 60
     os.utime(stale[-1], (a_minute_ago, a_minute_ago))  # used a minute ago, but no process holds it
     with held_elsewhere(running):
