@@ -30,3 +30,16 @@ def add_fmu_arguments(p: argparse.ArgumentParser, whose: str = "the scenario's",
     if build:
         p.add_argument("--no-build", action="store_true",
                        help="do not build missing or stale project FMUs (fail instead)")
+
+
+def said_once(say):
+    """``say`` for what preparing FMUs reports, each line once: a command that prepares them more than once (a load
+    set resolves its base scenario, then its study) repeats no message."""
+    seen: set[str] = set()
+
+    def report(message: str) -> None:
+        if message not in seen:
+            seen.add(message)
+            say(message)
+
+    return report

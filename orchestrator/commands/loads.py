@@ -16,7 +16,7 @@ from pathlib import Path
 from .catalogue import help_line
 from .cluster_options import add_cluster_arguments, check_cluster_arguments, check_workers, ran
 from .cluster_options import where as cluster_where
-from .fmu_options import add_fmu_arguments
+from .fmu_options import add_fmu_arguments, said_once
 from .scenario_options import add_allow_argument, allow_implausible
 
 
@@ -161,7 +161,8 @@ def run(args: argparse.Namespace) -> int:
     lcs = allow_implausible(lcs, args.allow_implausible)
     out_dir = args.out if args.out is not None else default_out_dir(lcs.name)
     check_for_study(out_dir, lcs.name)  # a run's folder or another study's: refused before anything is prepared
-    plc = prepare_load_cases(lcs, fmu_dir=args.fmu_dir, build=not args.no_build)
+    say = (lambda msg: None) if quiet else (lambda msg: print(msg, file=sys.stderr))
+    plc = prepare_load_cases(lcs, fmu_dir=args.fmu_dir, build=not args.no_build, report=said_once(say))
     check_curves(plc)
     for note in plc.notes:
         print(f"dtcosim loads: warning: {note}", file=sys.stderr)
@@ -171,7 +172,6 @@ def run(args: argparse.Namespace) -> int:
             print(f"dtcosim loads: note: {earlier} holds the runs of an earlier `dtcosim loads {args.set}` (load sets "
                   f"wrote results/<set>/ before; now {out_dir}/, apart from `dtcosim run`'s folders): to continue "
                   f"them, move it first: mv {earlier} {out_dir}", file=sys.stderr)
-    say = (lambda msg: None) if quiet else (lambda msg: print(msg, file=sys.stderr))
     prepared = plc.prepared
     if args.check:
         todo = pending_points(prepared, read_journal(out_dir / JOURNAL_FILE), args.retry_failed)

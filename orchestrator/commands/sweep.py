@@ -18,7 +18,7 @@ from pathlib import Path
 from .catalogue import help_line
 from .cluster_options import add_cluster_arguments, check_cluster_arguments, check_workers, ran
 from .cluster_options import where as cluster_where
-from .fmu_options import add_fmu_arguments
+from .fmu_options import add_fmu_arguments, said_once
 from .scenario_options import add_allow_argument, allow_implausible
 
 
@@ -96,10 +96,10 @@ def run(args: argparse.Namespace) -> int:
     study = allow_implausible(study, args.allow_implausible)
     out_dir = args.out if args.out is not None else Path("results") / study.name
     check_for_study(out_dir, study.name)  # a run's folder or another study's: refused before anything is prepared
-    prepared = prepare_study(study, fmu_dir=args.fmu_dir, build=not args.no_build)
+    say = (lambda msg: None) if quiet else (lambda msg: print(msg, file=sys.stderr))
+    prepared = prepare_study(study, fmu_dir=args.fmu_dir, build=not args.no_build, report=said_once(say))
     for note in prepared.notes:
         print(f"dtcosim sweep: warning: {note}", file=sys.stderr)
-    say = (lambda msg: None) if quiet else (lambda msg: print(msg, file=sys.stderr))
     if args.check:
         todo = pending_points(prepared, read_journal(out_dir / JOURNAL_FILE), args.retry_failed)
         print(f"{study.name}: valid; engine {study.engine}, base {study.base.kind} {study.base.name}; "

@@ -44,7 +44,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Callable, Mapping
 
 from ..errors import EntryError, ScenarioError, suggestion
 from ..inputs.load_cases import SEED_PLACEHOLDER, LoadBin, LoadCaseError, LoadCaseSet
@@ -127,7 +127,8 @@ class PreparedLoadCases:
         return self.prepared.keys
 
 
-def _settled(lcs: LoadCaseSet, fmu_dir, build: bool) -> tuple[LoadCaseSet, dict | None, list[str]]:
+def _settled(lcs: LoadCaseSet, fmu_dir, build: bool,
+             report: Callable[[str], None] | None) -> tuple[LoadCaseSet, dict | None, list[str]]:
     """The set with transient and length in seconds (``"settled"``, ``"to_stop"`` resolved), the base drivetrain's
     settling time and the warnings about the window (the FMUs of the base scenario are instantiated once)."""
     from ..cosim.operating_point import settling_of
@@ -139,7 +140,7 @@ def _settled(lcs: LoadCaseSet, fmu_dir, build: bool) -> tuple[LoadCaseSet, dict 
     try:
         scenario = apply_parameters(load_any(lcs.base_path), lcs.base_parameters,
                                     lcs.base_origins()).with_allowed(*lcs.allow_implausible)
-        system = resolve_system(scenario, fmu_paths=ensure_fmus(scenario, fmu_dir, build=build))
+        system = resolve_system(scenario, fmu_paths=ensure_fmus(scenario, fmu_dir, build=build, report=report))
     except ScenarioError as exc:
         raise LoadCaseError("base.scenario", lcs.base_scenario, f"a valid scenario with its FMUs ({exc})",
                             lcs.source) from None
@@ -305,8 +306,10 @@ def _measures(channels: tuple[Channel, ...]):
     return tuple(parse_measure(n) for n in dict.fromkeys(names))
 
 
-def prepare_load_cases(lcs: LoadCaseSet, fmu_dir: str | Path | None = None, build: bool = True) -> PreparedLoadCases:
-    """Check a load-case set against its base scenario and build its study (nothing runs).
+def prepare_load_cases(lcs: LoadCaseSet, fmu_dir: str | Path | None = None, build: bool = True,
+                       report: Callable[[str], None] | None = None) -> PreparedLoadCases:
+    """Check a load-case set against its base scenario and build its study (nothing runs); ``report`` receives what
+    preparing the FMUs does (:func:`~orchestrator.study.prepare.prepare_study`).
 
     Raises
     ------
@@ -315,7 +318,7 @@ def prepare_load_cases(lcs: LoadCaseSet, fmu_dir: str | Path | None = None, buil
     """
     src = lcs.source
     bins = lcs.bins
-    lcs, settling, window_notes = _settled(lcs, fmu_dir, build)
+    lcs, settling, window_notes = _settled(lcs, fmu_dir, build, report)
     system = _base_system(lcs, fmu_dir, build)
     channels, hss, meshes, ratings = _channels(system, lcs)
     targets = _targets(system, lcs, bins)
@@ -329,7 +332,7 @@ def prepare_load_cases(lcs: LoadCaseSet, fmu_dir: str | Path | None = None, buil
                       base_dir=None if src is None else Path(src).resolve().parent, source=src,
                       allow_implausible=lcs.allow_implausible,
                       point_origins=tuple(_case_origins(lcs, bins, c, targets, seed_parameter) for c in cases))
-        prepared = prepare_study(study, fmu_dir=fmu_dir, build=build)
+        prepared = prepare_study(study, fmu_dir=fmu_dir, build=build, report=report)
     except LoadCaseError:
         raise  # a run's value, named where the set gives it
     except EntryError as exc:

@@ -26,7 +26,7 @@ import hashlib
 import json
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Callable, Mapping
 
 from ..errors import ScenarioError, suggestion
 from ..inputs.measures import Measure
@@ -284,8 +284,8 @@ def _prepare_model(study: Study) -> tuple[Study, StudyPayload, dict[str, Any]]:
     return study, payload, {"model": model.name}
 
 
-def _prepare_scenario(study: Study, fmu_dir,
-                      build: bool) -> tuple[Study, StudyPayload, dict[str, Any], dict[str, Path], tuple[str, ...]]:
+def _prepare_scenario(study: Study, fmu_dir, build: bool, report: Callable[[str], None] | None = None
+                      ) -> tuple[Study, StudyPayload, dict[str, Any], dict[str, Path], tuple[str, ...]]:
     from ..cosim.roles import GEARBOX
     from ..cosim.system import resolve_system
     from ..inputs.overrides import apply_parameters
@@ -303,7 +303,7 @@ def _prepare_scenario(study: Study, fmu_dir,
         key = exc.key if exc.key.startswith("simulation.") else "simulation"
         raise StudyError(key, exc.value, exc.expected, src) from None
     try:
-        paths = ensure_fmus(scenario, fmu_dir, build=build)
+        paths = ensure_fmus(scenario, fmu_dir, build=build, report=report)
     except ScenarioError as exc:
         raise StudyError("base.scenario", study.base.name, f"FMUs that exist or can be built ({exc})", src) from None
     from .declared_values import check_points, in_declared_units, scenario_converter, scenario_problem
@@ -476,7 +476,8 @@ def _content_sha256(path: Path) -> str:
     return h.hexdigest()
 
 
-def prepare_study(study: Study, fmu_dir: str | Path | None = None, build: bool = True) -> PreparedStudy:
+def prepare_study(study: Study, fmu_dir: str | Path | None = None, build: bool = True,
+                  report: Callable[[str], None] | None = None) -> PreparedStudy:
     """Check a study against its base and build the workers' payload (nothing runs).
 
     Parameters
@@ -487,6 +488,8 @@ def prepare_study(study: Study, fmu_dir: str | Path | None = None, build: bool =
         built); default :func:`orchestrator.provision.folders.default_fmu_dir`.
     build : bool
         Build missing project FMUs.
+    report : callable(str), optional
+        Receives what preparing the FMUs does (their builds, the kernels' compile), in one line each.
 
     Raises
     ------
@@ -498,7 +501,7 @@ def prepare_study(study: Study, fmu_dir: str | Path | None = None, build: bool =
         fmu_paths: dict[str, Path] = {}
         notes: tuple[str, ...] = ()
     else:
-        study, payload, base_identity, fmu_paths, notes = _prepare_scenario(study, fmu_dir, build)
+        study, payload, base_identity, fmu_paths, notes = _prepare_scenario(study, fmu_dir, build, report)
     identity = {
         "engine": study.engine,
         "base": {"kind": study.base.kind, **base_identity},

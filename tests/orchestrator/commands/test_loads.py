@@ -80,3 +80,20 @@ def test_a_full_disk_the_sweep_told_is_not_told_again_for_the_lifetime_results(t
         assert err == [f"dtcosim loads: error: cannot write {out / 'bins.csv'}: No space left on device; the lifetime "
                        f"results are not all written; every finished run is kept in {out / 'journal.jsonl'} and "
                        f"{out}/runs: free some space and run the same command with --report to write them"]
+
+
+@pytest.mark.parametrize("argv", [["loads", "paper-turbine", "--check"], ["sweep", "shaft3-seeds", "--check"]],
+                         ids=["loads", "sweep"])
+def test_what_preparing_the_fmus_says_reaches_the_user_once(argv, tmp_path, fmu_dir, monkeypatch, capsys):
+    """A study's commands show what their FMU preparation says (the kernels' compile: a minute on a new machine),
+    each line once, though a load set prepares its base scenario's FMUs more than once."""
+    import orchestrator.provision.project_fmus as project_fmus
+    from orchestrator.commands.cli import main
+
+    asked = []
+    monkeypatch.setattr(project_fmus, "ensure_compiled_kernels",
+                        lambda report=None, background=False: asked.append(background) or (report and report("the kernels: a note")))
+    monkeypatch.chdir(tmp_path)
+    assert main([*argv, "--fmu-dir", str(fmu_dir)]) == 0
+    assert capsys.readouterr().err.count("the kernels: a note") == 1
+    assert asked and not any(asked)  # a study waits for its kernels: its points would all run interpreted
