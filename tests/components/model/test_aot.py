@@ -285,6 +285,16 @@ def _one_missing_kernel(monkeypatch, cache):
     return compiled_kernels, fake
 
 
+def _ensure_in_background(monkeypatch, compiled_kernels):
+    """``ensure_compiled_kernels(background=True)`` with the detached builder replaced by one of pid 4242: the builds it
+    was asked to start (kernels, after), what it said and what it returned."""
+    started, said = [], []
+    monkeypatch.setattr(compiled_kernels, "build_in_background",
+                        lambda todo, after=None: started.append((todo, after)) or 4242)
+    problem = compiled_kernels.ensure_compiled_kernels(said.append, background=True)
+    return started, said, problem
+
+
 def test_the_first_run_does_not_wait_for_the_compiler(tmp_path, monkeypatch):
     """ensure_compiled_kernels(background=True): the build starts detached, this process compiles nothing just in
     time (DTCOSIM_JIT=0: its kernels run interpreted) and the message says what happens, without a duration."""
@@ -293,11 +303,7 @@ def test_the_first_run_does_not_wait_for_the_compiler(tmp_path, monkeypatch):
     compiled_kernels, fake = _one_missing_kernel(monkeypatch, tmp_path)
     import os
 
-    started = []
-    monkeypatch.setattr(compiled_kernels, "build_in_background",
-                        lambda todo, after=None: started.append((todo, after)) or 4242)
-    said = []
-    problem = compiled_kernels.ensure_compiled_kernels(said.append, background=True)
+    started, said, problem = _ensure_in_background(monkeypatch, compiled_kernels)
     assert started == [([fake], os.getpid())] and problem == "being compiled in the background (pid 4242)"
 
     assert os.environ[JIT_VARIABLE] == "0"
@@ -359,11 +365,7 @@ def test_without_a_module_a_run_leaves_the_just_in_time_compile_to_the_backgroun
     from components.compile.jit import JIT_VARIABLE
 
     compiled_kernels, fake = _failed_kernel(monkeypatch, tmp_path)
-    started = []
-    monkeypatch.setattr(compiled_kernels, "build_in_background",
-                        lambda todo, after=None: started.append((todo, after)) or 4242)
-    said = []
-    problem = compiled_kernels.ensure_compiled_kernels(said.append, background=True)
+    started, said, problem = _ensure_in_background(monkeypatch, compiled_kernels)
     assert started == [([fake], os.getpid())] and problem == aot.failed_before(fake)
     assert os.environ[JIT_VARIABLE] == "0"
     assert try_compiled(KernelSource("nojit", kernel.WIND.entry.with_name("contact.py"))) == (
