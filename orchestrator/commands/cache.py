@@ -12,13 +12,16 @@ that the installed dtcosim, Python, numpy, numba and C compiler would not load (
 modules and binary, so an older FMU keeps running; a later run rebuilds what it needs), and every unpacked
 FMU that is not one of the FMU folder's (:func:`orchestrator.provision.folders.default_fmu_dir`;
 a later run of it unpacks it again) unless a process holds it (a run is loading it). The FMU folder itself
-(``fmus/`` where no other is chosen) is the FMUs dtcosim builds, not a cache entry: its size is printed.
+(``fmus/`` where no other is chosen) is the FMUs dtcosim builds: its size is printed, and its folders of FMUs built
+from drivetrain files and load records (one per content: every edit of a file adds one) are listed, stale when no
+command used them for :data:`~orchestrator.provision.folders.UNUSED_DAYS` days (a later run builds them again).
 """
 
 from __future__ import annotations
 
 import argparse
 import shutil
+import time
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -33,7 +36,7 @@ from ..cosim.compiled_kernels import aot_kernels
 from ..cosim.fmu_interface import file_sha256
 from ..cosim.unpacked_fmus import FOLDER as UNPACKED_FOLDER
 from ..cosim.unpacked_fmus import folder_name, in_use
-from ..provision.folders import default_fmu_dir
+from ..provision.folders import UNUSED_DAYS, content_folders, default_fmu_dir, last_used
 from .catalogue import help_line
 
 
@@ -84,9 +87,13 @@ def cache_entries(root: Path | None = None) -> list[CacheEntry]:
     binary = cached_binary()
     for folder in sorted(p for p in (root / NATIVE_FOLDER).glob("*") if p.is_dir()):
         entries.append(CacheEntry(folder, _size(folder), binary is not None and folder == binary.parent))
+    fmu_dir = default_fmu_dir()
+    if fmu_dir.is_dir():  # the drivetrain files' and load records' FMUs no command used for UNUSED_DAYS days
+        since = time.time() - UNUSED_DAYS * 86400.0
+        entries += [CacheEntry(p, _size(p), last_used(p) >= since) for p in content_folders(fmu_dir)]
     unpacked = sorted(p for p in (root / UNPACKED_FOLDER).glob("*") if p.is_dir())
     if unpacked:
-        built = {folder_name(file_sha256(p)) for p in default_fmu_dir().rglob("*.fmu") if p.is_file()}
+        built = {folder_name(file_sha256(p)) for p in fmu_dir.rglob("*.fmu") if p.is_file()}
         entries += [CacheEntry(p, _size(p), p.name in built or in_use(p)) for p in unpacked]
     return entries
 
@@ -97,7 +104,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                        description=__doc__.splitlines()[0].split(": ", 1)[1])
     p.add_argument("--prune", action="store_true",
                    help="delete every entry the installed dtcosim, Python, numpy, numba and C compiler would not load, "
-                        "and the unpacked FMUs no run holds that are not the FMU folder's")
+                        "the unpacked FMUs no run holds that are not the FMU folder's, and the FMU folder's drivetrain "
+                        f"and load record FMUs no command used for {UNUSED_DAYS} days")
     p.set_defaults(func=run)
 
 
@@ -110,14 +118,14 @@ def run(args: argparse.Namespace) -> int:
         print("  (empty)")
         return 0
     for e in entries:
-        print(f"  {'current' if e.current else 'stale  '}  {e.size_bytes / 1e6:7.2f} MB  {e.path.relative_to(root)}")
+        print(f"  {'current' if e.current else 'stale  '}  {e.size_bytes / 1e6:7.2f} MB  {_shown(e.path, root)}")
     stale = [e for e in entries if not e.current]
     total = sum(e.size_bytes for e in entries) / 1e6
     print(f"{len(entries)} entries, {total:.1f} MB; stale: {len(stale)}, {sum(e.size_bytes for e in stale) / 1e6:.1f} MB")
     if args.prune:
         for e in stale:
             if e.path.is_dir():
-                shutil.rmtree(e.path, ignore_errors=True)
+                _remove_folder(e.path)
             else:
                 e.path.unlink(missing_ok=True)
         for folder in [*(root / "aot").glob("*"), *root.glob(f"numba-*/{WARM_FOLDER}"), *root.glob("numba-*"),
@@ -129,5 +137,21 @@ def run(args: argparse.Namespace) -> int:
         print("`dtcosim cache --prune` removes the stale entries")
     fmu_dir = default_fmu_dir()
     if fmu_dir.is_dir():
-        print(f"FMU folder {fmu_dir}: {_size(fmu_dir) / 1e6:.1f} MB (the FMUs runs build; not pruned)")
+        print(f"FMU folder {fmu_dir}: {_size(fmu_dir) / 1e6:.1f} MB (the FMUs runs build; of its drivetrain and load "
+              f"record folders, those no command used for {UNUSED_DAYS} days are stale)")
     return 0
+
+
+def _shown(path: Path, root: Path) -> str:
+    """``path`` relative to the cache where it is in it (the FMU folder may be elsewhere: $DTCOSIM_FMU_DIR)."""
+    return str(path.relative_to(root)) if path.is_relative_to(root) else str(path)
+
+
+def _remove_folder(path: Path) -> None:
+    """Remove ``path``: renamed away first, so that a command building into it meanwhile starts a new folder."""
+    gone = path.with_name(f".removing-{path.name}")
+    try:
+        path.rename(gone)
+    except OSError:
+        return
+    shutil.rmtree(gone, ignore_errors=True)

@@ -18,7 +18,7 @@ from fmus.build_lock import build_lock
 from fmus.registry import DRIVETRAIN_FILE, names_built_from
 
 from ..inputs.drivetrain_file import DrivetrainSpec
-from .folders import drivetrain_fmu_dir
+from .folders import drivetrain_fmu_dir, mark_used
 from .other_builds import swap_in
 from .staleness import broken_fmu, stale_project_fmus
 from .unpack_ahead import unpack_ahead
@@ -69,4 +69,5 @@ def ensure_drivetrain_fmus(spec: DrivetrainSpec, fmu_dir: Path, names: Iterable[
             names = [n for n in todo() if not swap_in(paths[n])]  # built meanwhile, or kept aside (other_builds)
             if names:
                 build_drivetrain_fmus(spec, folder, names, report)
+    mark_used(folder)
     return folder

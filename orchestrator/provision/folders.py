@@ -12,6 +12,9 @@ package or a source checkout. Inside it:
     Gearbox and GeneratorRotor built from a drivetrain file, one folder per file content.
 ``series/<load record stem>-<sha256[:16]>/``
     The TimeSeriesSource built from a scenario's load record, one folder per selected content.
+    Each of these content folders has a ``.used`` file that every command using its FMUs touches
+    (:func:`mark_used`); in the default FMU folder, ``dtcosim cache --prune`` removes those unused
+    for :data:`UNUSED_DAYS` days (a run of one builds its FMUs again).
 ``.other-builds/<Name>/<build id>.fmu`` (beside each of these FMUs)
     The builds of other dtcosim versions set aside, the last three per FMU
     (:mod:`orchestrator.provision.other_builds`).
@@ -97,3 +100,34 @@ def drivetrain_fmu_dir(fmu_dir: Path, spec: ContentKeyed) -> Path:
 def series_fmu_dir(fmu_dir: Path, spec: ContentKeyed) -> Path:
     """Where the TimeSeriesSource built from a load record lives: ``<fmu_dir>/series/<stem>-<sha256[:16]>/``."""
     return Path(fmu_dir) / SERIES_FOLDER / spec.key
+
+
+#: the file a content folder's FMUs touch each time a command uses them (:func:`mark_used`)
+USED_MARK = ".used"
+#: days after which a content folder of the default FMU folder that no command used is stale (``dtcosim cache``)
+UNUSED_DAYS = 30
+
+
+def mark_used(folder: Path) -> None:
+    """Record that a command uses the FMUs of content folder ``folder`` now (best effort: a read-only folder keeps
+    its older date)."""
+    try:
+        (Path(folder) / USED_MARK).touch()
+    except OSError:
+        pass
+
+
+def last_used(folder: Path) -> float:
+    """When a command last used the FMUs of content folder ``folder`` (POSIX time): its mark's date, else the newest
+    of its files' (a folder built before the marks)."""
+    folder = Path(folder)
+    try:
+        return (folder / USED_MARK).stat().st_mtime
+    except OSError:
+        return max((p.stat().st_mtime for p in folder.rglob("*") if p.is_file()), default=folder.stat().st_mtime)
+
+
+def content_folders(fmu_dir: Path) -> list[Path]:
+    """The content-keyed folders of FMU folder ``fmu_dir`` (drivetrain files' and load records')."""
+    return sorted(p for kind in (DRIVETRAIN_FOLDER, SERIES_FOLDER) for p in (Path(fmu_dir) / kind).glob("*")
+                  if p.is_dir())

@@ -19,7 +19,7 @@ from fmus.registry import LOAD_RECORD, built_from
 from fmus.slaves.time_series_source import DATA_FILE
 
 from ..inputs.series_spec import SeriesSpec
-from .folders import series_fmu_dir
+from .folders import mark_used, series_fmu_dir
 from .other_builds import swap_in
 from .staleness import broken_fmu, stale_project_fmus
 
@@ -50,4 +50,5 @@ def ensure_series_fmu(spec: SeriesSpec, fmu_dir: Path, report: Callable[[str], N
         with build_lock(path.parent, report):  # decided again and built by one process at a time
             if needed() and not swap_in(path):  # built meanwhile, or kept aside (other_builds)
                 build_series_fmu(spec, path.parent, report)
+    mark_used(path.parent)
     return path

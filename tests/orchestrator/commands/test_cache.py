@@ -16,6 +16,7 @@ from orchestrator.commands.cli import main
 from orchestrator.cosim import unpacked_fmus
 from orchestrator.cosim.compiled_kernels import aot_kernels
 from orchestrator.cosim.unpacked_fmus import MANIFEST, folder_name
+from orchestrator.provision.folders import UNUSED_DAYS, USED_MARK, mark_used
 from tests.helpers.holders import held_elsewhere
 
 
@@ -59,6 +60,21 @@ def cache(tmp_path, monkeypatch):
     built = tmp_path / "fmus" / "drivetrains" / "x-0123" / "Gearbox.fmu"  # an FMU of the FMU folder
     built.parent.mkdir(parents=True)
     built.write_bytes(b"an FMU")
+    current.append(built.parent)  # built now (before the folders' marks: dated by its files)
+    used = tmp_path / "fmus" / "series" / "record-4567"  # built long ago, used by a run yesterday
+    (used / "TimeSeriesSource.fmu").parent.mkdir(parents=True)
+    (used / "TimeSeriesSource.fmu").write_bytes(b"a record's FMU")
+    mark_used(used)
+    long_ago = time.time() - (UNUSED_DAYS + 1) * 86400
+    os.utime(used / "TimeSeriesSource.fmu", (long_ago, long_ago))
+    os.utime(used / USED_MARK, (long_ago + UNUSED_DAYS * 86400, long_ago + UNUSED_DAYS * 86400))
+    current.append(used)
+    for unused in (tmp_path / "fmus" / "drivetrains" / "x-89ab", tmp_path / "fmus" / "series" / "record-cdef"):
+        (unused / "Gearbox.fmu").parent.mkdir(parents=True)  # a drivetrain file since edited, a record since changed
+        (unused / "Gearbox.fmu").write_bytes(b"an older FMU")
+        mark_used(unused)
+        for path in (unused / "Gearbox.fmu", unused / USED_MARK):
+            os.utime(path, (long_ago, long_ago))
     unpacked = tmp_path / "unpacked" / folder_name(hashlib.sha256(b"an FMU").hexdigest())
     (unpacked / "resources").mkdir(parents=True)
     (unpacked / "resources" / "x.py").write_bytes(b"u" * 100)
@@ -76,9 +92,9 @@ def cache(tmp_path, monkeypatch):
             path.mkdir(parents=True)
             (path / "index.nbi").write_bytes(b"z")
     (stale[-1] / MANIFEST).write_text("{}")
-    stale.append(older_warm)
     a_minute_ago = time.time() - 60
     os.utime(stale[-1], (a_minute_ago, a_minute_ago))  # used a minute ago, but no process holds it
+    stale += [older_warm, tmp_path / "fmus" / "drivetrains" / "x-89ab", tmp_path / "fmus" / "series" / "record-cdef"]
     with held_elsewhere(running):
         yield tmp_path, current, stale
 
@@ -94,7 +110,8 @@ def test_the_listing_marks_what_the_installed_code_loads(cache, capsys):
         assert "stale" in next(line for line in out.splitlines() if line.endswith(str(path.relative_to(root))))
     assert f"{len(current) + len(stale)} entries" in out and f"stale: {len(stale)}," in out
     assert "`dtcosim cache --prune`" in out and ".building" not in out
-    assert f"FMU folder {root / 'fmus'}: 0.0 MB" in out
+    assert f"FMU folder {root / 'fmus'}: 0.0 MB (the FMUs runs build; of its drivetrain and load record folders, " \
+           f"those no command used for {UNUSED_DAYS} days are stale)" in out
     assert all(p.exists() for p in current + stale)  # listing changes nothing
 
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import shutil
+import time
 import zipfile
 from pathlib import Path
 
@@ -12,7 +13,7 @@ import pytest
 from components.model.kernel import choose_kernel
 from orchestrator.inputs.drivetrain_file import find_drivetrain, load_drivetrain_file
 from orchestrator.inputs.scenario_file import find_scenario
-from orchestrator.provision.folders import drivetrain_fmu_dir
+from orchestrator.provision.folders import USED_MARK, drivetrain_fmu_dir
 from tests.helpers.scenarios import dtcosim
 
 pytestmark = pytest.mark.slow
@@ -61,6 +62,7 @@ def test_grc_like_60_s_at_the_rated_point(fmu_home, tmp_path):
     folder = drivetrain_fmu_dir(fmu_home, spec)
     assert (folder / "Gearbox.fmu").is_file() and (folder / "GeneratorRotor.fmu").is_file()
     assert not (fmu_home / "Gearbox.fmu").exists()  # never the shared Gearbox.fmu
+    assert time.time() - (folder / USED_MARK).stat().st_mtime < 600  # the run's use, for `dtcosim cache --prune`
     assert record_of(folder / "Gearbox.fmu")["source"] == spec.origin
     generator = record_of(folder / "GeneratorRotor.fmu")["model"]["generator"]
     assert generator["inertia_kgm2"] == 24.0 and generator["counter_torque_nm"] == 3995.0  # the file's defaults
