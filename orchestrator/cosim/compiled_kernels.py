@@ -138,19 +138,38 @@ def _just_in_time(kernels: list[AotKernel], problem: str, report: Callable[[str]
                        "build again)")
             return problem
     elif cold:
-        if report:
-            report(f"kernels not compiled ahead of time ({problem}): numba compiles them just in time into its cache "
-                   "instead (once per machine and version) ...")
-        start = time.perf_counter()
-        not_warm = build_in_subprocess(cold, just_in_time=True)
-        if report:
-            report(f"not compiled just in time either ({not_warm}): each process compiles them itself" if not_warm
-                   else f"compiled {len(cold)} kernel(s) just in time in {time.perf_counter() - start:.0f} s")
-        return problem
+        said = _compile_just_in_time_now(cold, problem, report)
+        if said is not None:
+            if report:
+                report(said)
+            return problem
     if report:
         report(f"kernels not compiled ahead of time on this machine ({problem}); numba runs them compiled just in "
                "time (`dtcosim build` tries the ahead-of-time build again)")
     return problem
+
+
+def _compile_just_in_time_now(cold: list[AotKernel], problem: str, report: Callable[[str], None] | None) -> str | None:
+    """Compile ``cold`` just in time into numba's cache now, after a builder in progress; what came of it, or None
+    where that builder compiled them all."""
+    running = background_builder()
+    if running is not None and report:
+        report(f"waiting for the kernels being compiled in the background by another process (pid {running}) ...")
+    try:
+        with build_lock(WAIT_FOR_BACKGROUND_S):  # one builder at a time: what another compiled is not compiled again
+            cold = [k for k in cold if not is_warm(k)]
+            if not cold:
+                return None
+            if report:
+                report(f"kernels not compiled ahead of time ({problem}): numba compiles them just in time into its "
+                       "cache instead (once per machine and version) ...")
+            start = time.perf_counter()
+            not_warm = build_in_subprocess(cold, just_in_time=True)
+    except (OSError, TimeoutError) as exc:
+        not_warm = f"{type(exc).__name__}: {exc}"
+    if not_warm:
+        return f"not compiled just in time either ({not_warm}): each process compiles them itself"
+    return f"compiled {len(cold)} kernel(s) just in time in {time.perf_counter() - start:.0f} s"
 
 
 def _interpreted(unwritable: str, report: Callable[[str], None] | None) -> str:

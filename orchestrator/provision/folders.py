@@ -128,6 +128,6 @@ def last_used(folder: Path) -> float:
 
 
 def content_folders(fmu_dir: Path) -> list[Path]:
-    """The content-keyed folders of FMU folder ``fmu_dir`` (drivetrain files' and load records')."""
+    """The content-keyed folders of FMU folder ``fmu_dir`` (drivetrain files' and load records'; not hidden ones)."""
     return sorted(p for kind in (DRIVETRAIN_FOLDER, SERIES_FOLDER) for p in (Path(fmu_dir) / kind).glob("*")
-                  if p.is_dir())
+                  if p.is_dir() and not p.name.startswith("."))

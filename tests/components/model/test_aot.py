@@ -395,6 +395,17 @@ def test_without_a_module_a_study_waits_for_the_just_in_time_compile_once(tmp_pa
     assert said[1].startswith("compiled 1 kernel(s) just in time in ")
 
 
+def test_a_study_takes_what_a_builder_compiled_just_in_time_while_it_waited(tmp_path, monkeypatch):
+    compiled_kernels, fake = _failed_kernel(monkeypatch, tmp_path)
+    answers = iter([False, True])  # cold when asked, warm once the builder in progress has ended
+    monkeypatch.setattr(compiled_kernels, "is_warm", lambda kernel: next(answers))
+    monkeypatch.setattr(compiled_kernels, "build_in_subprocess", lambda *a, **k: pytest.fail("compiled again"))
+    said = []
+    assert compiled_kernels.ensure_compiled_kernels(said.append) == aot.failed_before(fake)
+    (line,) = said
+    assert line.endswith("numba runs them compiled just in time (`dtcosim build` tries the ahead-of-time build again)")
+
+
 @pytest.mark.parametrize("background", [True, False], ids=["run", "study or build"])
 def test_with_an_unwritable_cache_nothing_is_compiled_and_the_message_says_why(tmp_path, monkeypatch, background):
     """Compiled just in time without a cache to keep them, the kernels would be compiled anew by every process (~35 s):
