@@ -77,3 +77,10 @@ class WallTimeLimitError(SolverError):
 
     def __reduce__(self):
         return (type(self), (self.limit_s, self.time_s))
+
+
+def os_error_text(exc: OSError, named: str | None = None) -> str:
+    """What an OSError says, as a message quotes it: ``"<file>: <reason>"``, or ``"<reason>"`` where it names no file
+    or the file ``named`` (the one the message names already)."""
+    where = f"{exc.filename}: " if exc.filename not in (None, named) else ""
+    return f"{where}{exc.strerror or exc}"

@@ -51,7 +51,7 @@ import pythonfmu
 from pythonfmu import FmuBuilder
 
 import components
-from components.errors import DtcosimError
+from components.errors import DtcosimError, os_error_text
 from components.model.drivetrain import Drivetrain
 from components.model.wind import WindParameters
 
@@ -422,9 +422,8 @@ def build_fmu(name: str, out_dir: Path | str, preset: str = "table6", source: So
             built = _build_archive(name, kind, model, origin, source, Path(part), resources, validate)
             os.replace(built.path, final)
     except OSError as exc:  # a full disk: the error names no file, or one the build copied from
-        reason = f"{exc.filename}: {exc.strerror or exc}" if exc.filename is not None else f"{exc.strerror or exc}"
-        raise BuildError(f"{final} not built: {reason} (the build writes into {out_dir} and the temporary folder "
-                         f"{tempfile.gettempdir()})") from None
+        raise BuildError(f"{final} not built: {os_error_text(exc)} (the build writes into {out_dir} and the temporary "
+                         f"folder {tempfile.gettempdir()})") from None
     return dataclasses.replace(built, path=final)
 
 

@@ -6,9 +6,9 @@ kernel version: :mod:`components.compile.aot`, with the log of their last build)
 just-in-time machine code (``numba-<numba version>/<source hash>/``), the FMU binary
 (``native/<source and compiler hash>/``: :mod:`fmus.binary`) and the FMUs runs have unpacked
 (``unpacked/<content hash>-<Python tag>/``: :mod:`orchestrator.cosim.unpacked_fmus`). Every new version of a
-kernel's or the binary's sources adds entries (with, for each, the reason its ahead-of-time build failed, or the
-mark that numba's cache holds it compiled just in time) and nothing removes the old ones: ``--prune`` deletes every entry
-that the installed dtcosim, Python, numpy, numba and C compiler would not load (FMUs carry their own compiled
+kernel's or the binary's sources adds entries (with, for each, the reason its ahead-of-time build failed, or
+the mark that numba's cache holds it compiled just in time) and nothing removes the old ones: ``--prune`` deletes
+every entry that the installed dtcosim, Python, numpy, numba and C compiler would not load (FMUs carry their own compiled
 modules and binary, so an older FMU keeps running; a later run rebuilds what it needs), and every unpacked
 FMU that is not one of the FMU folder's (:func:`orchestrator.provision.folders.default_fmu_dir`;
 a later run of it unpacks it again) unless a process holds it (a run is loading it). The FMU folder itself

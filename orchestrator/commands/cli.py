@@ -20,7 +20,7 @@ import sys
 import warnings
 from collections.abc import Callable, Iterator, Sequence
 
-from components.errors import DtcosimError
+from components.errors import DtcosimError, os_error_text
 
 from ..cosim.stop_requests import STOP_SIGNALS
 from ..import_safe_signals import install, restore
@@ -156,8 +156,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"{_prog(args)}: {text}", file=sys.stderr)
             return 128 + int(signum)
         except OSError as exc:  # a full disk, a file-size limit: where a command has nothing more to say about it
-            where = f"{exc.filename}: " if exc.filename is not None else ""
-            print(f"{_prog(args)}: error: {where}{exc.strerror or exc}", file=sys.stderr)
+            print(f"{_prog(args)}: error: {os_error_text(exc)}", file=sys.stderr)
             return 1
         except Exception as exc:  # a bug: one line, the traceback only when asked for
             if os.environ.get(DEBUG_VARIABLE):

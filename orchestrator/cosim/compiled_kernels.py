@@ -34,6 +34,7 @@ from components.compile.aot import (
 )
 from components.compile.jit import JIT_OFF_REASON_VARIABLE, JIT_VARIABLE, jit_enabled
 from components.compile.user_cache import CACHE_VARIABLE, user_cache_root
+from components.errors import os_error_text
 from components.model.kernel import AHEAD_OF_TIME
 
 from .stepping.compiled_loop import aot_loop_kernel
@@ -190,8 +191,7 @@ def _unwritable_cache() -> str | None:
     try:
         aot_directory().mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        where = f"{exc.filename}: " if exc.filename is not None else ""
-        return f"{where}{exc.strerror or exc}"
+        return os_error_text(exc)
     return None
 
 

@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import Protocol
 
 from components.compile.user_cache import CACHE_VARIABLE, user_cache_root
+from components.errors import os_error_text
 
 from ..errors import EntryError
 
@@ -77,8 +78,7 @@ def usable_fmu_dir(fmu_dir: str | Path | None = None, option: str = "--fmu-dir")
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        where = f"{exc.filename}: " if exc.filename not in (None, str(folder)) else ""
-        reason = "a file is there" if folder.exists() and not folder.is_dir() else f"{where}{exc.strerror or exc}"
+        reason = "a file is there" if folder.exists() and not folder.is_dir() else os_error_text(exc, str(folder))
         if fmu_dir is not None:
             key, value = option, str(fmu_dir)
         elif os.environ.get(FMU_DIR_VARIABLE):
