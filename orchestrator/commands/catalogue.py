@@ -34,7 +34,8 @@ COMMANDS = (
     Command("modes", "orchestrator.commands.modes",
             "natural frequencies, damping and mode shapes at an operating point; Campbell diagram"),
     Command("cache", "orchestrator.commands.cache",
-            "list the per-user cache (compiled kernels, FMU binary, unpacked FMUs); --prune removes stale entries"),
+            "list the per-user cache (compiled kernels, FMU binary, unpacked FMUs, the FMU folder's drivetrain "
+            "and record FMUs); --prune removes stale entries"),
     Command("drivetrain", "orchestrator.commands.drivetrain",
             "drivetrain description files: show the derived design table"),
     Command("sweep", "orchestrator.commands.sweep",
