@@ -45,6 +45,7 @@ from ..errors import ParameterError, SolverError
 from . import kernel as model_kernel
 from .contact import ContactLaw, MeshContact
 from .drivetrain import Drivetrain
+from .generator import GENERATOR_BODY
 from .kernel.stiffness import N_PHASING_ROWS
 from .mesh_stiffness import MeshPhasing
 from .sparse import column_sparsity, dense_rows
@@ -184,7 +185,7 @@ class Assembly:
             previous_output = members["output"]
         generator_index = None
         if drivetrain.generator is not None:
-            generator_index = rows.body("generator", drivetrain.generator.inertia_kgm2, "generator", "generator")
+            generator_index = rows.body(GENERATOR_BODY, drivetrain.generator.inertia_kgm2, "generator", "generator")
             shaft(drivetrain.output_shaft, previous_output, generator_index)
         output_index = generator_index if generator_index is not None else previous_output
 

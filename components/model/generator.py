@@ -21,6 +21,8 @@ from ..errors import ParameterError
 from ..validation import finite, non_negative, one_of, positive, set_fields
 
 EVENT_KINDS = ("torque_step", "grid_fault", "emergency_stop")
+#: the generator's body in a drivetrain's assembly, and so in its linear and modal models
+GENERATOR_BODY = "generator"
 
 
 @dataclass(frozen=True)

@@ -142,8 +142,9 @@ def run(args: argparse.Namespace) -> int:
         for message in dict.fromkeys(m for m in messages if m.startswith("[warning]")):
             text = message.removeprefix("[warning]").strip().removeprefix("logStatusWarning:").strip()
             print(f"dtcosim run: warning: FMU {component}: {text}", file=sys.stderr)
-    if "window_warning" in s:
-        print(f"dtcosim run: warning: {s['window_warning']}", file=sys.stderr)
+    for warning in ("step_warning", "window_warning"):
+        if warning in s:
+            print(f"dtcosim run: warning: {s[warning]}", file=sys.stderr)
     if not outcome.time_s.size:  # stopped before the first sample: nothing to show
         told = f"{out_dir / 'summary.json'} says so" if "summary" in report.files else "no summary was written"
         for problem in report.problems[1:] if outcome.stage == "writing" else report.problems:

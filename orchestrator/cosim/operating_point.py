@@ -6,7 +6,9 @@ point from what the initialisation transferred: the Gearbox's ``omega_rotor`` (o
 mean speed where a WindSource drives it) and its ``counter_torque`` (else the generator's). The
 rotor is held where the rotor speed is prescribed and free where a torque-driven Rotor FMU
 drives the Gearbox. :func:`settling_of` turns it into the settling time of
-:mod:`components.analysis.settling`: the time a run's analysis window should start after.
+:mod:`components.analysis.settling`: the time a run's analysis window should start after;
+:func:`coupling_limit_of` into the longest communication step that resolves the modes split
+across FMUs (:mod:`components.analysis.coupling_step`).
 Both are used by ``dtcosim modes``, by every run (``summary.json`` ``settling``) and by the
 load-case sets (``runs.transient = "settled"``).
 """
@@ -16,14 +18,18 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 from typing import Any, Mapping
 
+import numpy as np
+
+from components.analysis.coupling_step import CouplingLimit, drivetrain_coupling_limit
 from components.analysis.equilibrium import OperatingPoint
+from components.analysis.rotor_coupling import ROTOR_BODY
 from components.analysis.settling import Settling, drivetrain_settling
 from components.model.drivetrain import Drivetrain
-from components.model.generator import GeneratorParameters
+from components.model.generator import GENERATOR_BODY, GeneratorParameters
 from components.model.rotor import RotorParameters
 
 from .physics_view import PhysicsUnavailable, drivetrain_with_generator, physics_view, rotor_driven_view
-from .roles import ROTOR, WIND_SOURCE
+from .roles import GENERATOR, ROTOR, WIND_SOURCE
 from .resolved import ResolvedSystem
 
 
@@ -95,6 +101,22 @@ def settling_of(system: ResolvedSystem, start_values: Mapping[str, Any] | None =
     except PhysicsUnavailable:
         return None
     except (ValueError, ArithmeticError, KeyError):
+        return None
+
+
+def coupling_limit_of(system: ResolvedSystem, start_values: Mapping[str, Any] | None = None) -> CouplingLimit | None:
+    """The longest communication step that resolves the scenario's modes split across FMUs at its start
+    (:mod:`components.analysis.coupling_step`): the generator's where a generator FMU of its own drives the
+    Gearbox, a torque-driven rotor's; None where there is no dtcosim drivetrain or no such mode (never a reason to
+    refuse a run)."""
+    try:
+        start = drivetrain_at_start(system, start_values)
+        split = [GENERATOR_BODY] if system.with_role(GENERATOR) else []
+        split += [ROTOR_BODY] if start.rotor is not None else []
+        return drivetrain_coupling_limit(start.drivetrain, start.operating_point, split, rotor=start.rotor)
+    except PhysicsUnavailable:
+        return None
+    except (ValueError, ArithmeticError, KeyError, np.linalg.LinAlgError):
         return None
 
 

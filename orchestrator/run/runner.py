@@ -232,18 +232,25 @@ def _run_in(folder: RunFolder, stop: StopRequests, system: ResolvedSystem, wall0
 
 def _settling(system: ResolvedSystem, outcome: RunOutcome) -> dict[str, Any]:
     """``settling`` (the drivetrain's settling time at the run's start) and a ``window_warning`` when the window
-    starts before it ({} without a dtcosim drivetrain)."""
-    from ..cosim.operating_point import settling_of, window_note
+    starts before it; ``coupling`` (the longest step that resolves its modes split across FMUs) and a
+    ``step_warning`` when the step is longer ({} without a dtcosim drivetrain)."""
+    from ..cosim.operating_point import coupling_limit_of, settling_of, window_note
 
-    settling = settling_of(system, outcome.start_values)
-    if settling is None:
-        return {}
     sim = system.scenario.simulation
-    out: dict[str, Any] = {"settling": settling.as_dict()}
-    note = window_note(settling, sim.window_s[0], sim.start_s, f"the analysis window [{sim.window_s[0]:g}, "
-                                                                f"{sim.window_s[1]:g}] s")
-    if note is not None:
-        out["window_warning"] = note
+    out: dict[str, Any] = {}
+    settling = settling_of(system, outcome.start_values)
+    if settling is not None:
+        out["settling"] = settling.as_dict()
+        note = window_note(settling, sim.window_s[0], sim.start_s, f"the analysis window [{sim.window_s[0]:g}, "
+                                                                    f"{sim.window_s[1]:g}] s")
+        if note is not None:
+            out["window_warning"] = note
+    limit = coupling_limit_of(system, outcome.start_values)
+    if limit is not None:
+        out["coupling"] = limit.as_dict()
+        note = limit.note(sim.step_s)
+        if note is not None:
+            out["step_warning"] = note
     return out
 
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import re
+from pathlib import Path
 
 import pytest
 
@@ -97,3 +98,14 @@ def test_what_preparing_the_fmus_says_reaches_the_user_once(argv, tmp_path, fmu_
     assert main([*argv, "--fmu-dir", str(fmu_dir)]) == 0
     assert capsys.readouterr().err.count("the kernels: a note") == 1
     assert asked and not any(asked)  # a study waits for its kernels: its points would all run interpreted
+
+
+def test_a_set_at_a_step_too_coarse_for_its_drivetrain_is_warned_about(tmp_path, fmu_dir):
+    text = (Path(__file__).resolve().parents[3] / "orchestrator" / "load_cases" / "paper-turbine.toml").read_text()
+    text = text.replace("[base]", "[simulation]\nstep = 0.25\n\n[base]", 1)
+    (tmp_path / "coarse.toml").write_text(text)
+    proc = dtcosim("loads", "coarse.toml", "--check", "--transient", "3", "--length", "601", "--fmu-dir", str(fmu_dir),
+                   cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert "dtcosim loads: warning: the communication step 0.25 s is longer than 1/20 of the period of the 0.953 Hz " \
+           "mode" in proc.stderr
