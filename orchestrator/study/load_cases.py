@@ -131,7 +131,7 @@ def _settled(lcs: LoadCaseSet, fmu_dir, build: bool,
              report: Callable[[str], None] | None) -> tuple[LoadCaseSet, dict | None, list[str]]:
     """The set with transient and length in seconds (``"settled"``, ``"to_stop"`` resolved), the base drivetrain's
     settling time and the warnings about the window (the FMUs of the base scenario are instantiated once)."""
-    from ..cosim.operating_point import coupling_limit_of, settling_of
+    from ..cosim.operating_point import settling_of
     from ..cosim.system import resolve_system
     from ..inputs.overrides import apply_parameters
     from ..provision.project_fmus import ensure_fmus
@@ -147,9 +147,23 @@ def _settled(lcs: LoadCaseSet, fmu_dir, build: bool,
     settling = settling_of(system)
     resolved, notes = lcs.settled(None if settling is None else settling.time_s,
                                   "" if settling is None else settling.describe(), scenario.simulation.stop_s)
+    return resolved, None if settling is None else settling.as_dict(), notes + _grid_notes(resolved, scenario, system)
+
+
+def _grid_notes(lcs: LoadCaseSet, scenario, system) -> list[str]:
+    """Warnings about the runs' step and output interval against the drivetrain's modes split across FMUs
+    (:mod:`components.analysis.coupling_step`); none where the grid is refused later (:func:`_base_system`)."""
+    from ..cosim.operating_point import coupling_limit_of
+
     limit = coupling_limit_of(system)
-    step_note = None if limit is None else limit.note(lcs.simulation.step_s or scenario.simulation.step_s)
-    return resolved, None if settling is None else settling.as_dict(), notes + ([step_note] if step_note else [])
+    try:
+        sim = lcs.time_grid().apply(scenario)[0].simulation
+    except ScenarioError:
+        return []
+    if limit is None:
+        return []
+    notes = [limit.note(sim.step_s), limit.sampling_note(sim.step_s * sim.output_stride)]
+    return [note for note in notes if note is not None]
 
 
 def _base_system(lcs: LoadCaseSet, fmu_dir, build: bool):

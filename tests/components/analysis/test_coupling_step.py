@@ -3,7 +3,8 @@
 The paper's drivetrain has one such mode: the generator's inertia on the shafts, 0.953 Hz at 30 % damping (the
 modal analysis of ``dtcosim modes`` gives the same mode and energy share from its own eigenvectors); at 20 steps
 per period the step limit is 1 / (20 x 0.953 Hz) = 52.5 ms. A co-simulation at 0.25 s (beyond it) came out 4.7 %
-off the monolithic reference in the gear forces' standard deviation, and is warned about.
+off the monolithic reference in the gear forces' standard deviation, and is warned about; so is an output interval
+that samples that mode fewer than 10 times per period (0.105 s: a DEL 14.5 % low at 0.5 s).
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ import json
 
 import pytest
 
-from components.analysis.coupling_step import STEPS_PER_PERIOD, drivetrain_coupling_limit
+from components.analysis.coupling_step import SAMPLES_PER_PERIOD, STEPS_PER_PERIOD, drivetrain_coupling_limit
 from components.analysis.equilibrium import OperatingPoint
 from components.analysis.modes import drivetrain_modes
 from components.analysis.rotor_coupling import ROTOR_BODY
@@ -73,3 +74,27 @@ def test_a_run_at_a_coarse_step_says_so_and_its_summary_keeps_it(tmp_path, fmu_d
                   str(tmp_path / "fine"), cwd=tmp_path)
     assert res.returncode == 0 and "communication step" not in res.stderr, res.stderr  # the paper's 20 ms
     assert "step_warning" not in json.loads((tmp_path / "fine" / "summary.json").read_text())
+
+
+@pytest.mark.parametrize("interval_s, warned", [(0.02, False), (0.1049, False), (0.1051, True), (0.5, True)])
+def test_an_output_interval_that_samples_the_mode_too_coarsely_is_warned_about(interval_s, warned):
+    limit = drivetrain_coupling_limit(cosim_preset("table6"), RATED, [GENERATOR_BODY])
+    assert limit.output_interval_s == pytest.approx(1.0 / (SAMPLES_PER_PERIOD * 0.95309), rel=1e-5)  # 0.105 s
+    note = limit.sampling_note(interval_s)
+    assert (note is not None) == warned
+    if warned:
+        assert note.startswith(f"the output interval {interval_s:g} s samples the 0.953 Hz mode (the gear forces' "
+                               "fluctuation: generator 100 % of its kinetic energy) ")
+        assert "times per period, fewer than 10: the statistics and fatigue loads come from the samples" in note
+        assert note.endswith("use an output interval of 0.105 s or less")
+
+
+def test_a_run_sampled_too_coarsely_says_so(tmp_path, fmu_dir):
+    out = tmp_path / "sparse"
+    res = dtcosim("run", "paper-60s", "--stop", "2", "--output-interval", "0.5", "--no-plots", "--fmu-dir",
+                  str(fmu_dir), "--out", str(out), cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert "dtcosim run: warning: the output interval 0.5 s samples the 0.953 Hz mode" in res.stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert "output_warning" in summary and "step_warning" not in summary
+    assert summary["coupling"]["output_interval_s"] == pytest.approx(0.1049, abs=1e-4)
