@@ -92,6 +92,17 @@ class CouplingLimit:
                 f"happens between them (on the paper's drivetrain a DEL came out 0.6 % low at 10 samples per period, "
                 f"15 % low at 2); use an output interval of {self.output_interval_s:.3g} s or less")
 
+    def window_note(self, window_s: tuple[float, float]) -> str | None:
+        """A warning where an analysis window is shorter than one period of the mode (None: it is not)."""
+        length, period = window_s[1] - window_s[0], 1.0 / self.frequency_hz
+        if length >= period * (1.0 - 1e-9):
+            return None
+        return (f"the analysis window [{window_s[0]:g}, {window_s[1]:g}] s is shorter than one period ({period:.3g} s) "
+                f"of the {self.frequency_hz:.3g} Hz mode in which the gear forces fluctuate: its statistics and "
+                f"fatigue loads see part of one oscillation (on the paper's drivetrain the stage-1 sun-planet force's "
+                f"standard deviation over [5, 5.25] s was a fifth of that over [5, 30] s); use a window of {period:.3g} "
+                "s or more")
+
     def as_dict(self) -> dict:
         return {"frequency_hz": self.frequency_hz, "damping_ratio": self.damping_ratio, "bodies": self.bodies,
                 "step_s": self.step_s, "steps_per_period": STEPS_PER_PERIOD,

@@ -142,7 +142,7 @@ def run(args: argparse.Namespace) -> int:
         for message in dict.fromkeys(m for m in messages if m.startswith("[warning]")):
             text = message.removeprefix("[warning]").strip().removeprefix("logStatusWarning:").strip()
             print(f"dtcosim run: warning: FMU {component}: {text}", file=sys.stderr)
-    for warning in ("step_warning", "output_warning", "window_warning"):
+    for warning in ("step_warning", "output_warning", "window_warning", "window_length_warning"):
         if warning in s:
             print(f"dtcosim run: warning: {s[warning]}", file=sys.stderr)
     if not outcome.time_s.size:  # stopped before the first sample: nothing to show

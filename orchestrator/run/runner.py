@@ -233,8 +233,9 @@ def _run_in(folder: RunFolder, stop: StopRequests, system: ResolvedSystem, wall0
 def _settling(system: ResolvedSystem, outcome: RunOutcome) -> dict[str, Any]:
     """``settling`` (the drivetrain's settling time at the run's start) and a ``window_warning`` when the window
     starts before it; ``coupling`` (the longest step that resolves its modes split across FMUs, the longest output
-    interval that samples them) and a ``step_warning`` or ``output_warning`` where they are longer ({} without a
-    dtcosim drivetrain)."""
+    interval that samples them) and a ``step_warning`` or ``output_warning`` where they are longer, a
+    ``window_length_warning`` where the window is shorter than one period of that mode ({} without a dtcosim
+    drivetrain)."""
     from ..cosim.operating_point import coupling_limit_of, settling_of, window_note
 
     sim = system.scenario.simulation
@@ -255,6 +256,9 @@ def _settling(system: ResolvedSystem, outcome: RunOutcome) -> dict[str, Any]:
         note = limit.sampling_note(sim.step_s * sim.output_stride)  # the recorded samples' interval
         if note is not None:
             out["output_warning"] = note
+        note = limit.window_note(sim.window_s)
+        if note is not None:
+            out["window_length_warning"] = note
     return out
 
 

@@ -162,7 +162,7 @@ def _grid_notes(lcs: LoadCaseSet, scenario, system) -> list[str]:
         return []
     if limit is None:
         return []
-    notes = [limit.note(sim.step_s), limit.sampling_note(sim.step_s * sim.output_stride)]
+    notes = [limit.note(sim.step_s), limit.sampling_note(sim.step_s * sim.output_stride), limit.window_note(sim.window_s)]
     return [note for note in notes if note is not None]
 
 

@@ -98,3 +98,15 @@ def test_a_run_sampled_too_coarsely_says_so(tmp_path, fmu_dir):
     summary = json.loads((out / "summary.json").read_text())
     assert "output_warning" in summary and "step_warning" not in summary
     assert summary["coupling"]["output_interval_s"] == pytest.approx(0.1049, abs=1e-4)
+
+
+@pytest.mark.parametrize("window_s, warned", [((5.0, 60.0), False), ((5.0, 6.05), False), ((5.0, 6.0), True),
+                                              ((5.0, 5.25), True)])
+def test_a_window_shorter_than_one_period_of_the_mode_is_warned_about(window_s, warned):
+    limit = drivetrain_coupling_limit(cosim_preset("table6"), RATED, [GENERATOR_BODY])  # period 1.049 s
+    note = limit.window_note(window_s)
+    assert (note is not None) == warned
+    if warned:
+        assert note.startswith(f"the analysis window [{window_s[0]:g}, {window_s[1]:g}] s is shorter than one period "
+                               "(1.05 s) of the 0.953 Hz mode in which the gear forces fluctuate")
+        assert note.endswith("use a window of 1.05 s or more")
