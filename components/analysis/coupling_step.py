@@ -1,4 +1,5 @@
-"""The longest communication step that resolves the modes a co-simulation splits across FMUs.
+"""The longest communication step that resolves the modes a co-simulation splits across FMUs, and the longest output
+interval and shortest analysis window that resolve them.
 
 A fixed-step master holds (or extrapolates) every FMU's inputs over a communication step ``H``.
 Inside one FMU a mode is integrated to its solver's tolerance, but a mode whose motion sits in
@@ -16,10 +17,11 @@ gear forces' fluctuation - must also be sampled finely enough by the recorded ou
 statistics and its rainflow counts come from the samples: at an output interval of 0.1 s (10.5
 samples per period) the stage-1 sun-planet force's DEL (m = 3) over [5, 30] s came out 0.6 % below
 the one of 0.02 s, at 0.5 s (2.1 per period) 14.5 % below, its maximum 0.4 % (same runs).
-:data:`SAMPLES_PER_PERIOD` = 10 is the interval a run is warned beyond.
+:data:`SAMPLES_PER_PERIOD` = 10 is the interval a run is warned beyond; a window shorter than one period
+is warned about too (over [5, 5.25] s that force's standard deviation was a fifth of the one over [5, 30] s).
 
 Only the linear model's eigenvectors are computed (numpy; the same linearisation as
-:mod:`components.analysis.settling`): every run checks its step.
+:mod:`components.analysis.settling`): every run checks its step, output interval and window.
 """
 
 from __future__ import annotations
@@ -46,7 +48,8 @@ SPLIT_SHARE = 0.1
 
 @dataclass(frozen=True)
 class CouplingLimit:
-    """The fastest mode split across FMUs and the longest step that resolves it.
+    """The fastest mode split across FMUs and the longest step that resolves it (:meth:`note`; the output interval:
+    :meth:`sampling_note`; the window: :meth:`window_note`).
 
     Attributes
     ----------
