@@ -72,10 +72,10 @@ class CouplingLimit:
         if step_s <= self.step_s * (1.0 + 1e-9):
             return None
         return (f"the communication step {step_s:g} s is longer than 1/{STEPS_PER_PERIOD} of the period of the "
-                f"{self.frequency_hz:.3g} Hz mode (damping ratio {self.damping_ratio:.2g}) whose motion is split across "
-                f"FMUs ({self.bodies} of its kinetic energy), {self.step_s:.3g} s: each FMU holds the other's outputs "
-                f"over a step, so that mode is coupled coarsely (on the paper's drivetrain the gear forces' standard "
-                f"deviation came out 0.4 % off at H f = 0.1, 5 % at 0.25, 36 % at 0.5); use a step of "
+                f"{self.frequency_hz:.3g} Hz mode (damping ratio {self.damping_ratio:.2g}) whose motion is split "
+                f"across FMUs ({self.bodies} of its kinetic energy), {self.step_s:.3g} s: each FMU holds the other's "
+                f"outputs over a step, so that mode is coupled coarsely (on the paper's drivetrain the gear forces' "
+                f"standard deviation came out 0.4 % off at H f = 0.1, 5 % at 0.25, 36 % at 0.5); use a step of "
                 f"{self.step_s:.3g} s or less (`dtcosim run --compare-reference` measures the difference)")
 
     @property
@@ -103,8 +103,15 @@ class CouplingLimit:
         return (f"the analysis window [{window_s[0]:g}, {window_s[1]:g}] s is shorter than one period ({period:.3g} s) "
                 f"of the {self.frequency_hz:.3g} Hz mode in which the gear forces fluctuate: its statistics and "
                 f"fatigue loads see part of one oscillation (on the paper's drivetrain the stage-1 sun-planet force's "
-                f"standard deviation over [5, 5.25] s was a fifth of that over [5, 30] s); use a window of {period:.3g} "
-                "s or more")
+                f"standard deviation over [5, 5.25] s was a fifth of that over [5, 30] s); use a window of "
+                f"{period:.3g} s or more")
+
+    def warnings(self, step_s: float, output_interval_s: float, window_s: tuple[float, float]) -> dict[str, str]:
+        """The warnings of a run with this step, output interval and analysis window [s], by what they are about
+        (``step_warning``, ``output_warning``, ``window_length_warning``); {} where none applies."""
+        notes = {"step_warning": self.note(step_s), "output_warning": self.sampling_note(output_interval_s),
+                 "window_length_warning": self.window_note(window_s)}
+        return {key: note for key, note in notes.items() if note is not None}
 
     def as_dict(self) -> dict:
         return {"frequency_hz": self.frequency_hz, "damping_ratio": self.damping_ratio, "bodies": self.bodies,

@@ -29,7 +29,7 @@ from ..model.drivetrain import Drivetrain
 from ..model.rotor import RotorParameters
 from .eigen import state_space_matrix
 from .equilibrium import OperatingPoint, linearise
-from .rotor_coupling import coupled
+from .rotor_coupling import CoupledModel, coupled
 
 if TYPE_CHECKING:
     from .modes import DrivetrainModalAnalysis
@@ -107,9 +107,13 @@ def drivetrain_settling(drivetrain: Drivetrain, operating_point: OperatingPoint,
     ValueError
         As :func:`settling_time`.
     """
-    model = coupled(linearise(drivetrain, operating_point, stiffness_factor), rotor)
+    return model_settling(coupled(linearise(drivetrain, operating_point, stiffness_factor), rotor), n_time_constants)
+
+
+def model_settling(model: CoupledModel, n_time_constants: float = N_TIME_CONSTANTS) -> Settling:
+    """:func:`drivetrain_settling` of a drivetrain already linearised (rotor held where ``model.rotor`` is None)."""
     eigenvalues = np.linalg.eigvals(state_space_matrix(model.mass, model.damping, model.stiffness))
-    return settling_of_eigenvalues(eigenvalues, rotor is None, n_time_constants)
+    return settling_of_eigenvalues(eigenvalues, model.rotor is None, n_time_constants)
 
 
 def settling_of_eigenvalues(eigenvalues: np.ndarray, rotor_held: bool,

@@ -5,10 +5,10 @@
 point from what the initialisation transferred: the Gearbox's ``omega_rotor`` (or the wind's
 mean speed where a WindSource drives it) and its ``counter_torque`` (else the generator's). The
 rotor is held where the rotor speed is prescribed and free where a torque-driven Rotor FMU
-drives the Gearbox. :func:`settling_of` turns it into the settling time of
-:mod:`components.analysis.settling`: the time a run's analysis window should start after;
-:func:`coupling_limit_of` into the longest communication step that resolves the modes split
-across FMUs (:mod:`components.analysis.coupling_step`).
+drives the Gearbox. :func:`start_analyses` turns it into the settling time of
+:mod:`components.analysis.settling` (the time a run's analysis window should start after) and
+the limits that resolve the modes split across FMUs (:mod:`components.analysis.coupling_step`:
+the longest step and output interval, the shortest window).
 Both are used by ``dtcosim modes``, by every run (``summary.json`` ``settling``) and by the
 load-case sets (``runs.transient = "settled"``).
 """
@@ -16,12 +16,12 @@ load-case sets (``runs.transient = "settled"``).
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from typing import Any, Mapping
+from typing import Any, Mapping, NamedTuple
 
-from components.analysis.coupling_step import CouplingLimit, drivetrain_coupling_limit
-from components.analysis.equilibrium import OperatingPoint
-from components.analysis.rotor_coupling import ROTOR_BODY
-from components.analysis.settling import Settling, drivetrain_settling
+from components.analysis.coupling_step import CouplingLimit, coupling_limit
+from components.analysis.equilibrium import OperatingPoint, linearise
+from components.analysis.rotor_coupling import ROTOR_BODY, coupled
+from components.analysis.settling import Settling, model_settling
 from components.model.drivetrain import Drivetrain
 from components.model.generator import GENERATOR_BODY, GeneratorParameters
 from components.model.rotor import RotorParameters
@@ -87,34 +87,39 @@ def drivetrain_at_start(system: ResolvedSystem, start_values: Mapping[str, Any] 
     return StartPoint(dt, rotor, OperatingPoint(omega0, torque), f"{speed_source}; {torque_source}")
 
 
-def settling_of(system: ResolvedSystem, start_values: Mapping[str, Any] | None = None) -> Settling | None:
-    """The settling time of a scenario's drivetrain at its start; None where there is no dtcosim drivetrain.
+class StartAnalyses(NamedTuple):
+    """What a scenario's drivetrain at its start says about a run of it (None where it says nothing)."""
 
-    Raises nothing for a drivetrain the modal analysis cannot linearise either (returns None): the
-    settling time is a statement about a run, never a reason to refuse one.
+    #: the settling time (:mod:`components.analysis.settling`): when a run's analysis window should start
+    settling: Settling | None
+    #: the longest step and output interval, and the shortest window, that resolve the modes split across FMUs
+    #: (:mod:`components.analysis.coupling_step`)
+    coupling: CouplingLimit | None
+
+
+def start_analyses(system: ResolvedSystem, start_values: Mapping[str, Any] | None = None) -> StartAnalyses:
+    """The settling time and the coupling limit of a scenario's drivetrain at its start, from one start point and one
+    linearisation; both None where there is no dtcosim drivetrain (``start_values``: see :func:`drivetrain_at_start`).
+
+    The modes split across FMUs are the generator's where a generator FMU of its own drives the Gearbox, and a
+    torque-driven rotor's. Raises nothing for a drivetrain the modal analysis cannot linearise either (None): both
+    are statements about a run, never reasons to refuse one.
     """
     try:
         start = drivetrain_at_start(system, start_values)
-        return drivetrain_settling(start.drivetrain, start.operating_point, rotor=start.rotor)
-    except PhysicsUnavailable:
-        return None
-    except (ValueError, ArithmeticError, KeyError):
-        return None
+        model = coupled(linearise(start.drivetrain, start.operating_point), start.rotor)
+    except (PhysicsUnavailable, ValueError, ArithmeticError, KeyError):  # numpy's LinAlgError is a ValueError
+        return StartAnalyses(None, None)
+    split = [GENERATOR_BODY] if system.with_role(GENERATOR) else []
+    split += [ROTOR_BODY] if start.rotor is not None else []
+    return StartAnalyses(_or_none(model_settling, model), _or_none(coupling_limit, model, split))
 
 
-def coupling_limit_of(system: ResolvedSystem, start_values: Mapping[str, Any] | None = None) -> CouplingLimit | None:
-    """The longest communication step that resolves the scenario's modes split across FMUs at its start
-    (:mod:`components.analysis.coupling_step`): the generator's where a generator FMU of its own drives the
-    Gearbox, a torque-driven rotor's; None where there is no dtcosim drivetrain or no such mode (never a reason to
-    refuse a run)."""
+def _or_none(analysis, *args):
+    """``analysis(*args)``, or None where the linear model has no answer (no decaying mode, a singular matrix)."""
     try:
-        start = drivetrain_at_start(system, start_values)
-        split = [GENERATOR_BODY] if system.with_role(GENERATOR) else []
-        split += [ROTOR_BODY] if start.rotor is not None else []
-        return drivetrain_coupling_limit(start.drivetrain, start.operating_point, split, rotor=start.rotor)
-    except PhysicsUnavailable:
-        return None
-    except (ValueError, ArithmeticError, KeyError):  # numpy's LinAlgError is a ValueError
+        return analysis(*args)
+    except (ValueError, ArithmeticError):
         return None
 
 

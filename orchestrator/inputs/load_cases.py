@@ -67,7 +67,7 @@ FOLDER = "load_cases"
 DEFAULT_LENGTH_S = 600.0
 DEFAULT_TRANSIENT_S = 10.0
 #: ``runs.transient = "settled"`` (the default): the drivetrain's settling time, rounded up to 0.1 s
-#: (:func:`orchestrator.cosim.operating_point.settling_of`: five time constants of its slowest mode at
+#: (:func:`orchestrator.cosim.operating_point.start_analyses`: five time constants of its slowest mode at
 #: the base scenario's start)
 SETTLED = "settled"
 #: the most seeds per bin and runs per set: far above any design load case set (IEC 61400-1 asks for six

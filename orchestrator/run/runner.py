@@ -236,29 +236,20 @@ def _settling(system: ResolvedSystem, outcome: RunOutcome) -> dict[str, Any]:
     interval that samples them) and a ``step_warning`` or ``output_warning`` where they are longer, a
     ``window_length_warning`` where the window is shorter than one period of that mode ({} without a dtcosim
     drivetrain)."""
-    from ..cosim.operating_point import coupling_limit_of, settling_of, window_note
+    from ..cosim.operating_point import start_analyses, window_note
 
     sim = system.scenario.simulation
     out: dict[str, Any] = {}
-    settling = settling_of(system, outcome.start_values)
+    settling, limit = start_analyses(system, outcome.start_values)
     if settling is not None:
         out["settling"] = settling.as_dict()
         note = window_note(settling, sim.window_s[0], sim.start_s, f"the analysis window [{sim.window_s[0]:g}, "
                                                                     f"{sim.window_s[1]:g}] s")
         if note is not None:
             out["window_warning"] = note
-    limit = coupling_limit_of(system, outcome.start_values)
     if limit is not None:
         out["coupling"] = limit.as_dict()
-        note = limit.note(sim.step_s)
-        if note is not None:
-            out["step_warning"] = note
-        note = limit.sampling_note(sim.step_s * sim.output_stride)  # the recorded samples' interval
-        if note is not None:
-            out["output_warning"] = note
-        note = limit.window_note(sim.window_s)
-        if note is not None:
-            out["window_length_warning"] = note
+        out.update(limit.warnings(sim.step_s, sim.step_s * sim.output_stride, sim.window_s))  # the samples' interval
     return out
 
 

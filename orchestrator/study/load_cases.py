@@ -131,7 +131,7 @@ def _settled(lcs: LoadCaseSet, fmu_dir, build: bool,
              report: Callable[[str], None] | None) -> tuple[LoadCaseSet, dict | None, list[str]]:
     """The set with transient and length in seconds (``"settled"``, ``"to_stop"`` resolved), the base drivetrain's
     settling time and the warnings about the window (the FMUs of the base scenario are instantiated once)."""
-    from ..cosim.operating_point import settling_of
+    from ..cosim.operating_point import start_analyses
     from ..cosim.system import resolve_system
     from ..inputs.overrides import apply_parameters
     from ..provision.project_fmus import ensure_fmus
@@ -144,26 +144,23 @@ def _settled(lcs: LoadCaseSet, fmu_dir, build: bool,
     except ScenarioError as exc:
         raise LoadCaseError("base.scenario", lcs.base_scenario, f"a valid scenario with its FMUs ({exc})",
                             lcs.source) from None
-    settling = settling_of(system)
+    settling, limit = start_analyses(system)
     resolved, notes = lcs.settled(None if settling is None else settling.time_s,
                                   "" if settling is None else settling.describe(), scenario.simulation.stop_s)
-    return resolved, None if settling is None else settling.as_dict(), notes + _grid_notes(resolved, scenario, system)
+    return resolved, None if settling is None else settling.as_dict(), notes + _grid_notes(resolved, scenario, limit)
 
 
-def _grid_notes(lcs: LoadCaseSet, scenario, system) -> list[str]:
-    """Warnings about the runs' step and output interval against the drivetrain's modes split across FMUs
-    (:mod:`components.analysis.coupling_step`); none where the grid is refused later (:func:`_base_system`)."""
-    from ..cosim.operating_point import coupling_limit_of
-
-    limit = coupling_limit_of(system)
+def _grid_notes(lcs: LoadCaseSet, scenario, limit) -> list[str]:
+    """Warnings about the runs' step, output interval and window against the drivetrain's modes split across FMUs
+    (``limit``: :mod:`components.analysis.coupling_step`); none where the grid is refused later
+    (:func:`_base_system`)."""
+    if limit is None:
+        return []
     try:
         sim = lcs.time_grid().apply(scenario)[0].simulation
     except ScenarioError:
         return []
-    if limit is None:
-        return []
-    notes = [limit.note(sim.step_s), limit.sampling_note(sim.step_s * sim.output_stride), limit.window_note(sim.window_s)]
-    return [note for note in notes if note is not None]
+    return list(limit.warnings(sim.step_s, sim.step_s * sim.output_stride, sim.window_s).values())
 
 
 def _base_system(lcs: LoadCaseSet, fmu_dir, build: bool):
