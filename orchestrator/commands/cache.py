@@ -35,7 +35,7 @@ from fmus.binary import cached_binary
 from ..cosim.compiled_kernels import aot_kernels
 from ..cosim.fmu_interface import file_sha256
 from ..cosim.unpacked_fmus import FOLDER as UNPACKED_FOLDER
-from ..cosim.unpacked_fmus import folder_name, in_use
+from ..cosim.unpacked_fmus import folder_name, in_use, remove_unheld
 from ..provision.folders import UNUSED_DAYS, content_folders, default_fmu_dir, last_used
 from .catalogue import help_line
 
@@ -124,7 +124,9 @@ def run(args: argparse.Namespace) -> int:
     print(f"{len(entries)} entries, {total:.1f} MB; stale: {len(stale)}, {sum(e.size_bytes for e in stale) / 1e6:.1f} MB")
     if args.prune:
         for e in stale:
-            if e.path.is_dir():
+            if e.path.parent == root / UNPACKED_FOLDER:
+                remove_unheld(e.path)  # unless a run has taken it since it was listed
+            elif e.path.is_dir():
                 _remove_folder(e.path)
             else:
                 e.path.unlink(missing_ok=True)

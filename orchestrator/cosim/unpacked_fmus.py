@@ -295,13 +295,13 @@ def _prune(root: Path) -> None:
     whole = sorted(((p, t) for p, t in entries if not p.name.startswith(PARTIAL_PREFIX)), key=lambda e: -e[1])
     for folder, _ in whole[KEPT:]:
         if folder not in _held:
-            _remove_unheld(folder)
+            remove_unheld(folder)
     for folder, made in entries:
         if folder.name.startswith(PARTIAL_PREFIX) and now - made > IN_USE_S:
             shutil.rmtree(folder, ignore_errors=True)
 
 
-def _remove_unheld(folder: Path) -> None:
+def remove_unheld(folder: Path) -> None:
     """Remove ``folder`` unless a process holds it: locked exclusively, moved out of the way, deleted (one without its
     manifest, which no process can hold or load, at once). Where nothing can be locked: once unused for an hour."""
     try:
